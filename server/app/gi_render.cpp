@@ -1,0 +1,208 @@
+// gi-render: renders one frame (or the median of N frames) of a scene with a GI technique and writes
+// the image and the per-pass stats. Exit codes: 0 success, 1 runtime failure, 2 bad usage.
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "encode/Encoder.h"
+#include "gi/Technique.h"
+#include "gl/Platform.h"
+#include "render/FrameParams.h"
+#include "render/FrameRenderer.h"
+#include "scene/SceneLoader.h"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: gi-render [options]
+
+Renders a scene with a global-illumination technique and writes the image and per-pass timings.
+
+  --scene NAME          builtin:NAME or a .gltf/.glb file (default builtin:cornell)
+  --technique NAME      GI technique (default rsm_gather; see --list-techniques)
+  --param NAME=VALUE    set a frame or technique parameter (repeatable; see --list-params)
+  --size WxH            image size in pixels, 16..4096 each (default 512x512)
+  --out FILE            write the image: .png, .jpg (tone-mapped) or .exr (linear radiance)
+  --stats FILE          write the stats JSON (per-pass ms, counts, params); '-' for stdout
+  --frames N            render a warm-up frame, then N frames, and report per-pass medians (default 1)
+  --gl egl|osmesa       headless GL backend (default: $GI_GL, else egl)
+  --no-timer-queries    time passes with glFinish on the CPU instead of GPU timer queries
+  --list-techniques     list the techniques and exit
+  --list-params TECH    list the frame parameters and TECH's parameters and exit
+  --list-scenes         list the built-in scenes and exit
+  --quiet               only errors on stderr
+  --help                this text
+
+Example:
+  gi-render --scene builtin:cornell --technique rsm_gather --param vpl_grid=16 \
+            --size 512x512 --out out.png --stats stats.json
+)";
+
+struct UsageError {
+    std::string message;
+};
+
+struct Options {
+    std::string scene = "builtin:cornell";
+    std::string technique = "rsm_gather";
+    std::vector<std::pair<std::string, std::string>> params;
+    int width = 512, height = 512;
+    std::string out, stats;
+    int frames = 1;
+    std::string gl;
+    bool timerQueries = true;
+    bool quiet = false;
+};
+
+int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
+    try {
+        size_t used = 0;
+        long v = std::stol(text, &used);
+        if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
+    } catch (...) {
+    }
+    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
+                     text + "'"};
+}
+
+void parseSize(const std::string& text, int& w, int& h) {
+    auto x = text.find('x');
+    if (x == std::string::npos) throw UsageError{"--size must look like 512x512, got '" + text + "'"};
+    w = parseInt("--size width", text.substr(0, x), 16, 4096);
+    h = parseInt("--size height", text.substr(x + 1), 16, 4096);
+}
+
+void listTechniques() {
+    for (const auto& e : gis::techniqueRegistry())
+        std::printf("%-14s %s [%s]\n", e.info.name.c_str(), e.info.description.c_str(), e.info.paper.c_str());
+}
+
+void writeText(const std::string& path, const std::string& text) {
+    if (path == "-") {
+        std::cout << text << "\n";
+        return;
+    }
+    std::ofstream f(path);
+    if (!f) throw gis::InputError(path, "cannot open for writing");
+    f << text << "\n";
+}
+
+int run(int argc, char** argv) {
+    Options o;
+    std::vector<std::string> args(argv + 1, argv + argc);
+    auto value = [&](size_t& i) -> const std::string& {
+        if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+        return args[++i];
+    };
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--help" || a == "-h") {
+            std::cout << kUsage;
+            return 0;
+        } else if (a == "--list-techniques") {
+            listTechniques();
+            return 0;
+        } else if (a == "--list-scenes") {
+            for (const auto& n : gis::builtinSceneNames()) std::printf("builtin:%s\n", n.c_str());
+            return 0;
+        } else if (a == "--list-params") {
+            const std::string& t = value(i);
+            const auto& entry = gis::findTechnique(t, "--list-params");
+            std::printf("frame parameters (every technique):\n%s", gis::frameParamTable().describe().c_str());
+            std::printf("%s parameters:\n%s", t.c_str(),
+                        entry.info.params.empty() ? "  (none)\n" : entry.info.params.describe().c_str());
+            return 0;
+        } else if (a == "--scene") o.scene = value(i);
+        else if (a == "--technique") o.technique = value(i);
+        else if (a == "--param") {
+            const std::string& kv = value(i);
+            auto eq = kv.find('=');
+            if (eq == std::string::npos || eq == 0) throw UsageError{"--param must look like NAME=VALUE, got '" + kv + "'"};
+            o.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+        } else if (a == "--size") parseSize(value(i), o.width, o.height);
+        else if (a == "--out") o.out = value(i);
+        else if (a == "--stats") o.stats = value(i);
+        else if (a == "--frames") o.frames = parseInt("--frames", value(i), 1, 10000);
+        else if (a == "--gl") o.gl = value(i);
+        else if (a == "--no-timer-queries") o.timerQueries = false;
+        else if (a == "--quiet") o.quiet = true;
+        else throw UsageError{"unknown option '" + a + "' (see --help)"};
+    }
+    if (o.quiet) gis::setLogLevel(gis::LogLevel::Error);
+    if (!o.out.empty() && !(o.out.ends_with(".png") || o.out.ends_with(".jpg") || o.out.ends_with(".jpeg") ||
+                            o.out.ends_with(".exr")))
+        throw UsageError{"--out must end in .png, .jpg or .exr, got '" + o.out + "'"};
+
+    // Validate everything that needs no GL before creating a context.
+    gis::gl::Backend backend;
+    try {
+        backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);
+    } catch (const gis::InputError& e) {
+        throw UsageError{e.what()};
+    }
+    auto scene = std::make_shared<gis::Scene>(gis::loadScene(o.scene));
+    gis::FrameState state;
+    try {
+        state = gis::makeFrameState(*scene, o.technique);
+        for (const auto& [k, v] : o.params) gis::setParamFromString(state, k, v, "--param " + k);
+    } catch (const gis::InputError& e) {
+        throw UsageError{e.what()};
+    }
+    state.width = o.width;
+    state.height = o.height;
+
+    auto context = gis::gl::createContext(backend);
+    if (!o.quiet)
+        gis::logInfo("gl: " + context->info().backend + ", " + context->info().renderer + ", " + context->info().version);
+    gis::FrameRenderer renderer(o.timerQueries);
+    renderer.setScene(scene);
+
+    const bool wantLinear = gis::imageFileNeedsLinear(o.out);
+    gis::FrameOutput frame = renderer.render(state, wantLinear); // warm-up (shader JIT, allocation)
+    std::vector<nlohmann::json> stats;
+    for (int f = 0; f < o.frames; ++f) {
+        frame = renderer.render(state, wantLinear);
+        stats.push_back(frame.stats);
+    }
+    nlohmann::json summary = gis::medianStats(stats);
+    summary["scene"] = o.scene;
+    summary["gl"] = {{"backend", context->info().backend}, {"renderer", context->info().renderer}};
+
+    if (!o.out.empty()) {
+        gis::writeImageFile(o.out, frame.width, frame.height, frame.rgba8, frame.linear,
+                            {{"gi:technique", o.technique}, {"gi:scene", o.scene}, {"gi:params", summary["params"].dump()}});
+    }
+    if (!o.stats.empty()) writeText(o.stats, summary.dump(2));
+    if (!o.quiet) {
+        std::string line = "gi-render: " + o.technique + " " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                           " frame " + std::to_string(summary["frame_ms"].get<double>()) + " ms (median of " +
+                           std::to_string(o.frames) + ")";
+        for (const auto& p : summary["passes"])
+            line += "\n  " + p["name"].get<std::string>() + ": " + std::to_string(p["gpu_ms"].get<double>()) + " ms";
+        gis::logInfo(line);
+    }
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "gi-render: %s\n", e.message.c_str());
+        return 2;
+    } catch (const gis::InputError& e) {
+        std::fprintf(stderr, "gi-render: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "gi-render: %s\n", e.what());
+        return 1;
+    }
+}

@@ -1,0 +1,126 @@
+#include "core/JsonSchema.h"
+
+#include <cmath>
+
+namespace gis {
+namespace {
+
+bool matchesType(const nlohmann::json& v, const std::string& type) {
+    if (type == "object") return v.is_object();
+    if (type == "array") return v.is_array();
+    if (type == "string") return v.is_string();
+    if (type == "boolean") return v.is_boolean();
+    if (type == "null") return v.is_null();
+    if (type == "number") return v.is_number();
+    if (type == "integer") {
+        if (v.is_number_integer()) return true;
+        if (!v.is_number_float()) return false;
+        double d = v.get<double>();
+        return std::isfinite(d) && d == std::floor(d);
+    }
+    return false;
+}
+
+std::string describe(const nlohmann::json& v) {
+    std::string s = v.dump();
+    if (s.size() > 60) s = s.substr(0, 57) + "...";
+    return s;
+}
+
+std::string escapePointerToken(const std::string& key) {
+    std::string out;
+    for (char c : key) {
+        if (c == '~') out += "~0";
+        else if (c == '/') out += "~1";
+        else out += c;
+    }
+    return out;
+}
+
+std::optional<SchemaViolation> check(const nlohmann::json& v, const nlohmann::json& schema, const std::string& at) {
+    if (schema.is_boolean()) {
+        if (schema.get<bool>()) return std::nullopt;
+        return SchemaViolation{at, "is not allowed here"};
+    }
+    if (!schema.is_object()) return std::nullopt;
+
+    if (auto t = schema.find("type"); t != schema.end()) {
+        bool ok = false;
+        std::string expected;
+        if (t->is_string()) {
+            ok = matchesType(v, *t);
+            expected = *t;
+        } else if (t->is_array()) {
+            for (const auto& one : *t) {
+                ok = ok || matchesType(v, one);
+                expected += (expected.empty() ? "" : " or ") + one.get<std::string>();
+            }
+        }
+        if (!ok) return SchemaViolation{at, "expected " + expected + ", got " + describe(v)};
+    }
+    if (auto c = schema.find("const"); c != schema.end() && v != *c)
+        return SchemaViolation{at, "must be " + c->dump() + ", got " + describe(v)};
+    if (auto e = schema.find("enum"); e != schema.end()) {
+        bool found = false;
+        for (const auto& option : *e) found = found || option == v;
+        if (!found) return SchemaViolation{at, "must be one of " + e->dump() + ", got " + describe(v)};
+    }
+    if (v.is_number()) {
+        double d = v.get<double>();
+        if (!std::isfinite(d)) return SchemaViolation{at, "must be a finite number"};
+        if (auto m = schema.find("minimum"); m != schema.end() && d < m->get<double>())
+            return SchemaViolation{at, "must be >= " + m->dump() + ", got " + describe(v)};
+        if (auto m = schema.find("maximum"); m != schema.end() && d > m->get<double>())
+            return SchemaViolation{at, "must be <= " + m->dump() + ", got " + describe(v)};
+        if (auto m = schema.find("exclusiveMinimum"); m != schema.end() && d <= m->get<double>())
+            return SchemaViolation{at, "must be > " + m->dump() + ", got " + describe(v)};
+        if (auto m = schema.find("exclusiveMaximum"); m != schema.end() && d >= m->get<double>())
+            return SchemaViolation{at, "must be < " + m->dump() + ", got " + describe(v)};
+    }
+    if (v.is_string()) {
+        auto len = v.get_ref<const std::string&>().size();
+        if (auto m = schema.find("minLength"); m != schema.end() && len < m->get<size_t>())
+            return SchemaViolation{at, "must have at least " + m->dump() + " characters"};
+        if (auto m = schema.find("maxLength"); m != schema.end() && len > m->get<size_t>())
+            return SchemaViolation{at, "must have at most " + m->dump() + " characters"};
+    }
+    if (v.is_array()) {
+        if (auto m = schema.find("minItems"); m != schema.end() && v.size() < m->get<size_t>())
+            return SchemaViolation{at, "must have at least " + m->dump() + " items, got " + std::to_string(v.size())};
+        if (auto m = schema.find("maxItems"); m != schema.end() && v.size() > m->get<size_t>())
+            return SchemaViolation{at, "must have at most " + m->dump() + " items, got " + std::to_string(v.size())};
+        if (auto items = schema.find("items"); items != schema.end()) {
+            for (size_t i = 0; i < v.size(); ++i)
+                if (auto r = check(v[i], *items, at + "/" + std::to_string(i))) return r;
+        }
+    }
+    if (v.is_object()) {
+        if (auto req = schema.find("required"); req != schema.end()) {
+            for (const auto& key : *req)
+                if (!v.contains(key.get<std::string>()))
+                    return SchemaViolation{at, "missing required field '" + key.get<std::string>() + "'"};
+        }
+        const nlohmann::json* props = nullptr;
+        if (auto p = schema.find("properties"); p != schema.end()) props = &*p;
+        auto additional = schema.find("additionalProperties");
+        for (const auto& [key, value] : v.items()) {
+            std::string child = at + "/" + escapePointerToken(key);
+            if (props && props->contains(key)) {
+                if (auto r = check(value, (*props)[key], child)) return r;
+            } else if (additional != schema.end()) {
+                if (additional->is_boolean() && !additional->get<bool>())
+                    return SchemaViolation{child, "unknown field '" + key + "'"};
+                if (auto r = check(value, *additional, child)) return r;
+            }
+        }
+    }
+    return std::nullopt;
+}
+
+} // namespace
+
+std::optional<SchemaViolation> validateJson(const nlohmann::json& instance, const nlohmann::json& schema) {
+    return check(instance, schema, "");
+}
+
+} // namespace gis

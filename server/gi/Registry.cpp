@@ -1,0 +1,24 @@
+#include "core/Error.h"
+#include "gi/Technique.h"
+#include "gi/none/NoIndirect.h"
+#include "gi/rsm_gather/RsmGather.h"
+
+namespace gis {
+
+const std::vector<TechniqueEntry>& techniqueRegistry() {
+    static const std::vector<TechniqueEntry> registry = {
+        {NoIndirect::info(), [] { return std::make_unique<NoIndirect>(); }},
+        {RsmGather::info(), [] { return std::make_unique<RsmGather>(); }},
+    };
+    return registry;
+}
+
+const TechniqueEntry& findTechnique(const std::string& name, const std::string& where) {
+    for (const auto& e : techniqueRegistry())
+        if (e.info.name == name) return e;
+    std::string known;
+    for (const auto& e : techniqueRegistry()) known += (known.empty() ? "'" : ", '") + e.info.name + "'";
+    throw InputError(where, "unknown technique '" + name + "' (known: " + known + ")");
+}
+
+} // namespace gis

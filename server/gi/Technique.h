@@ -1,0 +1,65 @@
+// The interface every GI technique implements (DESIGN.md §4), and the one registry that the CLI,
+// server, client UI, tests and benchmarks enumerate.
+//
+// Life cycle, all on the render thread with its GL context current:
+//   create()            compiles shaders: may throw gis::Error (a setup boundary)
+//   resize(w, h)        allocates size-dependent targets: may throw
+//   execute(...)        one frame: never throws; sanitises its output
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/Param.h"
+#include "gl/Objects.h"
+#include "gl/PassTimer.h"
+
+namespace gis {
+
+/// The frame pipeline's products a technique may read. Textures are owned by the renderer.
+struct FrameInputs {
+    int width = 0, height = 0;
+    const gl::Texture* gPosition = nullptr; ///< RGBA32F world position, w = 1 where covered
+    const gl::Texture* gNormal = nullptr;   ///< RGBA16F unit normal facing the camera
+    const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 linear albedo
+    int rsmSize = 0;
+    const gl::Texture* rsmPosition = nullptr; ///< RGBA32F, w = 1 where a surface was hit
+    const gl::Texture* rsmNormal = nullptr;   ///< RGBA16F, facing the light
+    const gl::Texture* rsmFlux = nullptr;     ///< RGBA32F reflected flux per texel
+    bool lightEnabled = true;
+};
+
+using Counters = std::map<std::string, double>;
+
+struct TechniqueInfo {
+    std::string name;        ///< registry key, e.g. "rsm_gather"
+    std::string description; ///< one line
+    std::string paper;       ///< seed paper and section
+    ParamTable params;
+};
+
+class Technique {
+public:
+    virtual ~Technique() = default;
+    virtual void resize(int width, int height) = 0;
+    /// Renders the indirect radiance for this frame into indirect(); records passes in `timer` and
+    /// counts (VPLs, receivers, ...) in `counters`.
+    virtual void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer, Counters& counters) = 0;
+    /// Linear RGB radiance to add to the direct light, or nullptr when the technique adds none.
+    virtual const gl::Texture* indirect() const = 0;
+};
+
+struct TechniqueEntry {
+    TechniqueInfo info;
+    std::function<std::unique_ptr<Technique>()> create;
+};
+
+/// All techniques, in a stable order.
+const std::vector<TechniqueEntry>& techniqueRegistry();
+/// Throws gis::InputError listing the known names when `name` is unknown.
+const TechniqueEntry& findTechnique(const std::string& name, const std::string& where = "technique");
+
+} // namespace gis

@@ -1,0 +1,46 @@
+// Technique `rsm_gather`: one-bounce indirect light gathered at full resolution from virtual point
+// lights on a regular reflective-shadow-map grid.
+//
+// Paper: 000 (Nichols & Wyman 2009) §3 steps 1-3 and Eq. 2 with diffuse BRDFs; the "rsm_naive"
+// preset of digest S.3 (VPL set A, receivers R0, kernel K1, no visibility between VPL and receiver).
+// It is the full-resolution baseline that the multiresolution techniques are measured against.
+//
+// Pipeline:
+//   1. (renderer) RSM from the spotlight: position, normal, reflected flux per texel
+//   2. vpl_extract: a compute pass turns each of vpl_grid^2 cells into one VPL (centre texel's
+//      position and normal, the cell's summed flux) written to a buffer
+//   3. vpl_gather: a full-screen pass per batch of up to 1024 VPLs (read as a uniform block)
+//      evaluates the clamped point kernel at every covered pixel, blended additively
+//   4. output: linear radiance albedo/pi * E, sanitised and >= 0
+//
+// Parameters:
+//   vpl_grid      VPLs per side, [1, 256] (clamped to rsm_size), default 16 (256 VPLs)
+//   min_distance  distance clamp of the 1/d^2 falloff, [0, 1] m, default 0.1 m
+//
+// Limits: no indirect visibility (light leaks behind occluders, as in 000/001); VPLs are diffuse;
+// grid sampling ignores flux (000 suggests importance sampling as future work).
+#pragma once
+
+#include "gi/Technique.h"
+#include "gl/Shader.h"
+
+namespace gis {
+
+class RsmGather final : public Technique {
+public:
+    static TechniqueInfo info();
+    RsmGather();
+    void resize(int width, int height) override;
+    void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer, Counters& counters) override;
+    const gl::Texture* indirect() const override { return &mIndirect; }
+
+private:
+    gl::Program mExtract;
+    gl::Program mGather;
+    gl::Buffer mVpls;
+    gl::Texture mIndirect;
+    gl::Framebuffer mTarget;
+    gl::VertexArray mEmptyVao;
+};
+
+} // namespace gis

@@ -1,0 +1,116 @@
+#include "gl/Objects.h"
+
+#include "core/Error.h"
+#include "core/Log.h"
+
+namespace gis::gl {
+
+Buffer Buffer::create(GLsizeiptr bytes, const void* data, GLbitfield flags) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    glNamedBufferStorage(id, bytes, data, flags);
+    Buffer b(id);
+    b.mSize = bytes;
+    return b;
+}
+
+void Buffer::upload(GLintptr offset, GLsizeiptr bytes, const void* data) {
+    GIS_ASSERT(offset >= 0 && offset + bytes <= mSize);
+    glNamedBufferSubData(id(), offset, bytes, data);
+}
+
+Texture Texture::create2D(GLenum internalFormat, int width, int height, int levels) {
+    GIS_ASSERT(width > 0 && height > 0 && levels > 0);
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &id);
+    glTextureStorage2D(id, levels, internalFormat, width, height);
+    Texture t(id);
+    t.mWidth = width;
+    t.mHeight = height;
+    t.mLevels = levels;
+    t.mFormat = internalFormat;
+    t.setFilter(GL_NEAREST, GL_NEAREST);
+    t.setWrap(GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+void Texture::setFilter(GLenum minFilter, GLenum magFilter) {
+    glTextureParameteri(id(), GL_TEXTURE_MIN_FILTER, static_cast<GLint>(minFilter));
+    glTextureParameteri(id(), GL_TEXTURE_MAG_FILTER, static_cast<GLint>(magFilter));
+}
+
+void Texture::setWrap(GLenum wrap) {
+    glTextureParameteri(id(), GL_TEXTURE_WRAP_S, static_cast<GLint>(wrap));
+    glTextureParameteri(id(), GL_TEXTURE_WRAP_T, static_cast<GLint>(wrap));
+}
+
+Framebuffer Framebuffer::create() {
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    return Framebuffer(id);
+}
+
+void Framebuffer::attachColor(int index, const Texture& texture, int level) {
+    glNamedFramebufferTexture(id(), GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index), texture.id(), level);
+}
+
+void Framebuffer::attachDepth(const Texture& texture, int level) {
+    glNamedFramebufferTexture(id(), GL_DEPTH_ATTACHMENT, texture.id(), level);
+}
+
+void Framebuffer::finish(int colorCount, const std::string& label) {
+    GLenum buffers[8];
+    GIS_ASSERT(colorCount >= 0 && colorCount <= 8);
+    for (int i = 0; i < colorCount; ++i) buffers[i] = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i);
+    if (colorCount == 0) glNamedFramebufferDrawBuffer(id(), GL_NONE);
+    else glNamedFramebufferDrawBuffers(id(), colorCount, buffers);
+    GLenum status = glCheckNamedFramebufferStatus(id(), GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+        throw Error("gl: framebuffer '" + label + "' is incomplete (status 0x" + std::to_string(status) + ")");
+}
+
+VertexArray VertexArray::create() {
+    GLuint id = 0;
+    glCreateVertexArrays(1, &id);
+    return VertexArray(id);
+}
+
+Query Query::create(GLenum target) {
+    GLuint id = 0;
+    glCreateQueries(target, 1, &id);
+    return Query(id);
+}
+
+Sampler Sampler::create() {
+    GLuint id = 0;
+    glCreateSamplers(1, &id);
+    return Sampler(id);
+}
+
+namespace {
+std::string collectErrors() {
+    std::string errors;
+    for (int i = 0; i < 16; ++i) {
+        GLenum e = glGetError();
+        if (e == GL_NO_ERROR) break;
+        char buf[16];
+        std::snprintf(buf, sizeof buf, "0x%04x", e);
+        errors += (errors.empty() ? "" : ", ") + std::string(buf);
+    }
+    return errors;
+}
+} // namespace
+
+void checkErrors(const char* where) {
+    std::string e = collectErrors();
+    if (!e.empty()) throw Error(std::string("gl: error ") + e + " in " + where);
+}
+
+bool logErrors(const char* where) {
+    std::string e = collectErrors();
+    if (e.empty()) return true;
+    logError(std::string("gl: error ") + e + " in " + where);
+    return false;
+}
+
+} // namespace gis::gl

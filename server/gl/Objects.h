@@ -1,0 +1,125 @@
+// Move-only RAII owners of GL objects. Destructors delete (the owning context must be current);
+// a default-constructed owner holds nothing and needs no context, so GL-free code can hold them.
+// Only server/gl and the pass code that issues draw calls read id().
+#pragma once
+
+#include <string>
+#include <utility>
+
+#include "gl/GlApi.h"
+
+namespace gis::gl {
+
+template <class Traits> class Object {
+public:
+    Object() = default;
+    explicit Object(GLuint id) : mId(id) {}
+    ~Object() { reset(); }
+    Object(const Object&) = delete;
+    Object& operator=(const Object&) = delete;
+    Object(Object&& o) noexcept : mId(std::exchange(o.mId, 0)) {}
+    Object& operator=(Object&& o) noexcept {
+        if (this != &o) {
+            reset();
+            mId = std::exchange(o.mId, 0);
+        }
+        return *this;
+    }
+    GLuint id() const { return mId; }
+    explicit operator bool() const { return mId != 0; }
+    void reset() {
+        if (mId) Traits::destroy(mId);
+        mId = 0;
+    }
+    /// Gives up ownership without deleting.
+    GLuint release() { return std::exchange(mId, 0); }
+
+private:
+    GLuint mId = 0;
+};
+
+struct BufferTraits { static void destroy(GLuint id) { glDeleteBuffers(1, &id); } };
+struct TextureTraits { static void destroy(GLuint id) { glDeleteTextures(1, &id); } };
+struct FramebufferTraits { static void destroy(GLuint id) { glDeleteFramebuffers(1, &id); } };
+struct VertexArrayTraits { static void destroy(GLuint id) { glDeleteVertexArrays(1, &id); } };
+struct ProgramTraits { static void destroy(GLuint id) { glDeleteProgram(id); } };
+struct QueryTraits { static void destroy(GLuint id) { glDeleteQueries(1, &id); } };
+struct SamplerTraits { static void destroy(GLuint id) { glDeleteSamplers(1, &id); } };
+
+class Buffer : public Object<BufferTraits> {
+public:
+    Buffer() = default;
+    /// Immutable-size storage (glNamedBufferStorage with dynamic updates allowed).
+    static Buffer create(GLsizeiptr bytes, const void* data = nullptr, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
+    GLsizeiptr size() const { return mSize; }
+    void upload(GLintptr offset, GLsizeiptr bytes, const void* data);
+
+private:
+    using Object::Object;
+    GLsizeiptr mSize = 0;
+};
+
+class Texture : public Object<TextureTraits> {
+public:
+    Texture() = default;
+    static Texture create2D(GLenum internalFormat, int width, int height, int levels = 1);
+    int width() const { return mWidth; }
+    int height() const { return mHeight; }
+    GLenum format() const { return mFormat; }
+    int levels() const { return mLevels; }
+    /// Nearest or linear filtering and clamp-to-edge wrapping.
+    void setFilter(GLenum minFilter, GLenum magFilter);
+    void setWrap(GLenum wrap);
+
+private:
+    using Object::Object;
+    int mWidth = 0, mHeight = 0, mLevels = 0;
+    GLenum mFormat = 0;
+};
+
+class Framebuffer : public Object<FramebufferTraits> {
+public:
+    Framebuffer() = default;
+    static Framebuffer create();
+    void attachColor(int index, const Texture& texture, int level = 0);
+    void attachDepth(const Texture& texture, int level = 0);
+    /// Selects the draw buffers 0..count-1 and checks completeness; throws gis::Error naming `label`.
+    void finish(int colorCount, const std::string& label);
+
+private:
+    using Object::Object;
+};
+
+class VertexArray : public Object<VertexArrayTraits> {
+public:
+    VertexArray() = default;
+    static VertexArray create();
+
+private:
+    using Object::Object;
+};
+
+class Query : public Object<QueryTraits> {
+public:
+    Query() = default;
+    static Query create(GLenum target);
+
+private:
+    using Object::Object;
+};
+
+class Sampler : public Object<SamplerTraits> {
+public:
+    Sampler() = default;
+    static Sampler create();
+
+private:
+    using Object::Object;
+};
+
+/// Throws gis::Error when glGetError reports anything; `where` names the pass.
+void checkErrors(const char* where);
+/// Like checkErrors but only logs: for the per-frame path, which never throws. Returns false on error.
+bool logErrors(const char* where);
+
+} // namespace gis::gl

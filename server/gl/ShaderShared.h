@@ -1,0 +1,19 @@
+// C++ view of shaders/shared/*.h: the same struct text, with GLSL's vector types mapped to GLM.
+#pragma once
+
+#include <cstddef>
+
+#include <glm/glm.hpp>
+
+namespace gis::shader {
+using vec4 = glm::vec4;
+using mat4 = glm::mat4;
+#include "shaders/shared/FrameData.h"
+
+static_assert(sizeof(FrameUniforms) % 16 == 0, "std140 blocks must be whole vec4s");
+static_assert(sizeof(FrameUniforms) == 2 * 64 + 7 * 16, "FrameUniforms layout drifted from the GLSL side");
+static_assert(offsetof(FrameUniforms, lightViewProj) == 64);
+static_assert(offsetof(FrameUniforms, toneInfo) == 128 + 6 * 16);
+static_assert(sizeof(Vpl) == 48, "Vpl must be three vec4s in std140 and std430");
+static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) <= 65536, "a VPL batch must fit the 64 KiB UBO limit");
+} // namespace gis::shader

@@ -1,0 +1,317 @@
+#include "render/FrameRenderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/Timer.h"
+#include "gl/ShaderShared.h"
+
+namespace gis {
+namespace {
+
+// Spot cones wider than this get a light frustum of this half-angle: tan() grows without bound
+// towards 90 degrees. Radians (85 degrees).
+constexpr float kMaxLightHalfFov = 1.4835299f;
+
+glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
+    float len2 = glm::dot(v, v);
+    return len2 > 1e-24f ? v / std::sqrt(len2) : fallback;
+}
+
+glm::vec3 upFor(glm::vec3 forward, glm::vec3 preferred) {
+    glm::vec3 up = safeNormalize(preferred, {0, 1, 0});
+    if (std::abs(glm::dot(up, forward)) > 0.999f) up = std::abs(forward.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
+    return up;
+}
+
+std::vector<std::uint8_t> readRgba8(const gl::Framebuffer& fbo, int attachment, int w, int h) {
+    std::vector<std::uint8_t> pixels(static_cast<size_t>(w) * static_cast<size_t>(h) * 4);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo.id());
+    glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+    // GL's rows run bottom to top; images everywhere else run top to bottom.
+    const size_t row = static_cast<size_t>(w) * 4;
+    std::vector<std::uint8_t> tmp(row);
+    for (int y = 0; y < h / 2; ++y) {
+        std::uint8_t* a = pixels.data() + static_cast<size_t>(y) * row;
+        std::uint8_t* b = pixels.data() + static_cast<size_t>(h - 1 - y) * row;
+        std::memcpy(tmp.data(), a, row);
+        std::memcpy(a, b, row);
+        std::memcpy(b, tmp.data(), row);
+    }
+    return pixels;
+}
+
+std::vector<float> readRgba32f(const gl::Framebuffer& fbo, int attachment, int w, int h) {
+    std::vector<float> pixels(static_cast<size_t>(w) * static_cast<size_t>(h) * 4);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo.id());
+    glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, pixels.data());
+    const size_t row = static_cast<size_t>(w) * 4;
+    std::vector<float> tmp(row);
+    for (int y = 0; y < h / 2; ++y) {
+        float* a = pixels.data() + static_cast<size_t>(y) * row;
+        float* b = pixels.data() + static_cast<size_t>(h - 1 - y) * row;
+        std::memcpy(tmp.data(), a, row * sizeof(float));
+        std::memcpy(a, b, row * sizeof(float));
+        std::memcpy(b, tmp.data(), row * sizeof(float));
+    }
+    return pixels;
+}
+
+} // namespace
+
+glm::mat4 FrameRenderer::cameraViewProj(const Camera& camera, int width, int height) {
+    glm::vec3 forward = safeNormalize(camera.target - camera.position, {0, 0, -1});
+    glm::mat4 view = glm::lookAt(camera.position, camera.position + forward, upFor(forward, camera.up));
+    float aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
+    float fov = std::clamp(camera.yfovRadians, 0.01f, 3.0f);
+    float znear = std::max(camera.znear, 1e-4f);
+    float zfar = std::max(camera.zfar, znear * 2.0f);
+    return glm::perspective(fov, aspect, znear, zfar) * view;
+}
+
+glm::mat4 FrameRenderer::lightViewProj(const Light& light, const Bounds& bounds, float* tanHalfFov) {
+    glm::vec3 dir = safeNormalize(light.direction, {0, -1, 0});
+    glm::mat4 view = glm::lookAt(light.position, light.position + dir, upFor(dir, {0, 1, 0}));
+    float half = std::clamp(light.outerConeAngle, 0.01f, kMaxLightHalfFov);
+    if (tanHalfFov) *tanHalfFov = std::tan(half);
+    float reach = glm::length(bounds.center() - light.position) + bounds.radius() * 1.5f + 1.0f;
+    float znear = std::max(reach * 1e-3f, 1e-3f);
+    return glm::perspective(2.0f * half, 1.0f, znear, reach) * view;
+}
+
+FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
+    const gl::ShaderStage meshVert{GL_VERTEX_SHADER, "render/mesh.vert"};
+    const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
+    mShadowProgram = gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, "render/shadow.frag"}});
+    mRsmProgram = gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, "render/rsm.frag"}});
+    mGBufferProgram = gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, "render/gbuffer.frag"}});
+    mDirectProgram = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
+    mCompositeProgram = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/composite.frag"}});
+    mFrameUbo = gl::Buffer::create(sizeof(shader::FrameUniforms));
+    mEmptyVao = gl::VertexArray::create();
+    gl::checkErrors("renderer setup");
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
+    GIS_ASSERT(scene != nullptr);
+    mSceneGpu = std::make_unique<SceneGpu>(*scene);
+    mScene = std::move(scene);
+}
+
+void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadowSize) {
+    if (shadowSize != mShadowSize) {
+        mShadowDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, shadowSize, shadowSize);
+        mShadowDepth.setFilter(GL_LINEAR, GL_LINEAR); // hardware 2x2 PCF with the compare mode
+        glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        mShadowFbo = gl::Framebuffer::create();
+        mShadowFbo.attachDepth(mShadowDepth);
+        mShadowFbo.finish(0, "shadow map");
+        mShadowSize = shadowSize;
+    }
+    if (rsmSize != mRsmSize) {
+        mRsmPosition = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
+        mRsmNormal = gl::Texture::create2D(GL_RGBA16F, rsmSize, rsmSize);
+        mRsmFlux = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
+        mRsmDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, rsmSize, rsmSize);
+        mRsmFbo = gl::Framebuffer::create();
+        mRsmFbo.attachColor(0, mRsmPosition);
+        mRsmFbo.attachColor(1, mRsmNormal);
+        mRsmFbo.attachColor(2, mRsmFlux);
+        mRsmFbo.attachDepth(mRsmDepth);
+        mRsmFbo.finish(3, "reflective shadow map");
+        mRsmSize = rsmSize;
+    }
+    if (width != mWidth || height != mHeight) {
+        mGPosition = gl::Texture::create2D(GL_RGBA32F, width, height);
+        mGNormal = gl::Texture::create2D(GL_RGBA16F, width, height);
+        mGAlbedo = gl::Texture::create2D(GL_RGBA8, width, height);
+        mGEmissive = gl::Texture::create2D(GL_RGBA16F, width, height);
+        mGDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, width, height);
+        mGBufferFbo = gl::Framebuffer::create();
+        mGBufferFbo.attachColor(0, mGPosition);
+        mGBufferFbo.attachColor(1, mGNormal);
+        mGBufferFbo.attachColor(2, mGAlbedo);
+        mGBufferFbo.attachColor(3, mGEmissive);
+        mGBufferFbo.attachDepth(mGDepth);
+        mGBufferFbo.finish(4, "G-buffer");
+        mDirect = gl::Texture::create2D(GL_RGBA32F, width, height);
+        mDirectFbo = gl::Framebuffer::create();
+        mDirectFbo.attachColor(0, mDirect);
+        mDirectFbo.finish(1, "direct light");
+        mDisplay = gl::Texture::create2D(GL_RGBA8, width, height);
+        mLinear = gl::Texture::create2D(GL_RGBA32F, width, height);
+        mCompositeFbo = gl::Framebuffer::create();
+        mCompositeFbo.attachColor(0, mDisplay);
+        mCompositeFbo.attachColor(1, mLinear);
+        mCompositeFbo.finish(2, "composite");
+        mWidth = width;
+        mHeight = height;
+    }
+}
+
+void FrameRenderer::ensureTechnique(const std::string& name, int width, int height) {
+    if (!mTechnique || name != mTechniqueName) {
+        mTechnique = findTechnique(name).create();
+        mTechniqueName = name;
+        mTechniqueWidth = mTechniqueHeight = 0;
+    }
+    if (width != mTechniqueWidth || height != mTechniqueHeight) {
+        mTechnique->resize(width, height);
+        mTechniqueWidth = width;
+        mTechniqueHeight = height;
+    }
+}
+
+FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
+    GIS_ASSERT(mSceneGpu != nullptr);
+    GIS_ASSERT(state.width > 0 && state.height > 0);
+    Stopwatch frameClock;
+    const ParamSet& fp = state.frameParams;
+    const int rsmSize = fp.getInt("rsm_size");
+    ensureTargets(state.width, state.height, rsmSize, fp.getInt("shadow_map_size"));
+    ensureTechnique(state.technique, state.width, state.height);
+
+    // Frame uniforms.
+    shader::FrameUniforms u{};
+    float tanHalf = 1.0f;
+    u.viewProj = cameraViewProj(state.camera, state.width, state.height);
+    u.lightViewProj = lightViewProj(state.light, mScene->bounds, &tanHalf);
+    u.cameraPos = glm::vec4(state.camera.position, 0.0f);
+    const bool lightOn = state.lightEnabled && state.light.intensity > 0.0f && std::isfinite(state.light.intensity);
+    u.lightPos = glm::vec4(state.light.position, lightOn ? state.light.intensity : 0.0f);
+    u.lightDir = glm::vec4(safeNormalize(state.light.direction, {0, -1, 0}), std::cos(state.light.outerConeAngle));
+    u.lightColor = glm::vec4(glm::max(state.light.color, glm::vec3(0.0f)), std::cos(state.light.innerConeAngle));
+    u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
+    u.rsmInfo = glm::vec4(rsmSize, tanHalf, mShadowSize, fp.getInt("pcf_radius"));
+    u.toneInfo = glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
+                           lightOn ? 1.0f : 0.0f, 0.0f);
+    mFrameUbo.upload(0, sizeof u, &u);
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+
+    mTimer.beginFrame();
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    const float zero[4] = {0, 0, 0, 0};
+    const float one = 1.0f;
+
+    // 1. Shadow map (depth only, slope-scaled offset against acne).
+    mTimer.begin("shadow_map");
+    glBindFramebuffer(GL_FRAMEBUFFER, mShadowFbo.id());
+    glViewport(0, 0, mShadowSize, mShadowSize);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glClearNamedFramebufferfv(mShadowFbo.id(), GL_DEPTH, 0, &one);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(2.0f, 4.0f);
+    glUseProgram(mShadowProgram.id());
+    glUniform1i(mShadowProgram.uniform("uView"), 1);
+    mSceneGpu->draw(mShadowProgram, false);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    mTimer.end();
+
+    // 2. Reflective shadow map.
+    mTimer.begin("rsm");
+    glBindFramebuffer(GL_FRAMEBUFFER, mRsmFbo.id());
+    glViewport(0, 0, rsmSize, rsmSize);
+    for (int i = 0; i < 3; ++i) glClearNamedFramebufferfv(mRsmFbo.id(), GL_COLOR, i, zero);
+    glClearNamedFramebufferfv(mRsmFbo.id(), GL_DEPTH, 0, &one);
+    glUseProgram(mRsmProgram.id());
+    glUniform1i(mRsmProgram.uniform("uView"), 1);
+    mSceneGpu->draw(mRsmProgram, true);
+    mTimer.end();
+
+    // 3. Eye G-buffer.
+    mTimer.begin("gbuffer");
+    glBindFramebuffer(GL_FRAMEBUFFER, mGBufferFbo.id());
+    glViewport(0, 0, state.width, state.height);
+    for (int i = 0; i < 4; ++i) glClearNamedFramebufferfv(mGBufferFbo.id(), GL_COLOR, i, zero);
+    glClearNamedFramebufferfv(mGBufferFbo.id(), GL_DEPTH, 0, &one);
+    glUseProgram(mGBufferProgram.id());
+    glUniform1i(mGBufferProgram.uniform("uView"), 0);
+    mSceneGpu->draw(mGBufferProgram, true);
+    glDisable(GL_DEPTH_TEST);
+    mTimer.end();
+
+    // 4. Direct light.
+    mTimer.begin("direct");
+    glBindFramebuffer(GL_FRAMEBUFFER, mDirectFbo.id());
+    glUseProgram(mDirectProgram.id());
+    glBindTextureUnit(0, mGPosition.id());
+    glBindTextureUnit(1, mGNormal.id());
+    glBindTextureUnit(2, mGAlbedo.id());
+    glBindTextureUnit(3, mGEmissive.id());
+    glBindTextureUnit(4, mShadowDepth.id());
+    glBindVertexArray(mEmptyVao.id());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    mTimer.end();
+
+    // 5. The technique's indirect passes.
+    Counters counters;
+    FrameInputs in;
+    in.width = state.width;
+    in.height = state.height;
+    in.gPosition = &mGPosition;
+    in.gNormal = &mGNormal;
+    in.gAlbedo = &mGAlbedo;
+    in.rsmSize = rsmSize;
+    in.rsmPosition = &mRsmPosition;
+    in.rsmNormal = &mRsmNormal;
+    in.rsmFlux = &mRsmFlux;
+    in.lightEnabled = lightOn;
+    mTechnique->execute(in, state.techniqueParams, mTimer, counters);
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+
+    // 6. Composite and tone map.
+    mTimer.begin("composite");
+    glBindFramebuffer(GL_FRAMEBUFFER, mCompositeFbo.id());
+    glViewport(0, 0, state.width, state.height);
+    glUseProgram(mCompositeProgram.id());
+    const gl::Texture* indirect = mTechnique->indirect();
+    glUniform1i(mCompositeProgram.uniform("uHasIndirect"), indirect ? 1 : 0);
+    glBindTextureUnit(0, mDirect.id());
+    glBindTextureUnit(1, indirect ? indirect->id() : mDirect.id());
+    glBindVertexArray(mEmptyVao.id());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    mTimer.end();
+
+    FrameOutput out;
+    out.width = state.width;
+    out.height = state.height;
+    Stopwatch readClock;
+    out.rgba8 = readRgba8(mCompositeFbo, 0, state.width, state.height);
+    if (wantLinear) out.linear = readRgba32f(mCompositeFbo, 1, state.width, state.height);
+    const double readbackMs = readClock.elapsedMs();
+    std::vector<gl::PassTiming> passes = mTimer.resolve();
+    gl::logErrors("frame");
+
+    nlohmann::json passJson = nlohmann::json::array();
+    for (const auto& p : passes) passJson.push_back({{"name", p.name}, {"gpu_ms", p.gpuMs}, {"cpu_ms", p.cpuMs}});
+    nlohmann::json countJson = nlohmann::json::object();
+    countJson["triangles"] = mSceneGpu->triangleCount();
+    countJson["pixels"] = state.width * state.height;
+    for (const auto& [k, v] : counters) countJson[k] = v;
+    nlohmann::json params = paramsJson(state);
+    out.stats = {{"technique", state.technique},
+                 {"size", {state.width, state.height}},
+                 {"frame_ms", frameClock.elapsedMs()},
+                 {"readback_ms", readbackMs},
+                 {"timing", mTimer.usesQueries() ? "gpu_query" : "cpu_finish"},
+                 {"passes", std::move(passJson)},
+                 {"counts", std::move(countJson)},
+                 {"params", std::move(params)}};
+    return out;
+}
+
+} // namespace gis

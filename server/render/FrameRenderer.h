@@ -1,0 +1,78 @@
+// The frame pipeline (DESIGN.md §3): shadow map and RSM from the spotlight, eye G-buffer, direct
+// light, the technique's indirect passes, composite with tone mapping, read-back.
+//
+// Threading: one FrameRenderer per GL context, used on the thread where that context is current.
+// Errors: construction, setScene() and the first render() after a technique or size change may
+// throw gis::Error (shader compile, allocation: setup boundaries); steady-state frames never throw.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "gi/Technique.h"
+#include "gl/Objects.h"
+#include "gl/PassTimer.h"
+#include "gl/Shader.h"
+#include "render/FrameState.h"
+#include "render/SceneGpu.h"
+
+namespace gis {
+
+struct FrameOutput {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgba8; ///< tone-mapped sRGB, rows top to bottom
+    std::vector<float> linear;       ///< linear RGBA radiance, rows top to bottom (when requested)
+    /// The stats object documented in protocol/PROTOCOL.md: technique, size, frame_ms, passes,
+    /// counts, params.
+    nlohmann::json stats;
+};
+
+class FrameRenderer {
+public:
+    explicit FrameRenderer(bool useTimerQueries = true);
+    ~FrameRenderer();
+    void setScene(std::shared_ptr<const Scene> scene);
+    const Scene* scene() const { return mScene.get(); }
+    /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics).
+    FrameOutput render(const FrameState& state, bool wantLinear = false);
+
+    /// Camera and spotlight matrices exactly as the pipeline builds them (also used by tests and
+    /// the reference renderer so both see the same view).
+    static glm::mat4 cameraViewProj(const Camera& camera, int width, int height);
+    static glm::mat4 lightViewProj(const Light& light, const Bounds& sceneBounds, float* tanHalfFov = nullptr);
+
+private:
+    void ensureTargets(int width, int height, int rsmSize, int shadowSize);
+    void ensureTechnique(const std::string& name, int width, int height);
+
+    std::shared_ptr<const Scene> mScene;
+    std::unique_ptr<SceneGpu> mSceneGpu;
+    gl::PassTimer mTimer;
+
+    gl::Program mShadowProgram, mRsmProgram, mGBufferProgram, mDirectProgram, mCompositeProgram;
+    gl::Buffer mFrameUbo;
+    gl::VertexArray mEmptyVao;
+
+    int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0;
+    gl::Texture mShadowDepth;
+    gl::Framebuffer mShadowFbo;
+    gl::Texture mRsmPosition, mRsmNormal, mRsmFlux, mRsmDepth;
+    gl::Framebuffer mRsmFbo;
+    gl::Texture mGPosition, mGNormal, mGAlbedo, mGEmissive, mGDepth;
+    gl::Framebuffer mGBufferFbo;
+    gl::Texture mDirect;
+    gl::Framebuffer mDirectFbo;
+    gl::Texture mDisplay, mLinear;
+    gl::Framebuffer mCompositeFbo;
+
+    std::string mTechniqueName;
+    std::unique_ptr<Technique> mTechnique;
+    int mTechniqueWidth = 0, mTechniqueHeight = 0;
+};
+
+} // namespace gis

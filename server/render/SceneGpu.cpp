@@ -1,0 +1,93 @@
+#include "render/SceneGpu.h"
+
+#include <cmath>
+
+#include "core/Error.h"
+
+namespace gis {
+namespace {
+struct Vertex {
+    float position[3];
+    float normal[3];
+    float texcoord[2];
+};
+static_assert(sizeof(Vertex) == 32);
+} // namespace
+
+SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
+    std::vector<Vertex> vertices;
+    std::vector<std::uint32_t> indices;
+    for (const Mesh& mesh : scene.meshes) {
+        Draw d;
+        d.firstIndex = static_cast<GLint>(indices.size());
+        d.indexCount = static_cast<GLsizei>(mesh.indices.size());
+        d.baseVertex = static_cast<GLint>(vertices.size());
+        d.material = mesh.material;
+        for (size_t i = 0; i < mesh.positions.size(); ++i) {
+            Vertex v{};
+            v.position[0] = mesh.positions[i].x;
+            v.position[1] = mesh.positions[i].y;
+            v.position[2] = mesh.positions[i].z;
+            if (i < mesh.normals.size()) {
+                v.normal[0] = mesh.normals[i].x;
+                v.normal[1] = mesh.normals[i].y;
+                v.normal[2] = mesh.normals[i].z;
+            }
+            if (i < mesh.texcoords.size()) {
+                v.texcoord[0] = mesh.texcoords[i].x;
+                v.texcoord[1] = mesh.texcoords[i].y;
+            }
+            vertices.push_back(v);
+        }
+        indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+        mTriangles += mesh.indices.size() / 3;
+        if (d.indexCount > 0) mDraws.push_back(d);
+    }
+    if (vertices.empty() || indices.empty()) throw Error("render: scene '" + scene.name + "' has no triangles");
+
+    mVertices = gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0);
+    mIndices = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(), 0);
+    mVao = gl::VertexArray::create();
+    const GLuint vao = mVao.id();
+    glVertexArrayVertexBuffer(vao, 0, mVertices.id(), 0, sizeof(Vertex));
+    glVertexArrayElementBuffer(vao, mIndices.id());
+    const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal), offsetof(Vertex, texcoord)};
+    const GLint sizes[3] = {3, 3, 2};
+    for (GLuint a = 0; a < 3; ++a) {
+        glEnableVertexArrayAttrib(vao, a);
+        glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+        glVertexArrayAttribBinding(vao, a, 0);
+    }
+
+    for (const TextureImage& image : scene.textures) {
+        int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(std::max(image.width, image.height), 1))));
+        gl::Texture t = gl::Texture::create2D(GL_SRGB8_ALPHA8, image.width, image.height, levels);
+        glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+        glGenerateTextureMipmap(t.id());
+        t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
+        t.setWrap(GL_REPEAT);
+        mTextures.push_back(std::move(t));
+    }
+    gl::checkErrors("scene upload");
+}
+
+void SceneGpu::draw(const gl::Program& program, bool withMaterials) const {
+    glBindVertexArray(mVao.id());
+    const GLint baseColor = program.uniform("uBaseColor");
+    const GLint emissive = program.uniform("uEmissive");
+    const GLint hasTexture = program.uniform("uHasTexture");
+    for (const Draw& d : mDraws) {
+        if (withMaterials) {
+            const Material& m = mMaterials[static_cast<size_t>(d.material)];
+            glUniform4f(baseColor, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
+            glUniform3f(emissive, m.emissive.r, m.emissive.g, m.emissive.b);
+            const bool textured = m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());
+            glUniform1i(hasTexture, textured ? 1 : 0);
+            if (textured) glBindTextureUnit(0, mTextures[static_cast<size_t>(m.baseColorTexture)].id());
+        }
+        glDrawElementsBaseVertex(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(static_cast<uintptr_t>(d.firstIndex) * 4), d.baseVertex);
+    }
+}
+
+} // namespace gis

@@ -1,0 +1,148 @@
+// Scenes generated in code, so tests, benchmarks and the default session need no asset files.
+// Every surface is a grid of quads (vertex-based effects need more than 2 triangles per wall) wound
+// CCW as seen from the side its normal points to.
+#include "scene/SceneLoader.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/Error.h"
+
+namespace gis {
+namespace {
+
+constexpr int kWallGrid = 8;
+constexpr glm::vec3 kWhite{0.725f, 0.71f, 0.68f};
+constexpr glm::vec3 kRed{0.63f, 0.065f, 0.05f};
+constexpr glm::vec3 kGreen{0.14f, 0.45f, 0.091f};
+constexpr glm::vec3 kGrey{0.8f};
+
+int addMaterial(Scene& scene, const std::string& name, const glm::vec3& albedo) {
+    scene.materials.push_back(Material{.name = name, .baseColor = glm::vec4(albedo, 1.0f)});
+    return static_cast<int>(scene.materials.size()) - 1;
+}
+
+/// Appends an n x n grid spanning origin + [0,1]u + [0,1]v, facing cross(u, v).
+void addGrid(Mesh& mesh, const glm::vec3& origin, const glm::vec3& u, const glm::vec3& v, int n) {
+    const glm::vec3 normal = glm::normalize(glm::cross(u, v));
+    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            const float s = static_cast<float>(i) / static_cast<float>(n);
+            const float t = static_cast<float>(j) / static_cast<float>(n);
+            mesh.positions.push_back(origin + s * u + t * v);
+            mesh.normals.push_back(normal);
+            mesh.texcoords.emplace_back(s, t);
+        }
+    const auto row = static_cast<std::uint32_t>(n + 1);
+    for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(n); ++j)
+        for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(n); ++i) {
+            const std::uint32_t p00 = base + j * row + i, p10 = p00 + 1, p01 = p00 + row, p11 = p01 + 1;
+            mesh.indices.insert(mesh.indices.end(), {p00, p10, p11, p00, p11, p01});
+        }
+}
+
+Mesh makeGrid(const std::string& name, int material, const glm::vec3& origin, const glm::vec3& u,
+              const glm::vec3& v) {
+    Mesh mesh{.name = name, .material = material};
+    addGrid(mesh, origin, u, v, kWallGrid);
+    return mesh;
+}
+
+/// Box of the given full size centred at center, turned by yaw about +Y, outward-facing, all 6 faces.
+Mesh makeBox(const std::string& name, int material, const glm::vec3& center, const glm::vec3& size,
+             float yaw) {
+    const glm::mat3 r(glm::rotate(glm::mat4(1.0f), yaw, glm::vec3(0.0f, 1.0f, 0.0f)));
+    const glm::vec3 h = 0.5f * size;
+    const glm::vec3 x(size.x, 0, 0), y(0, size.y, 0), z(0, 0, size.z);
+    struct Face {
+        glm::vec3 origin, u, v;
+    };
+    const Face faces[] = {
+        {{h.x, -h.y, -h.z}, y, z}, {{-h.x, -h.y, -h.z}, z, y}, // +x, -x
+        {{-h.x, h.y, -h.z}, z, x}, {{-h.x, -h.y, -h.z}, x, z}, // +y, -y
+        {{-h.x, -h.y, h.z}, x, y}, {{-h.x, -h.y, -h.z}, y, x}, // +z, -z
+    };
+    Mesh mesh{.name = name, .material = material};
+    for (const Face& f : faces) addGrid(mesh, center + r * f.origin, r * f.u, r * f.v, 2);
+    return mesh;
+}
+
+Light makeSpot(const std::string& name, const glm::vec3& position, const glm::vec3& direction, float innerDeg,
+               float outerDeg) {
+    return Light{.name = name,
+                 .type = LightType::Spot,
+                 .position = position,
+                 .direction = glm::normalize(direction),
+                 .color = glm::vec3(1.0f),
+                 .intensity = 6.0f,
+                 .innerConeAngle = glm::radians(innerDeg),
+                 .outerConeAngle = glm::radians(outerDeg)};
+}
+
+Camera makeCamera(const glm::vec3& position, const glm::vec3& target) {
+    return Camera{.name = "default",
+                  .position = position,
+                  .target = target,
+                  .up = glm::vec3(0.0f, 1.0f, 0.0f),
+                  .yfovRadians = glm::radians(40.0f),
+                  .znear = 0.05f,
+                  .zfar = 20.0f};
+}
+
+Scene makeCornell(bool withBoxes) {
+    Scene scene;
+    const int white = addMaterial(scene, "white", kWhite);
+    const int red = addMaterial(scene, "red", kRed);
+    const int green = addMaterial(scene, "green", kGreen);
+    const glm::vec3 x(2, 0, 0), y(0, 2, 0), z(0, 0, 2);
+    scene.meshes.push_back(makeGrid("floor", white, {-1, 0, -1}, z, x));
+    scene.meshes.push_back(makeGrid("ceiling", white, {-1, 2, -1}, x, z));
+    scene.meshes.push_back(makeGrid("back_wall", white, {-1, 0, -1}, x, y));
+    scene.meshes.push_back(makeGrid("left_wall", red, {-1, 0, -1}, y, z));
+    scene.meshes.push_back(makeGrid("right_wall", green, {1, 0, -1}, z, y));
+    if (withBoxes) {
+        scene.meshes.push_back(
+            makeBox("short_box", white, {0.35f, 0.3f, 0.3f}, glm::vec3(0.6f), glm::radians(-17.0f)));
+        scene.meshes.push_back(
+            makeBox("tall_box", white, {-0.35f, 0.6f, -0.35f}, {0.6f, 1.2f, 0.6f}, glm::radians(17.0f)));
+    }
+    scene.lights.push_back(makeSpot("ceiling_spot", {0.0f, 1.95f, 0.0f}, {0.0f, -1.0f, 0.0f}, 50.0f, 60.0f));
+    scene.cameras.push_back(makeCamera({0.0f, 1.0f, 3.9f}, {0.0f, 1.0f, 0.0f}));
+    return scene;
+}
+
+Scene makeCrease() {
+    Scene scene;
+    const int grey = addMaterial(scene, "grey", kGrey);
+    scene.meshes.push_back(makeGrid("floor", grey, {-1, 0, -1}, {0, 0, 2}, {2, 0, 0}));
+    scene.meshes.push_back(makeGrid("wall", grey, {-1, 0, -1}, {0, 2, 0}, {0, 0, 2}));
+    scene.lights.push_back(makeSpot("crease_spot", {0.2f, 1.5f, 0.0f}, {-1.0f, -1.0f, 0.0f}, 40.0f, 50.0f));
+    scene.cameras.push_back(makeCamera({1.6f, 1.2f, 2.8f}, {-0.6f, 0.4f, 0.0f}));
+    return scene;
+}
+
+} // namespace
+
+std::vector<std::string> builtinSceneNames() {
+    return {"cornell", "cornell-empty", "crease"};
+}
+
+Scene makeBuiltinScene(const std::string& name) {
+    Scene scene;
+    if (name == "cornell")
+        scene = makeCornell(true);
+    else if (name == "cornell-empty")
+        scene = makeCornell(false);
+    else if (name == "crease")
+        scene = makeCrease();
+    else {
+        std::string known;
+        for (const auto& n : builtinSceneNames()) known += (known.empty() ? "" : ", ") + n;
+        throw InputError("builtin:" + name, "unknown built-in scene; known: " + known);
+    }
+    scene.name = "builtin:" + name;
+    finalizeScene(scene, scene.name);
+    return scene;
+}
+
+} // namespace gis

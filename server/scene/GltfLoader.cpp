@@ -1,0 +1,600 @@
+// glTF 2.0 (.gltf / .glb) to Scene, through Debian's shared tinygltf build. tinygltf parses the
+// JSON and decodes buffers and images; everything it does not check (accessor ranges, index values,
+// transforms, extensions) is checked here before any byte is read, so a hostile file yields an
+// InputError naming the file and the offending object instead of a crash.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <tiny_gltf.h>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "scene/Geometry.h"
+#include "scene/SceneLoader.h"
+
+namespace gis {
+namespace {
+
+constexpr const char* kLightsExtension = "KHR_lights_punctual";
+constexpr const char* kEmissiveStrengthExtension = "KHR_materials_emissive_strength";
+// Quantized attributes are just non-float component types, which the accessor reader handles.
+constexpr const char* kQuantizationExtension = "KHR_mesh_quantization";
+constexpr int kNotConverted = -2;
+
+/// tinygltf joins several messages with newlines; an InputError reads best as one line.
+std::string oneLine(const std::string& text) {
+    std::string out;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        std::size_t end = text.find('\n', start);
+        if (end == std::string::npos) end = text.size();
+        std::string line = text.substr(start, end - start);
+        line.erase(0, line.find_first_not_of(" \t\r"));
+        line.erase(line.find_last_not_of(" \t\r") + 1);
+        if (!line.empty()) out += (out.empty() ? "" : "; ") + line;
+        start = end + 1;
+    }
+    return out;
+}
+
+int componentCount(int type) {
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR:
+        return 1;
+    case TINYGLTF_TYPE_VEC2:
+        return 2;
+    case TINYGLTF_TYPE_VEC3:
+        return 3;
+    case TINYGLTF_TYPE_VEC4:
+        return 4;
+    case TINYGLTF_TYPE_MAT2:
+        return 4;
+    case TINYGLTF_TYPE_MAT3:
+        return 9;
+    case TINYGLTF_TYPE_MAT4:
+        return 16;
+    default:
+        return 0;
+    }
+}
+
+std::size_t componentSize(int componentType) {
+    switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+        return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+        return 4;
+    default:
+        return 0;
+    }
+}
+
+template <typename T> T loadUnaligned(const unsigned char* p) {
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    return v;
+}
+
+/// One component as float, applying the glTF normalisation rules when the accessor is normalized.
+float readComponent(const unsigned char* p, int componentType, bool normalized) {
+    switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+        return loadUnaligned<float>(p);
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        const float v = loadUnaligned<std::int8_t>(p);
+        return normalized ? std::max(v / 127.0f, -1.0f) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+        const float v = loadUnaligned<std::uint8_t>(p);
+        return normalized ? v / 255.0f : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        const float v = loadUnaligned<std::int16_t>(p);
+        return normalized ? std::max(v / 32767.0f, -1.0f) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        const float v = loadUnaligned<std::uint16_t>(p);
+        return normalized ? v / 65535.0f : v;
+    }
+    default: {
+        const auto v = static_cast<double>(loadUnaligned<std::uint32_t>(p));
+        return static_cast<float>(normalized ? v / 4294967295.0 : v);
+    }
+    }
+}
+
+glm::mat4 localMatrix(const tinygltf::Node& node) {
+    if (node.matrix.size() == 16) {
+        glm::mat4 m(1.0f);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r)
+                m[c][r] = static_cast<float>(node.matrix[static_cast<std::size_t>(c * 4 + r)]);
+        return m;
+    }
+    glm::mat4 m(1.0f);
+    if (node.translation.size() == 3)
+        m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+    if (node.rotation.size() == 4) {
+        // glTF stores (x, y, z, w); glm's constructor takes w first.
+        glm::quat q(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                    static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]));
+        const float len = glm::length(q);
+        if (std::isfinite(len) && len > 1e-12f) m *= glm::mat4_cast(q / len);
+    }
+    if (node.scale.size() == 3) m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+    return m;
+}
+
+std::string nameOr(const std::string& name, const char* kind, int index) {
+    return name.empty() ? std::string(kind) + " " + std::to_string(index) : name;
+}
+
+/// Where an accessor's elements lie, after every range check has passed.
+struct AccessorView {
+    const unsigned char* data = nullptr;
+    std::size_t count = 0;
+    std::size_t stride = 0;
+    int componentType = 0;
+    int components = 0;
+    bool normalized = false;
+};
+
+class GltfReader {
+public:
+    GltfReader(const tinygltf::Model& model, const std::string& path)
+        : mModel(model), mPath(path), mImageTexture(model.images.size(), kNotConverted),
+          mOnPath(model.nodes.size(), false) {}
+
+    Scene read() {
+        checkRequiredExtensions();
+        readMaterials();
+        for (int root : rootNodes()) visitNode(root, glm::mat4(1.0f));
+        mScene.name = mPath;
+        mScene.updateBounds();
+        closeInfiniteFarPlanes();
+        finalizeScene(mScene, mPath);
+        return std::move(mScene);
+    }
+
+private:
+    [[noreturn]] void fail(const std::string& message) const { throw InputError(mPath, message); }
+    void warn(const std::string& message) const { logWarn("scene: " + mPath + ": " + message); }
+
+    void checkRequiredExtensions() const {
+        for (const auto& ext : mModel.extensionsRequired)
+            if (ext != kLightsExtension && ext != kEmissiveStrengthExtension && ext != kQuantizationExtension)
+                fail("unsupported required extension '" + ext + "'");
+    }
+
+    std::vector<int> rootNodes() const {
+        if (!mModel.scenes.empty()) {
+            const int s = mModel.defaultScene < 0 ? 0 : mModel.defaultScene;
+            if (s >= static_cast<int>(mModel.scenes.size()))
+                fail("default scene " + std::to_string(s) + " does not exist");
+            return mModel.scenes[static_cast<std::size_t>(s)].nodes;
+        }
+        std::vector<bool> isChild(mModel.nodes.size(), false);
+        for (const auto& node : mModel.nodes)
+            for (int c : node.children)
+                if (c >= 0 && c < static_cast<int>(isChild.size()))
+                    isChild[static_cast<std::size_t>(c)] = true;
+        std::vector<int> roots;
+        for (std::size_t i = 0; i < isChild.size(); ++i)
+            if (!isChild[i]) roots.push_back(static_cast<int>(i));
+        return roots;
+    }
+
+    void visitNode(int index, const glm::mat4& parent) {
+        if (index < 0 || index >= static_cast<int>(mModel.nodes.size()))
+            fail("node " + std::to_string(index) + " does not exist");
+        const auto i = static_cast<std::size_t>(index);
+        if (mOnPath[i])
+            fail("node " + std::to_string(index) + " is its own ancestor (cycle in the node graph)");
+        mOnPath[i] = true;
+        const tinygltf::Node& node = mModel.nodes[i];
+        const glm::mat4 world = parent * localMatrix(node);
+        if (node.mesh >= 0) addMesh(node.mesh, world);
+        if (node.camera >= 0) addCamera(node, index, world);
+        addNodeLight(node, index, world);
+        for (int child : node.children) visitNode(child, world);
+        mOnPath[i] = false;
+    }
+
+    // ---- accessors -------------------------------------------------------------------------------
+
+    AccessorView accessorView(int index, int expectedType, const std::string& context) const {
+        const std::string where = context + ": accessor " + std::to_string(index);
+        if (index < 0 || index >= static_cast<int>(mModel.accessors.size())) fail(where + " does not exist");
+        const tinygltf::Accessor& acc = mModel.accessors[static_cast<std::size_t>(index)];
+        if (acc.sparse.isSparse) fail(where + ": sparse accessors are not supported");
+        if (acc.type != expectedType)
+            fail(where + ": expected " + std::to_string(componentCount(expectedType)) +
+                 " components per element, got " + std::to_string(componentCount(acc.type)));
+        const std::size_t componentBytes = componentSize(acc.componentType);
+        if (componentBytes == 0)
+            fail(where + ": unsupported component type " + std::to_string(acc.componentType));
+        AccessorView view{.count = acc.count,
+                          .componentType = acc.componentType,
+                          .components = componentCount(acc.type),
+                          .normalized = acc.normalized};
+        if (acc.count == 0) return view;
+        if (acc.bufferView < 0 || acc.bufferView >= static_cast<int>(mModel.bufferViews.size()))
+            fail(where + ": bufferView " + std::to_string(acc.bufferView) + " does not exist");
+        const tinygltf::BufferView& bv = mModel.bufferViews[static_cast<std::size_t>(acc.bufferView)];
+        if (bv.buffer < 0 || bv.buffer >= static_cast<int>(mModel.buffers.size()))
+            fail(where + ": buffer " + std::to_string(bv.buffer) + " does not exist");
+        const std::vector<unsigned char>& data = mModel.buffers[static_cast<std::size_t>(bv.buffer)].data;
+        if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
+            fail(where + ": bufferView " + std::to_string(acc.bufferView) + " (offset " +
+                 std::to_string(bv.byteOffset) + ", length " + std::to_string(bv.byteLength) +
+                 ") extends past the end of buffer " + std::to_string(bv.buffer) + " (" +
+                 std::to_string(data.size()) + " bytes)");
+        const std::size_t elementBytes = componentBytes * static_cast<std::size_t>(view.components);
+        view.stride = bv.byteStride != 0 ? bv.byteStride : elementBytes;
+        if (view.stride < elementBytes)
+            fail(where + ": byteStride " + std::to_string(view.stride) + " is smaller than an element (" +
+                 std::to_string(elementBytes) + " bytes)");
+        // Needs offset + (count - 1) * stride + elementBytes <= byteLength, written so nothing overflows.
+        const bool fits = acc.byteOffset <= bv.byteLength && elementBytes <= bv.byteLength - acc.byteOffset &&
+                          acc.count - 1 <= (bv.byteLength - acc.byteOffset - elementBytes) / view.stride;
+        if (!fits)
+            fail(where + " (offset " + std::to_string(acc.byteOffset) + ", " + std::to_string(acc.count) +
+                 " elements, stride " + std::to_string(view.stride) + ") reads past the end of bufferView " +
+                 std::to_string(acc.bufferView) + " (" + std::to_string(bv.byteLength) + " bytes)");
+        view.data = data.data() + bv.byteOffset + acc.byteOffset;
+        return view;
+    }
+
+    template <int N>
+    std::vector<glm::vec<N, float>> readVectors(int index, int type, const std::string& context) const {
+        const AccessorView v = accessorView(index, type, context);
+        const std::size_t componentBytes = componentSize(v.componentType);
+        std::vector<glm::vec<N, float>> out(v.count);
+        for (std::size_t e = 0; e < v.count; ++e)
+            for (int c = 0; c < N; ++c)
+                out[e][c] =
+                    readComponent(v.data + e * v.stride + static_cast<std::size_t>(c) * componentBytes,
+                                  v.componentType, v.normalized);
+        return out;
+    }
+
+    std::vector<std::uint32_t> readIndices(int index, const std::string& context) const {
+        const AccessorView v = accessorView(index, TINYGLTF_TYPE_SCALAR, context);
+        const int type = v.componentType;
+        if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(context + ": accessor " + std::to_string(index) +
+                 ": indices must be unsigned byte, short or int");
+        std::vector<std::uint32_t> out(v.count);
+        for (std::size_t e = 0; e < v.count; ++e) {
+            const unsigned char* p = v.data + e * v.stride;
+            out[e] = type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? loadUnaligned<std::uint8_t>(p)
+                     : type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? loadUnaligned<std::uint16_t>(p)
+                                                                      : loadUnaligned<std::uint32_t>(p);
+        }
+        return out;
+    }
+
+    // ---- materials and textures ------------------------------------------------------------------
+
+    void readMaterials() {
+        for (std::size_t i = 0; i < mModel.materials.size(); ++i) {
+            const tinygltf::Material& src = mModel.materials[i];
+            const auto& pbr = src.pbrMetallicRoughness;
+            Material m;
+            m.name = nameOr(src.name, "material", static_cast<int>(i));
+            if (pbr.baseColorFactor.size() == 4)
+                m.baseColor = glm::clamp(glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
+                                                   pbr.baseColorFactor[2], pbr.baseColorFactor[3]),
+                                         0.0f, 1.0f);
+            m.metallic = std::clamp(static_cast<float>(pbr.metallicFactor), 0.0f, 1.0f);
+            m.roughness = std::clamp(static_cast<float>(pbr.roughnessFactor), 0.0f, 1.0f);
+            if (src.emissiveFactor.size() == 3)
+                m.emissive = glm::vec3(src.emissiveFactor[0], src.emissiveFactor[1], src.emissiveFactor[2]);
+            const auto strength = src.extensions.find(kEmissiveStrengthExtension);
+            if (strength != src.extensions.end() && strength->second.IsObject() &&
+                strength->second.Has("emissiveStrength") &&
+                strength->second.Get("emissiveStrength").IsNumber())
+                m.emissive *=
+                    static_cast<float>(strength->second.Get("emissiveStrength").GetNumberAsDouble());
+            if (pbr.baseColorTexture.index >= 0)
+                m.baseColorTexture = convertTexture(pbr.baseColorTexture.index, "material '" + m.name + "'");
+            mScene.materials.push_back(std::move(m));
+        }
+    }
+
+    int defaultMaterial() {
+        if (mDefaultMaterial < 0) {
+            mScene.materials.push_back(Material{.name = "default"});
+            mDefaultMaterial = static_cast<int>(mScene.materials.size()) - 1;
+        }
+        return mDefaultMaterial;
+    }
+
+    int convertTexture(int textureIndex, const std::string& context) {
+        if (textureIndex >= static_cast<int>(mModel.textures.size()))
+            fail(context + ": texture " + std::to_string(textureIndex) + " does not exist");
+        const int source = mModel.textures[static_cast<std::size_t>(textureIndex)].source;
+        if (source < 0 || source >= static_cast<int>(mModel.images.size())) {
+            warn(context + ": texture " + std::to_string(textureIndex) + " has no usable image; ignored");
+            return -1;
+        }
+        int& cached = mImageTexture[static_cast<std::size_t>(source)];
+        if (cached == kNotConverted) cached = convertImage(source, context);
+        return cached;
+    }
+
+    int convertImage(int index, const std::string& context) {
+        const tinygltf::Image& img = mModel.images[static_cast<std::size_t>(index)];
+        const std::string where = context + ": image " + std::to_string(index);
+        if (img.image.empty() || img.width <= 0 || img.height <= 0) {
+            warn(where + " was not decoded; texture ignored");
+            return -1;
+        }
+        if (img.bits != 8 && img.bits != 16)
+            fail(where + ": unsupported bit depth " + std::to_string(img.bits));
+        if (img.component < 1 || img.component > 4)
+            fail(where + ": unsupported channel count " + std::to_string(img.component));
+        const auto pixels = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
+        const auto channels = static_cast<std::size_t>(img.component);
+        const std::size_t bytesPerChannel = static_cast<std::size_t>(img.bits) / 8;
+        if (img.image.size() < pixels * channels * bytesPerChannel) fail(where + ": pixel data is truncated");
+        TextureImage tex{.width = img.width, .height = img.height, .name = nameOr(img.name, "image", index)};
+        tex.rgba.resize(pixels * 4);
+        for (std::size_t p = 0; p < pixels; ++p) {
+            std::uint8_t c[4] = {0, 0, 0, 255};
+            for (std::size_t k = 0; k < channels; ++k) {
+                const unsigned char* src = img.image.data() + (p * channels + k) * bytesPerChannel;
+                // 16-bit samples keep their high byte: the pipeline samples RGBA8 only.
+                c[k] = bytesPerChannel == 1
+                           ? *src
+                           : static_cast<std::uint8_t>(loadUnaligned<std::uint16_t>(src) >> 8);
+            }
+            std::uint8_t* dst = tex.rgba.data() + p * 4;
+            if (channels <= 2) { // grey or grey + alpha
+                dst[0] = dst[1] = dst[2] = c[0];
+                dst[3] = channels == 2 ? c[1] : 255;
+            } else {
+                std::copy(c, c + 4, dst);
+            }
+        }
+        mScene.textures.push_back(std::move(tex));
+        return static_cast<int>(mScene.textures.size()) - 1;
+    }
+
+    // ---- meshes ----------------------------------------------------------------------------------
+
+    void addMesh(int meshIndex, const glm::mat4& world) {
+        if (meshIndex >= static_cast<int>(mModel.meshes.size()))
+            fail("mesh " + std::to_string(meshIndex) + " does not exist");
+        const tinygltf::Mesh& mesh = mModel.meshes[static_cast<std::size_t>(meshIndex)];
+        for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+            addPrimitive(mesh, meshIndex, static_cast<int>(p), world);
+    }
+
+    static std::vector<std::uint32_t> toTriangleList(const std::vector<std::uint32_t>& v, int mode) {
+        if (mode == TINYGLTF_MODE_TRIANGLES) return v;
+        std::vector<std::uint32_t> out;
+        for (std::size_t i = 0; i + 2 < v.size(); ++i) {
+            if (mode == TINYGLTF_MODE_TRIANGLE_FAN)
+                out.insert(out.end(), {v[i + 1], v[i + 2], v[0]});
+            else if (i % 2 == 0)
+                out.insert(out.end(), {v[i], v[i + 1], v[i + 2]});
+            else
+                out.insert(out.end(), {v[i + 1], v[i], v[i + 2]}); // keep strips' alternating winding CCW
+        }
+        return out;
+    }
+
+    void addPrimitive(const tinygltf::Mesh& src, int meshIndex, int primIndex, const glm::mat4& world) {
+        const tinygltf::Primitive& prim = src.primitives[static_cast<std::size_t>(primIndex)];
+        Mesh mesh;
+        mesh.name = nameOr(src.name, "mesh", meshIndex);
+        if (src.primitives.size() > 1) mesh.name += "#" + std::to_string(primIndex);
+        const std::string context = "mesh '" + mesh.name + "' (mesh " + std::to_string(meshIndex) +
+                                    ", primitive " + std::to_string(primIndex) + ")";
+        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE || mode == TINYGLTF_MODE_LINE_LOOP ||
+            mode == TINYGLTF_MODE_LINE_STRIP) {
+            warn(context + ": points and lines are not rendered; primitive skipped");
+            return;
+        }
+        if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+            mode != TINYGLTF_MODE_TRIANGLE_FAN)
+            fail(context + ": unknown primitive mode " + std::to_string(mode));
+        const auto attribute = [&](const char* name) {
+            const auto it = prim.attributes.find(name);
+            return it == prim.attributes.end() ? -1 : it->second;
+        };
+        const int positionAccessor = attribute("POSITION");
+        if (positionAccessor < 0) {
+            warn(context + ": no POSITION attribute; primitive skipped");
+            return;
+        }
+        mesh.positions = readVectors<3>(positionAccessor, TINYGLTF_TYPE_VEC3, context + " POSITION");
+        if (const int a = attribute("NORMAL"); a >= 0)
+            mesh.normals = readVectors<3>(a, TINYGLTF_TYPE_VEC3, context + " NORMAL");
+        if (const int a = attribute("TEXCOORD_0"); a >= 0)
+            mesh.texcoords = readVectors<2>(a, TINYGLTF_TYPE_VEC2, context + " TEXCOORD_0");
+        if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+            fail(context + ": NORMAL has " + std::to_string(mesh.normals.size()) + " elements, POSITION " +
+                 std::to_string(mesh.positions.size()));
+        if (!mesh.texcoords.empty() && mesh.texcoords.size() != mesh.positions.size())
+            fail(context + ": TEXCOORD_0 has " + std::to_string(mesh.texcoords.size()) +
+                 " elements, POSITION " + std::to_string(mesh.positions.size()));
+
+        std::vector<std::uint32_t> indices;
+        if (prim.indices >= 0) {
+            indices = readIndices(prim.indices, context + " indices");
+        } else {
+            indices.resize(mesh.positions.size());
+            std::iota(indices.begin(), indices.end(), 0u);
+        }
+        mesh.indices = toTriangleList(indices, mode);
+        if (mesh.indices.empty()) {
+            warn(context + ": no triangles; primitive skipped");
+            return;
+        }
+
+        const glm::mat3 linear(world);
+        const glm::mat3 normalMatrix = glm::inverseTranspose(linear);
+        for (auto& p : mesh.positions) p = glm::vec3(world * glm::vec4(p, 1.0f));
+        // Zero results are left for finalizeScene, which replaces them with face normals.
+        for (auto& n : mesh.normals) n = safeNormalize(normalMatrix * n, glm::vec3(0.0f));
+        // A mirroring transform turns CCW into CW; swap to keep front faces CCW (glTF 3.7.4).
+        if (glm::determinant(linear) < 0.0f)
+            for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+                std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+
+        if (prim.material >= static_cast<int>(mModel.materials.size()))
+            fail(context + ": material " + std::to_string(prim.material) + " does not exist");
+        mesh.material = prim.material >= 0 ? prim.material : defaultMaterial();
+        mScene.meshes.push_back(std::move(mesh));
+    }
+
+    // ---- cameras and lights ----------------------------------------------------------------------
+
+    static glm::vec3 forwardOf(const glm::mat4& world) {
+        return safeNormalize(glm::mat3(world) * glm::vec3(0.0f, 0.0f, -1.0f), glm::vec3(0.0f, 0.0f, -1.0f));
+    }
+
+    void addCamera(const tinygltf::Node& node, int nodeIndex, const glm::mat4& world) {
+        if (node.camera >= static_cast<int>(mModel.cameras.size()))
+            fail("node " + std::to_string(nodeIndex) + ": camera " + std::to_string(node.camera) +
+                 " does not exist");
+        const tinygltf::Camera& src = mModel.cameras[static_cast<std::size_t>(node.camera)];
+        const std::string name = !src.name.empty() ? src.name : nameOr(node.name, "camera", node.camera);
+        if (src.type != "perspective") {
+            warn("camera '" + name + "': only perspective cameras are supported; skipped");
+            return;
+        }
+        Camera cam;
+        cam.name = name;
+        cam.position = glm::vec3(world[3]);
+        cam.target = cam.position + forwardOf(world);
+        cam.up = safeNormalize(glm::mat3(world) * glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+        cam.yfovRadians = static_cast<float>(src.perspective.yfov);
+        cam.znear = static_cast<float>(src.perspective.znear);
+        cam.zfar = static_cast<float>(src.perspective.zfar); // 0: infinite, closed once bounds are known
+        mScene.cameras.push_back(cam);
+    }
+
+    void closeInfiniteFarPlanes() {
+        const float reach = mScene.bounds.radius() * 2.0f;
+        for (auto& cam : mScene.cameras)
+            if (cam.zfar <= 0.0f)
+                cam.zfar =
+                    std::max(2.0f * cam.znear, glm::distance(cam.position, mScene.bounds.center()) + reach);
+    }
+
+    void addNodeLight(const tinygltf::Node& node, int nodeIndex, const glm::mat4& world) {
+        const auto ext = node.extensions.find(kLightsExtension);
+        if (ext == node.extensions.end()) return;
+        const tinygltf::Value& ref = ext->second;
+        if (!ref.IsObject() || !ref.Has("light") || !ref.Get("light").IsNumber())
+            fail("node " + std::to_string(nodeIndex) + ": KHR_lights_punctual needs a numeric 'light'");
+        const int index = ref.Get("light").GetNumberAsInt();
+        if (index < 0 || index >= static_cast<int>(mModel.lights.size()))
+            fail("node " + std::to_string(nodeIndex) + ": light " + std::to_string(index) +
+                 " does not exist");
+        const tinygltf::Light& src = mModel.lights[static_cast<std::size_t>(index)];
+        Light light;
+        light.name = !src.name.empty() ? src.name : nameOr(node.name, "light", index);
+        if (src.type == "spot")
+            light.type = LightType::Spot;
+        else if (src.type == "point")
+            light.type = LightType::Point;
+        else if (src.type == "directional")
+            light.type = LightType::Directional;
+        else {
+            warn("light '" + light.name + "': unknown type '" + src.type + "'; skipped");
+            return;
+        }
+        if (src.color.size() == 3) light.color = glm::vec3(src.color[0], src.color[1], src.color[2]);
+        light.intensity = static_cast<float>(src.intensity);
+        light.range = static_cast<float>(src.range);
+        light.innerConeAngle = static_cast<float>(src.spot.innerConeAngle);
+        light.outerConeAngle = static_cast<float>(src.spot.outerConeAngle);
+        light.position = glm::vec3(world[3]);
+        light.direction = forwardOf(world);
+        mScene.lights.push_back(light);
+    }
+
+    const tinygltf::Model& mModel;
+    const std::string& mPath;
+    Scene mScene;
+    std::vector<int> mImageTexture; ///< glTF image -> Scene::textures index, kNotConverted, or -1
+    std::vector<bool> mOnPath;      ///< nodes on the current root-to-node path, to reject cycles
+    int mDefaultMaterial = -1;
+};
+
+/// tinygltf reports a short GLB only as "Invalid glTF binary."; say what is wrong instead.
+void checkGlbLength(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    unsigned char header[12] = {};
+    if (!file.read(reinterpret_cast<char*>(header), sizeof header)) return; // tinygltf reports it
+    if (std::memcmp(header, "glTF", 4) != 0) return;
+    const std::uint64_t declared =
+        header[8] | header[9] << 8 | header[10] << 16 | std::uint64_t(header[11]) << 24;
+    std::error_code ec;
+    const std::uint64_t actual = std::filesystem::file_size(path, ec);
+    if (!ec && declared > actual)
+        throw InputError(path, "truncated GLB: header declares " + std::to_string(declared) +
+                                   " bytes, file has " + std::to_string(actual));
+}
+
+tinygltf::Model parseFile(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a regular file");
+    const std::string ext = std::filesystem::path(path).extension().string();
+    const bool binary = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'g' &&
+                        std::tolower(static_cast<unsigned char>(ext[2])) == 'l' &&
+                        std::tolower(static_cast<unsigned char>(ext[3])) == 'b';
+    if (binary) checkGlbLength(path);
+    tinygltf::TinyGLTF parser;
+    tinygltf::Model model;
+    std::string err, warnings;
+    const bool ok = binary ? parser.LoadBinaryFromFile(&model, &err, &warnings, path)
+                           : parser.LoadASCIIFromFile(&model, &err, &warnings, path);
+    if (!warnings.empty()) logWarn("scene: " + path + ": " + oneLine(warnings));
+    if (!ok) {
+        // nlohmann's messages ("[json.exception.parse_error.101] ...") do not say what was parsed.
+        const std::string reason = oneLine(err);
+        if (reason.starts_with("[json.exception")) throw InputError(path, "malformed JSON: " + reason);
+        throw InputError(path, reason.empty() ? "not a valid glTF file" : reason);
+    }
+    return model;
+}
+
+} // namespace
+
+Scene loadGltf(const std::string& path) {
+    try {
+        const tinygltf::Model model = parseFile(path);
+        return GltfReader(model, path).read();
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw InputError(path, "out of memory while loading");
+    } catch (const std::exception& e) {
+        throw InputError(path, std::string("failed to load: ") + e.what());
+    } catch (...) {
+        throw InputError(path, "failed to load: unknown error");
+    }
+}
+
+} // namespace gis

@@ -1,0 +1,91 @@
+// Scene: the renderer-neutral description every layer above works on (GL pipeline, reference
+// renderer, analysis). Geometry is flattened to world space at load time: the node hierarchy is
+// applied once, so consumers never walk a graph.
+//
+// Units: lengths in metres; punctual light intensity in candela (lm/sr, glTF's
+// KHR_lights_punctual convention); colours linear RGB.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace gis {
+
+/// RGBA8 image, rows top to bottom, sRGB-encoded colour as stored in the source file.
+struct TextureImage {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgba; ///< width * height * 4 bytes
+    std::string name;               ///< for messages only
+};
+
+/// glTF metallic-roughness material, reduced to what the pipeline reads.
+struct Material {
+    std::string name;
+    glm::vec4 baseColor{1.0f}; ///< linear RGBA factor, each in [0, 1]
+    int baseColorTexture = -1; ///< index into Scene::textures, -1 for none
+    float metallic = 0.0f;     ///< [0, 1]
+    float roughness = 1.0f;    ///< [0, 1], perceptual
+    glm::vec3 emissive{0.0f};  ///< linear RGB radiance scale (glTF emissiveFactor)
+};
+
+/// One triangle list in world space. Every vertex attribute array has positions.size() entries.
+struct Mesh {
+    std::string name;
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;     ///< unit length; generated when the source has none
+    std::vector<glm::vec2> texcoords;   ///< empty when the source has none
+    std::vector<std::uint32_t> indices; ///< triangle list, 3 per triangle, all < positions.size()
+    int material = 0;                   ///< index into Scene::materials
+};
+
+enum class LightType { Spot, Point, Directional };
+
+struct Light {
+    std::string name;
+    LightType type = LightType::Spot;
+    glm::vec3 position{0.0f};               ///< metres (unused for directional)
+    glm::vec3 direction{0.0f, -1.0f, 0.0f}; ///< unit vector the light points along
+    glm::vec3 color{1.0f};                  ///< linear RGB, each in [0, 1]
+    float intensity = 1.0f;                 ///< candela for spot/point, lux for directional
+    float innerConeAngle = 0.0f;            ///< radians, spot only, [0, outer)
+    float outerConeAngle = 0.7853982f;      ///< radians, spot only, (0, pi/2]
+    float range = 0.0f;                     ///< metres, 0 = infinite
+};
+
+struct Camera {
+    std::string name;
+    glm::vec3 position{0.0f, 0.0f, 5.0f};
+    glm::vec3 target{0.0f}; ///< point looked at
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float yfovRadians = 0.6981317f; ///< vertical field of view, (0, pi)
+    float znear = 0.05f;            ///< metres, > 0
+    float zfar = 100.0f;            ///< metres, > znear
+};
+
+struct Bounds {
+    glm::vec3 min{0.0f};
+    glm::vec3 max{0.0f};
+    glm::vec3 center() const { return 0.5f * (min + max); }
+    float radius() const { return 0.5f * glm::length(max - min); }
+};
+
+struct Scene {
+    std::string name; ///< "builtin:cornell" or the file path it came from
+    std::vector<Mesh> meshes;
+    std::vector<Material> materials; ///< never empty after loading (a default is added)
+    std::vector<TextureImage> textures;
+    std::vector<Light> lights;
+    std::vector<Camera> cameras; ///< never empty after loading (a framing camera is added)
+    Bounds bounds;
+
+    std::size_t triangleCount() const;
+    /// Recomputes bounds from all mesh positions.
+    void updateBounds();
+};
+
+} // namespace gis

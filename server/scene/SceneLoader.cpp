@@ -1,0 +1,38 @@
+#include "scene/SceneLoader.h"
+
+#include <algorithm>
+#include <cctype>
+#include <string_view>
+
+#include "core/Error.h"
+
+namespace gis {
+namespace {
+
+constexpr std::string_view kBuiltinPrefix = "builtin:";
+
+bool endsWithIgnoreCase(const std::string& s, std::string_view suffix) {
+    if (s.size() < suffix.size()) return false;
+    return std::equal(suffix.begin(), suffix.end(), s.end() - static_cast<std::ptrdiff_t>(suffix.size()),
+                      [](char a, char b) {
+                          return std::tolower(static_cast<unsigned char>(a)) ==
+                                 std::tolower(static_cast<unsigned char>(b));
+                      });
+}
+
+std::string joinedBuiltinNames() {
+    std::string out;
+    for (const auto& n : builtinSceneNames()) out += (out.empty() ? "" : ", ") + n;
+    return out;
+}
+
+} // namespace
+
+Scene loadScene(const std::string& name) {
+    if (name.starts_with(kBuiltinPrefix)) return makeBuiltinScene(name.substr(kBuiltinPrefix.size()));
+    if (endsWithIgnoreCase(name, ".gltf") || endsWithIgnoreCase(name, ".glb")) return loadGltf(name);
+    throw InputError(name, "unsupported scene: expected 'builtin:NAME' (NAME one of " + joinedBuiltinNames() +
+                               ") or a path to a .gltf or .glb file");
+}
+
+} // namespace gis

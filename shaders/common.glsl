@@ -1,0 +1,26 @@
+// Declarations every pass shares: the frame uniform block and numeric guards.
+#include "shared/FrameData.h"
+
+layout(std140, binding = GIS_UBO_FRAME) uniform FrameBlock {
+    FrameUniforms gFrame;
+};
+
+const float kPi = 3.14159265358979;
+const float kInvPi = 0.31830988618379;
+
+// True for NaN and +-Inf: the boundary sanitiser turns such values into 0.
+bool isBad(float v) { return isnan(v) || isinf(v); }
+vec3 sanitize(vec3 c) {
+    return vec3(isBad(c.r) ? 0.0 : c.r, isBad(c.g) ? 0.0 : c.g, isBad(c.b) ? 0.0 : c.b);
+}
+
+// glTF KHR_lights_punctual spot attenuation: 1 inside the inner cone, 0 outside the outer,
+// smooth in between. cosInner > cosOuter is guaranteed by scene validation; the max() keeps the
+// division finite if both cones coincide.
+float spotFactor(vec3 dirFromLight) {
+    float cd = dot(normalize(gFrame.lightDir.xyz), dirFromLight);
+    float cosOuter = gFrame.lightDir.w;
+    float cosInner = gFrame.lightColor.w;
+    float t = clamp((cd - cosOuter) / max(cosInner - cosOuter, 1e-4), 0.0, 1.0);
+    return t * t;
+}

@@ -1,0 +1,35 @@
+#version 450 core
+// Full-resolution gather (digest S.3 preset rsm_naive, receivers R0): every covered pixel sums the
+// irradiance of every VPL in the current batch. Batches are accumulated with additive blending.
+#include "common.glsl"
+#include "gi/vpl_transport.glsl"
+
+layout(binding = 0) uniform sampler2D gPosition;
+layout(binding = 1) uniform sampler2D gNormal;
+layout(binding = 2) uniform sampler2D gAlbedo;
+
+layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
+    Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
+};
+
+uniform int uVplCount;       // VPLs in this batch
+uniform float uMinDistance;  // m
+
+layout(location = 0) out vec4 outRadiance;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 pos = texelFetch(gPosition, px, 0);
+    if (pos.w < 0.5) { // background receives exactly 0 (digest S.4 case 4)
+        outRadiance = vec4(0.0);
+        return;
+    }
+    vec3 n = texelFetch(gNormal, px, 0).xyz;
+    vec3 e = vec3(0.0);
+    for (int i = 0; i < uVplCount; ++i) {
+        Vpl v = gVpls[i];
+        e += vplIrradiance(pos.xyz, n, v.position.xyz, v.normal.xyz, v.flux.rgb, uMinDistance) * v.position.w;
+    }
+    vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
+    outRadiance = vec4(max(sanitize(albedo * kInvPi * e), vec3(0.0)), 1.0);
+}

@@ -1,0 +1,57 @@
+#version 450 core
+// VPLs on a regular RSM grid (000 §3 step 3): one VPL per grid cell, placed at the cell's centre
+// texel (or the valid texel nearest to it) and carrying the summed flux of every valid texel in the
+// cell, so the VPL set conserves the RSM's total flux exactly (digest S.4 case 7).
+#include "shared/FrameData.h"
+
+layout(local_size_x = 64) in;
+
+layout(binding = 0) uniform sampler2D gRsmPosition;
+layout(binding = 1) uniform sampler2D gRsmNormal;
+layout(binding = 2) uniform sampler2D gRsmFlux;
+
+layout(std430, binding = 0) writeonly buffer VplOut {
+    Vpl gVplsOut[];
+};
+
+uniform int uGrid;     // VPLs per side
+uniform int uRsmSize;  // texels per side
+
+void main() {
+    int index = int(gl_GlobalInvocationID.x);
+    if (index >= uGrid * uGrid) return;
+    ivec2 cell = ivec2(index % uGrid, index / uGrid);
+    ivec2 lo = (cell * uRsmSize) / uGrid;
+    ivec2 hi = ((cell + 1) * uRsmSize) / uGrid; // exclusive; cells tile the RSM exactly
+    ivec2 centre = (lo + hi) / 2;
+
+    vec3 flux = vec3(0.0);
+    float texels = 0.0;
+    ivec2 best = ivec2(-1);
+    int bestDist = 1 << 30;
+    for (int y = lo.y; y < hi.y; ++y)
+        for (int x = lo.x; x < hi.x; ++x) {
+            ivec2 t = ivec2(x, y);
+            if (texelFetch(gRsmPosition, t, 0).w < 0.5) continue; // empty texel: no surface
+            flux += texelFetch(gRsmFlux, t, 0).rgb;
+            texels += 1.0;
+            ivec2 d = t - centre;
+            int dist = d.x * d.x + d.y * d.y;
+            if (dist < bestDist) {
+                bestDist = dist;
+                best = t;
+            }
+        }
+
+    Vpl v;
+    if (best.x < 0) {
+        v.position = vec4(0.0);
+        v.normal = vec4(0.0, 1.0, 0.0, 0.0);
+        v.flux = vec4(0.0);
+    } else {
+        v.position = vec4(texelFetch(gRsmPosition, best, 0).xyz, 1.0);
+        v.normal = vec4(texelFetch(gRsmNormal, best, 0).xyz, 0.0);
+        v.flux = vec4(flux, texels);
+    }
+    gVplsOut[index] = v;
+}

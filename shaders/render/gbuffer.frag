@@ -1,0 +1,22 @@
+#version 450 core
+// Eye G-buffer (000 §3 step 2): world position, normal, albedo, emission.
+#include "common.glsl"
+#include "render/material.glsl"
+
+in vec3 vWorldPos;
+in vec3 vNormal;
+in vec2 vTexcoord;
+
+layout(location = 0) out vec4 outPosition; // xyz world (m), w = 1 covered
+layout(location = 1) out vec4 outNormal;   // xyz unit normal facing the camera
+layout(location = 2) out vec4 outAlbedo;   // rgb linear albedo
+layout(location = 3) out vec4 outEmissive; // rgb emitted radiance
+
+void main() {
+    vec3 toEye = gFrame.cameraPos.xyz - vWorldPos;
+    vec3 n = safeNormal(vNormal, vWorldPos, toEye);
+    outPosition = vec4(vWorldPos, 1.0);
+    outNormal = vec4(n, 0.0);
+    outAlbedo = vec4(materialAlbedo(vTexcoord), 1.0);
+    outEmissive = vec4(max(sanitize(uEmissive), vec3(0.0)), 1.0);
+}

@@ -1,0 +1,60 @@
+#include "GlTestSupport.h"
+
+#include <map>
+
+#include <OpenImageIO/imageio.h>
+
+#include "render/FrameState.h"
+
+namespace gis::test {
+
+gl::Context& sharedContext() {
+    static std::unique_ptr<gl::Context> context = gl::createContext(gl::defaultBackend());
+    context->makeCurrent();
+    return *context;
+}
+
+FrameOutput renderScene(const std::string& sceneName, const std::string& technique, int w, int h,
+                        const nlohmann::json& params) {
+    sharedContext();
+    static std::map<std::string, std::shared_ptr<Scene>> scenes;
+    auto& scene = scenes[sceneName];
+    if (!scene) scene = std::make_shared<Scene>(loadScene(sceneName));
+    static std::unique_ptr<FrameRenderer> renderer;
+    if (!renderer) renderer = std::make_unique<FrameRenderer>();
+    if (renderer->scene() != scene.get()) renderer->setScene(scene);
+    FrameState state = makeFrameState(*scene, technique);
+    state.width = w;
+    state.height = h;
+    applyParams(state, params, "test");
+    return renderer->render(state, true);
+}
+
+glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h) {
+    glm::vec4 clip = FrameRenderer::cameraViewProj(scene.cameras.front(), w, h) * glm::vec4(p, 1.0f);
+    glm::vec2 ndc = glm::vec2(clip) / clip.w;
+    return {static_cast<int>((ndc.x * 0.5f + 0.5f) * w), static_cast<int>((0.5f - ndc.y * 0.5f) * h)};
+}
+
+bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>& rgb) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return false;
+    const auto& spec = in->spec();
+    w = spec.width;
+    h = spec.height;
+    rgb.resize(static_cast<size_t>(w) * h * 3);
+    std::vector<std::uint8_t> all(static_cast<size_t>(w) * h * spec.nchannels);
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, all.data())) return false;
+    for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
+        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
+    return true;
+}
+
+bool writePng(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba) {
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) return false;
+    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::UINT8);
+    return out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, rgba.data()) && out->close();
+}
+
+} // namespace gis::test

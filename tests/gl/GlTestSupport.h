@@ -1,0 +1,29 @@
+// Shared fixture for tests that need a GL context: one context per test process, backend from GI_GL
+// (CTest runs the same binary once per backend).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "gl/Platform.h"
+#include "render/FrameRenderer.h"
+#include "scene/SceneLoader.h"
+
+namespace gis::test {
+
+gl::Context& sharedContext();
+
+/// Renders `scene` with `technique` and optional parameter overrides at w x h, with the linear frame.
+FrameOutput renderScene(const std::string& scene, const std::string& technique, int w, int h,
+                        const nlohmann::json& params = nlohmann::json::object());
+
+/// Pixel (x, y), top-left origin, where world point p lands in the scene's default camera.
+glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h);
+
+bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>& rgb);
+bool writePng(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);
+
+} // namespace gis::test
