@@ -1,0 +1,156 @@
+#include <algorithm>
+
+#include <glm/gtc/constants.hpp>
+#include <gtest/gtest.h>
+
+#include "core/Error.h"
+#include "scene/SceneLoader.h"
+
+namespace gis {
+namespace {
+
+const Mesh* findMesh(const Scene& s, const std::string& name) {
+    const auto it =
+        std::find_if(s.meshes.begin(), s.meshes.end(), [&](const Mesh& m) { return m.name == name; });
+    return it == s.meshes.end() ? nullptr : &*it;
+}
+
+void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
+    EXPECT_NEAR(a.x, b.x, eps);
+    EXPECT_NEAR(a.y, b.y, eps);
+    EXPECT_NEAR(a.z, b.z, eps);
+}
+
+TEST(BuiltinScenes, NamesList) {
+    EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{"cornell", "cornell-empty", "crease"}));
+}
+
+TEST(BuiltinScenes, EachBuildsAndValidates) {
+    for (const auto& name : builtinSceneNames()) {
+        SCOPED_TRACE(name);
+        const Scene s = loadScene("builtin:" + name);
+        EXPECT_EQ(s.name, "builtin:" + name);
+        EXPECT_NO_THROW(validateScene(s, s.name));
+        EXPECT_GT(s.triangleCount(), 0u);
+        EXPECT_EQ(s.lights.size(), 1u);
+        ASSERT_EQ(s.cameras.size(), 1u);
+        EXPECT_EQ(s.cameras[0].name, "default");
+        for (const Mesh& m : s.meshes) {
+            EXPECT_EQ(m.texcoords.size(), m.positions.size()) << m.name;
+            // Winding is CCW seen from the side the stored normal points to.
+            for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+                const glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]],
+                                c = m.positions[m.indices[t + 2]];
+                ASSERT_GT(glm::dot(glm::cross(b - a, c - a), m.normals[m.indices[t]]), 0.0f)
+                    << m.name << " triangle " << t / 3;
+            }
+        }
+    }
+}
+
+TEST(BuiltinScenes, CornellRoomMaterialsLightAndCamera) {
+    const Scene s = makeBuiltinScene("cornell");
+    expectNear(s.bounds.min, {-1, 0, -1});
+    expectNear(s.bounds.max, {1, 2, 1});
+
+    const Mesh* left = findMesh(s, "left_wall");
+    ASSERT_NE(left, nullptr);
+    for (const auto& p : left->positions) EXPECT_FLOAT_EQ(p.x, -1.0f);
+    for (const auto& n : left->normals) expectNear(n, {1, 0, 0});
+    EXPECT_EQ(s.materials[static_cast<std::size_t>(left->material)].name, "red");
+    EXPECT_EQ(s.materials[static_cast<std::size_t>(left->material)].baseColor,
+              glm::vec4(0.63f, 0.065f, 0.05f, 1.0f));
+    EXPECT_GE(left->indices.size() / 3, 128u); // subdivided, not one quad
+
+    const Mesh* right = findMesh(s, "right_wall");
+    ASSERT_NE(right, nullptr);
+    for (const auto& n : right->normals) expectNear(n, {-1, 0, 0});
+    EXPECT_EQ(s.materials[static_cast<std::size_t>(right->material)].name, "green");
+    for (const char* white : {"floor", "ceiling", "back_wall", "short_box", "tall_box"}) {
+        const Mesh* m = findMesh(s, white);
+        ASSERT_NE(m, nullptr) << white;
+        EXPECT_EQ(s.materials[static_cast<std::size_t>(m->material)].name, "white") << white;
+    }
+    EXPECT_EQ(findMesh(s, "front_wall"), nullptr);
+
+    ASSERT_EQ(s.lights.size(), 1u);
+    const Light& l = s.lights[0];
+    EXPECT_EQ(l.name, "ceiling_spot");
+    EXPECT_EQ(l.type, LightType::Spot);
+    expectNear(l.position, {0, 1.95f, 0});
+    expectNear(l.direction, {0, -1, 0});
+    EXPECT_FLOAT_EQ(l.intensity, 6.0f);
+    EXPECT_NEAR(l.innerConeAngle, glm::radians(50.0f), 1e-6f);
+    EXPECT_NEAR(l.outerConeAngle, glm::radians(60.0f), 1e-6f);
+
+    const Camera& c = s.cameras[0];
+    expectNear(c.position, {0, 1, 3.9f});
+    expectNear(c.target, {0, 1, 0});
+    EXPECT_NEAR(c.yfovRadians, glm::radians(40.0f), 1e-6f);
+    EXPECT_FLOAT_EQ(c.znear, 0.05f);
+    EXPECT_FLOAT_EQ(c.zfar, 20.0f);
+}
+
+TEST(BuiltinScenes, BoxesFaceOutwardAndSitOnTheFloor) {
+    const Scene s = makeBuiltinScene("cornell");
+    const struct {
+        const char* name;
+        glm::vec3 center;
+        float height;
+    } boxes[] = {{"short_box", {0.35f, 0.3f, 0.3f}, 0.6f}, {"tall_box", {-0.35f, 0.6f, -0.35f}, 1.2f}};
+    for (const auto& box : boxes) {
+        const Mesh* m = findMesh(s, box.name);
+        ASSERT_NE(m, nullptr) << box.name;
+        float minY = 10.0f, maxY = -10.0f;
+        for (const auto& p : m->positions) {
+            minY = std::min(minY, p.y);
+            maxY = std::max(maxY, p.y);
+        }
+        EXPECT_NEAR(minY, 0.0f, 1e-5f) << box.name;
+        EXPECT_NEAR(maxY, box.height, 1e-5f) << box.name;
+        for (std::size_t t = 0; t < m->indices.size(); t += 3) {
+            const glm::vec3 centroid = (m->positions[m->indices[t]] + m->positions[m->indices[t + 1]] +
+                                        m->positions[m->indices[t + 2]]) /
+                                       3.0f;
+            EXPECT_GT(glm::dot(m->normals[m->indices[t]], centroid - box.center), 0.0f) << box.name;
+        }
+    }
+}
+
+TEST(BuiltinScenes, CornellEmptyHasNoBoxes) {
+    const Scene s = makeBuiltinScene("cornell-empty");
+    EXPECT_EQ(s.meshes.size(), 5u);
+    EXPECT_EQ(findMesh(s, "short_box"), nullptr);
+    EXPECT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].name, "ceiling_spot");
+}
+
+TEST(BuiltinScenes, CreaseLightAimsAtTheCrease) {
+    const Scene s = makeBuiltinScene("crease");
+    EXPECT_EQ(s.meshes.size(), 2u);
+    const Light& l = s.lights[0];
+    expectNear(l.position, {0.2f, 1.5f, 0});
+    expectNear(l.direction, glm::normalize(glm::vec3(-1, -1, 0)));
+    EXPECT_NEAR(l.innerConeAngle, glm::radians(40.0f), 1e-6f);
+    EXPECT_NEAR(l.outerConeAngle, glm::radians(50.0f), 1e-6f);
+    expectNear(s.cameras[0].position, {1.6f, 1.2f, 2.8f});
+    expectNear(s.cameras[0].target, {-0.6f, 0.4f, 0});
+    EXPECT_EQ(s.materials.size(), 1u);
+    EXPECT_EQ(s.materials[0].baseColor, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));
+}
+
+TEST(BuiltinScenes, UnknownNameListsKnownNames) {
+    for (const auto& call : {+[] { makeBuiltinScene("teapot"); }, +[] { loadScene("builtin:teapot"); }}) {
+        try {
+            call();
+            FAIL() << "expected InputError";
+        } catch (const InputError& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("teapot"), std::string::npos) << what;
+            for (const auto& n : builtinSceneNames()) EXPECT_NE(what.find(n), std::string::npos) << what;
+        }
+    }
+}
+
+} // namespace
+} // namespace gis

@@ -1,0 +1,322 @@
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+#include <gtest/gtest.h>
+
+#include "GltfBuilder.h"
+#include "core/Error.h"
+#include "scene/SceneLoader.h"
+
+namespace gis {
+namespace {
+
+using test::GltfBuilder;
+using test::TempDir;
+
+void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
+    EXPECT_NEAR(a.x, b.x, eps);
+    EXPECT_NEAR(a.y, b.y, eps);
+    EXPECT_NEAR(a.z, b.z, eps);
+}
+
+TEST(GltfLoader, GltfWithDataUriBufferAndU16Indices) {
+    TempDir dir;
+    GltfBuilder b;
+    b.setScene({b.addTriangleNode()});
+    const std::string path = b.writeGltf(dir, "tri.gltf");
+    const Scene s = loadGltf(path);
+    EXPECT_EQ(s.name, path);
+    ASSERT_EQ(s.meshes.size(), 1u);
+    const Mesh& m = s.meshes[0];
+    EXPECT_EQ(m.name, "tri");
+    ASSERT_EQ(m.positions.size(), 3u);
+    expectNear(m.positions[1], {1, 0, 0});
+    EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2}));
+    EXPECT_TRUE(m.texcoords.empty());
+    ASSERT_EQ(s.materials.size(), 1u); // the default material
+    EXPECT_EQ(m.material, 0);
+    EXPECT_EQ(s.materials[0].baseColor, glm::vec4(1.0f));
+    ASSERT_EQ(s.cameras.size(), 1u); // a framing camera
+    expectNear(s.bounds.min, {0, 0, -1});
+    expectNear(s.bounds.max, {1, 0, 0});
+}
+
+TEST(GltfLoader, GlbWithU8U32AndNonIndexedPrimitives) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {1, 0, -1}});
+    const int i8 = b.addIndices(std::vector<std::uint8_t>{0, 1, 2, 2, 1, 3}, test::kUnsignedByte);
+    const int i32 = b.addIndices(std::vector<std::uint32_t>{2, 1, 3}, test::kUnsignedInt);
+    const int posFlat = b.addVec3s({{0, 1, 0}, {1, 1, 0}, {0, 1, -1}});
+    const int m8 = b.addMesh("u8", {{"attributes", {{"POSITION", pos}}}, {"indices", i8}});
+    const int m32 = b.addMesh("u32", {{"attributes", {{"POSITION", pos}}}, {"indices", i32}});
+    const int mFlat = b.addMesh("flat", {{"attributes", {{"POSITION", posFlat}}}});
+    b.setScene({b.addNode({{"mesh", m8}}), b.addNode({{"mesh", m32}}), b.addNode({{"mesh", mFlat}})});
+    const Scene s = loadGltf(b.writeGlb(dir, "three.glb"));
+    ASSERT_EQ(s.meshes.size(), 3u);
+    EXPECT_EQ(s.meshes[0].indices, (std::vector<std::uint32_t>{0, 1, 2, 2, 1, 3}));
+    EXPECT_EQ(s.meshes[1].indices, (std::vector<std::uint32_t>{2, 1, 3}));
+    EXPECT_EQ(s.meshes[2].indices, (std::vector<std::uint32_t>{0, 1, 2}));
+    expectNear(s.meshes[2].positions[2], {0, 1, -1});
+    EXPECT_EQ(s.triangleCount(), 4u);
+}
+
+TEST(GltfLoader, ChildTranslatedUnderScaledParentGetsWorldPositions) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const int mesh = b.addMesh("child_tri", {{"attributes", {{"POSITION", pos}}}});
+    const int child = b.addNode({{"mesh", mesh}, {"translation", {1, 0, 0}}});
+    const int parent = b.addNode({{"scale", {2, 2, 2}}, {"children", {child}}});
+    b.setScene({parent});
+    const Scene s = loadGltf(b.writeGlb(dir, "tree.glb"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    expectNear(s.meshes[0].positions[0], {2, 0, 0});
+    expectNear(s.meshes[0].positions[1], {4, 0, 0});
+    expectNear(s.meshes[0].positions[2], {2, 0, -2});
+}
+
+TEST(GltfLoader, MatrixTransformAndNoSceneUsesAllRoots) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    // Column-major: translation in elements 12..14, uniform scale 3.
+    b.doc["nodes"][tri]["matrix"] = {3, 0, 0, 0, 0, 3, 0, 0, 0, 0, 3, 0, 5, 6, 7, 1};
+    const Scene s = loadGltf(b.writeGltf(dir, "matrix.gltf")); // no "scenes": every root node is drawn
+    ASSERT_EQ(s.meshes.size(), 1u);
+    expectNear(s.meshes[0].positions[1], {8, 6, 7});
+}
+
+TEST(GltfLoader, RotationAndNonUniformScaleTransformSuppliedNormals) {
+    TempDir dir;
+    GltfBuilder b;
+    // A 45-degree slope x = y; its normal (-1,1,0)/sqrt2 must follow the inverse transpose.
+    const int pos = b.addVec3s({{0, 0, 0}, {0, 0, 1}, {1, 1, 0}});
+    const glm::vec3 n = glm::normalize(glm::vec3(-1, 1, 0));
+    const int nrm = b.addVec3s({n, n, n});
+    const int mesh = b.addMesh("slope", {{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}});
+    b.setScene({b.addNode({{"mesh", mesh}, {"scale", {2, 1, 1}}})});
+    const Scene s = loadGltf(b.writeGlb(dir, "slope.glb"));
+    // Scaled slope is x = 2y, whose normal is (-1, 2, 0)/sqrt5.
+    expectNear(s.meshes[0].normals[0], glm::normalize(glm::vec3(-1, 2, 0)));
+}
+
+TEST(GltfLoader, MirroredNodeKeepsCounterClockwiseFrontFaces) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["nodes"][tri]["scale"] = {-1, 1, 1};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "mirror.glb"));
+    const Mesh& m = s.meshes[0];
+    const glm::vec3 geometric = glm::cross(m.positions[m.indices[1]] - m.positions[m.indices[0]],
+                                           m.positions[m.indices[2]] - m.positions[m.indices[0]]);
+    EXPECT_GT(geometric.y, 0.0f);
+    expectNear(m.normals[0], {0, 1, 0});
+}
+
+TEST(GltfLoader, MissingNormalsAreGeneratedUnitLengthOnTheCounterClockwiseSide) {
+    TempDir dir;
+    GltfBuilder b;
+    // Two triangles sharing an edge at a 90-degree fold: shared vertices get the averaged normal.
+    const int pos = b.addVec3s({{0, 0, 0}, {0, 0, -1}, {1, 0, 0}, {0, 1, 0}});
+    const int idx = b.addIndices(std::vector<std::uint16_t>{0, 2, 1, 0, 1, 3}, test::kUnsignedShort);
+    const int mesh = b.addMesh("fold", {{"attributes", {{"POSITION", pos}}}, {"indices", idx}});
+    b.setScene({b.addNode({{"mesh", mesh}})});
+    const Scene s = loadGltf(b.writeGltf(dir, "fold.gltf"));
+    const Mesh& m = s.meshes[0];
+    ASSERT_EQ(m.normals.size(), 4u);
+    for (const auto& nrm : m.normals) EXPECT_NEAR(glm::length(nrm), 1.0f, 1e-5f);
+    expectNear(m.normals[2], {0, 1, 0});                                 // floor only
+    expectNear(m.normals[3], {1, 0, 0});                                 // wall x = 0 only
+    expectNear(m.normals[0], glm::normalize(glm::vec3(1, 1, 0)), 1e-5f); // shared, equal areas
+}
+
+TEST(GltfLoader, NanSuppliedNormalIsRepairedWithTheFaceNormal) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const float nan = std::nanf("");
+    const int nrm = b.addVec3s({{0, 1, 0}, {nan, nan, nan}, {0, 0, 0}});
+    const int mesh = b.addMesh("tri", {{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}});
+    b.setScene({b.addNode({{"mesh", mesh}})});
+    const Scene s = loadGltf(b.writeGlb(dir, "nan_normal.glb"));
+    for (const auto& nrm_ : s.meshes[0].normals) expectNear(nrm_, {0, 1, 0});
+}
+
+TEST(GltfLoader, PerspectiveCameraAndSpotLightFromNodeWorldTransforms) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["cameras"] = {{{"name", "cam"},
+                         {"type", "perspective"},
+                         {"perspective", {{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 50.0}}}}};
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensionsRequired"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+        {{"name", "spot"},
+         {"type", "spot"},
+         {"color", {1.0, 0.5, 0.25}},
+         {"intensity", 12.0},
+         {"range", 8.0},
+         {"spot", {{"innerConeAngle", 0.3}, {"outerConeAngle", 0.6}}}}};
+    const int cam = b.addNode({{"camera", 0}, {"translation", {0, 1, 5}}});
+    // -90 degrees about X turns the light's -Z axis into -Y.
+    const float h = std::sqrt(0.5f);
+    const int light = b.addNode({{"translation", {0, 2, 0}},
+                                 {"rotation", {-h, 0, 0, h}},
+                                 {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    const int rig = b.addNode({{"translation", {1, 0, 0}}, {"children", {cam, light}}});
+    b.setScene({tri, rig});
+    const Scene s = loadGltf(b.writeGltf(dir, "camlight.gltf"));
+
+    ASSERT_EQ(s.cameras.size(), 1u);
+    const Camera& c = s.cameras[0];
+    EXPECT_EQ(c.name, "cam");
+    expectNear(c.position, {1, 1, 5});
+    expectNear(glm::normalize(c.target - c.position), {0, 0, -1});
+    expectNear(c.up, {0, 1, 0});
+    EXPECT_FLOAT_EQ(c.yfovRadians, 0.8f);
+    EXPECT_FLOAT_EQ(c.znear, 0.1f);
+    EXPECT_FLOAT_EQ(c.zfar, 50.0f);
+
+    ASSERT_EQ(s.lights.size(), 1u);
+    const Light& l = s.lights[0];
+    EXPECT_EQ(l.name, "spot");
+    EXPECT_EQ(l.type, LightType::Spot);
+    expectNear(l.position, {1, 2, 0});
+    expectNear(l.direction, {0, -1, 0});
+    expectNear(l.color, {1.0f, 0.5f, 0.25f});
+    EXPECT_FLOAT_EQ(l.intensity, 12.0f);
+    EXPECT_FLOAT_EQ(l.range, 8.0f);
+    EXPECT_FLOAT_EQ(l.innerConeAngle, 0.3f);
+    EXPECT_FLOAT_EQ(l.outerConeAngle, 0.6f);
+}
+
+TEST(GltfLoader, InfiniteFarPlaneIsClosedBeyondTheScene) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+    b.setScene({tri, b.addNode({{"camera", 0}, {"translation", {0, 0, 10}}})});
+    const Scene s = loadGltf(b.writeGlb(dir, "inf.glb"));
+    ASSERT_EQ(s.cameras.size(), 1u);
+    EXPECT_GT(s.cameras[0].zfar, 11.0f);
+}
+
+// A 2x1 24-bit BMP: one red and one green pixel.
+std::vector<std::uint8_t> tinyBmp() {
+    std::vector<std::uint8_t> f(54 + 8, 0);
+    const auto u32 = [&f](std::size_t at, std::uint32_t v) {
+        for (int i = 0; i < 4; ++i)
+            f[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+    };
+    f[0] = 'B';
+    f[1] = 'M';
+    u32(2, static_cast<std::uint32_t>(f.size()));
+    u32(10, 54);
+    u32(14, 40);
+    u32(18, 2);
+    u32(22, 1);
+    f[26] = 1;
+    f[28] = 24;
+    u32(34, 8);
+    const std::uint8_t pixels[] = {0, 0, 255, 0, 255, 0, 0, 0}; // BGR BGR + row padding
+    std::copy(std::begin(pixels), std::end(pixels), f.begin() + 54);
+    return f;
+}
+
+TEST(GltfLoader, MaterialFactorsEmissiveStrengthAndBaseColorTexture) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["materials"] = {
+        {{"name", "paint"},
+         {"pbrMetallicRoughness",
+          {{"baseColorFactor", {0.5, 0.25, 1.0, 1.0}},
+           {"metallicFactor", 0.2},
+           {"roughnessFactor", 0.7},
+           {"baseColorTexture", {{"index", 0}}}}},
+         {"emissiveFactor", {1.0, 0.5, 0.0}},
+         {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4.0}}}}}}};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGltf(dir, "material.gltf"));
+    ASSERT_EQ(s.materials.size(), 1u);
+    const Material& m = s.materials[0];
+    EXPECT_EQ(m.name, "paint");
+    EXPECT_EQ(m.baseColor, glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
+    EXPECT_FLOAT_EQ(m.metallic, 0.2f);
+    EXPECT_FLOAT_EQ(m.roughness, 0.7f);
+    expectNear(m.emissive, {4.0f, 2.0f, 0.0f});
+    ASSERT_EQ(m.baseColorTexture, 0);
+    ASSERT_EQ(s.textures.size(), 1u);
+    const TextureImage& t = s.textures[0];
+    EXPECT_EQ(t.width, 2);
+    EXPECT_EQ(t.height, 1);
+    EXPECT_EQ(t.rgba, (std::vector<std::uint8_t>{255, 0, 0, 255, 0, 255, 0, 255}));
+}
+
+TEST(GltfLoader, InterleavedStrideAndNormalizedTexcoords) {
+    TempDir dir;
+    GltfBuilder b;
+    // Position and normal interleaved: 24-byte stride.
+    const std::vector<float> interleaved = {0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 1, 0, 0, 0, -1, 0, 1, 0};
+    const int view = b.addView(interleaved, 24);
+    const int pos = b.addAccessor(view, test::kFloat, 3, "VEC3");
+    const int nrm = b.addAccessor(view, test::kFloat, 3, "VEC3", {{"byteOffset", 12}});
+    const std::vector<std::uint8_t> uv8 = {0, 255, 255, 0, 51, 102};
+    const int uv = b.addAccessor(b.addView(uv8), test::kUnsignedByte, 3, "VEC2", {{"normalized", true}});
+    const int mesh =
+        b.addMesh("il", {{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_0", uv}}}});
+    b.setScene({b.addNode({{"mesh", mesh}})});
+    const Scene s = loadGltf(b.writeGlb(dir, "interleaved.glb"));
+    const Mesh& m = s.meshes[0];
+    expectNear(m.positions[1], {1, 0, 0});
+    expectNear(m.normals[2], {0, 1, 0});
+    ASSERT_EQ(m.texcoords.size(), 3u);
+    EXPECT_FLOAT_EQ(m.texcoords[0].y, 1.0f);
+    EXPECT_FLOAT_EQ(m.texcoords[2].x, 0.2f);
+    EXPECT_FLOAT_EQ(m.texcoords[2].y, 0.4f);
+}
+
+TEST(GltfLoader, StripsAreConvertedAndLinesSkipped) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {1, 0, -1}});
+    const int strip = b.addMesh("strip", {{"attributes", {{"POSITION", pos}}}, {"mode", 5}});
+    const int lines = b.addMesh("lines", {{"attributes", {{"POSITION", pos}}}, {"mode", 1}});
+    b.setScene({b.addNode({{"mesh", strip}}), b.addNode({{"mesh", lines}})});
+    const Scene s = loadGltf(b.writeGlb(dir, "strip.glb"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    const Mesh& m = s.meshes[0];
+    ASSERT_EQ(m.indices.size(), 6u);
+    for (std::size_t t = 0; t < 6; t += 3) {
+        const glm::vec3 n = glm::cross(m.positions[m.indices[t + 1]] - m.positions[m.indices[t]],
+                                       m.positions[m.indices[t + 2]] - m.positions[m.indices[t]]);
+        EXPECT_GT(n.y, 0.0f) << "triangle " << t / 3;
+    }
+}
+
+TEST(SceneLoader, DispatchesOnPrefixAndExtension) {
+    TempDir dir;
+    GltfBuilder b;
+    b.setScene({b.addTriangleNode()});
+    EXPECT_EQ(loadScene(b.writeGltf(dir, "UPPER.GLTF")).meshes.size(), 1u);
+    EXPECT_EQ(loadScene("builtin:crease").name, "builtin:crease");
+    try {
+        loadScene("model.obj");
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("model.obj"), std::string::npos) << what;
+        EXPECT_NE(what.find("builtin:"), std::string::npos) << what;
+        EXPECT_NE(what.find(".gltf"), std::string::npos) << what;
+        EXPECT_NE(what.find(".glb"), std::string::npos) << what;
+    }
+}
+
+} // namespace
+} // namespace gis
