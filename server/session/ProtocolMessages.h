@@ -1,0 +1,36 @@
+// The wire contract of protocol/PROTOCOL.md on the C++ side: validation of client messages against
+// the JSON Schemas in protocol/schema (embedded in the binary), the binary frame header, and
+// builders for server messages.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace gis {
+
+constexpr int kProtocolVersion = 0;
+constexpr std::size_t kFrameHeaderSize = 16;
+enum class FrameCodec : std::uint8_t { Jpeg = 1, Png = 2 };
+
+/// A request the server rejects; becomes an `error` message, the session survives.
+struct ProtocolError {
+    std::string code;    ///< invalid_json, invalid_message, unknown_type, invalid_param, ...
+    std::string message; ///< what is wrong and how to fix it
+    std::string where;   ///< JSON pointer into the message, may be empty
+    std::string request; ///< the message type, when known
+};
+
+/// Parses and validates one client text message. Returns the parsed object; throws ProtocolError.
+nlohmann::json parseClientMessage(std::string_view text);
+
+nlohmann::json errorMessage(const ProtocolError& e);
+
+/// 16-byte header + payload, as documented.
+std::vector<std::uint8_t> makeFrameMessage(std::uint32_t frameId, int width, int height, FrameCodec codec,
+                                           const std::vector<std::uint8_t>& payload);
+
+} // namespace gis

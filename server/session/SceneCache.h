@@ -1,0 +1,23 @@
+// Scenes shared read-only by every session: loaded once per name, kept while anyone holds them.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "scene/Scene.h"
+
+namespace gis {
+
+class SceneCache {
+public:
+    /// Loads (or returns the cached) scene; throws gis::InputError from the loader.
+    std::shared_ptr<const Scene> get(const std::string& name);
+
+private:
+    std::mutex mMutex;
+    std::map<std::string, std::weak_ptr<const Scene>> mScenes;
+};
+
+} // namespace gis
