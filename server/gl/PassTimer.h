@@ -33,7 +33,9 @@ private:
         Query query;
         double cpuMs = 0;
         double fallbackGpuMs = 0;
+        double startMs = 0; ///< wall clock since beginFrame()
     };
+    Stopwatch mFrameClock;
     std::vector<Slot> mSlots;
     size_t mUsed = 0;
     bool mUseQueries;

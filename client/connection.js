@@ -1,0 +1,96 @@
+// The stream's WebSocket with automatic reconnect. A server that restarts or a laptop that wakes
+// up should find its way back without a page reload, but without hammering a server that is down.
+
+import { SUBPROTOCOL } from './protocol.js';
+
+export const BACKOFF_START_MS = 500;
+export const BACKOFF_MAX_MS = 8000;
+
+/** Delay before reconnect attempt number `attempt` (0-based): 0.5 s doubling up to 8 s. */
+export function backoffDelay(attempt) {
+    return Math.min(BACKOFF_MAX_MS, BACKOFF_START_MS * 2 ** Math.max(0, attempt));
+}
+
+/** ws(s)://<same host>/ws for a page at `location`. */
+export function streamUrl(location) {
+    const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
+    return `${scheme}//${location.host}/ws`;
+}
+
+/**
+ * Handlers: onOpen(), onText(string), onBinary(ArrayBuffer), onState(state, detail) with state
+ * one of 'connecting', 'open', 'waiting' (detail: ms until the next attempt) and 'closed'.
+ */
+export class StreamConnection {
+    constructor(url, handlers) {
+        this.url = url;
+        this.handlers = handlers;
+        this.socket = null;
+        this.attempt = 0;
+        this.retryTimer = null;
+        this.stopped = false;
+    }
+
+    connect() {
+        this.stopped = false;
+        clearTimeout(this.retryTimer);
+        this.handlers.onState?.('connecting');
+        const socket = new WebSocket(this.url, SUBPROTOCOL);
+        socket.binaryType = 'arraybuffer';
+        this.socket = socket;
+        // Every handler checks that its socket is still the current one: events of a socket that
+        // was replaced must not touch the new session.
+        socket.onopen = () => {
+            if (socket !== this.socket) return;
+            this.handlers.onState?.('open');
+            this.handlers.onOpen?.();
+        };
+        socket.onmessage = (e) => {
+            if (socket !== this.socket) return;
+            if (typeof e.data === 'string') this.handlers.onText?.(e.data);
+            else this.handlers.onBinary?.(e.data);
+        };
+        socket.onclose = () => {
+            if (socket !== this.socket) return;
+            this.socket = null;
+            this.scheduleReconnect();
+        };
+        // onclose follows every error; the reconnect is scheduled there.
+        socket.onerror = () => {};
+    }
+
+    /** The session is known good (welcome arrived): the next outage starts the backoff afresh. */
+    markHealthy() {
+        this.attempt = 0;
+    }
+
+    scheduleReconnect() {
+        if (this.stopped) {
+            this.handlers.onState?.('closed');
+            return;
+        }
+        const delay = backoffDelay(this.attempt++);
+        this.handlers.onState?.('waiting', delay);
+        this.retryTimer = setTimeout(() => this.connect(), delay);
+    }
+
+    get isOpen() {
+        return this.socket !== null && this.socket.readyState === WebSocket.OPEN;
+    }
+
+    /** Sends a message object as JSON; returns false when there is no open socket. */
+    send(msg) {
+        if (!this.isOpen) return false;
+        this.socket.send(JSON.stringify(msg));
+        return true;
+    }
+
+    close() {
+        this.stopped = true;
+        clearTimeout(this.retryTimer);
+        const socket = this.socket;
+        this.socket = null;
+        socket?.close();
+        this.handlers.onState?.('closed');
+    }
+}

@@ -1,0 +1,224 @@
+// Client protocol tests: the shared vectors in protocol/vectors, the frame header and the orbit
+// camera math. Run: node --test client/test/
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+
+import {
+    ackMsg, buildFrameHeader, cameraMsg, CLIENT_MESSAGE_TYPES, frameSizeFor, helloMsg, lightMsg,
+    paramsMsg, parseFrameHeader, parseServerMessage, pingMsg, resizeMsg, sceneMsg, techniqueMsg,
+    validateClientMessage, validateJson, validateParamValues,
+} from '../protocol.js';
+import { OrbitCamera, cameraBasis, orbitFromPosition, positionFromOrbit } from '../camera.js';
+import { backoffDelay, streamUrl } from '../connection.js';
+import { niceStep, sliderMapping, widgetKind } from '../controls.js';
+import { CLIENT_SCHEMAS } from '../schemas.js';
+import { loadProtocolSchemas, loadVectors } from '../tools/protocol-files.mjs';
+
+const schemas = loadProtocolSchemas();
+
+function assertClose(actual, expected, eps, what) {
+    assert.equal(actual.length, expected.length, `${what}: length`);
+    actual.forEach((v, i) => assert.ok(Math.abs(v - expected[i]) <= eps, `${what}[${i}]: ${v} vs ${expected[i]}`));
+}
+
+test('every client message type has a schema and the client carries the current copy', () => {
+    assert.deepEqual(Object.keys(schemas).sort(), [...CLIENT_MESSAGE_TYPES].sort());
+    assert.deepEqual(CLIENT_SCHEMAS, schemas,
+        'client/schemas.js differs from protocol/schema; run node client/tools/update-schemas.mjs');
+});
+
+test('valid vectors are accepted', () => {
+    const vectors = loadVectors('valid');
+    assert.ok(vectors.length >= Object.keys(schemas).length, 'expected a valid vector per message type');
+    for (const { name, message } of vectors) {
+        assert.equal(validateClientMessage(message, schemas), null, `vectors/valid/${name} rejected`);
+    }
+});
+
+test('invalid vectors are rejected', () => {
+    const vectors = loadVectors('invalid');
+    assert.ok(vectors.length > 0);
+    for (const { name, message } of vectors) {
+        const problem = validateClientMessage(message, schemas);
+        assert.ok(problem, `vectors/invalid/${name} accepted`);
+        assert.ok(['invalid_message', 'unknown_type'].includes(problem.code), `${name}: code ${problem.code}`);
+        assert.equal(typeof problem.where, 'string', `${name}: where`);
+        assert.ok(problem.message.length > 0, `${name}: message`);
+    }
+});
+
+test('rejections carry the server error code and a JSON pointer', () => {
+    const check = (msg) => validateClientMessage(msg, schemas);
+    assert.deepEqual(check({ type: 'teleport' }).code, 'unknown_type');
+    assert.equal(check([1, 2, 3]).code, 'invalid_message');
+    assert.equal(check(null).code, 'invalid_message');
+    assert.equal(check('hello').code, 'invalid_message');
+    assert.match(check({ position: [0, 0, 0] }).message, /missing required field 'type'/);
+    assert.equal(check({ type: 7 }).where, '/type');
+    assert.deepEqual(check({ type: 'resize', size: [8, 8] }),
+        { code: 'invalid_message', where: '/size/0', message: 'must be >= 16, got 8' });
+    assert.equal(check({ type: 'resize', size: [640, '480'] }).where, '/size/1');
+    assert.equal(check({ type: 'resize', size: [640.5, 480] }).where, '/size/0');
+    assert.equal(check({ type: 'resize', size: [640, 480, 1] }).where, '/size');
+    assert.equal(check({ type: 'camera', position: [0, 1, 2], target: [0, 1, 0], fov_deg: 200 }).where, '/fov_deg');
+    assert.equal(check({ type: 'camera', position: [0, NaN, 2], target: [0, 1, 0] }).where, '/position/1');
+    assert.equal(check({ type: 'technique', name: 'rsm_gather', extra: 1 }).where, '/extra');
+    assert.equal(check({ type: 'technique', name: '' }).where, '/name');
+    assert.equal(check({ type: 'params', values: [1, 2] }).where, '/values');
+    assert.equal(check({ type: 'params', values: { a: null } }).where, '/values/a');
+    assert.equal(check({ type: 'params', values: { 'a/b': [] } }).where, '/values/a~1b');
+    assert.equal(check({ type: 'ack', frame: -1 }).where, '/frame');
+    assert.equal(check({ type: 'hello', protocol: 0, client: 'x'.repeat(201) }).where, '/client');
+});
+
+test('validateJson covers the rest of the subset', () => {
+    assert.equal(validateJson('b', { enum: ['a', 'b'] }), null);
+    assert.equal(validateJson('c', { enum: ['a', 'b'] }).message, 'must be one of ["a","b"], got "c"');
+    assert.equal(validateJson(3, { type: ['string', 'integer'] }), null);
+    assert.equal(validateJson(1, { exclusiveMinimum: 1 }).message, 'must be > 1, got 1');
+    assert.equal(validateJson(2, { exclusiveMaximum: 2 }).message, 'must be < 2, got 2');
+    assert.equal(validateJson({ a: 1 }, { additionalProperties: { type: 'string' } }).where, '/a');
+    assert.equal(validateJson({ a: 1 }, { properties: { a: false } }).message, 'is not allowed here');
+    assert.equal(validateJson({ k: [1, { x: 2 }] }, { const: { k: [1, { x: 2 }] } }), null);
+});
+
+test('parameter values are checked against the welcome schemas', () => {
+    const technique = { type: 'object', properties: { vpl_grid: { type: 'integer', minimum: 1, maximum: 256 } } };
+    const frame = { type: 'object', properties: { tonemap: { type: 'string', enum: ['filmic', 'linear'] } } };
+    assert.equal(validateParamValues({ vpl_grid: 8, tonemap: 'linear' }, technique, frame), null);
+    assert.deepEqual(validateParamValues({ vpl_grid: 100000 }, technique, frame),
+        { code: 'invalid_param', where: '/values/vpl_grid', message: 'must be <= 256, got 100000' });
+    assert.equal(validateParamValues({ nope: 1 }, technique, frame).message, "unknown parameter 'nope'");
+    assert.equal(validateParamValues({ tonemap: 'aces' }, technique, frame).code, 'invalid_param');
+});
+
+test('message builders produce messages that validate', () => {
+    const built = [
+        helloMsg(), cameraMsg({ position: [0, 1, 3.9], target: [0, 1, 0], up: [0, 1, 0], fov_deg: 40 }),
+        cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] }), lightMsg({ intensity: 8, enabled: false }),
+        techniqueMsg('none'), paramsMsg({ vpl_grid: 8 }), resizeMsg(256, 256), sceneMsg('builtin:crease'),
+        ackMsg(0), pingMsg(), pingMsg(12.5),
+    ];
+    for (const msg of built) assert.equal(validateClientMessage(msg, schemas), null, JSON.stringify(msg));
+    assert.deepEqual(helloMsg('t'), { type: 'hello', protocol: 0, client: 't' });
+    assert.equal('up' in cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] }), false);
+});
+
+test('frame size requests stay within the resize schema and keep the aspect ratio', () => {
+    assert.deepEqual(frameSizeFor(800, 600, 1), [800, 600]);
+    assert.deepEqual(frameSizeFor(800, 600, 2), [1024, 768]);
+    assert.deepEqual(frameSizeFor(3000, 100, 1), [1024, 34]);
+    assert.deepEqual(frameSizeFor(5000, 10, 1), [1024, 16]);
+    assert.deepEqual(frameSizeFor(0, 0, 1), [16, 16]);
+    assert.deepEqual(frameSizeFor(300, 200, NaN), [300, 200]);
+    for (const [w, h, dpr] of [[1, 1, 1], [1920, 1080, 3], [375, 667, 2.625], [17, 4000, 1]]) {
+        assert.equal(validateClientMessage(resizeMsg(...frameSizeFor(w, h, dpr)), schemas), null, `${w}x${h}@${dpr}`);
+    }
+});
+
+function frameWith(header, payload = [0xff, 0xd8, 0xff, 0xd9]) {
+    const bytes = new Uint8Array(16 + payload.length);
+    bytes.set(new Uint8Array(header));
+    bytes.set(payload, 16);
+    return bytes.buffer;
+}
+
+test('parseFrameHeader reads a good header', () => {
+    const bytes = new Uint8Array(frameWith(new ArrayBuffer(16)));
+    bytes.set([0x47, 0x49, 0x46, 0x52, 0x2a, 0x01, 0x00, 0x00, 0x00, 0x02, 0x80, 0x01, 0x01, 0, 0, 0]);
+    assert.deepEqual(parseFrameHeader(bytes.buffer),
+        { frame: 298, width: 512, height: 384, codec: 'jpeg', payloadOffset: 16 });
+    const png = frameWith(buildFrameHeader({ frame: 0xfffffffe, width: 65535, height: 16, codec: 'png' }));
+    assert.deepEqual(parseFrameHeader(png), { frame: 0xfffffffe, width: 65535, height: 16, codec: 'png', payloadOffset: 16 });
+    // A typed-array view into a larger buffer (node's ws hands out Buffers like that).
+    const padded = new Uint8Array(40);
+    padded.set(new Uint8Array(png), 8);
+    assert.equal(parseFrameHeader(padded.subarray(8)).frame, 0xfffffffe);
+});
+
+test('parseFrameHeader rejects bad frames', () => {
+    const good = buildFrameHeader({ frame: 1, width: 64, height: 64 });
+    const badMagic = new Uint8Array(frameWith(good));
+    badMagic[0] = 0x4a;
+    assert.throws(() => parseFrameHeader(badMagic.buffer), /magic/);
+    assert.throws(() => parseFrameHeader(new ArrayBuffer(15)), /too short/);
+    assert.throws(() => parseFrameHeader(new ArrayBuffer(0)), /too short/);
+    const badCodec = new Uint8Array(frameWith(good));
+    badCodec[12] = 3;
+    assert.throws(() => parseFrameHeader(badCodec.buffer), /codec/);
+    const zeroSize = new Uint8Array(frameWith(good));
+    zeroSize[8] = zeroSize[9] = 0;
+    assert.throws(() => parseFrameHeader(zeroSize.buffer), /size/);
+    assert.throws(() => parseFrameHeader('GIFR'), TypeError);
+});
+
+test('parseServerMessage keeps JSON objects with a type only', () => {
+    assert.deepEqual(parseServerMessage('{"type":"pong","t":1}'), { type: 'pong', t: 1 });
+    for (const text of ['{not json', '[1]', '{"t":1}', 'null', '{"type":3}']) {
+        assert.equal(parseServerMessage(text), null, text);
+    }
+});
+
+test('orbit math round-trips position -> yaw/pitch/distance -> position', () => {
+    const target = [0.3, 1, -0.2];
+    for (const position of [[0, 1, 3.9], [2, 3, -1], [-1.5, -0.5, 0.25], [0.01, 5, 0.02], [7, 1, 0]]) {
+        const orbit = orbitFromPosition(position, target);
+        assertClose(positionFromOrbit(orbit, target), position, 1e-9, `round trip of ${position}`);
+    }
+    const welcome = orbitFromPosition([0, 1, 3.9], [0, 1, 0]);
+    assertClose([welcome.yaw, welcome.pitch, welcome.distance], [0, 0, 3.9], 1e-12, 'welcome camera');
+    for (const [yaw, pitch, distance] of [[0.5, 0.2, 2], [-2.5, -1.2, 10], [3, 1.5, 0.5]]) {
+        const o = orbitFromPosition(positionFromOrbit({ yaw, pitch, distance }, target), target);
+        assertClose([o.yaw, o.pitch, o.distance], [yaw, pitch, distance], 1e-9, `orbit ${yaw},${pitch},${distance}`);
+    }
+});
+
+test('camera basis is orthonormal and perpendicular to the view direction', () => {
+    for (const [yaw, pitch] of [[0, 0], [1, 0.4], [-2, -1.3]]) {
+        const { right, up } = cameraBasis(yaw, pitch);
+        const forward = positionFromOrbit({ yaw, pitch, distance: -1 }, [0, 0, 0]);
+        const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        assertClose([dot(right, right), dot(up, up), dot(right, up), dot(right, forward), dot(up, forward)],
+            [1, 1, 0, 0, 0], 1e-12, `basis at ${yaw},${pitch}`);
+    }
+});
+
+test('OrbitCamera orbits, zooms, pans and resets', () => {
+    const home = { position: [0, 1, 3.9], target: [0, 1, 0], up: [0, 1, 0], fov_deg: 40 };
+    const cam = new OrbitCamera(home);
+    assert.deepEqual(cam.toCamera(), home);
+    cam.orbit(100, 0);
+    assert.ok(cam.position[0] < 0, 'dragging right moves the eye to its left');
+    cam.orbit(0, 100000);
+    assert.ok(cam.pitch < Math.PI / 2, 'pitch stays off the pole');
+    const before = cam.distance;
+    cam.zoom(100);
+    assert.ok(cam.distance > before, 'positive wheel moves away');
+    cam.reset();
+    assertClose(cam.position, home.position, 1e-12, 'reset');
+    cam.pan(100, 0, 500);
+    assert.ok(cam.target[0] < 0 && Math.abs(cam.target[1] - 1) < 1e-12, 'panning right moves the target left');
+    assertClose(cam.position, [cam.target[0], 1, 3.9], 1e-12, 'pan keeps the view direction');
+    assert.equal(validateClientMessage(cameraMsg(cam.toCamera()), schemas), null);
+});
+
+test('reconnect backoff doubles from 0.5 s up to 8 s', () => {
+    assert.deepEqual([0, 1, 2, 3, 4, 5, 9].map(backoffDelay), [500, 1000, 2000, 4000, 8000, 8000, 8000]);
+    assert.equal(streamUrl({ protocol: 'https:', host: 'example.org:8443' }), 'wss://example.org:8443/ws');
+    assert.equal(streamUrl({ protocol: 'http:', host: '127.0.0.1:8080' }), 'ws://127.0.0.1:8080/ws');
+});
+
+test('parameter widgets follow the schema', () => {
+    assert.equal(widgetKind({ type: 'integer', minimum: 1, maximum: 256 }), 'integer');
+    assert.equal(widgetKind({ type: 'string', enum: ['filmic', 'linear'] }), 'enum');
+    assert.equal(widgetKind({ type: 'boolean' }), 'boolean');
+    assert.equal(niceStep(-10, 10), 0.1);
+    assert.equal(niceStep(0, 1), 0.005);
+    const linear = sliderMapping({ type: 'integer', minimum: 1, maximum: 256 });
+    assert.equal(linear.toValue(0), 1);
+    assert.equal(linear.toValue(1000), 256);
+    assert.equal(linear.toValue(linear.toPosition(128)), 128);
+    const log = sliderMapping({ type: 'number', minimum: 0.01, maximum: 100, 'x-log-scale': true });
+    assert.ok(log.log);
+    assert.ok(Math.abs(log.toValue(500) - 1) < 1e-9, 'log slider middle is the geometric mean');
+});

@@ -1,0 +1,30 @@
+// Reads the shared protocol files (protocol/schema, protocol/vectors) for the JS tests.
+import { readFileSync, readdirSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
+import path from 'node:path';
+
+export const PROTOCOL_DIR = fileURLToPath(new URL('../../protocol/', import.meta.url));
+
+function jsonFilesIn(dir) {
+    return readdirSync(dir)
+        .filter((f) => f.endsWith('.json'))
+        .sort()
+        .map((f) => ({ name: f, path: path.join(dir, f) }));
+}
+
+/** {type: schema} for every protocol/schema/<type>.json. */
+export function loadProtocolSchemas() {
+    const schemas = {};
+    for (const f of jsonFilesIn(path.join(PROTOCOL_DIR, 'schema'))) {
+        schemas[path.basename(f.name, '.json')] = JSON.parse(readFileSync(f.path, 'utf8'));
+    }
+    return schemas;
+}
+
+/** [{name, message}] for protocol/vectors/<kind>/*.json, kind being 'valid' or 'invalid'. */
+export function loadVectors(kind) {
+    return jsonFilesIn(path.join(PROTOCOL_DIR, 'vectors', kind)).map((f) => ({
+        name: f.name,
+        message: JSON.parse(readFileSync(f.path, 'utf8')),
+    }));
+}
