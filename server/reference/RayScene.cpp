@@ -1,0 +1,268 @@
+// Embree 3 scene for the reference renderer. Geometry is copied into Embree-owned buffers once; the
+// scene is committed with RTC_SCENE_FLAG_ROBUST (watertight triangle test, so rays do not leak through
+// shared edges of the grid walls) and RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION (the all-hits query
+// installs its collector through the intersect context, plain queries pay nothing).
+#include "reference/RayScene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <embree3/rtcore.h>
+
+#include "core/Error.h"
+
+namespace gis::reference {
+namespace {
+
+struct LinearTexture {
+    int width = 0;
+    int height = 0;
+    std::vector<glm::vec3> texels; ///< linear RGB (sRGB decoded per texel, as GL's sRGB sampler does)
+};
+
+float srgbToLinear(std::uint8_t v) {
+    const float c = static_cast<float>(v) / 255.0f;
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+glm::vec3 sanitizePositive(const glm::vec3& c) {
+    glm::vec3 r;
+    for (int i = 0; i < 3; ++i) r[i] = std::isfinite(c[i]) ? std::max(c[i], 0.0f) : 0.0f;
+    return r;
+}
+
+int wrapIndex(int i, int n) {
+    const int m = i % n;
+    return m < 0 ? m + n : m;
+}
+
+/// Bilinear, wrap-repeat lookup; texel centres at (i + 0.5) / size like GL.
+glm::vec3 sampleBilinear(const LinearTexture& tex, glm::vec2 uv) {
+    if (tex.width <= 0 || tex.height <= 0) return glm::vec3(1.0f);
+    for (int i = 0; i < 2; ++i) {
+        if (!std::isfinite(uv[i])) uv[i] = 0.0f;
+        uv[i] -= std::floor(uv[i]); // keeps huge coordinates from overflowing the int conversion
+    }
+    const float x = uv.x * static_cast<float>(tex.width) - 0.5f;
+    const float y = uv.y * static_cast<float>(tex.height) - 0.5f;
+    const float x0f = std::floor(x), y0f = std::floor(y);
+    const float fx = x - x0f, fy = y - y0f;
+    const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+    auto at = [&](int xi, int yi) {
+        const auto idx = static_cast<size_t>(wrapIndex(yi, tex.height)) * static_cast<size_t>(tex.width) +
+                         static_cast<size_t>(wrapIndex(xi, tex.width));
+        return tex.texels[idx];
+    };
+    const glm::vec3 top = glm::mix(at(x0, y0), at(x0 + 1, y0), fx);
+    const glm::vec3 bottom = glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
+    return glm::mix(top, bottom, fy);
+}
+
+struct CollectContext {
+    RTCIntersectContext base; // must stay first: Embree hands back a pointer to it
+    std::vector<RawHit>* hits;
+};
+
+// Records every candidate hit and rejects it, so traversal goes on to the next surface.
+void collectAllHits(const RTCFilterFunctionNArguments* args) {
+    auto* ctx = reinterpret_cast<CollectContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        RawHit h;
+        h.t = RTCRayN_tfar(args->ray, args->N, i);
+        h.geomId = RTCHitN_geomID(args->hit, args->N, i);
+        h.primId = RTCHitN_primID(args->hit, args->N, i);
+        h.u = RTCHitN_u(args->hit, args->N, i);
+        h.v = RTCHitN_v(args->hit, args->N, i);
+        // Embree may report a primitive more than once; a watertight test may also report both
+        // triangles of an edge (a measure-zero event for sampled rays). Keep the first report.
+        const bool seen = std::any_of(ctx->hits->begin(), ctx->hits->end(), [&](const RawHit& o) {
+            return o.geomId == h.geomId && o.primId == h.primId;
+        });
+        if (!seen) ctx->hits->push_back(h);
+        args->valid[i] = 0;
+    }
+}
+
+RTCRay makeRay(const glm::vec3& o, const glm::vec3& d, float tnear, float tfar) {
+    RTCRay r{};
+    r.org_x = o.x;
+    r.org_y = o.y;
+    r.org_z = o.z;
+    r.dir_x = d.x;
+    r.dir_y = d.y;
+    r.dir_z = d.z;
+    r.tnear = tnear;
+    r.tfar = tfar;
+    r.mask = 0xffffffffu;
+    r.flags = 0;
+    r.time = 0.0f;
+    return r;
+}
+
+} // namespace
+
+struct RayScene::Impl {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    Scene source;                    // copied: the renderer must not depend on the caller's lifetime
+    std::vector<int> meshOfGeometry; // Embree geometry id -> index into source.meshes
+    std::vector<LinearTexture> textures;
+
+    ~Impl() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
+    Impl& m = *mImpl;
+    m.source = scene;
+    m.device = rtcNewDevice(nullptr);
+    if (!m.device) throw Error("reference: cannot create the Embree device");
+    m.scene = rtcNewScene(m.device);
+    rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
+
+    for (size_t mi = 0; mi < m.source.meshes.size(); ++mi) {
+        const Mesh& mesh = m.source.meshes[mi];
+        const size_t triangles = mesh.indices.size() / 3;
+        if (triangles == 0 || mesh.positions.empty()) continue;
+        RTCGeometry geom = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles));
+        if (!vertices || !indices) {
+            rtcReleaseGeometry(geom);
+            throw Error("reference: Embree could not allocate buffers for mesh '" + mesh.name + "'");
+        }
+        for (size_t i = 0; i < mesh.positions.size(); ++i)
+            for (int c = 0; c < 3; ++c) vertices[3 * i + static_cast<size_t>(c)] = mesh.positions[i][c];
+        const auto vertexCount = static_cast<std::uint32_t>(mesh.positions.size());
+        for (size_t i = 0; i < triangles * 3; ++i)
+            indices[i] =
+                std::min<std::uint32_t>(mesh.indices[i], vertexCount - 1); // validated; belt and braces
+        rtcCommitGeometry(geom);
+        const unsigned id = rtcAttachGeometry(m.scene, geom);
+        rtcReleaseGeometry(geom);
+        if (m.meshOfGeometry.size() <= id) m.meshOfGeometry.resize(id + 1, -1);
+        m.meshOfGeometry[id] = static_cast<int>(mi);
+    }
+    rtcCommitScene(m.scene);
+    if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
+        throw Error("reference: Embree failed to build the scene");
+
+    // One sRGB decode table: textures are decoded to linear once, then filtered in linear space.
+    std::array<float, 256> decode{};
+    for (int i = 0; i < 256; ++i) decode[static_cast<size_t>(i)] = srgbToLinear(static_cast<std::uint8_t>(i));
+    for (const TextureImage& img : m.source.textures) {
+        LinearTexture t;
+        const size_t count =
+            static_cast<size_t>(std::max(img.width, 0)) * static_cast<size_t>(std::max(img.height, 0));
+        if (count > 0 && img.rgba.size() >= count * 4) {
+            t.width = img.width;
+            t.height = img.height;
+            t.texels.resize(count);
+            for (size_t i = 0; i < count; ++i)
+                t.texels[i] = {decode[img.rgba[4 * i]], decode[img.rgba[4 * i + 1]],
+                               decode[img.rgba[4 * i + 2]]};
+        }
+        m.textures.push_back(std::move(t));
+    }
+
+    // Far enough to clear float rounding of positions anywhere in the scene (coordinates up to
+    // |centre| + radius carry a relative error of ~1e-7), small enough not to skip real geometry in
+    // contact (1e-4 of the scene's size: 0.3 mm in the 2 m Cornell box).
+    const float extent = scene.bounds.radius() + glm::length(scene.bounds.center());
+    mEpsilon = 1e-4f * (std::isfinite(extent) ? std::max(extent, 1e-2f) : 1.0f);
+}
+
+RayScene::~RayScene() = default;
+
+bool RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                         SurfaceHit& hit) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh{};
+    rh.ray = makeRay(origin, dir, tnear, tfar);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(mImpl->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit = resolve(RawHit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v}, origin, dir);
+    return true;
+}
+
+bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const {
+    if (!(tfar > tnear)) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray = makeRay(origin, dir, tnear, tfar);
+    rtcOccluded1(mImpl->scene, &ctx, &ray);
+    return ray.tfar < 0.0f; // Embree sets tfar to -inf on a hit
+}
+
+void RayScene::intersectAll(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                            std::vector<RawHit>& hits) const {
+    hits.clear();
+    CollectContext ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.base.filter = collectAllHits;
+    ctx.hits = &hits;
+    RTCRayHit rh{};
+    rh.ray = makeRay(origin, dir, tnear, tfar);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(mImpl->scene, &ctx.base, &rh);
+}
+
+SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const glm::vec3& dir) const {
+    const Impl& m = *mImpl;
+    SurfaceHit h;
+    h.t = raw.t;
+    const int meshIndex = raw.geomId < m.meshOfGeometry.size() ? m.meshOfGeometry[raw.geomId] : -1;
+    if (meshIndex < 0) {
+        h.position = origin + raw.t * dir;
+        return h;
+    }
+    const Mesh& mesh = m.source.meshes[static_cast<size_t>(meshIndex)];
+    const size_t base = static_cast<size_t>(raw.primId) * 3;
+    const std::uint32_t last = static_cast<std::uint32_t>(mesh.positions.size() - 1);
+    const std::uint32_t i0 = std::min(mesh.indices[base], last), i1 = std::min(mesh.indices[base + 1], last),
+                        i2 = std::min(mesh.indices[base + 2], last);
+    const float w1 = raw.u, w2 = raw.v, w0 = 1.0f - raw.u - raw.v;
+
+    // Barycentric interpolation puts the point on the triangle (origin + t * dir would drift off it).
+    const glm::vec3 &p0 = mesh.positions[i0], &p1 = mesh.positions[i1], &p2 = mesh.positions[i2];
+    h.position = w0 * p0 + w1 * p1 + w2 * p2;
+    const glm::vec3 cross = glm::cross(p1 - p0, p2 - p0);
+    const float c2 = glm::dot(cross, cross);
+    h.geometricNormal = c2 > 1e-30f ? cross / std::sqrt(c2) : glm::vec3(0.0f, 1.0f, 0.0f);
+
+    h.shadingNormal = h.geometricNormal;
+    if (mesh.normals.size() == mesh.positions.size()) {
+        const glm::vec3 n = w0 * mesh.normals[i0] + w1 * mesh.normals[i1] + w2 * mesh.normals[i2];
+        const float n2 = glm::dot(n, n);
+        if (n2 > 1e-12f && std::isfinite(n2)) h.shadingNormal = n / std::sqrt(n2); // as safeNormal() in GLSL
+    }
+
+    glm::vec2 uv(0.0f); // GL feeds (0, 0) to meshes without texcoords
+    if (mesh.texcoords.size() == mesh.positions.size())
+        uv = w0 * mesh.texcoords[i0] + w1 * mesh.texcoords[i1] + w2 * mesh.texcoords[i2];
+
+    if (mesh.material >= 0 && static_cast<size_t>(mesh.material) < m.source.materials.size()) {
+        const Material& mat = m.source.materials[static_cast<size_t>(mesh.material)];
+        glm::vec3 c(mat.baseColor);
+        if (mat.baseColorTexture >= 0 && static_cast<size_t>(mat.baseColorTexture) < m.textures.size())
+            c *= sampleBilinear(m.textures[static_cast<size_t>(mat.baseColorTexture)], uv);
+        h.albedo = glm::clamp(sanitizePositive(c), 0.0f, 1.0f);
+        h.emission = sanitizePositive(mat.emissive);
+    }
+    return h;
+}
+
+} // namespace gis::reference

@@ -1,0 +1,61 @@
+// Ray queries and surface shading data for the reference renderer: the scene's triangles in an Embree 3
+// BVH, plus the same material and normal rules as the GL pipeline (shaders/render/material.glsl), so a
+// hit here and a G-buffer / RSM texel there describe the same surface.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/Scene.h"
+
+namespace gis::reference {
+
+/// A ray-surface hit with what the light transport needs.
+struct SurfaceHit {
+    float t = 0.0f;
+    glm::vec3 position{0.0f};
+    glm::vec3 geometricNormal{0.0f, 1.0f, 0.0f}; ///< unit, unoriented (triangle winding)
+    glm::vec3 shadingNormal{0.0f, 1.0f, 0.0f};   ///< unit, unoriented (interpolated vertex normals)
+    glm::vec3 albedo{0.0f};                      ///< clamp(baseColor * texture, 0, 1)
+    glm::vec3 emission{0.0f};                    ///< >= 0, finite
+};
+
+/// Minimal ray record for the all-hits query: the surface is resolved only when needed.
+struct RawHit {
+    float t = 0.0f;
+    unsigned geomId = 0;
+    unsigned primId = 0;
+    float u = 0.0f, v = 0.0f;
+};
+
+class RayScene {
+public:
+    /// Builds the BVH. Throws gis::Error if Embree cannot be set up.
+    explicit RayScene(const Scene& scene);
+    ~RayScene();
+    RayScene(const RayScene&) = delete;
+    RayScene& operator=(const RayScene&) = delete;
+
+    /// Closest hit in (tnear, tfar); false when the ray escapes.
+    bool intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                   SurfaceHit& hit) const;
+    /// True when anything lies in (tnear, tfar).
+    bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
+    /// Every surface crossing in (tnear, tfar), each triangle at most once, unordered. `hits` is cleared.
+    void intersectAll(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                      std::vector<RawHit>& hits) const;
+    SurfaceHit resolve(const RawHit& raw, const glm::vec3& origin, const glm::vec3& dir) const;
+
+    /// Ray-origin offset (metres) that keeps a spawned ray off the surface it leaves.
+    float epsilon() const { return mEpsilon; }
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> mImpl;
+    float mEpsilon = 1e-4f;
+};
+
+} // namespace gis::reference

@@ -1,0 +1,189 @@
+// Reference cache: content-hash keys and EXR files carrying the render's metadata (OpenImageIO).
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "reference/ContentHash.h"
+#include "reference/ReferenceRenderer.h"
+
+namespace gis {
+namespace reference {
+
+// Bump when the renderer's output for the same request changes (estimators, epsilon, sampling), so old
+// cache files stop matching.
+constexpr const char* kKeyVersion = "gis-reference-1";
+
+std::string sceneDigest(const Scene& scene) {
+    Hasher h;
+    h.value(scene.meshes.size());
+    for (const Mesh& m : scene.meshes) {
+        h.value(m.positions.size());
+        h.bytes(m.positions.data(), m.positions.size() * sizeof(glm::vec3));
+        h.value(m.normals.size());
+        h.bytes(m.normals.data(), m.normals.size() * sizeof(glm::vec3));
+        h.value(m.texcoords.size());
+        h.bytes(m.texcoords.data(), m.texcoords.size() * sizeof(glm::vec2));
+        h.value(m.indices.size());
+        h.bytes(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
+        h.value(m.material);
+    }
+    h.value(scene.materials.size());
+    for (const Material& m : scene.materials) {
+        h.value(m.baseColor);
+        h.value(m.baseColorTexture);
+        h.value(m.metallic);
+        h.value(m.roughness);
+        h.value(m.emissive);
+    }
+    h.value(scene.textures.size());
+    for (const TextureImage& t : scene.textures) {
+        h.value(t.width);
+        h.value(t.height);
+        h.value(t.rgba.size());
+        h.bytes(t.rgba.data(), t.rgba.size());
+    }
+    h.value(scene.bounds.min); // the ray epsilon scales with the bounds
+    h.value(scene.bounds.max);
+    return h.hex();
+}
+
+std::string requestKey(const std::string& digest, const FrameState& state, const ReferenceOptions& options) {
+    Hasher h;
+    h.text(kKeyVersion);
+    h.text(digest);
+    const Camera& c = state.camera;
+    h.value(c.position);
+    h.value(c.target);
+    h.value(c.up);
+    h.value(c.yfovRadians);
+    h.value(c.znear);
+    h.value(c.zfar);
+    const Light& l = state.light;
+    h.value(static_cast<int>(l.type));
+    h.value(l.position);
+    h.value(l.direction);
+    h.value(l.color);
+    h.value(l.intensity);
+    h.value(l.innerConeAngle);
+    h.value(l.outerConeAngle);
+    h.value(l.range);
+    h.value(state.lightEnabled);
+    h.value(state.width);
+    h.value(state.height);
+    h.text(options.mode);
+    h.value(options.spp);
+    h.value(options.timeBudgetSeconds);
+    h.value(options.maxDepth);
+    h.value(options.seed);
+    h.value(options.jitter);
+    return h.hex();
+}
+
+} // namespace reference
+
+std::string referenceCacheKey(const Scene& scene, const FrameState& state, const ReferenceOptions& options) {
+    return reference::requestKey(reference::sceneDigest(scene), state, options);
+}
+
+void writeReferenceExr(const std::string& path, const ReferenceImage& image) {
+    const size_t expected =
+        static_cast<size_t>(std::max(image.width, 0)) * static_cast<size_t>(std::max(image.height, 0)) * 3;
+    if (image.width <= 0 || image.height <= 0 || image.rgb.size() != expected)
+        throw Error("reference: cannot write '" + path + "': image size and pixel data disagree");
+    // A unique temporary name in the same directory, renamed into place: readers never see half a file
+    // and concurrent writers of the same key each publish a whole one.
+    static std::atomic<unsigned> counter{0};
+    const std::string tmp =
+        path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ".exr";
+    auto out = OIIO::ImageOutput::create(tmp);
+    if (!out) throw Error("reference: cannot write '" + path + "': " + OIIO::geterror());
+    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
+    spec.attribute("compression", "zip");
+    spec.attribute("gis:mode", image.mode);
+    spec.attribute("gis:spp", image.spp);
+    spec.attribute("gis:seconds", static_cast<float>(image.seconds));
+    spec.attribute("gis:key", image.key);
+    const bool ok =
+        out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data()) && out->close();
+    if (!ok) {
+        const std::string why = out->geterror();
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw Error("reference: cannot write '" + path + "': " + why);
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        throw Error("reference: cannot move the EXR into place at '" + path + "'");
+    }
+}
+
+ReferenceImage readReferenceExr(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "file not found");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw InputError(path, "cannot read image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels < 3 || spec.depth != 1)
+        throw InputError(path, "expected an RGB image, got " + std::to_string(spec.nchannels) + " channels");
+    ReferenceImage img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.mode = spec.get_string_attribute("gis:mode");
+    img.spp = spec.get_int_attribute("gis:spp", 0);
+    img.seconds = spec.get_float_attribute("gis:seconds", 0.0f);
+    img.key = spec.get_string_attribute("gis:key");
+    const size_t pixels = static_cast<size_t>(img.width) * static_cast<size_t>(img.height);
+    std::vector<float> all(pixels * static_cast<size_t>(spec.nchannels));
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+        throw InputError(path, "cannot read pixels: " + in->geterror());
+    img.rgb.resize(pixels * 3);
+    for (size_t i = 0; i < pixels; ++i)
+        for (size_t c = 0; c < 3; ++c) {
+            const float v = all[i * static_cast<size_t>(spec.nchannels) + c];
+            img.rgb[i * 3 + c] = std::isfinite(v) && v > 0.0f ? v : 0.0f; // keep the no-NaN/negative promise
+        }
+    return img;
+}
+
+ReferenceImage renderReferenceCached(const Scene& scene, const FrameState& state,
+                                     const ReferenceOptions& options, const std::string& cacheDir,
+                                     bool* cacheHit) {
+    validateReferenceOptions(options);
+    if (cacheHit) *cacheHit = false;
+    const std::string key = referenceCacheKey(scene, state, options);
+    const std::filesystem::path file = std::filesystem::path(cacheDir) / (key + ".exr");
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(file, ec)) {
+        try {
+            ReferenceImage img = readReferenceExr(file.string());
+            if (img.key == key && img.width == state.width && img.height == state.height) {
+                if (cacheHit) *cacheHit = true;
+                return img;
+            }
+            logWarn("reference: cache file '" + file.string() + "' does not match its key; rendering again");
+        } catch (const InputError& e) {
+            logWarn(std::string("reference: unreadable cache file, rendering again: ") + e.what());
+        }
+    }
+    ReferenceRenderer renderer(scene);
+    ReferenceImage img = renderer.render(state, options);
+    std::filesystem::create_directories(cacheDir, ec);
+    try {
+        writeReferenceExr(file.string(), img);
+    } catch (const Error& e) {
+        // The render itself is good: hand it back and say why it was not kept.
+        logWarn(std::string("reference: could not cache the image: ") + e.what());
+    }
+    return img;
+}
+
+} // namespace gis

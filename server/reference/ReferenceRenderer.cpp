@@ -1,0 +1,390 @@
+// Reference light transport: the estimators behind the modes documented in ReferenceRenderer.h.
+//
+// All modes share one receiver and one direct-light evaluation, so a difference between two modes is
+// exactly the indirect term. Indirect estimators cosine-sample the hemisphere at the receiver
+// (pdf = cos(theta_x) / pi), which cancels the cosine and the 1/pi of the Lambertian BRDF: a sample's
+// value is rho_x times the radiance arriving along the sampled direction.
+#include "reference/ReferenceRenderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/matrix_inverse.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "core/Error.h"
+#include "reference/ContentHash.h"
+#include "reference/RayScene.h"
+#include "reference/Sampling.h"
+#include "render/FrameRenderer.h"
+
+namespace gis {
+namespace {
+
+using reference::kInvPi;
+using reference::RawHit;
+using reference::RayScene;
+using reference::Rng;
+using reference::SurfaceHit;
+
+enum class Mode { Direct, OneBounceUnoccluded, OneBounce, Path };
+
+constexpr int kTile = 16;
+constexpr int kMaxPassSamples = 64;
+constexpr int kMaxImageSide = 16384;
+constexpr int kRouletteDepth = 3; // vertices before Russian roulette starts
+
+Mode parseMode(const std::string& name) {
+    if (name == "direct") return Mode::Direct;
+    if (name == "one-bounce-unoccluded") return Mode::OneBounceUnoccluded;
+    if (name == "one-bounce") return Mode::OneBounce;
+    if (name == "path") return Mode::Path;
+    std::string known;
+    for (const std::string& m : referenceModes()) known += (known.empty() ? "" : ", ") + m;
+    throw InputError("mode", "unknown reference mode '" + name + "' (known: " + known + ")");
+}
+
+glm::vec3 unitOr(const glm::vec3& v, const glm::vec3& fallback) {
+    const float len2 = glm::dot(v, v);
+    return len2 > 1e-24f && std::isfinite(len2) ? v / std::sqrt(len2) : fallback;
+}
+
+glm::vec3 facing(const glm::vec3& n, const glm::vec3& towards) {
+    return glm::dot(n, towards) < 0.0f ? -n : n;
+}
+
+bool finiteVec(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// The light exactly as the shaders see it (FrameRenderer::render builds the same uniforms).
+struct LightModel {
+    bool on = false;
+    LightType type = LightType::Spot;
+    glm::vec3 position{0.0f};
+    glm::vec3 axis{0.0f, -1.0f, 0.0f}; ///< unit direction the light points along
+    glm::vec3 power{0.0f};             ///< intensity (cd, or lux for directional) times colour
+    float cosOuter = 0.0f;
+    float cosInner = 1.0f;
+
+    explicit LightModel(const FrameState& state) {
+        const Light& l = state.light;
+        on = state.lightEnabled && l.intensity > 0.0f && std::isfinite(l.intensity) && finiteVec(l.position);
+        type = l.type;
+        position = l.position;
+        axis = unitOr(l.direction, {0.0f, -1.0f, 0.0f});
+        glm::vec3 colour = glm::max(l.color, glm::vec3(0.0f));
+        if (!finiteVec(colour)) colour = glm::vec3(0.0f);
+        power = on ? l.intensity * colour : glm::vec3(0.0f);
+        cosOuter = std::cos(l.outerConeAngle);
+        cosInner = std::cos(l.innerConeAngle);
+    }
+
+    /// glTF KHR_lights_punctual cone attenuation, as spotFactor() in shaders/common.glsl.
+    float spotFactor(const glm::vec3& dirFromLight) const {
+        if (type != LightType::Spot) return 1.0f;
+        const float cd = glm::dot(axis, dirFromLight);
+        const float t = std::clamp((cd - cosOuter) / std::max(cosInner - cosOuter, 1e-4f), 0.0f, 1.0f);
+        return t * t;
+    }
+};
+
+/// A receiver or bounce vertex: the hit plus the normals turned to the side being shaded.
+struct Vertex {
+    SurfaceHit hit;
+    glm::vec3 n{0.0f};  ///< shading normal on the shaded side
+    glm::vec3 ng{0.0f}; ///< geometric normal on the same side (ray offsets, leaving-the-surface test)
+};
+
+Vertex orient(const SurfaceHit& hit, const glm::vec3& towards) {
+    Vertex v;
+    v.hit = hit;
+    v.n = facing(hit.shadingNormal, towards);
+    v.ng = facing(hit.geometricNormal, towards);
+    return v;
+}
+
+class Integrator {
+public:
+    Integrator(const RayScene& rays, const LightModel& light, Mode mode, int maxDepth)
+        : mRays(rays), mLight(light), mMode(mode), mMaxDepth(maxDepth), mEps(rays.epsilon()) {}
+
+    /// Unit direction from p towards the light and the distance (infinite for directional); false when
+    /// the direction is undefined (p at the light's position: digest S.4 case 1, contributes 0).
+    bool toLight(const glm::vec3& p, glm::vec3& l, float& dist) const {
+        if (mLight.type == LightType::Directional) {
+            l = -mLight.axis;
+            dist = std::numeric_limits<float>::infinity();
+            return true;
+        }
+        const glm::vec3 d = mLight.position - p;
+        const float d2 = glm::dot(d, d);
+        if (!(d2 > 1e-12f) || !std::isfinite(d2)) return false; // same threshold as direct.frag
+        dist = std::sqrt(d2);
+        l = d / dist;
+        return true;
+    }
+
+    /// E_d at p for the side of unit normal n: I c f max(0, n.l) / d^2 times a hard shadow ray.
+    glm::vec3 directIrradiance(const glm::vec3& p, const glm::vec3& n, const glm::vec3& ngRaw) const {
+        if (!mLight.on) return glm::vec3(0.0f);
+        glm::vec3 l;
+        float dist = 0.0f;
+        if (!toLight(p, l, dist)) return glm::vec3(0.0f);
+        const float cosTheta = glm::dot(n, l);
+        if (!(cosTheta > 0.0f)) return glm::vec3(0.0f);
+        const float falloff = mLight.type == LightType::Directional ? 1.0f : 1.0f / (dist * dist);
+        const float scale = mLight.spotFactor(-l) * cosTheta * falloff;
+        if (!(scale > 0.0f)) return glm::vec3(0.0f);
+        // Leave from the light's side of the geometric surface so the ray cannot re-hit its own triangle.
+        const glm::vec3 origin = p + facing(ngRaw, l) * mEps;
+        float tfar = std::numeric_limits<float>::infinity();
+        if (std::isfinite(dist)) tfar = glm::length(mLight.position - origin) - mEps;
+        if (tfar > mEps && mRays.occluded(origin, l, 0.0f, tfar)) return glm::vec3(0.0f);
+        return mLight.power * scale;
+    }
+
+    /// Outgoing radiance of vertex v due to direct light: rho / pi * E_d.
+    glm::vec3 reflectedDirect(const Vertex& v) const {
+        return v.hit.albedo * kInvPi * directIrradiance(v.hit.position, v.n, v.hit.geometricNormal);
+    }
+
+    /// One sample of the pixel's radiance for the camera ray (origin, dir, tfar).
+    glm::vec3 sample(const glm::vec3& origin, const glm::vec3& dir, float tfar, Rng& rng,
+                     std::vector<RawHit>& scratch) const {
+        SurfaceHit hit;
+        if (!mRays.intersect(origin, dir, 0.0f, tfar, hit)) return glm::vec3(0.0f); // background
+        const Vertex x = orient(hit, -dir); // camera-facing, like the G-buffer normal
+        glm::vec3 radiance = x.hit.emission + reflectedDirect(x);
+        switch (mMode) {
+        case Mode::Direct:
+            break;
+        case Mode::OneBounce:
+            radiance += oneBounce(x, rng);
+            break;
+        case Mode::OneBounceUnoccluded:
+            radiance += oneBounceUnoccluded(x, rng, scratch);
+            break;
+        case Mode::Path:
+            radiance += pathIndirect(x, rng);
+            break;
+        }
+        return radiance;
+    }
+
+private:
+    /// Cosine-distributed direction around the shading normal, leaving x on its shaded side. Where
+    /// shading and geometric normals differ (smooth-shaded meshes) the lobe can dip below the geometric
+    /// surface by the angle a between them; such a direction is mirrored back above it rather than
+    /// dropped, so no energy is lost (the directional bias covers a probability of about a^2 / 4).
+    /// False only for a direction in the surface plane.
+    bool sampleBounce(const Vertex& x, Rng& rng, glm::vec3& w) const {
+        const float u1 = rng.uniform();
+        const float u2 = rng.uniform();
+        w = unitOr(reference::sampleCosine(x.n, u1, u2), x.n);
+        const float below = glm::dot(w, x.ng);
+        if (below < 0.0f) w = unitOr(w - 2.0f * below * x.ng, x.ng);
+        return glm::dot(w, x.ng) > 0.0f;
+    }
+
+    // L_1 with visibility: the first surface y along w, seen from its x-facing side, reflects its direct
+    // light. Estimate: rho_x * L_r(y).
+    glm::vec3 oneBounce(const Vertex& x, Rng& rng) const {
+        glm::vec3 w;
+        if (!sampleBounce(x, rng, w)) return glm::vec3(0.0f);
+        SurfaceHit hit;
+        if (!mRays.intersect(x.hit.position + x.ng * mEps, w, 0.0f, std::numeric_limits<float>::infinity(),
+                             hit))
+            return glm::vec3(0.0f);
+        return x.hit.albedo * reflectedDirect(orient(hit, -w));
+    }
+
+    // L_1 without visibility between x and y. Changing the area integral to directions at x turns
+    // dA_y cos(theta_y) / |x - y|^2 into d(omega) for EVERY surface the line crosses, so one cosine
+    // sample sums L_r(y) over all crossings y whose light-facing side faces x (cos(theta_y) > 0); the
+    // ratio of y's shading to geometric cosine is taken as 1 (exact for flat-shaded meshes). Each y
+    // still needs its own shadow ray to the light (it must be in the RSM). No 1/d^2 appears, so there
+    // is no singularity where y approaches x.
+    glm::vec3 oneBounceUnoccluded(const Vertex& x, Rng& rng, std::vector<RawHit>& hits) const {
+        glm::vec3 w;
+        if (!sampleBounce(x, rng, w) || !mLight.on) return glm::vec3(0.0f);
+        const glm::vec3 origin = x.hit.position + x.ng * mEps;
+        mRays.intersectAll(origin, w, 0.0f, std::numeric_limits<float>::infinity(), hits);
+        glm::vec3 sum(0.0f);
+        for (const RawHit& raw : hits) {
+            const SurfaceHit y = mRays.resolve(raw, origin, w);
+            glm::vec3 l;
+            float dist = 0.0f;
+            if (!toLight(y.position, l, dist)) continue;
+            const glm::vec3 nLight = facing(y.shadingNormal, l); // the RSM's light-facing normal
+            if (!(glm::dot(nLight, -w) > 0.0f)) continue;        // x behind y's lit side
+            sum += y.albedo * kInvPi * directIrradiance(y.position, nLight, y.geometricNormal);
+        }
+        return x.hit.albedo * sum;
+    }
+
+    // Multi-bounce path: next-event estimation to the delta light at every vertex (the only way to reach
+    // it), emission where a bounce ray hits an emissive surface, Russian roulette from vertex
+    // kRouletteDepth on with survival probability min(max albedo, 0.95).
+    glm::vec3 pathIndirect(const Vertex& first, Rng& rng) const {
+        glm::vec3 radiance(0.0f);
+        glm::vec3 throughput(1.0f);
+        Vertex v = first;
+        for (int depth = 1; depth < mMaxDepth; ++depth) {
+            glm::vec3 w;
+            if (!sampleBounce(v, rng, w)) break;
+            throughput *= v.hit.albedo;
+            if (depth >= kRouletteDepth) {
+                // Survival follows this vertex's albedo (not the accumulated throughput), so on grey
+                // surfaces the weight of a surviving path stays constant instead of jumping by 1/q.
+                const glm::vec3& a = v.hit.albedo;
+                const float survive = std::min(std::max({a.x, a.y, a.z}), 0.95f);
+                if (!(survive > 0.0f) || rng.uniform() >= survive) break;
+                throughput /= survive;
+            }
+            SurfaceHit hit;
+            if (!mRays.intersect(v.hit.position + v.ng * mEps, w, 0.0f,
+                                 std::numeric_limits<float>::infinity(), hit))
+                break;
+            v = orient(hit, -w);
+            radiance += throughput * (v.hit.emission + reflectedDirect(v));
+        }
+        return radiance;
+    }
+
+    const RayScene& mRays;
+    const LightModel& mLight;
+    Mode mMode;
+    int mMaxDepth;
+    float mEps;
+};
+
+void addSanitized(double* acc, const glm::vec3& c) {
+    for (int i = 0; i < 3; ++i)
+        if (std::isfinite(c[i]) && c[i] > 0.0f) acc[i] += static_cast<double>(c[i]);
+}
+
+} // namespace
+
+std::vector<std::string> referenceModes() {
+    return {"direct", "one-bounce-unoccluded", "one-bounce", "path"};
+}
+
+void validateReferenceOptions(const ReferenceOptions& options) {
+    parseMode(options.mode);
+    if (options.spp <= 0) throw InputError("spp", "must be at least 1, got " + std::to_string(options.spp));
+    if (!std::isfinite(options.timeBudgetSeconds) || options.timeBudgetSeconds < 0)
+        throw InputError("time_budget", "must be a finite number of seconds >= 0 (0 = none)");
+    if (options.maxDepth < 1 || options.maxDepth > 1024)
+        throw InputError("max_depth", "must be in [1, 1024], got " + std::to_string(options.maxDepth));
+    if (options.threads < 0) throw InputError("threads", "must be >= 0 (0 = all hardware threads)");
+}
+
+ReferenceRenderer::ReferenceRenderer(const Scene& scene)
+    : mRays(std::make_unique<reference::RayScene>(scene)), mSceneDigest(reference::sceneDigest(scene)) {}
+
+ReferenceRenderer::~ReferenceRenderer() = default;
+
+ReferenceImage ReferenceRenderer::render(const FrameState& state, const ReferenceOptions& options,
+                                         const std::function<void(int, double)>& progress) {
+    validateReferenceOptions(options);
+    const Mode mode = parseMode(options.mode);
+    const int w = state.width, h = state.height;
+    if (w <= 0 || w > kMaxImageSide)
+        throw InputError("width", "must be in [1, 16384], got " + std::to_string(w));
+    if (h <= 0 || h > kMaxImageSide)
+        throw InputError("height", "must be in [1, 16384], got " + std::to_string(h));
+
+    const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+
+    // Rays through the pipeline's own projection: unproject NDC at the near (z = -1) and far (z = 1)
+    // planes, so the reference sees exactly the GL frustum, clipping included. Double precision keeps
+    // the inverse accurate for large far/near ratios.
+    const glm::dmat4 invViewProj =
+        glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
+    const LightModel light(state);
+    const Integrator integrator(*mRays, light, mode, options.maxDepth);
+
+    // A pixel-centre direct render has no random decision: one sample is the exact answer.
+    const int target = (mode == Mode::Direct && !options.jitter) ? 1 : options.spp;
+    const size_t pixels = static_cast<size_t>(w) * static_cast<size_t>(h);
+    std::vector<double> accum(pixels * 3, 0.0);
+    const int tilesX = (w + kTile - 1) / kTile, tilesY = (h + kTile - 1) / kTile;
+
+    auto renderPass = [&](int firstSample, int count) {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
+                std::vector<RawHit> scratch;
+                for (int tile = r.begin(); tile != r.end(); ++tile) {
+                    const int x0 = (tile % tilesX) * kTile, y0 = (tile / tilesX) * kTile;
+                    for (int py = y0; py < std::min(y0 + kTile, h); ++py)
+                        for (int px = x0; px < std::min(x0 + kTile, w); ++px) {
+                            const size_t index =
+                                static_cast<size_t>(py) * static_cast<size_t>(w) + static_cast<size_t>(px);
+                            for (int s = firstSample; s < firstSample + count; ++s) {
+                                Rng rng(options.seed, index, static_cast<std::uint64_t>(s));
+                                const float ox = options.jitter ? rng.uniform() : 0.5f;
+                                const float oy = options.jitter ? rng.uniform() : 0.5f;
+                                // Rows run top to bottom; NDC y runs bottom to top.
+                                const double nx = 2.0 * (px + ox) / w - 1.0;
+                                const double ny = 1.0 - 2.0 * (py + oy) / h;
+                                glm::dvec4 nearP = invViewProj * glm::dvec4(nx, ny, -1.0, 1.0);
+                                glm::dvec4 farP = invViewProj * glm::dvec4(nx, ny, 1.0, 1.0);
+                                if (!(std::abs(nearP.w) > 1e-300) || !(std::abs(farP.w) > 1e-300)) continue;
+                                const glm::dvec3 a = glm::dvec3(nearP) / nearP.w,
+                                                 b = glm::dvec3(farP) / farP.w;
+                                const double len = glm::length(b - a);
+                                if (!(len > 0.0) || !std::isfinite(len)) continue;
+                                const glm::vec3 dir(glm::normalize(b - a));
+                                addSanitized(&accum[index * 3],
+                                             integrator.sample(glm::vec3(a), dir, static_cast<float>(len),
+                                                               rng, scratch));
+                            }
+                        }
+                }
+            });
+    };
+
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    int done = 0;
+    int passSize = 1;
+    while (done < target) {
+        int count = std::min(passSize, target - done);
+        if (options.timeBudgetSeconds > 0 && done > 0) {
+            // Size the pass to what is likely to fit the remaining time, so the budget is not overrun
+            // by a long pass; at least one sample per pass keeps making progress.
+            const double perSample = elapsed() / done;
+            const double remaining = options.timeBudgetSeconds - elapsed();
+            if (perSample > 0) count = std::max(1, std::min(count, static_cast<int>(remaining / perSample)));
+        }
+        arena.execute([&] { renderPass(done, count); });
+        done += count;
+        if (progress) progress(done, elapsed());
+        if (options.timeBudgetSeconds > 0 && elapsed() >= options.timeBudgetSeconds) break;
+        passSize = std::min(passSize * 2, kMaxPassSamples);
+    }
+
+    ReferenceImage image;
+    image.width = w;
+    image.height = h;
+    image.spp = done;
+    image.mode = options.mode;
+    image.key = reference::requestKey(mSceneDigest, state, options);
+    image.rgb.resize(pixels * 3);
+    const double inv = 1.0 / std::max(done, 1);
+    for (size_t i = 0; i < pixels * 3; ++i) {
+        const auto v = static_cast<float>(accum[i] * inv);
+        image.rgb[i] = std::isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
+    image.seconds = elapsed();
+    return image;
+}
+
+} // namespace gis

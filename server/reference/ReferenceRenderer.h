@@ -1,0 +1,116 @@
+// CPU ground-truth renderer (DESIGN.md §4 "Reference"): Monte Carlo light transport on Embree ray
+// queries, seeing exactly the scene, camera and spotlight the GL pipeline sees, so that a GL image
+// and a reference image differ only by the light transport.
+//
+// Notation: x a receiver (first hit of the camera ray through a pixel centre), n_x its shading normal
+// turned towards the camera, rho the Lambertian albedo, L_e emission, and for the light (position p_l,
+// intensity I in cd, colour c, spot factor f = t^2 with t = clamp((cos - cosOuter) / max(cosInner -
+// cosOuter, 1e-4), 0, 1), f = 1 for point lights) the direct irradiance
+//     E_d(x) = I c f(x) max(0, n_x . l) / |p_l - x|^2 * V(x, p_l)       (0 when |p_l - x|^2 == 0).
+// Modes (the integral each estimates per pixel; L is outgoing radiance towards the camera):
+//  - "direct":                L = L_e(x) + rho_x / pi * E_d(x)
+//  - "one-bounce-unoccluded": direct + L_1 with
+//        L_1(x) = rho_x / pi * Integral_A L_r(y) cos(theta_x) cos(theta_y) / |x - y|^2 dA_y,
+//        L_r(y) = rho_y / pi * E_d(y), over every light-visible surface point y, WITHOUT the visibility
+//        between x and y; cos(theta_y) uses y's light-facing normal and is 0 when x lies behind y's lit
+//        side. This is what RSM/VPL gathering without indirect shadows and without a distance clamp
+//        converges to (rsm_gather with one VPL per RSM texel and min_distance 0).
+//  - "one-bounce":            direct + L_1 with the visibility V(x, y) inside the integral (the rendering
+//        equation truncated after one diffuse bounce of the light's direct illumination).
+//  - "path":                  the rendering equation for Lambertian surfaces, paths of up to maxDepth
+//        surface vertices (1 = direct only), Russian roulette after vertex 3, next-event estimation
+//        to the (delta) light at every vertex, emission added where a path hits an emissive surface.
+// The one-bounce modes bounce the light source only: emissive surfaces are seen directly but do not
+// light other surfaces (as in the GL pipeline, whose VPLs come from the spotlight's RSM).
+//
+// Sampling: one camera ray through each pixel centre per sample (GL's single raster sample), or a
+// uniformly jittered point in the pixel with `jitter` (box filter). Estimators are in README.md.
+//
+// Determinism: each (seed, pixel, sample) has its own random stream and each pixel sums its samples in
+// order, so an image depends on the options and not on the thread count or schedule. With a time
+// budget the sample count reached depends on the machine; the image for a given count does not.
+//
+// Threading: render() runs on TBB worker threads; one ReferenceRenderer may be used from one thread at a
+// time. The renderer copies what it needs from the scene.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/FrameState.h"
+#include "scene/Scene.h"
+
+namespace gis {
+
+namespace reference {
+class RayScene;
+}
+
+struct ReferenceOptions {
+    std::string mode = "one-bounce";
+    int spp = 64; ///< samples per pixel to stop at, >= 1
+    double timeBudgetSeconds =
+        0;            ///< also stop once this much time has passed (checked between passes); 0 = none
+    int maxDepth = 8; ///< path mode: surface vertices per path, >= 1
+    std::uint64_t seed = 1;
+    bool jitter = false; ///< box-filtered jitter inside each pixel instead of the pixel centre
+    int threads = 0;     ///< 0 = all hardware threads
+};
+
+struct ReferenceImage {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgb; ///< linear radiance, 3 floats per pixel, rows top to bottom; finite and >= 0
+    int spp = 0;            ///< samples per pixel actually taken
+    double seconds = 0;     ///< wall-clock render time (0 for a cache hit's load)
+    std::string mode;
+    std::string key; ///< referenceCacheKey() of the request (may be empty for images read from elsewhere)
+};
+
+class ReferenceRenderer {
+public:
+    /// Builds the ray-tracing acceleration structure (seconds for millions of triangles).
+    explicit ReferenceRenderer(const Scene& scene);
+    ~ReferenceRenderer();
+    ReferenceRenderer(const ReferenceRenderer&) = delete;
+    ReferenceRenderer& operator=(const ReferenceRenderer&) = delete;
+
+    /// Renders `state` (camera, light, lightEnabled, width, height; the parameter tables are ignored).
+    /// `progress` is called after each pass with the samples per pixel and seconds so far.
+    /// Throws InputError naming the option for bad options or sizes.
+    /// "direct" without jitter is deterministic, so it stops after one sample (reported spp = 1).
+    ReferenceImage render(const FrameState& state, const ReferenceOptions& options,
+                          const std::function<void(int spp, double seconds)>& progress = {});
+
+private:
+    std::unique_ptr<reference::RayScene> mRays;
+    std::string mSceneDigest; // scene part of the cache key, hashed once
+};
+
+/// "direct", "one-bounce-unoccluded", "one-bounce", "path".
+std::vector<std::string> referenceModes();
+
+/// Throws InputError(option name, ...) when an option is out of range.
+void validateReferenceOptions(const ReferenceOptions& options);
+
+/// Content hash (hex, 32 digits) of everything the image depends on: geometry, materials, textures,
+/// camera, light, size, mode, spp, time budget, seed, depth, jitter (not the thread count).
+std::string referenceCacheKey(const Scene& scene, const FrameState& state, const ReferenceOptions& options);
+
+/// Writes an RGB float EXR with metadata gis:mode, gis:spp, gis:seconds, gis:key (atomic: temp + rename).
+/// Throws gis::Error on I/O failure.
+void writeReferenceExr(const std::string& path, const ReferenceImage& image);
+/// Reads an EXR written by writeReferenceExr (other RGB(A) EXRs load with empty metadata).
+/// Throws InputError(path, ...) when the file is missing or unreadable.
+ReferenceImage readReferenceExr(const std::string& path);
+
+/// Returns the cached image for the request's key from cacheDir if present (and whole), else renders,
+/// writes it there and returns it. cacheDir is created if missing.
+ReferenceImage renderReferenceCached(const Scene& scene, const FrameState& state,
+                                     const ReferenceOptions& options, const std::string& cacheDir,
+                                     bool* cacheHit = nullptr);
+
+} // namespace gis
