@@ -1,5 +1,7 @@
 // gi-render: renders one frame (or the median of N frames) of a scene with a GI technique and writes
 // the image and the per-pass stats. Exit codes: 0 success, 1 runtime failure, 2 bad usage.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -12,9 +14,11 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "encode/Encoder.h"
+#include "analysis/Metrics.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
 #include "render/FrameParams.h"
+#include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
 #include "scene/SceneLoader.h"
 
@@ -36,6 +40,19 @@ Renders a scene with a global-illumination technique and writes the image and pe
   --list-techniques     list the techniques and exit
   --list-params TECH    list the frame parameters and TECH's parameters and exit
   --list-scenes         list the built-in scenes and exit
+
+Ground truth and error (CPU reference renderer, Embree):
+  --reference MODE      render with the reference instead of GL: direct, one-bounce-unoccluded,
+                        one-bounce or path (.exr keeps linear radiance; .png/.jpg are tone-mapped)
+  --spp N               reference samples per pixel, 1..1000000 (default 256)
+  --time-budget S       stop the reference after S seconds (reports the spp reached)
+  --seed N              reference random seed (default 1)
+  --max-depth N         path mode: vertices per path, 1..64 (default 8)
+  --cache-dir DIR       reuse references rendered before ($GI_CACHE_DIR, default ~/.cache/gi-render)
+  --no-cache            always render the reference
+  --compare REF.exr     compare the rendered frame's linear radiance with a reference EXR of the same
+                        size: prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP (background
+                        pixels, black in the reference, are left out)
   --quiet               only errors on stderr
   --help                this text
 
@@ -58,7 +75,60 @@ struct Options {
     std::string gl;
     bool timerQueries = true;
     bool quiet = false;
+    std::string referenceMode;
+    gis::ReferenceOptions reference = [] {
+        gis::ReferenceOptions r;
+        r.spp = 256; // the CLI's default: a cleaner image than the library's
+        return r;
+    }();
+    std::string cacheDir;
+    bool useCache = true;
+    std::string compare;
 };
+
+std::string defaultCacheDir() {
+    if (const char* d = std::getenv("GI_CACHE_DIR"); d && *d) return d;
+    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/gi-render";
+    return "/tmp/gi-render-cache";
+}
+
+/// Renders the CPU reference for `state` and writes it; returns the stats JSON.
+nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const gis::FrameState& state) {
+    gis::ReferenceOptions ro = o.reference;
+    ro.mode = o.referenceMode;
+    gis::validateReferenceOptions(ro);
+    gis::ReferenceImage image;
+    bool hit = false;
+    if (o.useCache) {
+        image = gis::renderReferenceCached(scene, state, ro, o.cacheDir, &hit);
+    } else {
+        gis::ReferenceRenderer renderer(scene);
+        image = renderer.render(state, ro, [&](int spp, double seconds) {
+            if (!o.quiet) std::fprintf(stderr, "\rgi-render: reference %s %d spp, %.1f s", ro.mode.c_str(), spp, seconds);
+        });
+        if (!o.quiet) std::fprintf(stderr, "\n");
+    }
+    if (!o.out.empty()) {
+        std::vector<float> rgba(static_cast<size_t>(image.width) * image.height * 4, 1.0f);
+        for (size_t i = 0, n = static_cast<size_t>(image.width) * image.height; i < n; ++i)
+            for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = image.rgb[i * 3 + c];
+        if (gis::imageFileNeedsLinear(o.out)) {
+            gis::writeReferenceExr(o.out, image);
+        } else {
+            gis::ImageView view(rgba.data(), image.width, image.height, 4);
+            std::vector<float> srgb = gis::toneMapForMetrics(view, state.frameParams.getFloat("exposure"));
+            std::vector<std::uint8_t> rgba8(rgba.size());
+            for (size_t i = 0, n = srgb.size() / 3; i < n; ++i) {
+                for (int c = 0; c < 3; ++c)
+                    rgba8[i * 4 + c] = static_cast<std::uint8_t>(std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+                rgba8[i * 4 + 3] = 255;
+            }
+            gis::writeImageFile(o.out, image.width, image.height, rgba8, rgba, {{"gi:reference", ro.mode}});
+        }
+    }
+    return {{"reference", ro.mode},  {"size", {image.width, image.height}}, {"spp", image.spp},
+            {"seconds", image.seconds}, {"cache_hit", hit}, {"key", image.key}, {"scene", o.scene}};
+}
 
 int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
     try {
@@ -132,9 +202,35 @@ int run(int argc, char** argv) {
         else if (a == "--gl") o.gl = value(i);
         else if (a == "--no-timer-queries") o.timerQueries = false;
         else if (a == "--quiet") o.quiet = true;
+        else if (a == "--reference") o.referenceMode = value(i);
+        else if (a == "--spp") o.reference.spp = parseInt("--spp", value(i), 1, 1000000);
+        else if (a == "--time-budget") {
+            const std::string& t = value(i);
+            try {
+                size_t used = 0;
+                o.reference.timeBudgetSeconds = std::stod(t, &used);
+                if (used != t.size() || !(o.reference.timeBudgetSeconds > 0)) throw std::invalid_argument(t);
+            } catch (const std::exception&) {
+                throw UsageError{"--time-budget must be a positive number of seconds, got '" + t + "'"};
+            }
+        } else if (a == "--seed") o.reference.seed = static_cast<std::uint64_t>(parseInt("--seed", value(i), 0, 2147483647));
+        else if (a == "--max-depth") o.reference.maxDepth = parseInt("--max-depth", value(i), 1, 64);
+        else if (a == "--cache-dir") o.cacheDir = value(i);
+        else if (a == "--no-cache") o.useCache = false;
+        else if (a == "--compare") o.compare = value(i);
         else throw UsageError{"unknown option '" + a + "' (see --help)"};
     }
     if (o.quiet) gis::setLogLevel(gis::LogLevel::Error);
+    if (o.cacheDir.empty()) o.cacheDir = defaultCacheDir();
+    if (!o.referenceMode.empty()) {
+        auto modes = gis::referenceModes();
+        if (std::find(modes.begin(), modes.end(), o.referenceMode) == modes.end()) {
+            std::string known;
+            for (const auto& m : modes) known += (known.empty() ? "" : ", ") + m;
+            throw UsageError{"--reference must be one of " + known + ", got '" + o.referenceMode + "'"};
+        }
+        if (!o.compare.empty()) throw UsageError{"--compare compares a GL frame: it cannot be used with --reference"};
+    }
     if (!o.out.empty() && !(o.out.ends_with(".png") || o.out.ends_with(".jpg") || o.out.ends_with(".jpeg") ||
                             o.out.ends_with(".exr")))
         throw UsageError{"--out must end in .png, .jpg or .exr, got '" + o.out + "'"};
@@ -157,13 +253,31 @@ int run(int argc, char** argv) {
     state.width = o.width;
     state.height = o.height;
 
+    if (!o.referenceMode.empty()) {
+        nlohmann::json summary = renderReference(o, *scene, state);
+        if (!o.stats.empty()) writeText(o.stats, summary.dump(2));
+        if (!o.quiet)
+            gis::logInfo("gi-render: reference " + o.referenceMode + " " + std::to_string(summary["spp"].get<int>()) +
+                         " spp in " + std::to_string(summary["seconds"].get<double>()) + " s" +
+                         (summary["cache_hit"].get<bool>() ? " (from the cache)" : ""));
+        return 0;
+    }
+    gis::ReferenceImage compareWith;
+    if (!o.compare.empty()) {
+        compareWith = gis::readReferenceExr(o.compare);
+        if (compareWith.width != o.width || compareWith.height != o.height)
+            throw UsageError{"--compare: '" + o.compare + "' is " + std::to_string(compareWith.width) + "x" +
+                             std::to_string(compareWith.height) + " but --size is " + std::to_string(o.width) + "x" +
+                             std::to_string(o.height)};
+    }
+
     auto context = gis::gl::createContext(backend);
     if (!o.quiet)
         gis::logInfo("gl: " + context->info().backend + ", " + context->info().renderer + ", " + context->info().version);
     gis::FrameRenderer renderer(o.timerQueries);
     renderer.setScene(scene);
 
-    const bool wantLinear = gis::imageFileNeedsLinear(o.out);
+    const bool wantLinear = gis::imageFileNeedsLinear(o.out) || !o.compare.empty();
     gis::FrameOutput frame = renderer.render(state, wantLinear); // warm-up (shader JIT, allocation)
     std::vector<nlohmann::json> stats;
     for (int f = 0; f < o.frames; ++f) {
@@ -174,6 +288,15 @@ int run(int argc, char** argv) {
     summary["scene"] = o.scene;
     summary["gl"] = {{"backend", context->info().backend}, {"renderer", context->info().renderer}};
 
+    if (!o.compare.empty()) {
+        gis::ImageView test(frame.linear.data(), frame.width, frame.height, 4);
+        gis::ImageView ref(compareWith.rgb.data(), compareWith.width, compareWith.height, 3);
+        gis::ImageMetrics m = gis::compareImages(test, ref, gis::maskFromNonZero(ref),
+                                                 state.frameParams.getFloat("exposure"));
+        summary["compare"] = gis::toJson(m);
+        summary["compare"]["reference"] = o.compare;
+        std::cout << summary["compare"].dump(2) << "\n";
+    }
     if (!o.out.empty()) {
         gis::writeImageFile(o.out, frame.width, frame.height, frame.rgba8, frame.linear,
                             {{"gi:technique", o.technique}, {"gi:scene", o.scene}, {"gi:params", summary["params"].dump()}});

@@ -1,0 +1,243 @@
+// gi-bench: accuracy against time. Subcommands:
+//   compare A.exr B.exr         error metrics of A against the reference B
+//   table [options]             renders technique configurations and references of one scene side by
+//                               side and prints the error-versus-time table (Markdown and JSON)
+// Exit codes: 0 success, 1 runtime failure, 2 bad usage.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/Metrics.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "gl/Platform.h"
+#include "reference/ReferenceRenderer.h"
+#include "render/FrameRenderer.h"
+#include "scene/SceneLoader.h"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
+       gi-bench table [options]
+
+compare  prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
+         size; pixels black in the reference are left out) as JSON.
+
+table    renders each technique configuration with GL (median frame time over --frames after a
+         warm-up) and the CPU references, then prints one row per configuration: frame time, the sum
+         of the GPU pass times, and the error against every reference.
+  --scene NAME            (default builtin:cornell)
+  --size WxH              (default 256x256)
+  --config SPEC           technique[:name=value,...], repeatable (default: none, rsm_gather)
+  --reference MODE        reference mode, repeatable (default: one-bounce-unoccluded, one-bounce)
+  --spp N                 reference samples per pixel (default 1024)
+  --frames N              timed GL frames per configuration (default 5)
+  --cache-dir DIR         reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)
+  --json FILE             also write the rows as JSON
+  --gl egl|osmesa
+)";
+
+struct UsageError {
+    std::string message;
+};
+
+int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
+    try {
+        size_t used = 0;
+        long v = std::stol(text, &used);
+        if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
+    } catch (...) {
+    }
+    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
+                     text + "'"};
+}
+
+std::string defaultCacheDir() {
+    if (const char* d = std::getenv("GI_CACHE_DIR"); d && *d) return d;
+    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/gi-render";
+    return "/tmp/gi-render-cache";
+}
+
+int compare(const std::vector<std::string>& args) {
+    if (args.size() != 2) throw UsageError{"compare needs two files: TEST.exr REFERENCE.exr"};
+    gis::ReferenceImage a = gis::readReferenceExr(args[0]);
+    gis::ReferenceImage b = gis::readReferenceExr(args[1]);
+    if (a.width != b.width || a.height != b.height)
+        throw gis::InputError(args[0], "is " + std::to_string(a.width) + "x" + std::to_string(a.height) + " but " +
+                                           args[1] + " is " + std::to_string(b.width) + "x" + std::to_string(b.height));
+    gis::ImageView test(a.rgb.data(), a.width, a.height, 3), ref(b.rgb.data(), b.width, b.height, 3);
+    nlohmann::json out = gis::toJson(gis::compareImages(test, ref, gis::maskFromNonZero(ref)));
+    out["test"] = args[0];
+    out["reference"] = args[1];
+    std::cout << out.dump(2) << "\n";
+    return 0;
+}
+
+struct Config {
+    std::string technique;
+    std::vector<std::pair<std::string, std::string>> params;
+    std::string label;
+};
+
+Config parseConfig(const std::string& spec) {
+    Config c;
+    c.label = spec;
+    auto colon = spec.find(':');
+    c.technique = spec.substr(0, colon);
+    if (colon == std::string::npos) return c;
+    std::stringstream rest(spec.substr(colon + 1));
+    std::string kv;
+    while (std::getline(rest, kv, ',')) {
+        auto eq = kv.find('=');
+        if (eq == std::string::npos || eq == 0) throw UsageError{"--config: expected name=value, got '" + kv + "'"};
+        c.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+    }
+    return c;
+}
+
+int table(const std::vector<std::string>& args) {
+    std::string sceneName = "builtin:cornell", jsonPath, gl, cacheDir = defaultCacheDir();
+    int width = 256, height = 256, frames = 5;
+    std::vector<Config> configs;
+    std::vector<std::string> modes;
+    gis::ReferenceOptions ro;
+    ro.spp = 1024;
+    for (size_t i = 0; i < args.size(); ++i) {
+        auto value = [&]() -> const std::string& {
+            if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+            return args[++i];
+        };
+        const std::string& a = args[i];
+        if (a == "--scene") sceneName = value();
+        else if (a == "--size") {
+            const std::string& s = value();
+            auto x = s.find('x');
+            if (x == std::string::npos) throw UsageError{"--size must look like 256x256"};
+            width = parseInt("--size width", s.substr(0, x), 16, 4096);
+            height = parseInt("--size height", s.substr(x + 1), 16, 4096);
+        } else if (a == "--config") configs.push_back(parseConfig(value()));
+        else if (a == "--reference") modes.push_back(value());
+        else if (a == "--spp") ro.spp = parseInt("--spp", value(), 1, 1000000);
+        else if (a == "--frames") frames = parseInt("--frames", value(), 1, 1000);
+        else if (a == "--cache-dir") cacheDir = value();
+        else if (a == "--json") jsonPath = value();
+        else if (a == "--gl") gl = value();
+        else throw UsageError{"unknown option '" + a + "' (see --help)"};
+    }
+    if (configs.empty()) configs = {parseConfig("none"), parseConfig("rsm_gather")};
+    if (modes.empty()) modes = {"one-bounce-unoccluded", "one-bounce"};
+
+    auto scene = std::make_shared<gis::Scene>(gis::loadScene(sceneName));
+    std::vector<gis::FrameState> states;
+    for (const auto& c : configs) {
+        try {
+            gis::FrameState s = gis::makeFrameState(*scene, c.technique);
+            for (const auto& [k, v] : c.params) gis::setParamFromString(s, k, v, "--config " + c.label);
+            s.width = width;
+            s.height = height;
+            states.push_back(std::move(s));
+        } catch (const gis::InputError& e) {
+            throw UsageError{e.what()};
+        }
+    }
+
+    // References first (CPU, cached), so GL timings are not disturbed by them.
+    std::vector<gis::ReferenceImage> refs;
+    for (const auto& m : modes) {
+        ro.mode = m;
+        gis::validateReferenceOptions(ro);
+        bool hit = false;
+        refs.push_back(gis::renderReferenceCached(*scene, states.front(), ro, cacheDir, &hit));
+        gis::logInfo("gi-bench: reference " + m + ": " + std::to_string(refs.back().spp) + " spp, " +
+                     (hit ? "from the cache" : std::to_string(refs.back().seconds) + " s"));
+    }
+
+    auto backend = gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(gl);
+    auto context = gis::gl::createContext(backend);
+    gis::FrameRenderer renderer;
+    renderer.setScene(scene);
+    nlohmann::json rows = nlohmann::json::array();
+    for (size_t i = 0; i < configs.size(); ++i) {
+        gis::FrameOutput f = renderer.render(states[i], true);
+        std::vector<nlohmann::json> stats;
+        for (int k = 0; k < frames; ++k) {
+            f = renderer.render(states[i], true);
+            stats.push_back(f.stats);
+        }
+        nlohmann::json s = gis::medianStats(stats);
+        double gpu = 0;
+        for (const auto& p : s["passes"]) gpu += p["gpu_ms"].get<double>();
+        nlohmann::json row = {{"config", configs[i].label}, {"frame_ms", s["frame_ms"]}, {"gpu_ms", gpu},
+                              {"counts", s["counts"]}, {"params", s["params"]}};
+        gis::ImageView test(f.linear.data(), f.width, f.height, 4);
+        for (size_t r = 0; r < refs.size(); ++r) {
+            gis::ImageView ref(refs[r].rgb.data(), refs[r].width, refs[r].height, 3);
+            row["error"][modes[r]] = gis::toJson(gis::compareImages(test, ref, gis::maskFromNonZero(ref)));
+        }
+        rows.push_back(row);
+    }
+
+    std::printf("scene %s, %dx%d, GL %s (%s), references at %d spp\n\n", sceneName.c_str(), width, height,
+                context->info().backend.c_str(), context->info().renderer.c_str(), ro.spp);
+    std::printf("| configuration | frame ms | GPU ms |");
+    for (const auto& m : modes) std::printf(" rel. RMSE vs %s | SSIM | FLIP |", m.c_str());
+    std::printf("\n|---|---|---|");
+    for (size_t r = 0; r < modes.size(); ++r) std::printf("---|---|---|");
+    std::printf("\n");
+    for (const auto& row : rows) {
+        std::printf("| %s | %.1f | %.1f |", row["config"].get<std::string>().c_str(), row["frame_ms"].get<double>(),
+                    row["gpu_ms"].get<double>());
+        for (const auto& m : modes) {
+            const auto& e = row["error"][m];
+            std::printf(" %.4f | %.4f | %.4f |", e["relative_rmse"].get<double>(), e["ssim"].get<double>(),
+                        e["flip"].get<double>());
+        }
+        std::printf("\n");
+    }
+    if (!jsonPath.empty()) {
+        std::ofstream f(jsonPath);
+        if (!f) throw gis::InputError(jsonPath, "cannot open for writing");
+        f << nlohmann::json({{"scene", sceneName}, {"size", {width, height}}, {"reference_spp", ro.spp},
+                             {"rows", rows}})
+                 .dump(2)
+          << "\n";
+    }
+    return 0;
+}
+
+int run(int argc, char** argv) {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+        std::cout << kUsage;
+        return args.empty() ? 2 : 0;
+    }
+    std::string command = args[0];
+    args.erase(args.begin());
+    if (command == "compare") return compare(args);
+    if (command == "table") return table(args);
+    throw UsageError{"unknown command '" + command + "': use compare or table (see --help)"};
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "gi-bench: %s\n", e.message.c_str());
+        return 2;
+    } catch (const gis::InputError& e) {
+        std::fprintf(stderr, "gi-bench: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "gi-bench: %s\n", e.what());
+        return 1;
+    }
+}
