@@ -14,6 +14,10 @@ const ParamTable& frameParamTable() {
          .help = "soft-shadow filter radius: (2r+1)^2 shadow-map taps", .source = "eng"},
         {.name = "rsm_size", .type = ParamType::Int, .defaultValue = 256, .min = 16, .max = 1024, .unit = "texels",
          .help = "side of the reflective shadow map (VPL candidates)", .source = "001 §4 (256^2)"},
+        {.name = "rsm_solid_angle", .type = ParamType::Enum, .defaultValue = 0,
+         .help = "solid angle per RSM texel: exact (cos^3 law) or equal for every texel (001 Eq. 4; biased, "
+                 "000 Fig. 13)",
+         .source = "001 Eq. 4", .options = {"exact", "equal"}},
     });
     return table;
 }

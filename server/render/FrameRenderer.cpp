@@ -196,7 +196,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
     u.rsmInfo = glm::vec4(rsmSize, tanHalf, mShadowSize, fp.getInt("pcf_radius"));
     u.toneInfo = glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
-                           lightOn ? 1.0f : 0.0f, 0.0f);
+                           lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 

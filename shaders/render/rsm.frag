@@ -25,6 +25,11 @@ void main() {
     vec2 uv = (gl_FragCoord.xy / res * 2.0 - 1.0) * t;
     float texel = 2.0 * t / res;
     float solidAngle = texel * texel * pow(1.0 + dot(uv, uv), -1.5);
+    if (gFrame.toneInfo.w > 0.5) {
+        // 001 Eq. 4: every texel gets the frustum's solid angle / N^2. A square frustum of half-angle
+        // tangent t subtends 4 asin(t^2 / (1 + t^2)) sr. Brighter off-axis, dimmer on-axis (000 Fig. 13).
+        solidAngle = 4.0 * asin(clamp(t * t / (1.0 + t * t), 0.0, 1.0)) / (res * res);
+    }
 
     float intensity = gFrame.lightPos.w * spotFactor(-l);
     vec3 albedo = materialAlbedo(vTexcoord);

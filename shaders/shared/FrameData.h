@@ -17,7 +17,7 @@ struct FrameUniforms {
     vec4 lightColor;     // rgb: linear colour; w: cos(inner cone)
     vec4 viewport;       // x: width, y: height (px); z: 1/width; w: 1/height
     vec4 rsmInfo;        // x: RSM size (texels); y: tan(half fov) of the light frustum; z: shadow map size; w: PCF radius (texels)
-    vec4 toneInfo;       // x: exposure scale 2^EV; y: operator (0 linear, 1 filmic); z: light enabled (0/1); w: unused
+    vec4 toneInfo;       // x: exposure scale 2^EV; y: operator (0 linear, 1 filmic); z: light enabled (0/1); w: RSM texel solid angle (0 exact, 1 equal)
 };
 
 // One virtual point light: a diffuse emitter of reflected flux at an RSM sample.
