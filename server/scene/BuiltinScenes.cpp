@@ -1,8 +1,12 @@
 // Scenes generated in code, so tests, benchmarks and the default session need no asset files.
-// Every surface is a grid of quads (vertex-based effects need more than 2 triangles per wall) wound
-// CCW as seen from the side its normal points to.
+// Every surface is a grid of quads (vertex-based effects need more than 2 triangles per wall; the
+// bumpy sphere is a latitude/longitude grid) wound CCW as seen from the side its normal points to.
 #include "scene/SceneLoader.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/Error.h"
@@ -89,7 +93,63 @@ Camera makeCamera(const glm::vec3& position, const glm::vec3& target) {
                   .zfar = 20.0f};
 }
 
-Scene makeCornell(bool withBoxes) {
+/// Radius factor of the bumpy sphere at polar angle theta (from +Y) and azimuth phi: a sum of
+/// sines whose azimuthal terms are weighted by sin(theta), so they fade out smoothly at the poles
+/// and the surface has a single well-defined point there. Integer frequencies keep it periodic in
+/// phi. Stays within [0.8, 1.2].
+double bumpyRadiusFactor(double theta, double phi) {
+    const double w = std::sin(theta);
+    return 1.0 + 0.12 * w * std::sin(12.0 * theta) * std::sin(12.0 * phi) +
+           0.05 * w * std::sin(31.0 * theta) * std::cos(29.0 * phi + 0.7) + 0.03 * std::cos(23.0 * theta);
+}
+
+/// Closed sphere of base radius radius with its radius displaced by bumpyRadiusFactor, tessellated
+/// as rings x segments latitude/longitude quads (one vertex per pole, the phi seam shared), so it
+/// has 2 * segments * (rings - 1) triangles. Shifted so its lowest point sits at y = 0 above the
+/// (x, z) position base. Normals are left empty: finalizeScene generates area-weighted vertex
+/// normals from the displaced surface, smooth everywhere because every vertex is shared.
+Mesh makeBumpySphere(const std::string& name, int material, const glm::vec3& base, float radius, int rings,
+                     int segments) {
+    Mesh mesh{.name = name, .material = material};
+    const double pi = glm::pi<double>();
+    auto addVertex = [&](double theta, double phi) {
+        const double r = radius * bumpyRadiusFactor(theta, phi);
+        mesh.positions.emplace_back(static_cast<float>(r * std::sin(theta) * std::cos(phi)),
+                                    static_cast<float>(r * std::cos(theta)),
+                                    static_cast<float>(r * std::sin(theta) * std::sin(phi)));
+        mesh.texcoords.emplace_back(static_cast<float>(phi / (2.0 * pi)), static_cast<float>(theta / pi));
+    };
+    addVertex(0.0, 0.0); // north pole
+    for (int j = 1; j < rings; ++j)
+        for (int i = 0; i < segments; ++i) addVertex(pi * j / rings, 2.0 * pi * i / segments);
+    addVertex(pi, 0.0); // south pole
+
+    const auto seg = static_cast<std::uint32_t>(segments);
+    const auto north = 0u, south = static_cast<std::uint32_t>(mesh.positions.size()) - 1;
+    auto at = [&](int ring, std::uint32_t i) {
+        return 1 + static_cast<std::uint32_t>(ring - 1) * seg + i % seg;
+    };
+    // Seen from outside, +phi then +theta turns counter-clockwise.
+    for (std::uint32_t i = 0; i < seg; ++i)
+        mesh.indices.insert(mesh.indices.end(), {north, at(1, i + 1), at(1, i)});
+    for (int j = 1; j + 1 < rings; ++j)
+        for (std::uint32_t i = 0; i < seg; ++i) {
+            const std::uint32_t p00 = at(j, i), p10 = at(j, i + 1), p01 = at(j + 1, i),
+                                p11 = at(j + 1, i + 1);
+            mesh.indices.insert(mesh.indices.end(), {p00, p10, p11, p00, p11, p01});
+        }
+    for (std::uint32_t i = 0; i < seg; ++i)
+        mesh.indices.insert(mesh.indices.end(), {at(rings - 1, i), at(rings - 1, i + 1), south});
+
+    float minY = 0.0f;
+    for (const glm::vec3& p : mesh.positions) minY = std::min(minY, p.y);
+    for (glm::vec3& p : mesh.positions) p += glm::vec3(base.x, base.y - minY, base.z);
+    return mesh;
+}
+
+enum class CornellContents { Boxes, Empty, Dense };
+
+Scene makeCornell(CornellContents contents) {
     Scene scene;
     const int white = addMaterial(scene, "white", kWhite);
     const int red = addMaterial(scene, "red", kRed);
@@ -100,11 +160,14 @@ Scene makeCornell(bool withBoxes) {
     scene.meshes.push_back(makeGrid("back_wall", white, {-1, 0, -1}, x, y));
     scene.meshes.push_back(makeGrid("left_wall", red, {-1, 0, -1}, y, z));
     scene.meshes.push_back(makeGrid("right_wall", green, {1, 0, -1}, z, y));
-    if (withBoxes) {
+    if (contents == CornellContents::Boxes) {
         scene.meshes.push_back(
             makeBox("short_box", white, {0.35f, 0.3f, 0.3f}, glm::vec3(0.6f), glm::radians(-17.0f)));
         scene.meshes.push_back(
             makeBox("tall_box", white, {-0.35f, 0.6f, -0.35f}, {0.6f, 1.2f, 0.6f}, glm::radians(17.0f)));
+    } else if (contents == CornellContents::Dense) {
+        // 2 * 256 * 127 = 65024 triangles, about 8 vertices per period of the finest ripple.
+        scene.meshes.push_back(makeBumpySphere("bumpy_sphere", white, {0.0f, 0.0f, 0.0f}, 0.5f, 128, 256));
     }
     scene.lights.push_back(makeSpot("ceiling_spot", {0.0f, 1.95f, 0.0f}, {0.0f, -1.0f, 0.0f}, 50.0f, 60.0f));
     scene.cameras.push_back(makeCamera({0.0f, 1.0f, 3.9f}, {0.0f, 1.0f, 0.0f}));
@@ -124,15 +187,17 @@ Scene makeCrease() {
 } // namespace
 
 std::vector<std::string> builtinSceneNames() {
-    return {"cornell", "cornell-empty", "crease"};
+    return {"cornell", "cornell-empty", "cornell-dense", "crease"};
 }
 
 Scene makeBuiltinScene(const std::string& name) {
     Scene scene;
     if (name == "cornell")
-        scene = makeCornell(true);
+        scene = makeCornell(CornellContents::Boxes);
     else if (name == "cornell-empty")
-        scene = makeCornell(false);
+        scene = makeCornell(CornellContents::Empty);
+    else if (name == "cornell-dense")
+        scene = makeCornell(CornellContents::Dense);
     else if (name == "crease")
         scene = makeCrease();
     else {

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 
 #include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
@@ -22,7 +23,8 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
 }
 
 TEST(BuiltinScenes, NamesList) {
-    EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{"cornell", "cornell-empty", "crease"}));
+    EXPECT_EQ(builtinSceneNames(),
+              (std::vector<std::string>{"cornell", "cornell-empty", "cornell-dense", "crease"}));
 }
 
 TEST(BuiltinScenes, EachBuildsAndValidates) {
@@ -123,6 +125,69 @@ TEST(BuiltinScenes, CornellEmptyHasNoBoxes) {
     EXPECT_EQ(findMesh(s, "short_box"), nullptr);
     EXPECT_EQ(s.lights.size(), 1u);
     EXPECT_EQ(s.lights[0].name, "ceiling_spot");
+}
+
+TEST(BuiltinScenes, CornellDenseIsTheCornellRoomWithOneDenseObject) {
+    const Scene s = makeBuiltinScene("cornell-dense");
+    const Scene cornell = makeBuiltinScene("cornell");
+    EXPECT_EQ(s.meshes.size(), 6u);
+    EXPECT_EQ(findMesh(s, "short_box"), nullptr);
+    EXPECT_EQ(findMesh(s, "tall_box"), nullptr);
+    for (const char* wall : {"floor", "ceiling", "back_wall", "left_wall", "right_wall"}) {
+        const Mesh *a = findMesh(s, wall), *b = findMesh(cornell, wall);
+        ASSERT_NE(a, nullptr) << wall;
+        ASSERT_NE(b, nullptr) << wall;
+        EXPECT_EQ(a->positions, b->positions) << wall;
+        EXPECT_EQ(s.materials[static_cast<std::size_t>(a->material)].baseColor,
+                  cornell.materials[static_cast<std::size_t>(b->material)].baseColor)
+            << wall;
+    }
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].name, "ceiling_spot");
+    expectNear(s.lights[0].position, cornell.lights[0].position);
+    expectNear(s.cameras[0].position, cornell.cameras[0].position);
+    expectNear(s.cameras[0].target, cornell.cameras[0].target);
+
+    const Mesh* obj = findMesh(s, "bumpy_sphere");
+    ASSERT_NE(obj, nullptr);
+    EXPECT_EQ(s.materials[static_cast<std::size_t>(obj->material)].name, "white");
+    const std::size_t triangles = obj->indices.size() / 3;
+    EXPECT_GT(triangles, 30000u);
+    EXPECT_LT(triangles, 100000u);
+    EXPECT_GT(s.triangleCount(), 30000u);
+    glm::vec3 lo(1e9f), hi(-1e9f);
+    for (std::size_t k = 0; k < obj->positions.size(); ++k) {
+        const glm::vec3& p = obj->positions[k];
+        const glm::vec3& n = obj->normals[k];
+        ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << k;
+        ASSERT_TRUE(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z)) << k;
+        ASSERT_NEAR(glm::length(n), 1.0f, 1e-4f) << k;
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    // Inside the room, standing on the floor, centred, and well away from the walls.
+    EXPECT_NEAR(lo.y, 0.0f, 1e-6f);
+    EXPECT_LT(hi.y, 1.5f);
+    EXPECT_GT(lo.x, -0.9f);
+    EXPECT_LT(hi.x, 0.9f);
+    EXPECT_GT(lo.z, -0.9f);
+    EXPECT_LT(hi.z, 0.9f);
+    expectNear(s.bounds.min, {-1, 0, -1});
+    expectNear(s.bounds.max, {1, 2, 1});
+
+    // Smooth: neighbouring vertex normals vary, i.e. the surface is really bumpy, not a plain sphere.
+    float minDot = 1.0f;
+    for (std::size_t t = 0; t < obj->indices.size(); t += 3)
+        minDot = std::min(minDot, glm::dot(obj->normals[obj->indices[t]], obj->normals[obj->indices[t + 1]]));
+    EXPECT_LT(minDot, 0.9f);
+
+    // Deterministic: a second build is bit-identical.
+    const Scene again = makeBuiltinScene("cornell-dense");
+    const Mesh* obj2 = findMesh(again, "bumpy_sphere");
+    ASSERT_NE(obj2, nullptr);
+    EXPECT_EQ(obj->positions, obj2->positions);
+    EXPECT_EQ(obj->normals, obj2->normals);
+    EXPECT_EQ(obj->indices, obj2->indices);
 }
 
 TEST(BuiltinScenes, CreaseLightAimsAtTheCrease) {
