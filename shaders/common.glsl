@@ -24,3 +24,17 @@ float spotFactor(vec3 dirFromLight) {
     float t = clamp((cd - cosOuter) / max(cosInner - cosOuter, 1e-4), 0.0, 1.0);
     return t * t;
 }
+
+// Solid angle (sr) of the RSM texel centred at `texelCentre` (texel units) seen from the spotlight.
+// exact (rsm_solid_angle=exact): the texel's area on the unit-distance image plane,
+// (2 tan(fov/2) / N)^2, times cos^3 of its off-axis angle, so the texels' sum is the frustum's solid
+// angle. equal: 001 Eq. 4, the frustum's solid angle 4 asin(t^2 / (1 + t^2)) split evenly over N^2
+// texels (biased: brighter off-axis, dimmer on-axis; 000 Fig. 13).
+float rsmTexelSolidAngle(vec2 texelCentre) {
+    float res = max(gFrame.rsmInfo.x, 1.0);
+    float t = gFrame.rsmInfo.y;
+    if (gFrame.toneInfo.w > 0.5) return 4.0 * asin(clamp(t * t / (1.0 + t * t), 0.0, 1.0)) / (res * res);
+    vec2 uv = (texelCentre / res * 2.0 - 1.0) * t;
+    float texel = 2.0 * t / res;
+    return texel * texel * pow(1.0 + dot(uv, uv), -1.5);
+}

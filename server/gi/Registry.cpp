@@ -1,6 +1,7 @@
 #include "core/Error.h"
 #include "gi/Technique.h"
 #include "gi/none/NoIndirect.h"
+#include "gi/multires_gather/MultiresGather.h"
 #include "gi/rsm_gather/RsmGather.h"
 
 namespace gis {
@@ -9,6 +10,7 @@ const std::vector<TechniqueEntry>& techniqueRegistry() {
     static const std::vector<TechniqueEntry> registry = {
         {NoIndirect::info(), [] { return std::make_unique<NoIndirect>(); }},
         {RsmGather::info(), [] { return std::make_unique<RsmGather>(); }},
+        {MultiresGather::info(), [] { return std::make_unique<MultiresGather>(); }},
     };
     return registry;
 }

@@ -58,6 +58,10 @@ void Framebuffer::attachDepth(const Texture& texture, int level) {
     glNamedFramebufferTexture(id(), GL_DEPTH_ATTACHMENT, texture.id(), level);
 }
 
+void Framebuffer::attachDepthStencil(const Texture& texture, int level) {
+    glNamedFramebufferTexture(id(), GL_DEPTH_STENCIL_ATTACHMENT, texture.id(), level);
+}
+
 void Framebuffer::finish(int colorCount, const std::string& label) {
     GLenum buffers[8];
     GIS_ASSERT(colorCount >= 0 && colorCount <= 8);

@@ -83,6 +83,7 @@ public:
     static Framebuffer create();
     void attachColor(int index, const Texture& texture, int level = 0);
     void attachDepth(const Texture& texture, int level = 0);
+    void attachDepthStencil(const Texture& texture, int level = 0); ///< GL_DEPTH24_STENCIL8 texture
     /// Selects the draw buffers 0..count-1 and checks completeness; throws gis::Error naming `label`.
     void finish(int colorCount, const std::string& label);
 

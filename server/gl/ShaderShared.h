@@ -8,7 +8,9 @@
 namespace gis::shader {
 using vec4 = glm::vec4;
 using mat4 = glm::mat4;
+using ivec4 = glm::ivec4;
 #include "shaders/shared/FrameData.h"
+#include "shaders/shared/EyeHierarchy.h"
 
 static_assert(sizeof(FrameUniforms) % 16 == 0, "std140 blocks must be whole vec4s");
 static_assert(sizeof(FrameUniforms) == 2 * 64 + 7 * 16, "FrameUniforms layout drifted from the GLSL side");
@@ -16,4 +18,6 @@ static_assert(offsetof(FrameUniforms, lightViewProj) == 64);
 static_assert(offsetof(FrameUniforms, toneInfo) == 128 + 6 * 16);
 static_assert(sizeof(Vpl) == 48, "Vpl must be three vec4s in std140 and std430");
 static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) <= 65536, "a VPL batch must fit the 64 KiB UBO limit");
+static_assert(sizeof(EyeHierarchyUniforms) == GIS_MAX_EYE_LEVELS * 16 + 2 * 16, "EyeHierarchyUniforms drifted");
+static_assert(offsetof(EyeHierarchyUniforms, info) == GIS_MAX_EYE_LEVELS * 16);
 } // namespace gis::shader

@@ -17,19 +17,8 @@ void main() {
     vec3 l = d2 > 1e-20 ? toLight * inversesqrt(d2) : -gFrame.lightDir.xyz;
     vec3 n = safeNormal(vNormal, vWorldPos, l);
 
-    // Exact solid angle of this texel seen from the light: the texel's area on the image plane at
-    // unit distance, (2 tan(fov/2) / N)^2, times cos^3 of its off-axis angle. Using it (rather than
-    // an equal solid angle per texel) makes the flux sum exact (000 Fig. 13 discusses the bias).
-    float res = gFrame.rsmInfo.x;
-    float t = gFrame.rsmInfo.y;
-    vec2 uv = (gl_FragCoord.xy / res * 2.0 - 1.0) * t;
-    float texel = 2.0 * t / res;
-    float solidAngle = texel * texel * pow(1.0 + dot(uv, uv), -1.5);
-    if (gFrame.toneInfo.w > 0.5) {
-        // 001 Eq. 4: every texel gets the frustum's solid angle / N^2. A square frustum of half-angle
-        // tangent t subtends 4 asin(t^2 / (1 + t^2)) sr. Brighter off-axis, dimmer on-axis (000 Fig. 13).
-        solidAngle = 4.0 * asin(clamp(t * t / (1.0 + t * t), 0.0, 1.0)) / (res * res);
-    }
+    // Exact per-texel solid angle (or 001 Eq. 4's equal split): see rsmTexelSolidAngle.
+    float solidAngle = rsmTexelSolidAngle(gl_FragCoord.xy);
 
     float intensity = gFrame.lightPos.w * spotFactor(-l);
     vec3 albedo = materialAlbedo(vTexcoord);

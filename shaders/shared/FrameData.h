@@ -23,7 +23,7 @@ struct FrameUniforms {
 // One virtual point light: a diffuse emitter of reflected flux at an RSM sample.
 struct Vpl {
     vec4 position;  // xyz: world position (m); w: 1 valid, 0 empty (contributes nothing)
-    vec4 normal;    // xyz: unit surface normal; w: unused
+    vec4 normal;    // xyz: unit surface normal; w: disk area A (m^2, 001 Eq. 3)
     vec4 flux;      // rgb: reflected flux (W, in the renderer's intensity units); w: texels merged
 };
 

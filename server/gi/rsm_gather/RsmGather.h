@@ -15,13 +15,15 @@
 //
 // Parameters:
 //   vpl_grid      VPLs per side, [1, 256] (clamped to rsm_size), default 16 (256 VPLs)
-//   min_distance  distance clamp of the 1/d^2 falloff, [0, 1] m, default 0.1 m
+//   kernel        point (000 Eq. 2, default) or disk (001 Eq. 1: bounded, needs no clamp)
+//   min_distance  point kernel: distance clamp of the 1/d^2 falloff, [0, 1] m, default 0.1 m
 //
 // Limits: no indirect visibility (light leaks behind occluders, as in 000/001); VPLs are diffuse;
 // grid sampling ignores flux (000 suggests importance sampling as future work).
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/VplGrid.h"
 #include "gl/Shader.h"
 
 namespace gis {
@@ -31,13 +33,13 @@ public:
     static TechniqueInfo info();
     RsmGather();
     void resize(int width, int height) override;
-    void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer, Counters& counters) override;
+    void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                 Counters& counters) override;
     const gl::Texture* indirect() const override { return &mIndirect; }
 
 private:
-    gl::Program mExtract;
-    gl::Program mGather;
-    gl::Buffer mVpls;
+    VplGrid mVpls;
+    KernelPrograms mGather;
     gl::Texture mIndirect;
     gl::Framebuffer mTarget;
     gl::VertexArray mEmptyVao;

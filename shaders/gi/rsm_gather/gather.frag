@@ -2,7 +2,7 @@
 // Full-resolution gather (digest S.3 preset rsm_naive, receivers R0): every covered pixel sums the
 // irradiance of every VPL in the current batch. Batches are accumulated with additive blending.
 #include "common.glsl"
-#include "gi/vpl_transport.glsl"
+#include "gi/common/vpl_transport.glsl"
 
 layout(binding = 0) uniform sampler2D gPosition;
 layout(binding = 1) uniform sampler2D gNormal;
@@ -13,7 +13,7 @@ layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
 };
 
 uniform int uVplCount;       // VPLs in this batch
-uniform float uMinDistance;  // m
+uniform float uMinDistance;  // m, point kernel only
 
 layout(location = 0) out vec4 outRadiance;
 
@@ -27,8 +27,7 @@ void main() {
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     vec3 e = vec3(0.0);
     for (int i = 0; i < uVplCount; ++i) {
-        Vpl v = gVpls[i];
-        e += vplIrradiance(pos.xyz, n, v.position.xyz, v.normal.xyz, v.flux.rgb, uMinDistance) * v.position.w;
+        e += vplIrradianceSelected(pos.xyz, n, gVpls[i], uMinDistance);
     }
     vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
     outRadiance = vec4(max(sanitize(albedo * kInvPi * e), vec3(0.0)), 1.0);

@@ -1,8 +1,9 @@
 #version 450 core
 // VPLs on a regular RSM grid (000 §3 step 3): one VPL per grid cell, placed at the cell's centre
 // texel (or the valid texel nearest to it) and carrying the summed flux of every valid texel in the
-// cell, so the VPL set conserves the RSM's total flux exactly (digest S.4 case 7).
-#include "shared/FrameData.h"
+// cell, so the VPL set conserves the RSM's total flux exactly (digest S.4 case 7). The VPL's disk
+// area (001 Eq. 3, A = omega |V|^2 summed over the cell's texels, m^2) feeds the disk kernel.
+#include "common.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -27,14 +28,18 @@ void main() {
 
     vec3 flux = vec3(0.0);
     float texels = 0.0;
+    float area = 0.0;
     ivec2 best = ivec2(-1);
     int bestDist = 1 << 30;
     for (int y = lo.y; y < hi.y; ++y)
         for (int x = lo.x; x < hi.x; ++x) {
             ivec2 t = ivec2(x, y);
-            if (texelFetch(gRsmPosition, t, 0).w < 0.5) continue; // empty texel: no surface
+            vec4 p = texelFetch(gRsmPosition, t, 0);
+            if (p.w < 0.5) continue; // empty texel: no surface
             flux += texelFetch(gRsmFlux, t, 0).rgb;
             texels += 1.0;
+            vec3 v = p.xyz - gFrame.lightPos.xyz;
+            area += rsmTexelSolidAngle(vec2(t) + 0.5) * dot(v, v);
             ivec2 d = t - centre;
             int dist = d.x * d.x + d.y * d.y;
             if (dist < bestDist) {
@@ -50,7 +55,7 @@ void main() {
         v.flux = vec4(0.0);
     } else {
         v.position = vec4(texelFetch(gRsmPosition, best, 0).xyz, 1.0);
-        v.normal = vec4(texelFetch(gRsmNormal, best, 0).xyz, 0.0);
+        v.normal = vec4(texelFetch(gRsmNormal, best, 0).xyz, area);
         v.flux = vec4(flux, texels);
     }
     gVplsOut[index] = v;

@@ -1,0 +1,83 @@
+#include "gi/common/VplGrid.h"
+
+#include <algorithm>
+
+#include "gl/ShaderShared.h"
+
+namespace gis {
+
+std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel) {
+    return {
+        {.name = "vpl_grid",
+         .type = ParamType::Int,
+         .defaultValue = 16,
+         .min = 1,
+         .max = 256,
+         .unit = "VPLs per side",
+         .help = "VPLs on a regular RSM grid, vpl_grid^2 in total (<= rsm_size)",
+         .source = "000 §3.1; 001 Table 1 uses 256 VPLs"},
+        {.name = "kernel",
+         .type = ParamType::Enum,
+         .defaultValue = static_cast<double>(defaultKernel),
+         .help = "VPL kernel: point with distance clamp (000 Eq. 2) or disk-to-point form factor (001 Eq. 1)",
+         .source = "000 Eq. 2; 001 Eq. 1",
+         .options = {"point", "disk"}},
+        {.name = "min_distance",
+         .type = ParamType::Float,
+         .defaultValue = 0.1,
+         .min = 0.0,
+         .max = 1.0,
+         .unit = "m",
+         .help = "point kernel only: distance clamp of the 1/d^2 falloff (bounds the r->0 singularity)",
+         .source = "000 Fig. 13 (value not given; chosen)"},
+    };
+}
+
+VplKernel vplKernel(const ParamSet& params) {
+    return params.getEnum("kernel") == "disk" ? VplKernel::Disk : VplKernel::Point;
+}
+
+KernelPrograms::KernelPrograms(const std::vector<gl::ShaderStage>& stages) {
+    mPoint = gl::Program::build(stages, {{"GIS_VPL_KERNEL", "GIS_KERNEL_POINT"}});
+    mDisk = gl::Program::build(stages, {{"GIS_VPL_KERNEL", "GIS_KERNEL_DISK"}});
+}
+
+VplGrid::VplGrid() {
+    mExtract = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/vpl_extract.comp"}});
+}
+
+int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Counters& counters) {
+    grid = std::clamp(grid, 1, std::max(in.rsmSize, 1));
+    mCount = in.lightEnabled ? grid * grid : 0;
+    counters["vpl_count"] = mCount;
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(std::max(mCount, 1)) * sizeof(shader::Vpl);
+    if (mVpls.size() < bytes) mVpls = gl::Buffer::create(bytes);
+    if (mCount == 0) return 0;
+
+    timer.begin("vpl_extract");
+    glUseProgram(mExtract.id());
+    glUniform1i(mExtract.uniform("uGrid"), grid);
+    glUniform1i(mExtract.uniform("uRsmSize"), in.rsmSize);
+    glBindTextureUnit(0, in.rsmPosition->id());
+    glBindTextureUnit(1, in.rsmNormal->id());
+    glBindTextureUnit(2, in.rsmFlux->id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
+    glDispatchCompute(static_cast<GLuint>((mCount + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    timer.end();
+    return mCount;
+}
+
+int VplGrid::forEachBatch(const std::function<void(int batchCount)>& draw) const {
+    int batches = 0;
+    for (int first = 0; first < mCount; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
+        const int count = std::min(GIS_MAX_VPLS_PER_BATCH, mCount - first);
+        glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, mVpls.id(),
+                          static_cast<GLintptr>(first) * static_cast<GLintptr>(sizeof(shader::Vpl)),
+                          static_cast<GLsizeiptr>(count) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
+        draw(count);
+    }
+    return batches;
+}
+
+} // namespace gis

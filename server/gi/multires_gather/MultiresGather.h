@@ -1,0 +1,49 @@
+// Technique `multires_gather`: one-bounce indirect light gathered into a multiresolution buffer
+// selected by a one-pass stencil, then reconstructed to full resolution.
+//
+// Paper: 001 (Nichols, Shopf & Wyman 2009) §3.2; digest S.3 preset multires_gather (VPL set A,
+// receivers R3, kernel K2, reconstruction U1).
+//
+// Pipeline:
+//   1. (renderer) RSM and G-buffer
+//   2. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid into the compact VPL buffer (the cache)
+//   3. eye_mipmap: level 0 statistics from the G-buffer, min-max / derivative / curvature mips up
+//      to the coarsest level, and the refinement flag of every texel (EyeHierarchy)
+//   4. stencil_setup: one full-screen pass over the flattened buffer sets stencil 1 at receivers
+//   5. vpl_gather: one full-screen pass per VPL batch with the stencil test; receivers sum the kernel
+//   6. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel
+//
+// Parameters: vpl_grid [1, 256] (16), kernel point|disk (disk), min_distance [0, 1] m (0.1, point
+// only); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16, depth 0.1 relative,
+// normal 0.25, diagonal on, detail_alpha 0).
+//
+// Limits: no indirect visibility; diffuse receivers; a coarse patch is lit at its mean position and
+// normal, so light varying inside a flat patch (near a VPL) is averaged: depth_threshold trades this.
+#pragma once
+
+#include "gi/Technique.h"
+#include "gi/common/EyeHierarchy.h"
+#include "gi/common/VplGrid.h"
+
+namespace gis {
+
+class MultiresGather final : public Technique {
+public:
+    static TechniqueInfo info();
+    MultiresGather();
+    void resize(int width, int height) override;
+    void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                 Counters& counters) override;
+    const gl::Texture* indirect() const override { return &mIndirect; }
+    EyeHierarchy& hierarchy() { return mEye; }
+
+private:
+    VplGrid mVpls;
+    EyeHierarchy mEye;
+    KernelPrograms mGather;
+    gl::VertexArray mEmptyVao;
+    gl::Texture mIndirect;
+    gl::Framebuffer mTarget;
+};
+
+} // namespace gis

@@ -1,0 +1,78 @@
+// Eye-space hierarchy access shared by every multiresolution pass (layout: shared/EyeHierarchy.h).
+#include "shared/EyeHierarchy.h"
+
+layout(std140, binding = GIS_UBO_EYE) uniform EyeBlock {
+    EyeHierarchyUniforms gEye;
+};
+
+int eyeLevelCount() { return gEye.info.x; }
+ivec2 eyeLevelSize(int level) { return gEye.level[level].zw; }
+ivec2 eyeAtlas(int level, ivec2 t) { return gEye.level[level].xy + t; }
+bool eyeInLevel(int level, ivec2 t) { return all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, gEye.level[level].zw)); }
+
+// The level holding atlas texel `a` (and the texel within it), or -1 for padding.
+int eyeLevelOf(ivec2 a, out ivec2 t) {
+    for (int l = 0; l < gEye.info.x; ++l) {
+        t = a - gEye.level[l].xy;
+        if (eyeInLevel(l, t)) return l;
+    }
+    t = ivec2(-1);
+    return -1;
+}
+
+// Full-resolution pixels under texel t of `level` (fewer on the last row/column of odd sizes).
+float eyeFootprintPixels(int level, ivec2 t) {
+    int s = 1 << level;
+    ivec2 lo = t * s;
+    ivec2 hi = min(lo + s, gEye.info.yz);
+    ivec2 n = max(hi - lo, ivec2(0));
+    return float(n.x * n.y);
+}
+
+// The receiver predicate (digest S.3 R2 == R3). A patch receives light when it has geometry, needs
+// no subdivision, and every ancestor was subdivided. 001's pseudo-code tests only the parent, which
+// equals the iterative refinement only when the refine test is monotone (a child never refines
+// without its parent); the diagonal rule breaks that, so the whole ancestor chain is tested
+// (<= C lookups). Boundary cases (001 leaves them open): the coarsest level has no ancestor, and
+// the finest level never refines, so its covered pixels receive whenever all ancestors refined.
+// Level 0 lives in the G-buffer: `pixelCovered` is its coverage at t when level == 0.
+bool eyeIsReceiver(usampler2D flags, int level, ivec2 t, bool pixelCovered) {
+    if (level == 0) {
+        if (!pixelCovered) return false;
+    } else {
+        uint f = texelFetch(flags, eyeAtlas(level, t), 0).r;
+        if ((f & GIS_EYE_FLAG_COVERED) == 0u || (f & GIS_EYE_FLAG_REFINE) != 0u) return false;
+    }
+    for (int l = level + 1; l < gEye.info.x; ++l) {
+        t >>= 1;
+        if ((texelFetch(flags, eyeAtlas(l, t), 0).r & GIS_EYE_FLAG_REFINE) == 0u) return false;
+    }
+    return true;
+}
+
+// Coarse-to-fine reconstruction step (000 §3.5, digest S.3 U1) for texel t of level `coarse - 1`:
+// when the texel lies under a coarser receiver (its parent holds data), interpolate the finished
+// coarse level bilinearly using only the coarse texels that hold data (alpha > 0), weights
+// renormalised, so energy is never pulled from empty or refined areas nor spread into them.
+// Otherwise the texel stays empty (alpha 0). 000 leaves the weights open: bilinear (tent) weights
+// of the 2x upsample.
+vec4 eyeInterpolateCoarse(sampler2D reconstructed, int coarse, ivec2 t) {
+    if (coarse >= gEye.info.x || texelFetch(reconstructed, eyeAtlas(coarse, t >> 1), 0).a <= 0.0) return vec4(0.0);
+    vec2 c = (vec2(t) + 0.5) * 0.5 - 0.5; // centre of t in the coarse level's texel coordinates
+    ivec2 base = ivec2(floor(c));
+    vec2 f = c - vec2(base);
+    vec3 sum = vec3(0.0);
+    float weight = 0.0;
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            ivec2 q = base + ivec2(i, j);
+            if (!eyeInLevel(coarse, q)) continue;
+            vec4 v = texelFetch(reconstructed, eyeAtlas(coarse, q), 0);
+            if (v.a <= 0.0) continue;
+            float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
+            sum += w * v.rgb;
+            weight += w;
+        }
+    // The parent holds data with weight >= 1/16, so weight > 0; guarded anyway.
+    return weight > 0.0 ? vec4(sum / weight, 1.0) : vec4(0.0);
+}

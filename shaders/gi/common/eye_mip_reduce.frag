@@ -1,0 +1,97 @@
+#version 450 core
+// One coarser level of the eye hierarchy (min-max mipmaps, 000 §3 step 4; 001 §3.1 step 3): min of
+// mins, max of maxes, max of the derivative and curvature max-mips, and coverage-weighted means of
+// position, normal and albedo (the coarse patch's receiver sample). Level 1 reduces G-buffer pixels
+// directly (GIS_FROM_GBUFFER); coarser levels read the level below from the atlas textures they
+// render into (the viewport covers only this level; glTextureBarrier between levels makes that
+// defined, GL 4.5 §9.3). Odd sizes: a texel reduces only the children that exist.
+#include "common.glsl"
+#include "gi/common/eye_hierarchy.glsl"
+#include "gi/common/eye_pixel.glsl"
+
+layout(binding = 0) uniform sampler2D uGeoPosition; // xyz mean position (m); w covered pixels
+layout(binding = 1) uniform sampler2D uGeoNormal;   // xyz mean unit normal
+layout(binding = 2) uniform sampler2D uGeoAlbedo;   // rgb mean albedo
+layout(binding = 3) uniform sampler2D uDepthInfo;   // x min d; y max d (m); z max |grad d|/d; w max curvature
+layout(binding = 4) uniform sampler2D uNormalMin;   // xyz per-component min
+layout(binding = 5) uniform sampler2D uNormalMax;   // xyz per-component max
+
+layout(location = 0) out vec4 outGeoPosition;
+layout(location = 1) out vec4 outGeoNormal;
+layout(location = 2) out vec4 outGeoAlbedo;
+layout(location = 3) out vec4 outDepthInfo;
+layout(location = 4) out vec4 outNormalMin;
+layout(location = 5) out vec4 outNormalMax;
+
+uniform int uLevel; // the level written (>= 1)
+
+struct PatchStats {
+    float count;
+    vec3 pos, normal, albedo, nmin, nmax;
+    vec4 depth;
+};
+
+PatchStats childStats(ivec2 c) {
+    PatchStats s;
+#if GIS_FROM_GBUFFER
+    s.count = eyePixelCovered(c) ? 1.0 : 0.0;
+    if (s.count == 0.0) {
+        s.depth = vec4(3.0e38, -3.0e38, 0.0, 0.0);
+        return s;
+    }
+    s.pos = texelFetch(gPosition, c, 0).xyz;
+    s.normal = texelFetch(gNormal, c, 0).xyz;
+    s.albedo = texelFetch(gAlbedo, c, 0).rgb;
+    s.nmin = s.normal;
+    s.nmax = s.normal;
+    float d = length(s.pos - gFrame.cameraPos.xyz);
+    s.depth = vec4(d, d, eyePixelDerivativeCurvature(c, d, s.normal));
+#else
+    ivec2 a = eyeAtlas(uLevel - 1, c);
+    vec4 gp = texelFetch(uGeoPosition, a, 0);
+    s.count = gp.w;
+    s.depth = texelFetch(uDepthInfo, a, 0);
+    if (s.count <= 0.0) return s;
+    s.pos = gp.xyz;
+    s.normal = texelFetch(uGeoNormal, a, 0).xyz;
+    s.albedo = texelFetch(uGeoAlbedo, a, 0).rgb;
+    s.nmin = texelFetch(uNormalMin, a, 0).xyz;
+    s.nmax = texelFetch(uNormalMax, a, 0).xyz;
+#endif
+    return s;
+}
+
+void main() {
+    ivec2 t = ivec2(gl_FragCoord.xy) - gEye.level[uLevel].xy;
+    ivec2 childSize = uLevel == 1 ? gEye.info.yz : gEye.level[uLevel - 1].zw;
+    float count = 0.0;
+    vec3 pos = vec3(0.0), nrm = vec3(0.0), alb = vec3(0.0);
+    vec4 depth = vec4(3.0e38, -3.0e38, 0.0, 0.0);
+    vec3 nmin = vec3(2.0), nmax = vec3(-2.0);
+    vec3 firstNormal = vec3(0.0);
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            ivec2 c = 2 * t + ivec2(i, j);
+            if (any(greaterThanEqual(c, childSize))) continue;
+            PatchStats s = childStats(c);
+            depth = vec4(min(depth.x, s.depth.x), max(depth.y, s.depth.y), max(depth.zw, s.depth.zw));
+            if (s.count <= 0.0) continue;
+            if (count == 0.0) firstNormal = s.normal;
+            count += s.count;
+            pos += s.pos * s.count;
+            nrm += s.normal * s.count;
+            alb += s.albedo * s.count;
+            nmin = min(nmin, s.nmin);
+            nmax = max(nmax, s.nmax);
+        }
+    float inv = count > 0.0 ? 1.0 / count : 0.0;
+    // Opposing normals can cancel: keep a child's normal rather than normalising ~0.
+    float len = length(nrm);
+    vec3 n = len > 1e-6 * max(count, 1.0) ? nrm / len : firstNormal;
+    outGeoPosition = vec4(pos * inv, count);
+    outGeoNormal = vec4(n, 0.0);
+    outGeoAlbedo = vec4(alb * inv, 0.0);
+    outDepthInfo = depth;
+    outNormalMin = vec4(nmin, 0.0);
+    outNormalMax = vec4(nmax, 0.0);
+}

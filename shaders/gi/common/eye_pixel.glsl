@@ -1,0 +1,30 @@
+// Level 0 of the eye hierarchy is the G-buffer itself (not copied into the atlas): the per-pixel
+// statistics the coarser levels reduce, computed on demand.
+layout(binding = 8) uniform sampler2D gPosition; // RGBA32F world position, w = 1 covered
+layout(binding = 9) uniform sampler2D gNormal;   // RGBA16F unit normal
+layout(binding = 10) uniform sampler2D gAlbedo;  // RGBA8 linear albedo
+
+bool eyePixelCovered(ivec2 p) {
+    return all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, gEye.info.yz)) && texelFetch(gPosition, p, 0).w > 0.5;
+}
+float eyePixelDistance(ivec2 p) { return length(texelFetch(gPosition, p, 0).xyz - gFrame.cameraPos.xyz); }
+
+// Relative depth derivative and curvature of covered pixel p (only when a metric needs them).
+// Derivative: the larger one-sided difference to a covered neighbour along each axis, so a step
+// between two surfaces registers in full (a central difference would halve it); relative to d so
+// thresholds do not depend on the scene's scale. Curvature: 2 sin(angle / 2) between unit normals
+// equals the chord |n1 - n2| (000 Eq. 1 without the acos); max over the 4 neighbours.
+vec2 eyePixelDerivativeCurvature(ivec2 p, float d, vec3 n) {
+    if ((gEye.info.w & (GIS_EYE_DEPTH_DERIVATIVE | GIS_EYE_CURVATURE)) == 0) return vec2(0.0);
+    vec2 grad = vec2(0.0);
+    float curvature = 0.0;
+    const ivec2 kOffsets[4] = ivec2[4](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
+    for (int i = 0; i < 4; ++i) {
+        ivec2 q = p + kOffsets[i];
+        if (!eyePixelCovered(q)) continue;
+        float dq = abs(eyePixelDistance(q) - d);
+        if (i < 2) grad.x = max(grad.x, dq); else grad.y = max(grad.y, dq);
+        curvature = max(curvature, length(texelFetch(gNormal, q, 0).xyz - n));
+    }
+    return vec2(length(grad) / max(d, 1e-6), curvature);
+}

@@ -1,0 +1,34 @@
+#version 450 core
+// Stenciled multiresolution gather (001 §3.2.2): one full-screen pass over the flattened
+// multiresolution buffer per batch of VPLs; the early stencil test leaves only receiver patches,
+// each of which sums the irradiance of every VPL in the batch (the VPL cache is the compact VPL
+// buffer bound as a uniform block) at its mean position and normal. Irradiance only: the albedo is
+// applied per pixel after reconstruction.
+#include "common.glsl"
+#include "gi/common/vpl_transport.glsl"
+
+layout(early_fragment_tests) in;
+
+layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position, w covered pixels
+layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
+layout(binding = 8) uniform sampler2D gPosition;    // level 0 is the G-buffer itself
+layout(binding = 9) uniform sampler2D gNormal;
+
+layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
+    Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
+};
+
+uniform int uVplCount;
+uniform float uMinDistance; // m, point kernel only
+
+layout(location = 0) out vec4 outIrradiance; // rgb added by blending; alpha 1 marks data
+
+void main() {
+    ivec2 a = ivec2(gl_FragCoord.xy);
+    bool pixel = all(lessThan(vec2(a), gFrame.viewport.xy));
+    vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
+    vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
+    vec3 e = vec3(0.0);
+    for (int i = 0; i < uVplCount; ++i) e += vplIrradianceSelected(pos, n, gVpls[i], uMinDistance);
+    outIrradiance = vec4(max(sanitize(e), vec3(0.0)), 1.0);
+}
