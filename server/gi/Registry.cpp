@@ -1,5 +1,7 @@
 #include "core/Error.h"
 #include "gi/Technique.h"
+#include "gi/hier_isr/HierIsr.h"
+#include "gi/isr/Isr.h"
 #include "gi/none/NoIndirect.h"
 #include "gi/multires_gather/MultiresGather.h"
 #include "gi/rsm_gather/RsmGather.h"
@@ -11,6 +13,8 @@ const std::vector<TechniqueEntry>& techniqueRegistry() {
         {NoIndirect::info(), [] { return std::make_unique<NoIndirect>(); }},
         {RsmGather::info(), [] { return std::make_unique<RsmGather>(); }},
         {MultiresGather::info(), [] { return std::make_unique<MultiresGather>(); }},
+        {Isr::info(), [] { return std::make_unique<Isr>(); }},
+        {HierIsr::info(), [] { return std::make_unique<HierIsr>(); }},
     };
     return registry;
 }

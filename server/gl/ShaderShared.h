@@ -11,6 +11,7 @@ using mat4 = glm::mat4;
 using ivec4 = glm::ivec4;
 #include "shaders/shared/FrameData.h"
 #include "shaders/shared/EyeHierarchy.h"
+#include "shaders/shared/LightTree.h"
 
 static_assert(sizeof(FrameUniforms) % 16 == 0, "std140 blocks must be whole vec4s");
 static_assert(sizeof(FrameUniforms) == 2 * 64 + 7 * 16, "FrameUniforms layout drifted from the GLSL side");
@@ -20,4 +21,8 @@ static_assert(sizeof(Vpl) == 48, "Vpl must be three vec4s in std140 and std430")
 static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) <= 65536, "a VPL batch must fit the 64 KiB UBO limit");
 static_assert(sizeof(EyeHierarchyUniforms) == GIS_MAX_EYE_LEVELS * 16 + 2 * 16, "EyeHierarchyUniforms drifted");
 static_assert(offsetof(EyeHierarchyUniforms, info) == GIS_MAX_EYE_LEVELS * 16);
+static_assert(sizeof(LightNode) == 80, "LightNode must be five vec4s in std430");
+static_assert(offsetof(LightNode, flux) == offsetof(Vpl, flux), "a LightNode starts with a Vpl's layout");
+static_assert(sizeof(LightTreeUniforms) == GIS_MAX_LIGHT_LEVELS * 16 + 16, "LightTreeUniforms drifted");
+static_assert(offsetof(LightTreeUniforms, info) == GIS_MAX_LIGHT_LEVELS * 16);
 } // namespace gis::shader

@@ -41,6 +41,9 @@ public:
     /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics).
     FrameOutput render(const FrameState& state, bool wantLinear = false);
 
+    /// The technique of the last frame (tests inspect its intermediate buffers); may be null.
+    Technique* technique() { return mTechnique.get(); }
+
     /// Camera and spotlight matrices exactly as the pipeline builds them (also used by tests and
     /// the reference renderer so both see the same view).
     static glm::mat4 cameraViewProj(const Camera& camera, int width, int height);

@@ -68,16 +68,20 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
     return mCount;
 }
 
-int VplGrid::forEachBatch(const std::function<void(int batchCount)>& draw) const {
+int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(int batchCount)>& draw) {
     int batches = 0;
-    for (int first = 0; first < mCount; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
-        const int count = std::min(GIS_MAX_VPLS_PER_BATCH, mCount - first);
-        glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, mVpls.id(),
+    for (int first = 0; first < count; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
+        const int n = std::min(GIS_MAX_VPLS_PER_BATCH, count - first);
+        glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, vpls.id(),
                           static_cast<GLintptr>(first) * static_cast<GLintptr>(sizeof(shader::Vpl)),
-                          static_cast<GLsizeiptr>(count) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
-        draw(count);
+                          static_cast<GLsizeiptr>(n) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
+        draw(n);
     }
     return batches;
+}
+
+int VplGrid::forEachBatch(const std::function<void(int batchCount)>& draw) const {
+    return forEachVplBatch(mVpls, mCount, draw);
 }
 
 } // namespace gis

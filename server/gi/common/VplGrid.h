@@ -31,6 +31,10 @@ private:
     gl::Program mPoint, mDisk;
 };
 
+/// Binds the first `count` VPLs of `vpls` batch by batch (GIS_MAX_VPLS_PER_BATCH each) at
+/// GIS_UBO_VPLS and calls `draw(batchCount)` for each batch. Returns the number of batches.
+int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(int batchCount)>& draw);
+
 class VplGrid {
 public:
     VplGrid();

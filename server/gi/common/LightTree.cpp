@@ -1,0 +1,90 @@
+#include "gi/common/LightTree.h"
+
+#include <algorithm>
+
+#include "core/Error.h"
+
+namespace gis {
+
+std::vector<LightLevel> lightTreeLayout(int rsmSize) {
+    GIS_ASSERT(rsmSize > 0);
+    std::vector<LightLevel> levels;
+    int offset = 0;
+    for (int side = rsmSize;; side = (side + 1) / 2) {
+        levels.push_back({offset, side});
+        offset += side * side;
+        if (side == 1) break;
+    }
+    GIS_ASSERT(levels.size() <= GIS_MAX_LIGHT_LEVELS);
+    return levels;
+}
+
+int lightLevelForResolution(const std::vector<LightLevel>& levels, int resolution) {
+    for (size_t l = 0; l < levels.size(); ++l)
+        if (levels[l].side <= resolution) return static_cast<int>(l);
+    return static_cast<int>(levels.size()) - 1; // resolution < 1: the 1 x 1 root
+}
+
+LightTree::LightTree() {
+    mBuild = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/light_tree_build.comp"}});
+    mUbo = gl::Buffer::create(sizeof(shader::LightTreeUniforms));
+}
+
+void LightTree::ensureLayout(int rsmSize) {
+    if (rsmSize == mRsmSize && mNodes) return;
+    mLevels = lightTreeLayout(rsmSize);
+    const LightLevel& last = mLevels.back();
+    const int nodeCount = last.offset + last.side * last.side;
+    mNodes = gl::Buffer::create(static_cast<GLsizeiptr>(nodeCount) *
+                                static_cast<GLsizeiptr>(sizeof(shader::LightNode)));
+    shader::LightTreeUniforms u{};
+    for (size_t l = 0; l < mLevels.size(); ++l)
+        u.level[l] = glm::ivec4(mLevels[l].offset, mLevels[l].side, 1 << l, 0);
+    u.info = glm::ivec4(static_cast<int>(mLevels.size()), rsmSize, nodeCount, 0);
+    mUbo.upload(0, sizeof u, &u);
+    mRsmSize = rsmSize;
+}
+
+void LightTree::bind() const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GIS_SSBO_LIGHT_NODES, mNodes.id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHT_TREE, mUbo.id());
+}
+
+void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
+    mLastInputs = in;
+    mValid = false;
+    if (in.rsmSize <= 0 || !in.rsmPosition) return;
+    ensureLayout(in.rsmSize);
+    counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
+    counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);
+    if (!in.lightEnabled) return;
+
+    timer.begin("light_tree");
+    glUseProgram(mBuild.id());
+    bind();
+    glBindTextureUnit(0, in.rsmPosition->id());
+    glBindTextureUnit(1, in.rsmNormal->id());
+    glBindTextureUnit(2, in.rsmFlux->id());
+    const GLint levelLoc = mBuild.uniform("uLevel");
+    // Level 1's dispatch writes level 0 too (light_tree_build.comp); then one dispatch per level.
+    for (size_t l = 1; l < mLevels.size(); ++l) {
+        if (l > 1) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); // level l - 1 is complete
+        glUniform1i(levelLoc, static_cast<int>(l));
+        const int count = mLevels[l].side * mLevels[l].side;
+        glDispatchCompute(static_cast<GLuint>((count + 63) / 64), 1, 1);
+    }
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    timer.end();
+    mValid = true;
+}
+
+std::vector<shader::LightNode> LightTree::readNodes() const {
+    std::vector<shader::LightNode> nodes;
+    if (!mNodes) return nodes;
+    nodes.resize(static_cast<size_t>(mNodes.size()) / sizeof(shader::LightNode));
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(mNodes.id(), 0, mNodes.size(), nodes.data());
+    return nodes;
+}
+
+} // namespace gis

@@ -1,0 +1,69 @@
+// The light-space VPL tree shared by isr and hier_isr (digest S.3 P4 C and D; 001 §3.4-3.5): an
+// implicit mip pyramid of the RSM from R x R (R = rsm_size) down to 1 x 1, every node holding the
+// exact sums (flux, disk area, valid texels), the flux-weighted mean position and normal, and the
+// min-max light distance and normal components of the texels under it.
+//
+// 001 keeps the tree "in one flat texture" with Haar-like clustering. The GL 4.5 form is one shader
+// storage buffer of LightNode records, level-major and row-major per level (shared/LightTree.h), plus
+// a uniform block with the level offsets: a traversal reads any node with one index computation, and
+// a level is contiguous for the per-level build and selection passes.
+//
+// Build: one compute dispatch per level from level 1 up (level 1's also writes level 0 from the RSM
+// textures), each node reducing its 2x2 children; about 4/3 R^2 nodes of 80 bytes (7 MB at
+// R = 1024). Compute writes the SSBO directly; the fragment + glTextureBarrier route that suits the
+// eye hierarchy's textures would need five render targets and a texture-to-buffer copy for the
+// traversal. 3.3 ms at R = 256 on llvmpipe (2 cores).
+#pragma once
+
+#include <vector>
+
+#include "gi/Technique.h"
+#include "gl/Objects.h"
+#include "gl/PassTimer.h"
+#include "gl/Shader.h"
+#include "gl/ShaderShared.h"
+
+namespace gis {
+
+struct LightLevel {
+    int offset = 0; ///< index of the level's first node in the flat buffer
+    int side = 0;   ///< nodes per side, ceil(R / 2^l)
+};
+
+/// Levels of the tree over an R x R RSM: level 0 is R x R, level l is ceil(R / 2^l) per side, the
+/// last one 1 x 1. Pure, so tests can check it without GL.
+std::vector<LightLevel> lightTreeLayout(int rsmSize);
+/// The finest level whose side does not exceed `resolution` (patches per side): the level a
+/// "16^2 light patches" style parameter names. Clamps to the tree (R when resolution >= R).
+int lightLevelForResolution(const std::vector<LightLevel>& levels, int resolution);
+
+class LightTree {
+public:
+    LightTree();
+    /// Builds every level from the RSM (pass "light_tree"); nothing when the light is off (valid()
+    /// then reports false). Writes the counters vpl_tree_levels and vpl_tree_nodes.
+    void build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters);
+    bool valid() const { return mValid; }
+    const std::vector<LightLevel>& levels() const { return mLevels; }
+    int rsmSize() const { return mRsmSize; }
+    const gl::Buffer& nodes() const { return mNodes; }
+    /// Binds the nodes at GIS_SSBO_LIGHT_NODES and the level table at GIS_UBO_LIGHT_TREE.
+    void bind() const;
+
+    /// Test hooks: the nodes read back (synchronises), and the inputs of the last build (the
+    /// renderer's RSM textures; valid until the renderer reallocates them).
+    std::vector<shader::LightNode> readNodes() const;
+    const FrameInputs& lastInputs() const { return mLastInputs; }
+
+private:
+    void ensureLayout(int rsmSize);
+
+    gl::Program mBuild;
+    gl::Buffer mNodes, mUbo;
+    std::vector<LightLevel> mLevels;
+    int mRsmSize = 0;
+    bool mValid = false;
+    FrameInputs mLastInputs;
+};
+
+} // namespace gis

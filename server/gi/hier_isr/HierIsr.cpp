@@ -1,0 +1,170 @@
+#include "gi/hier_isr/HierIsr.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gis {
+
+LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
+                                  int maxDepthResolution, double tau) {
+    LightCutSettings s;
+    s.leafLevel = lightLevelForResolution(levels, maxDepthResolution);
+    s.startLevel = std::max(s.leafLevel, lightLevelForResolution(levels, coarsestResolution));
+    // Decided on the float the shader sees: a tau that rounds to 0 must not reach the division.
+    s.tau = static_cast<float>(tau);
+    if (!(s.tau > 0.0f))
+        s.mode = LightRefine::Always;
+    else if (s.tau >= 1.0f)
+        s.mode = LightRefine::Never;
+    return s;
+}
+
+std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
+                             const std::vector<LightLevel>& levels, const LightCutSettings& s,
+                             float tanHalfFov, glm::vec3 receiver) {
+    std::vector<int> cut;
+    const float t2 = tanHalfFov * tanHalfFov;
+    const float omega = 4.0f * std::asin(std::clamp(t2 / (1.0f + t2), 0.0f, 1.0f));
+    const float scale = s.mode == LightRefine::Test
+                            ? omega * (1.0f - s.tau) / (3.14159265358979f * std::max(s.tau, 1e-30f))
+                            : 0.0f;
+    const auto index = [&](int level, int x, int y) {
+        const LightLevel& l = levels[static_cast<size_t>(level)];
+        return l.offset + y * l.side + x;
+    };
+    struct Item {
+        int level, x, y;
+    };
+    std::vector<Item> stack;
+    const int rootSide = levels[static_cast<size_t>(s.startLevel)].side;
+    for (int r = 0; r < rootSide * rootSide; ++r) {
+        stack.push_back({s.startLevel, r % rootSide, r / rootSide});
+        while (!stack.empty()) {
+            const Item it = stack.back();
+            stack.pop_back();
+            const int i = index(it.level, it.x, it.y);
+            const shader::LightNode& node = nodes[static_cast<size_t>(i)];
+            if (node.position.w < 0.5f) continue;
+            bool refine = false;
+            if (it.level > s.leafLevel) {
+                if (s.mode == LightRefine::Always) {
+                    refine = true;
+                } else if (s.mode == LightRefine::Test) {
+                    const glm::vec3 v = glm::vec3(node.position) - receiver;
+                    const float side = static_cast<float>(levels[static_cast<size_t>(it.level)].side);
+                    refine = glm::dot(v, v) * side * side <= scale * node.hi.w * node.hi.w;
+                }
+            }
+            if (!refine) {
+                cut.push_back(i);
+                continue;
+            }
+            const int childSide = levels[static_cast<size_t>(it.level - 1)].side;
+            for (int k = 3; k >= 0; --k) {
+                const int cx = it.x * 2 + (k & 1), cy = it.y * 2 + (k >> 1);
+                if (cx < childSide && cy < childSide) stack.push_back({it.level - 1, cx, cy});
+            }
+        }
+    }
+    return cut;
+}
+
+TechniqueInfo HierIsr::info() {
+    std::vector<ParamSpec> specs = {
+        {.name = "tau",
+         .type = ParamType::Float,
+         .defaultValue = 0.01,
+         .min = 0.0,
+         .max = 1.0,
+         .unit = "fraction of I",
+         .help = "refine a light node while its bounded contribution may exceed tau * I (0: full "
+                 "traversal, 1: coarsest level only)",
+         .source = "001 Eqs. 6-8 (no value given; chosen for <5% error at 1/10 the full gather's time)"},
+        {.name = "hier_coarsest",
+         .type = ParamType::Int,
+         .defaultValue = 16,
+         .min = 1,
+         .max = 256,
+         .unit = "patches per side",
+         .help = "where every receiver's traversal starts: the tree level with at most this many patches per "
+                 "side",
+         .source = "001 §3.5 (16^2)"},
+        {.name = "max_depth",
+         .type = ParamType::Int,
+         .defaultValue = 256,
+         .min = 1,
+         .max = 1024,
+         .unit = "patches per side",
+         .help = "finest tree level a traversal visits (maximal traversal depth), clamped to rsm_size",
+         .source = "001 §3.5, Figs. 12-13"},
+    };
+    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    return {"hier_isr", "hierarchical image-space radiosity: per-receiver cuts through the light tree",
+            "001 §3.5", ParamTable(std::move(specs))};
+}
+
+HierIsr::HierIsr() {
+    mGather = gl::Program::build(
+        {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/hier_isr/gather.frag"}});
+    mEmptyVao = gl::VertexArray::create();
+    mStats = gl::Buffer::create(6 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+}
+
+void HierIsr::resize(int width, int height) {
+    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
+    mTarget = gl::Framebuffer::create();
+    mTarget.attachColor(0, mIndirect);
+    mTarget.finish(1, "hier_isr indirect");
+}
+
+void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                      Counters& counters) {
+    mTree.build(in, timer, counters);
+    mEye.build(in, params, timer);
+
+    const GLuint zero[6] = {};
+    mStats.upload(0, sizeof zero, zero);
+    timer.begin("vpl_gather");
+    if (mTree.valid()) {
+        const LightCutSettings s = lightCutSettings(mTree.levels(), params.getInt("hier_coarsest"),
+                                                    params.getInt("max_depth"), params.getFloat("tau"));
+        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
+        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
+        glUseProgram(mGather.id());
+        glUniform1i(mGather.uniform("uStartLevel"), s.startLevel);
+        glUniform1i(mGather.uniform("uLeafLevel"), s.leafLevel);
+        glUniform1i(mGather.uniform("uRefineMode"), static_cast<int>(s.mode));
+        glUniform1f(mGather.uniform("uTau"), s.tau);
+        mTree.bind();
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, mStats.id());
+        glBindTextureUnit(0, mEye.geoPosition().id());
+        glBindTextureUnit(1, mEye.geoNormal().id());
+        mEye.bindPixels(in);
+        glBindVertexArray(mEmptyVao.id());
+        glEnable(GL_STENCIL_TEST);
+        glStencilFunc(GL_EQUAL, 1, 0xFF);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glDisable(GL_BLEND);
+        glDisable(GL_STENCIL_TEST);
+    }
+    timer.end();
+
+    mEye.reconstruct(in, params, true, mTarget, timer);
+    mEye.countReceivers(counters);
+
+    GLuint stats[6] = {};
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(mStats.id(), 0, sizeof stats, stats);
+    const double receivers = counters["receivers_total"];
+    const double visited = static_cast<double>(stats[0]) + 4294967296.0 * static_cast<double>(stats[1]);
+    const double cut = static_cast<double>(stats[3]) + 4294967296.0 * static_cast<double>(stats[4]);
+    counters["nodes_visited_mean"] = receivers > 0 ? visited / receivers : 0.0;
+    counters["nodes_visited_max"] = stats[2];
+    counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
+    counters["cut_size_max"] = stats[5];
+}
+
+} // namespace gis

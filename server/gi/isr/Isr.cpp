@@ -1,0 +1,164 @@
+#include "gi/isr/Isr.h"
+
+#include <algorithm>
+#include <string>
+
+#include "gi/common/VplGrid.h"
+
+namespace gis {
+namespace {
+constexpr int kSelectGroup = 256; // local_size_x of isr/select.comp
+}
+
+TechniqueInfo Isr::info() {
+    std::vector<ParamSpec> specs = {
+        {.name = "isr_coarsest",
+         .type = ParamType::Int,
+         .defaultValue = 16,
+         .min = 1,
+         .max = 256,
+         .unit = "patches per side",
+         .help = "coarsest light patches: the tree level with at most this many patches per side",
+         .source = "001 §3.4, Fig. 7 (16^2)"},
+        {.name = "isr_finest",
+         .type = ParamType::Int,
+         .defaultValue = 64,
+         .min = 1,
+         .max = 256,
+         .unit = "patches per side",
+         .help = "finest light patches (maximum VPL subdivision), clamped to rsm_size",
+         .source = "001 Fig. 10 (64^2)"},
+        {.name = "light_depth_threshold",
+         .type = ParamType::Float,
+         .defaultValue = 0.2,
+         .min = 0.0,
+         .max = 1.0,
+         .unit = "fraction of light distance",
+         .help =
+             "refine a light patch where (max - min) distance to the light exceeds this fraction of the min",
+         .source = "001 §3.4 (no value given; chosen)"},
+        {.name = "light_normal_threshold",
+         .type = ParamType::Float,
+         .defaultValue = 0.25,
+         .min = 0.0,
+         .max = 2.0,
+         .help = "refine a light patch where any normal component's range exceeds this",
+         .source = "001 §3.4 (no value given); 000 Figs. 11-12 eye-space quality setting"},
+    };
+    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    return {"isr", "image-space radiosity: per-frame light-space patches gathered at stencil receivers",
+            "001 §3.4", ParamTable(std::move(specs))};
+}
+
+Isr::Isr() {
+    mSelect = gl::Program::build({{GL_COMPUTE_SHADER, "gi/isr/select.comp"}});
+    // The gather is multires_gather's, always with the disk kernel (001 Eq. 1).
+    mGather = gl::Program::build({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
+                                  {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}},
+                                 {{"GIS_VPL_KERNEL", "GIS_KERNEL_DISK"}});
+    mEmptyVao = gl::VertexArray::create();
+}
+
+void Isr::resize(int width, int height) {
+    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
+    mTarget = gl::Framebuffer::create();
+    mTarget.attachColor(0, mIndirect);
+    mTarget.finish(1, "isr indirect");
+}
+
+int Isr::select(const ParamSet& params, gl::PassTimer& timer, Counters& counters) {
+    const auto& levels = mTree.levels();
+    const int finest = lightLevelForResolution(levels, params.getInt("isr_finest"));
+    const int coarsest = std::max(finest, lightLevelForResolution(levels, params.getInt("isr_coarsest")));
+    const int first = levels[static_cast<size_t>(finest)].offset;
+    const LightLevel& last = levels[static_cast<size_t>(coarsest)];
+    const int nodeCount = last.offset + last.side * last.side - first;
+    const int groups = (nodeCount + kSelectGroup - 1) / kSelectGroup;
+    // Each VPL covers at least one node of the finest level, so that level's size bounds the count.
+    const int capacity = levels[static_cast<size_t>(finest)].side * levels[static_cast<size_t>(finest)].side;
+
+    const GLsizeiptr vplBytes =
+        static_cast<GLsizeiptr>(capacity) * static_cast<GLsizeiptr>(sizeof(shader::Vpl));
+    if (mVpls.size() < vplBytes) mVpls = gl::Buffer::create(vplBytes);
+    const GLsizeiptr header = (1 + GIS_MAX_LIGHT_LEVELS) * sizeof(GLuint);
+    const GLsizeiptr countBytes =
+        header + static_cast<GLsizeiptr>(groups) * static_cast<GLsizeiptr>(sizeof(GLuint));
+    if (mCounts.size() < countBytes)
+        mCounts = gl::Buffer::create(countBytes, nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+
+    timer.begin("isr_select");
+    const GLuint zero = 0;
+    glClearNamedBufferSubData(mCounts.id(), GL_R32UI, 0, header, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glUseProgram(mSelect.id());
+    mTree.bind();
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, mCounts.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, mVpls.id());
+    glUniform1i(mSelect.uniform("uFinest"), finest);
+    glUniform1i(mSelect.uniform("uCoarsest"), coarsest);
+    glUniform1i(mSelect.uniform("uFirst"), first);
+    glUniform1i(mSelect.uniform("uNodeCount"), nodeCount);
+    glUniform1i(mSelect.uniform("uCapacity"), capacity);
+    glUniform1f(mSelect.uniform("uDepthThreshold"),
+                static_cast<float>(params.getFloat("light_depth_threshold")));
+    glUniform1f(mSelect.uniform("uNormalThreshold"),
+                static_cast<float>(params.getFloat("light_normal_threshold")));
+    for (int phase = 0; phase < 2; ++phase) {
+        glUniform1i(mSelect.uniform("uPhase"), phase);
+        glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    GLuint counts[1 + GIS_MAX_LIGHT_LEVELS] = {};
+    glGetNamedBufferSubData(mCounts.id(), 0, header, counts);
+    timer.end();
+
+    const int count = static_cast<int>(std::min<GLuint>(counts[0], static_cast<GLuint>(capacity)));
+    counters["vpl_count"] = count;
+    for (int l = finest; l <= coarsest; ++l)
+        counters["vpls_r" + std::to_string(levels[static_cast<size_t>(l)].side)] = counts[1 + l];
+    return count;
+}
+
+void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer, Counters& counters) {
+    mTree.build(in, timer, counters);
+    mVplCount = mTree.valid() ? select(params, timer, counters) : 0;
+    if (!mTree.valid()) counters["vpl_count"] = 0;
+    mEye.build(in, params, timer);
+
+    timer.begin("vpl_gather");
+    if (mVplCount > 0) {
+        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
+        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
+        glUseProgram(mGather.id());
+        glBindTextureUnit(0, mEye.geoPosition().id());
+        glBindTextureUnit(1, mEye.geoNormal().id());
+        mEye.bindPixels(in);
+        glBindVertexArray(mEmptyVao.id());
+        glEnable(GL_STENCIL_TEST);
+        glStencilFunc(GL_EQUAL, 1, 0xFF);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        const GLint countLoc = mGather.uniform("uVplCount");
+        counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
+            glUniform1i(countLoc, count);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        });
+        glDisable(GL_BLEND);
+        glDisable(GL_STENCIL_TEST);
+    }
+    timer.end();
+
+    mEye.reconstruct(in, params, true, mTarget, timer);
+    mEye.countReceivers(counters);
+}
+
+std::vector<shader::Vpl> Isr::readVpls() const {
+    std::vector<shader::Vpl> vpls(static_cast<size_t>(mVplCount));
+    if (mVplCount > 0)
+        glGetNamedBufferSubData(mVpls.id(), 0, static_cast<GLsizeiptr>(vpls.size() * sizeof(shader::Vpl)),
+                                vpls.data());
+    return vpls;
+}
+
+} // namespace gis

@@ -1,0 +1,101 @@
+#version 450 core
+// Hierarchical image-space radiosity gather (001 §3.5, digest S.3 P4 D + P6 lightcut): every eye
+// receiver (early stencil test, as multires_gather) walks the light tree itself. It starts from all
+// nodes of level uStartLevel and descends, with an explicit stack, wherever 001 Eq. 8 asks for
+// refinement, down to uLeafLevel; a node that is not refined (or is a leaf) contributes with the
+// disk kernel (001 Eq. 1) at its flux-weighted mean position with its summed flux and area. The
+// cut covers every valid texel exactly once, so it carries the RSM's whole flux.
+//
+// Refinement (HierIsr.h derives it): refine node j on a level of side R_l iff
+//   |V_ij|^2 <= T_l |V_j|max^2,   T_l = Omega (1 - tau) / (pi tau R_l^2),
+// Omega the light frustum's solid angle, |V_j|max the node's max light distance. uRefineMode
+// carries the degenerate taus: tau <= 0 always refines (T = +inf), tau >= 1 never (T <= 0).
+#include "common.glsl"
+#include "gi/common/light_tree.glsl"
+#include "gi/common/vpl_transport.glsl"
+
+layout(early_fragment_tests) in;
+
+layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position
+layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
+layout(binding = 8) uniform sampler2D gPosition;    // level 0 is the G-buffer itself
+layout(binding = 9) uniform sampler2D gNormal;
+
+// Traversal statistics: 64-bit sums as (lo, hi) pairs (a full traversal at R = 256 visits 87k
+// nodes per receiver, which overflows 32 bits over a frame).
+layout(std430, binding = 3) buffer CutStats {
+    uint gVisitedLo, gVisitedHi, gVisitedMax, gCutLo, gCutHi, gCutMax;
+};
+
+uniform int uStartLevel;  // level index of the roots
+uniform int uLeafLevel;   // finest level visited (<= uStartLevel)
+uniform int uRefineMode;  // 0 Eq. 8 test, 1 always refine, 2 never refine
+uniform float uTau;       // in (0, 1) when uRefineMode == 0
+
+layout(location = 0) out vec4 outIrradiance; // rgb added by blending; alpha 1 marks data
+
+// Depth-first, at most 3 pending siblings per level below the root: 1 + 3 * 11 < 48.
+const int kStack = 48;
+
+uint packNode(int level, ivec2 t) { return uint(level) | (uint(t.x) << 4) | (uint(t.y) << 18); }
+
+// Atomics need the buffer variable itself, hence a macro; the carry out of the low word goes high.
+#define GIS_ADD64(lo, hi, v) \
+    if (atomicAdd(lo, v) + (v) < (v)) atomicAdd(hi, 1u)
+
+void main() {
+    ivec2 a = ivec2(gl_FragCoord.xy);
+    bool pixel = all(lessThan(vec2(a), gFrame.viewport.xy));
+    vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
+    vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
+
+    // Omega (1 - tau) / (pi tau); tau is inside (0, 1) whenever the test runs.
+    float t = gFrame.rsmInfo.y;
+    float omega = 4.0 * asin(clamp(t * t / (1.0 + t * t), 0.0, 1.0));
+    float scale = uRefineMode == 0 ? omega * (1.0 - uTau) / (kPi * max(uTau, 1e-30)) : 0.0;
+
+    uint stack[kStack];
+    vec3 e = vec3(0.0);
+    uint visited = 0u, cut = 0u;
+    int rootSide = lightLevelSide(uStartLevel);
+    for (int r = 0; r < rootSide * rootSide; ++r) {
+        stack[0] = packNode(uStartLevel, ivec2(r % rootSide, r / rootSide));
+        int sp = 1;
+        while (sp > 0) {
+            uint s = stack[--sp];
+            int level = int(s & 15u);
+            ivec2 p = ivec2(int((s >> 4) & 0x3FFFu), int(s >> 18));
+            LightNode node = gLightNodes[lightNodeIndex(level, p)];
+            ++visited;
+            if (node.position.w < 0.5) continue; // empty: no flux below it
+            bool refine = false;
+            if (level > uLeafLevel && sp + 4 <= kStack) {
+                if (uRefineMode == 1) {
+                    refine = true;
+                } else if (uRefineMode == 0) {
+                    vec3 v = node.position.xyz - pos;
+                    float side = float(lightLevelSide(level));
+                    float dmax = node.hi.w;
+                    refine = dot(v, v) * side * side <= scale * dmax * dmax;
+                }
+            }
+            if (refine) {
+                int child = level - 1;
+                int childSide = lightLevelSide(child);
+                for (int k = 3; k >= 0; --k) {
+                    ivec2 c = p * 2 + ivec2(k & 1, k >> 1);
+                    if (c.x < childSide && c.y < childSide) stack[sp++] = packNode(child, c);
+                }
+            } else {
+                e += vplIrradianceDisk(pos, n, node.position.xyz, node.normal.xyz, node.flux.rgb, node.normal.w);
+                ++cut;
+            }
+        }
+    }
+
+    GIS_ADD64(gVisitedLo, gVisitedHi, visited);
+    atomicMax(gVisitedMax, visited);
+    GIS_ADD64(gCutLo, gCutHi, cut);
+    atomicMax(gCutMax, cut);
+    outIrradiance = vec4(max(sanitize(e), vec3(0.0)), 1.0);
+}

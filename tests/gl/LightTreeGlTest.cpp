@@ -1,0 +1,395 @@
+// The light-space VPL tree and the two techniques that cut it (001 §3.4-3.5): isr and hier_isr.
+// Flux conservation through every level and every cut (digest S.4 cases 4 and 7), the full
+// traversal against the per-texel gather (S.4 case 12), and no NaN/Inf/negative output at extreme
+// parameters and odd sizes.
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "GlTestSupport.h"
+#include "gi/common/LightTree.h"
+#include "gi/hier_isr/HierIsr.h"
+#include "gi/isr/Isr.h"
+#include "gl/ShaderShared.h"
+#include "render/FrameState.h"
+
+using namespace gis;
+
+namespace {
+
+struct Frame {
+    FrameOutput out;
+    Technique* technique = nullptr;
+    FrameState state;
+    const Scene* scene = nullptr;
+};
+
+// Like test::renderScene, with a renderer of its own so the technique's buffers can be inspected.
+Frame render(const std::string& sceneName, const std::string& technique, int w, int h,
+             const nlohmann::json& params = nlohmann::json::object()) {
+    test::sharedContext();
+    static std::map<std::string, std::shared_ptr<Scene>> scenes;
+    auto& scene = scenes[sceneName];
+    if (!scene) scene = std::make_shared<Scene>(loadScene(sceneName));
+    static std::unique_ptr<FrameRenderer> renderer;
+    if (!renderer) renderer = std::make_unique<FrameRenderer>();
+    if (renderer->scene() != scene.get()) renderer->setScene(scene);
+    Frame f;
+    f.state = makeFrameState(*scene, technique);
+    f.state.width = w;
+    f.state.height = h;
+    applyParams(f.state, params, "test");
+    f.out = renderer->render(f.state, true);
+    f.technique = renderer->technique();
+    f.scene = scene.get();
+    return f;
+}
+
+struct RsmTotals {
+    glm::dvec3 flux{0.0};
+    double validTexels = 0;
+};
+
+RsmTotals rsmTotals(const FrameInputs& in) {
+    const size_t n = static_cast<size_t>(in.rsmSize) * static_cast<size_t>(in.rsmSize);
+    std::vector<float> pos(n * 4), flux(n * 4);
+    glGetTextureImage(in.rsmPosition->id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pos.size() * 4),
+                      pos.data());
+    glGetTextureImage(in.rsmFlux->id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(flux.size() * 4),
+                      flux.data());
+    RsmTotals t;
+    for (size_t i = 0; i < n; ++i) {
+        if (pos[i * 4 + 3] < 0.5f) continue;
+        t.flux += glm::dvec3(flux[i * 4], flux[i * 4 + 1], flux[i * 4 + 2]);
+        t.validTexels += 1.0;
+    }
+    return t;
+}
+
+void expectFluxNear(glm::dvec3 actual, glm::dvec3 expected, double rel, const std::string& what) {
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(actual[c], expected[c], rel * std::max(expected[c], 1e-30)) << what << " channel " << c;
+}
+
+float tanHalfFov(const Frame& f) {
+    float t = 1.0f;
+    FrameRenderer::lightViewProj(f.state.light, f.scene->bounds, &t);
+    return t;
+}
+
+// sqrt(mean((a - b)^2)) / sqrt(mean(b^2)) over RGB.
+double relativeRmse(const std::vector<float>& a, const std::vector<float>& b) {
+    double num = 0, den = 0;
+    for (size_t i = 0; i < b.size(); i += 4)
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(a[i + c]) - b[i + c];
+            num += d * d;
+            den += double(b[i + c]) * b[i + c];
+        }
+    return den > 0 ? std::sqrt(num / den) : 0.0;
+}
+
+} // namespace
+
+TEST(LightTree, LayoutHalvesDownToOneNode) {
+    const auto l64 = lightTreeLayout(64);
+    ASSERT_EQ(l64.size(), 7u);
+    EXPECT_EQ(l64[0].offset, 0);
+    EXPECT_EQ(l64[1].offset, 64 * 64);
+    EXPECT_EQ(l64[6].side, 1);
+    EXPECT_EQ(l64[6].offset, 64 * 64 + 32 * 32 + 16 * 16 + 8 * 8 + 4 * 4 + 2 * 2);
+    // Odd sizes keep their last row and column: 100, 50, 25, 13, 7, 4, 2, 1.
+    const auto l100 = lightTreeLayout(100);
+    const int sides[] = {100, 50, 25, 13, 7, 4, 2, 1};
+    ASSERT_EQ(l100.size(), 8u);
+    for (size_t i = 0; i < l100.size(); ++i) EXPECT_EQ(l100[i].side, sides[i]);
+    EXPECT_EQ(lightTreeLayout(1024).size(), 11u);
+    // A resolution names the finest level not above it, clamped to the tree.
+    EXPECT_EQ(lightLevelForResolution(l64, 16), 2);
+    EXPECT_EQ(lightLevelForResolution(l64, 1024), 0);
+    EXPECT_EQ(lightLevelForResolution(l64, 20), 2);
+    EXPECT_EQ(lightLevelForResolution(l64, 1), 6);
+    EXPECT_EQ(lightLevelForResolution(l100, 30), 2);
+}
+
+TEST(LightTree, FluxIsConservedAtEveryLevel) {
+    const Frame f = render("builtin:cornell", "isr", 128, 128, {{"rsm_size", 64}});
+    const auto* isr = dynamic_cast<const Isr*>(f.technique);
+    ASSERT_NE(isr, nullptr);
+    const LightTree& tree = isr->tree();
+    ASSERT_TRUE(tree.valid());
+    const RsmTotals rsm = rsmTotals(tree.lastInputs());
+    ASSERT_GT(rsm.flux.r + rsm.flux.g + rsm.flux.b, 0.0);
+    ASSERT_GT(rsm.validTexels, 0.0);
+
+    const auto nodes = tree.readNodes();
+    const auto& levels = tree.levels();
+    ASSERT_EQ(levels.size(), 7u);
+    for (size_t l = 0; l < levels.size(); ++l) {
+        glm::dvec3 flux(0.0);
+        double texels = 0, area = 0;
+        for (int i = 0; i < levels[l].side * levels[l].side; ++i) {
+            const shader::LightNode& n = nodes[static_cast<size_t>(levels[l].offset + i)];
+            if (n.position.w < 0.5f) {
+                EXPECT_EQ(n.flux.w, 0.0f); // empty nodes hold nothing
+                continue;
+            }
+            flux += glm::dvec3(n.flux);
+            texels += n.flux.w;
+            area += n.normal.w;
+            EXPECT_LE(n.lo.w, n.hi.w);
+            EXPECT_NEAR(glm::length(glm::vec3(n.normal)), 1.0f, 2e-3f);
+            for (int c = 0; c < 3; ++c) EXPECT_LE(n.lo[c], n.hi[c]);
+        }
+        expectFluxNear(flux, rsm.flux, 1e-4, "level " + std::to_string(l));
+        EXPECT_EQ(texels, rsm.validTexels) << "level " << l;
+        EXPECT_GT(area, 0.0);
+    }
+    // The root's mean position lies inside the scene.
+    const shader::LightNode& root = nodes[static_cast<size_t>(levels.back().offset)];
+    const glm::vec3 p(root.position);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GE(p[c], f.scene->bounds.min[c] - 1e-3f);
+        EXPECT_LE(p[c], f.scene->bounds.max[c] + 1e-3f);
+    }
+}
+
+TEST(LightTree, IsrVplsCarryTheWholeFlux) {
+    const nlohmann::json cases[] = {
+        {{"rsm_size", 64}},
+        {{"rsm_size", 64}, {"light_depth_threshold", 0.0}, {"light_normal_threshold", 0.0}},
+        {{"rsm_size", 64}, {"light_depth_threshold", 1.0}, {"light_normal_threshold", 2.0}},
+        {{"rsm_size", 64}, {"isr_coarsest", 1}, {"isr_finest", 256}},
+        {{"rsm_size", 64}, {"isr_coarsest", 8}, {"isr_finest", 8}},
+    };
+    for (const auto& params : cases) {
+        const Frame f = render("builtin:cornell", "isr", 128, 128, params);
+        const auto* isr = dynamic_cast<const Isr*>(f.technique);
+        ASSERT_NE(isr, nullptr);
+        const RsmTotals rsm = rsmTotals(isr->tree().lastInputs());
+        const auto vpls = isr->readVpls();
+        const auto& counts = f.out.stats["counts"];
+        ASSERT_EQ(vpls.size(), counts["vpl_count"].get<size_t>()) << params.dump();
+        glm::dvec3 flux(0.0);
+        double texels = 0;
+        for (const auto& v : vpls) {
+            EXPECT_EQ(v.position.w, 1.0f);
+            EXPECT_GT(v.flux.w, 0.0f);
+            flux += glm::dvec3(v.flux);
+            texels += v.flux.w;
+        }
+        expectFluxNear(flux, rsm.flux, 1e-4, params.dump());
+        EXPECT_EQ(texels, rsm.validTexels) << params.dump(); // every valid texel under exactly one VPL
+        double perLevel = 0;
+        for (const auto& [k, v] : counts.items())
+            if (k.rfind("vpls_r", 0) == 0) perLevel += v.get<double>();
+        EXPECT_EQ(perLevel, static_cast<double>(vpls.size())) << params.dump();
+    }
+    // Thresholds at 0 refine every patch that varies at all: the finest level dominates.
+    const Frame fine =
+        render("builtin:cornell", "isr", 64, 64,
+               {{"rsm_size", 64}, {"light_depth_threshold", 0.0}, {"light_normal_threshold", 0.0}});
+    const Frame coarse =
+        render("builtin:cornell", "isr", 64, 64,
+               {{"rsm_size", 64}, {"light_depth_threshold", 1.0}, {"light_normal_threshold", 2.0}});
+    EXPECT_GT(fine.out.stats["counts"]["vpl_count"].get<double>(),
+              2.0 * coarse.out.stats["counts"]["vpl_count"].get<double>());
+}
+
+TEST(LightTree, HierIsrCutsCarryTheWholeFlux) {
+    const Frame f = render("builtin:cornell", "hier_isr", 128, 128, {{"rsm_size", 64}});
+    const auto* hier = dynamic_cast<const HierIsr*>(f.technique);
+    ASSERT_NE(hier, nullptr);
+    const LightTree& tree = hier->tree();
+    const RsmTotals rsm = rsmTotals(tree.lastInputs());
+    const auto nodes = tree.readNodes();
+    const float t = tanHalfFov(f);
+    // Receivers: on the floor near a wall, in the middle of the floor, on the back wall, in the air.
+    const glm::vec3 receivers[] = {
+        {-0.9f, 0.01f, 0.5f}, {0.0f, 0.01f, 0.0f}, {0.0f, 1.0f, -0.99f}, {0.2f, 1.2f, 0.3f}};
+    struct Setting {
+        double tau;
+        int coarsest, maxDepth;
+    };
+    for (const Setting& s : {Setting{0.01, 16, 256}, Setting{0.0, 16, 64}, Setting{1.0, 16, 64},
+                             Setting{0.001, 1, 64}, Setting{0.05, 64, 8}}) {
+        const LightCutSettings cs = lightCutSettings(tree.levels(), s.coarsest, s.maxDepth, s.tau);
+        for (const glm::vec3 r : receivers) {
+            const std::vector<int> cut = lightCutCpu(nodes, tree.levels(), cs, t, r);
+            glm::dvec3 flux(0.0);
+            double texels = 0;
+            for (int i : cut) {
+                flux += glm::dvec3(nodes[static_cast<size_t>(i)].flux);
+                texels += nodes[static_cast<size_t>(i)].flux.w;
+            }
+            const std::string what = "tau " + std::to_string(s.tau) + " receiver " + std::to_string(r.x) +
+                                     "," + std::to_string(r.y) + "," + std::to_string(r.z);
+            expectFluxNear(flux, rsm.flux, 1e-4, what);
+            EXPECT_EQ(texels, rsm.validTexels) << what;
+        }
+    }
+    // Degenerate taus: 0 traverses to max_depth (one node per valid leaf), 1 stops at the roots.
+    const auto& levels = tree.levels();
+    int validLeaves = 0, validRoots = 0;
+    for (int i = 0; i < levels[0].side * levels[0].side; ++i)
+        validLeaves += nodes[static_cast<size_t>(i)].position.w > 0.5f;
+    for (int i = 0; i < 16 * 16; ++i)
+        validRoots += nodes[static_cast<size_t>(levels[2].offset + i)].position.w > 0.5f;
+    EXPECT_EQ(lightCutCpu(nodes, levels, lightCutSettings(levels, 16, 1024, 0.0), t, receivers[0]).size(),
+              static_cast<size_t>(validLeaves));
+    EXPECT_EQ(lightCutCpu(nodes, levels, lightCutSettings(levels, 16, 1024, 1.0), t, receivers[0]).size(),
+              static_cast<size_t>(validRoots));
+    // A smaller tau never gives a smaller cut.
+    const size_t loose =
+        lightCutCpu(nodes, levels, lightCutSettings(levels, 16, 64, 0.05), t, receivers[0]).size();
+    const size_t tight =
+        lightCutCpu(nodes, levels, lightCutSettings(levels, 16, 64, 0.005), t, receivers[0]).size();
+    EXPECT_LE(loose, tight);
+    // The GPU's counters agree in kind: the mean cut lies between the roots and the leaves.
+    const double meanCut = f.out.stats["counts"]["cut_size_mean"].get<double>();
+    EXPECT_GE(meanCut, validRoots);
+    EXPECT_LE(meanCut, validLeaves);
+}
+
+TEST(LightTree, FullTraversalEqualsThePerTexelGather) {
+    // tau = 0 and max_depth = rsm_size: every receiver sums every valid RSM texel with the disk
+    // kernel; eye thresholds 0 make every covered pixel a level-0 receiver. That is rsm_gather with
+    // one VPL per texel and the disk kernel, up to float summation order.
+    const int rsm = 32;
+    const nlohmann::json eye = {{"rsm_size", rsm}, {"depth_threshold", 0.0}, {"normal_threshold", 0.0}};
+    nlohmann::json hierParams = eye;
+    hierParams["tau"] = 0.0;
+    hierParams["max_depth"] = rsm;
+    const Frame hier = render("builtin:cornell", "hier_isr", 64, 64, hierParams);
+    const Frame flat = render("builtin:cornell", "rsm_gather", 64, 64,
+                              {{"rsm_size", rsm}, {"vpl_grid", rsm}, {"kernel", "disk"}});
+    const Frame direct = render("builtin:cornell", "none", 64, 64, {{"rsm_size", rsm}});
+    const double totalError = relativeRmse(hier.out.linear, flat.out.linear);
+    EXPECT_LT(totalError, 1e-3);
+    // The indirect term alone (total minus the shared direct term) as well, a stricter view.
+    std::vector<float> hi = hier.out.linear, fi = flat.out.linear;
+    for (size_t i = 0; i < hi.size(); ++i) {
+        hi[i] -= direct.out.linear[i];
+        fi[i] -= direct.out.linear[i];
+    }
+    const double indirectError = relativeRmse(hi, fi);
+    EXPECT_LT(indirectError, 1e-3);
+    std::printf("full traversal vs per-texel gather: relative RMSE %.2e total, %.2e indirect\n", totalError,
+                indirectError);
+    const double receivers = hier.out.stats["counts"]["receivers_total"].get<double>();
+    EXPECT_EQ(receivers, hier.out.stats["counts"]["receivers_l0"].get<double>());
+}
+
+TEST(LightTree, NoNanInfOrNegativeAtExtremeParameters) {
+    const nlohmann::json isrCases[] = {
+        {{"rsm_size", 32}},
+        {{"rsm_size", 32},
+         {"light_depth_threshold", 0.0},
+         {"light_normal_threshold", 0.0},
+         {"isr_coarsest", 1},
+         {"isr_finest", 256},
+         {"depth_threshold", 0.0},
+         {"normal_threshold", 0.0}},
+        {{"rsm_size", 32},
+         {"light_depth_threshold", 1.0},
+         {"light_normal_threshold", 2.0},
+         {"isr_coarsest", 256},
+         {"isr_finest", 1},
+         {"depth_threshold", 1.0},
+         {"normal_threshold", 2.0},
+         {"detail_alpha", 1.0}},
+    };
+    const nlohmann::json hierCases[] = {
+        {{"rsm_size", 32}},
+        {{"rsm_size", 32},
+         {"tau", 0.0},
+         {"max_depth", 1024},
+         {"hier_coarsest", 1},
+         {"depth_threshold", 0.0},
+         {"normal_threshold", 0.0}},
+        {{"rsm_size", 32},
+         {"tau", 1.0},
+         {"max_depth", 1},
+         {"hier_coarsest", 256},
+         {"depth_threshold", 1.0},
+         {"normal_threshold", 2.0},
+         {"detail_alpha", 1.0}},
+        {{"rsm_size", 33}, {"tau", 1e-6}, {"max_depth", 17}, {"hier_coarsest", 3}},
+    };
+    for (const char* scene :
+         {"builtin:cornell", "builtin:cornell-empty", "builtin:crease", "builtin:cornell-dense"})
+        for (const glm::ivec2 size : {glm::ivec2(64, 64), glm::ivec2(63, 47)}) {
+            const auto check = [&](const char* technique, const nlohmann::json& params) {
+                const Frame f = render(scene, technique, size.x, size.y, params);
+                size_t bad = 0;
+                for (float v : f.out.linear)
+                    if (!std::isfinite(v) || v < 0.0f) ++bad;
+                EXPECT_EQ(bad, 0u) << technique << " on " << scene << " at " << size.x << "x" << size.y << " "
+                                   << params.dump();
+                for (const auto& [k, v] : f.out.stats["counts"].items())
+                    EXPECT_TRUE(std::isfinite(v.get<double>())) << k;
+            };
+            for (const auto& p : isrCases) check("isr", p);
+            for (const auto& p : hierCases) check("hier_isr", p);
+        }
+}
+
+TEST(LightTree, LightOffGivesNoIndirect) {
+    // With the light off the tree is not built and both techniques add exactly nothing.
+    for (const char* technique : {"isr", "hier_isr"}) {
+        test::sharedContext();
+        const Scene scene = loadScene("builtin:cornell");
+        FrameRenderer renderer;
+        renderer.setScene(std::make_shared<Scene>(scene));
+        FrameState state = makeFrameState(scene, technique);
+        state.width = 32;
+        state.height = 32;
+        state.lightEnabled = false;
+        applyParams(state, {{"rsm_size", 16}}, "test");
+        const FrameOutput on = renderer.render(state, true);
+        FrameState none = state;
+        setTechnique(none, "none");
+        applyParams(none, {{"rsm_size", 16}}, "test");
+        const FrameOutput off = renderer.render(none, true);
+        EXPECT_EQ(on.linear, off.linear) << technique;
+        EXPECT_EQ(on.stats["counts"].value("vpl_count", 0.0), 0.0);
+    }
+}
+
+TEST(LightTree, SharedLayoutMatchesGlsl) {
+    test::sharedContext();
+    const gl::Program p = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/light_tree_build.comp"}});
+    const GLuint block = glGetUniformBlockIndex(p.id(), "LightTreeBlock");
+    ASSERT_NE(block, GL_INVALID_INDEX);
+    GLint size = 0;
+    glGetActiveUniformBlockiv(p.id(), block, GL_UNIFORM_BLOCK_DATA_SIZE, &size);
+    EXPECT_EQ(static_cast<size_t>(size), sizeof(shader::LightTreeUniforms));
+    // The node array: stride and member offsets as C++ sees them.
+    struct Member {
+        const char* name;
+        size_t offset;
+    };
+    for (const Member& m :
+         {Member{"LightNodes.gLightNodes[0].position", offsetof(shader::LightNode, position)},
+          Member{"LightNodes.gLightNodes[0].flux", offsetof(shader::LightNode, flux)},
+          Member{"LightNodes.gLightNodes[0].hi", offsetof(shader::LightNode, hi)}}) {
+        const GLuint index = glGetProgramResourceIndex(p.id(), GL_BUFFER_VARIABLE, m.name);
+        if (index == GL_INVALID_INDEX) continue; // the name spelling some drivers use differs
+        const GLenum props[] = {GL_OFFSET, GL_TOP_LEVEL_ARRAY_STRIDE};
+        GLint values[2] = {-1, -1};
+        glGetProgramResourceiv(p.id(), GL_BUFFER_VARIABLE, index, 2, props, 2, nullptr, values);
+        EXPECT_EQ(static_cast<size_t>(values[0]), m.offset) << m.name;
+        EXPECT_EQ(static_cast<size_t>(values[1]), sizeof(shader::LightNode)) << m.name;
+    }
+}
+
+TEST(LightTree, RenderingTwiceGivesIdenticalBytes) {
+    // The VPL compaction is ordered (isr) and each receiver's traversal is its own (hier_isr), so
+    // frames repeat bit for bit (digest S.4 case 15).
+    for (const char* technique : {"isr", "hier_isr"}) {
+        const Frame a = render("builtin:cornell", technique, 64, 64, {{"rsm_size", 64}});
+        const Frame b = render("builtin:cornell", technique, 64, 64, {{"rsm_size", 64}});
+        EXPECT_TRUE(a.out.linear == b.out.linear) << technique;
+    }
+}
