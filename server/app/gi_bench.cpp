@@ -2,6 +2,8 @@
 //   compare A.exr B.exr         error metrics of A against the reference B
 //   table [options]             renders technique configurations and references of one scene side by
 //                               side and prints the error-versus-time table (Markdown and JSON)
+//   passes [options]            per-pass times of configurations rendered interleaved in one run,
+//                               their ratios, receiver counts and the error against a GL baseline
 // Exit codes: 0 success, 1 runtime failure, 2 bad usage.
 #include <algorithm>
 #include <cstdio>
@@ -24,8 +26,10 @@
 
 namespace {
 
+constexpr int kMaxEyeLevels = 16;
 constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
        gi-bench table [options]
+       gi-bench passes [options]
 
 compare  prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
          size; pixels black in the reference are left out) as JSON.
@@ -42,6 +46,16 @@ table    renders each technique configuration with GL (median frame time over --
   --cache-dir DIR         reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)
   --json FILE             also write the rows as JSON
   --gl egl|osmesa
+  --timing query|finish   GPU timer queries, or glFinish around each pass (default finish:
+                          llvmpipe's queries attribute deferred work to later passes)
+
+passes   renders every configuration --frames times, interleaved (frame k of each configuration
+         before frame k+1 of any), and prints the median ms of each pass per configuration, the
+         total, the ratio of each total to the first configuration's, the receivers per eye level
+         against the covered pixels (fill-rate saving) and, with --baseline, the relative RMSE of
+         each configuration against that GL configuration (rendered once, untimed).
+  --scene, --size, --config, --frames, --gl, --timing, --json as for table (default size 512x512)
+  --baseline SPEC         GL configuration the errors are measured against
 )";
 
 struct UsageError {
@@ -102,9 +116,166 @@ Config parseConfig(const std::string& spec) {
     return c;
 }
 
+bool parseTiming(const std::string& text) {
+    if (text == "query") return true;
+    if (text == "finish") return false;
+    throw UsageError{"--timing must be query or finish, got '" + text + "'"};
+}
+
+std::vector<gis::FrameState> makeStates(const gis::Scene& scene, const std::vector<Config>& configs, int width,
+                                        int height) {
+    std::vector<gis::FrameState> states;
+    for (const auto& c : configs) {
+        try {
+            gis::FrameState s = gis::makeFrameState(scene, c.technique);
+            for (const auto& [k, v] : c.params) gis::setParamFromString(s, k, v, "--config " + c.label);
+            s.width = width;
+            s.height = height;
+            states.push_back(std::move(s));
+        } catch (const gis::InputError& e) {
+            throw UsageError{e.what()};
+        }
+    }
+    return states;
+}
+
+int passes(const std::vector<std::string>& args) {
+    std::string sceneName = "builtin:cornell", jsonPath, gl;
+    int width = 512, height = 512, frames = 5;
+    bool timerQueries = false;
+    std::vector<Config> configs, baseline;
+    for (size_t i = 0; i < args.size(); ++i) {
+        auto value = [&]() -> const std::string& {
+            if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+            return args[++i];
+        };
+        const std::string& a = args[i];
+        if (a == "--scene") sceneName = value();
+        else if (a == "--size") {
+            const std::string& s = value();
+            auto x = s.find('x');
+            if (x == std::string::npos) throw UsageError{"--size must look like 512x512"};
+            width = parseInt("--size width", s.substr(0, x), 16, 4096);
+            height = parseInt("--size height", s.substr(x + 1), 16, 4096);
+        } else if (a == "--config") configs.push_back(parseConfig(value()));
+        else if (a == "--baseline") baseline = {parseConfig(value())};
+        else if (a == "--frames") frames = parseInt("--frames", value(), 1, 1000);
+        else if (a == "--json") jsonPath = value();
+        else if (a == "--gl") gl = value();
+        else if (a == "--timing") timerQueries = parseTiming(value());
+        else throw UsageError{"unknown option '" + a + "' (see --help)"};
+    }
+    if (configs.empty()) configs = {parseConfig("multires_splat"), parseConfig("multires_gather")};
+
+    auto scene = std::make_shared<gis::Scene>(gis::loadScene(sceneName));
+    std::vector<gis::FrameState> states = makeStates(*scene, configs, width, height);
+    std::vector<gis::FrameState> baseStates = makeStates(*scene, baseline, width, height);
+    auto backend = gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(gl);
+    auto context = gis::gl::createContext(backend);
+    gis::FrameRenderer renderer(timerQueries);
+    renderer.setScene(scene);
+
+    std::vector<gis::FrameOutput> last(configs.size());
+    std::vector<std::vector<nlohmann::json>> stats(configs.size());
+    for (size_t i = 0; i < configs.size(); ++i) last[i] = renderer.render(states[i], true); // warm-up
+    for (int k = 0; k < frames; ++k) {
+        for (size_t i = 0; i < configs.size(); ++i) {
+            gis::logInfo("gi-bench: frame " + std::to_string(k + 1) + "/" + std::to_string(frames) + " of " +
+                         configs[i].label);
+            last[i] = renderer.render(states[i], true);
+            stats[i].push_back(last[i].stats);
+        }
+    }
+    gis::FrameOutput base;
+    if (!baseStates.empty()) {
+        gis::logInfo("gi-bench: baseline " + baseline.front().label);
+        base = renderer.render(baseStates.front(), true);
+    }
+
+    // Pass names in pipeline order, as they first appear.
+    std::vector<std::string> names;
+    nlohmann::json rows = nlohmann::json::array();
+    for (size_t i = 0; i < configs.size(); ++i) {
+        nlohmann::json s = gis::medianStats(stats[i]);
+        nlohmann::json row = {{"config", configs[i].label}, {"frame_ms", s["frame_ms"]}, {"counts", s["counts"]}};
+        double total = 0;
+        size_t insertAt = 0; // a new pass goes after the previous pass of its own pipeline
+        for (const auto& p : s["passes"]) {
+            const std::string name = p["name"].get<std::string>();
+            auto found = std::find(names.begin(), names.end(), name);
+            if (found == names.end()) found = names.insert(names.begin() + static_cast<long>(insertAt), name);
+            insertAt = static_cast<size_t>(found - names.begin()) + 1;
+            row["passes"][name] = p["gpu_ms"];
+            total += p["gpu_ms"].get<double>();
+        }
+        row["total_ms"] = total;
+        if (!baseStates.empty()) {
+            gis::ImageView test(last[i].linear.data(), width, height, 4), ref(base.linear.data(), width, height, 4);
+            row["relative_rmse_vs_baseline"] = gis::relativeRmse(test, ref);
+        }
+        rows.push_back(row);
+    }
+
+    std::printf("scene %s, %dx%d, GL %s (%s), timing %s, median of %d interleaved frames\n\n", sceneName.c_str(), width,
+                height, context->info().backend.c_str(), context->info().renderer.c_str(),
+                timerQueries ? "timer queries" : "glFinish per pass", frames);
+    std::printf("| pass (ms) |");
+    for (const auto& c : configs) std::printf(" %s |", c.label.c_str());
+    std::printf("\n|---|");
+    for (size_t i = 0; i < configs.size(); ++i) std::printf("---|");
+    std::printf("\n");
+    for (const auto& n : names) {
+        std::printf("| %s |", n.c_str());
+        for (const auto& row : rows)
+            row["passes"].contains(n) ? std::printf(" %.1f |", row["passes"][n].get<double>()) : std::printf(" - |");
+        std::printf("\n");
+    }
+    const double first = std::max(rows[0]["total_ms"].get<double>(), 1e-9);
+    std::printf("| **total** |");
+    for (const auto& row : rows) std::printf(" **%.1f** |", row["total_ms"].get<double>());
+    std::printf("\n| total / %s |", configs[0].label.c_str());
+    for (const auto& row : rows) std::printf(" %.3f |", row["total_ms"].get<double>() / first);
+    std::printf("\n| frame ms (wall, incl. read-back) |");
+    for (const auto& row : rows) std::printf(" %.1f |", row["frame_ms"].get<double>());
+    std::printf("\n");
+    const double pixels = static_cast<double>(width) * height;
+    std::printf("| receivers (fraction of %d pixels) |", width * height);
+    for (const auto& row : rows) {
+        const auto& c = row["counts"];
+        if (c.contains("receivers_total"))
+            std::printf(" %.0f (%.1f%%) |", c["receivers_total"].get<double>(),
+                        100.0 * c["receivers_total"].get<double>() / pixels);
+        else
+            std::printf(" %.0f (100%%) |", pixels);
+    }
+    std::printf("\n");
+    for (int l = 0; l < kMaxEyeLevels; ++l) {
+        const std::string key = "receivers_l" + std::to_string(l);
+        bool any = false;
+        for (const auto& row : rows) any |= row["counts"].contains(key);
+        if (!any) break;
+        std::printf("| receivers level %d |", l);
+        for (const auto& row : rows)
+            row["counts"].contains(key) ? std::printf(" %.0f |", row["counts"][key].get<double>()) : std::printf(" - |");
+        std::printf("\n");
+    }
+    if (!baseStates.empty()) {
+        std::printf("| rel. RMSE vs %s |", baseline.front().label.c_str());
+        for (const auto& row : rows) std::printf(" %.4f |", row["relative_rmse_vs_baseline"].get<double>());
+        std::printf("\n");
+    }
+    if (!jsonPath.empty()) {
+        std::ofstream f(jsonPath);
+        if (!f) throw gis::InputError(jsonPath, "cannot open for writing");
+        f << nlohmann::json({{"scene", sceneName}, {"size", {width, height}}, {"rows", rows}}).dump(2) << "\n";
+    }
+    return 0;
+}
+
 int table(const std::vector<std::string>& args) {
     std::string sceneName = "builtin:cornell", jsonPath, gl, cacheDir = defaultCacheDir();
     int width = 256, height = 256, frames = 5;
+    bool timerQueries = false;
     std::vector<Config> configs;
     std::vector<std::string> modes;
     gis::ReferenceOptions ro;
@@ -129,24 +300,14 @@ int table(const std::vector<std::string>& args) {
         else if (a == "--cache-dir") cacheDir = value();
         else if (a == "--json") jsonPath = value();
         else if (a == "--gl") gl = value();
+        else if (a == "--timing") timerQueries = parseTiming(value());
         else throw UsageError{"unknown option '" + a + "' (see --help)"};
     }
     if (configs.empty()) configs = {parseConfig("none"), parseConfig("rsm_gather")};
     if (modes.empty()) modes = {"one-bounce-unoccluded", "one-bounce"};
 
     auto scene = std::make_shared<gis::Scene>(gis::loadScene(sceneName));
-    std::vector<gis::FrameState> states;
-    for (const auto& c : configs) {
-        try {
-            gis::FrameState s = gis::makeFrameState(*scene, c.technique);
-            for (const auto& [k, v] : c.params) gis::setParamFromString(s, k, v, "--config " + c.label);
-            s.width = width;
-            s.height = height;
-            states.push_back(std::move(s));
-        } catch (const gis::InputError& e) {
-            throw UsageError{e.what()};
-        }
-    }
+    std::vector<gis::FrameState> states = makeStates(*scene, configs, width, height);
 
     // References first (CPU, cached), so GL timings are not disturbed by them.
     std::vector<gis::ReferenceImage> refs;
@@ -161,7 +322,7 @@ int table(const std::vector<std::string>& args) {
 
     auto backend = gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(gl);
     auto context = gis::gl::createContext(backend);
-    gis::FrameRenderer renderer;
+    gis::FrameRenderer renderer(timerQueries);
     renderer.setScene(scene);
     nlohmann::json rows = nlohmann::json::array();
     for (size_t i = 0; i < configs.size(); ++i) {
@@ -222,7 +383,8 @@ int run(int argc, char** argv) {
     args.erase(args.begin());
     if (command == "compare") return compare(args);
     if (command == "table") return table(args);
-    throw UsageError{"unknown command '" + command + "': use compare or table (see --help)"};
+    if (command == "passes") return passes(args);
+    throw UsageError{"unknown command '" + command + "': use compare, table or passes (see --help)"};
 }
 
 } // namespace

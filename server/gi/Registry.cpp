@@ -4,6 +4,7 @@
 #include "gi/isr/Isr.h"
 #include "gi/none/NoIndirect.h"
 #include "gi/multires_gather/MultiresGather.h"
+#include "gi/multires_splat/MultiresSplat.h"
 #include "gi/rsm_gather/RsmGather.h"
 
 namespace gis {
@@ -12,6 +13,7 @@ const std::vector<TechniqueEntry>& techniqueRegistry() {
     static const std::vector<TechniqueEntry> registry = {
         {NoIndirect::info(), [] { return std::make_unique<NoIndirect>(); }},
         {RsmGather::info(), [] { return std::make_unique<RsmGather>(); }},
+        {MultiresSplat::info(), [] { return std::make_unique<MultiresSplat>(); }},
         {MultiresGather::info(), [] { return std::make_unique<MultiresGather>(); }},
         {Isr::info(), [] { return std::make_unique<Isr>(); }},
         {HierIsr::info(), [] { return std::make_unique<HierIsr>(); }},

@@ -9,9 +9,11 @@ namespace gis::shader {
 using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 using ivec4 = glm::ivec4;
+using uvec4 = glm::uvec4;
 #include "shaders/shared/FrameData.h"
 #include "shaders/shared/EyeHierarchy.h"
 #include "shaders/shared/LightTree.h"
+#include "shaders/shared/Subsplat.h"
 
 static_assert(sizeof(FrameUniforms) % 16 == 0, "std140 blocks must be whole vec4s");
 static_assert(sizeof(FrameUniforms) == 2 * 64 + 7 * 16, "FrameUniforms layout drifted from the GLSL side");
@@ -25,4 +27,6 @@ static_assert(sizeof(LightNode) == 80, "LightNode must be five vec4s in std430")
 static_assert(offsetof(LightNode, flux) == offsetof(Vpl, flux), "a LightNode starts with a Vpl's layout");
 static_assert(sizeof(LightTreeUniforms) == GIS_MAX_LIGHT_LEVELS * 16 + 16, "LightTreeUniforms drifted");
 static_assert(offsetof(LightTreeUniforms, info) == GIS_MAX_LIGHT_LEVELS * 16);
+static_assert(sizeof(SubsplatCounters) == 7 * 16, "SubsplatCounters drifted from the GLSL side");
+static_assert(4 * 4 >= GIS_MAX_EYE_LEVELS, "perLevel holds one count per eye level");
 } // namespace gis::shader

@@ -47,7 +47,8 @@ public:
     /// Camera and spotlight matrices exactly as the pipeline builds them (also used by tests and
     /// the reference renderer so both see the same view).
     static glm::mat4 cameraViewProj(const Camera& camera, int width, int height);
-    static glm::mat4 lightViewProj(const Light& light, const Bounds& sceneBounds, float* tanHalfFov = nullptr);
+    static glm::mat4 lightViewProj(const Light& light, const Bounds& sceneBounds,
+                                   float* tanHalfFov = nullptr);
 
 private:
     void ensureTargets(int width, int height, int rsmSize, int shadowSize);

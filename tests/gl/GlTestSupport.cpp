@@ -14,14 +14,19 @@ gl::Context& sharedContext() {
     return *context;
 }
 
+FrameRenderer& sharedRenderer() {
+    sharedContext();
+    static std::unique_ptr<FrameRenderer> renderer = std::make_unique<FrameRenderer>();
+    return *renderer;
+}
+
 FrameOutput renderScene(const std::string& sceneName, const std::string& technique, int w, int h,
                         const nlohmann::json& params) {
     sharedContext();
     static std::map<std::string, std::shared_ptr<Scene>> scenes;
     auto& scene = scenes[sceneName];
     if (!scene) scene = std::make_shared<Scene>(loadScene(sceneName));
-    static std::unique_ptr<FrameRenderer> renderer;
-    if (!renderer) renderer = std::make_unique<FrameRenderer>();
+    FrameRenderer* renderer = &sharedRenderer();
     if (renderer->scene() != scene.get()) renderer->setScene(scene);
     FrameState state = makeFrameState(*scene, technique);
     state.width = w;

@@ -16,6 +16,9 @@ namespace gis::test {
 
 gl::Context& sharedContext();
 
+/// The renderer renderScene() uses (tests inspect its technique after a frame).
+FrameRenderer& sharedRenderer();
+
 /// Renders `scene` with `technique` and optional parameter overrides at w x h, with the linear frame.
 FrameOutput renderScene(const std::string& scene, const std::string& technique, int w, int h,
                         const nlohmann::json& params = nlohmann::json::object());

@@ -256,6 +256,7 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     glBindVertexArray(mEmptyVao.id());
     glBindFramebuffer(GL_FRAMEBUFFER, mReconFbo.id());
     glUseProgram(mUpsample.id());
+    glUniform1i(mUpsample.uniform("uInterpolate"), irradiance ? 1 : 0);
     glBindTextureUnit(0, mIllumination.id());
     glBindTextureUnit(1, mReconstructed.id());
     for (int l = static_cast<int>(mLevels.size()) - 1; l >= 1; --l) {
@@ -268,6 +269,7 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     glViewport(0, 0, in.width, in.height);
     glUseProgram(mResolve.id());
     glUniform1i(mResolve.uniform("uIrradiance"), irradiance ? 1 : 0);
+    glUniform1i(mResolve.uniform("uInterpolate"), irradiance ? 1 : 0);
     glUniform1f(mResolve.uniform("uDetailAlpha"), static_cast<float>(params.getFloat("detail_alpha")));
     glBindTextureUnit(0, in.gPosition->id());
     glBindTextureUnit(1, in.gNormal->id());

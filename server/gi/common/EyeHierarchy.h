@@ -48,6 +48,8 @@ public:
     /// receivers_total, receivers_l<k> and receiver_fraction (receivers / covered pixels).
     void countReceivers(Counters& counters, int coveredPixels = -1);
     /// Reconstructs level 0 ("upsample") and writes the full-resolution indirect radiance.
+    /// `irradiance`: one receiver list per frame holding irradiance (bilinear upsampling, albedo / pi
+    /// applied per pixel); false: per-VPL lists holding radiance (parent replicated, see eyeCombine).
     void reconstruct(const FrameInputs& in, const ParamSet& params, bool irradiance,
                      const gl::Framebuffer& indirectTarget, gl::PassTimer& timer);
 

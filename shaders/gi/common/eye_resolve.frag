@@ -13,6 +13,7 @@ layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gAlbedo;
 layout(binding = 3) uniform sampler2D uReconstructed; // levels >= 1 finished
 layout(binding = 4) uniform sampler2D uRendered;      // level 0 receivers (alpha 1)
+uniform int uInterpolate; // 0: replicate the parent (per-VPL lists)
 layout(location = 0) out vec4 outIndirect;
 
 uniform int uIrradiance;   // 1: buffer holds irradiance (multiply by albedo / pi); 0: radiance
@@ -23,8 +24,7 @@ void main() {
     vec4 pos = texelFetch(gPosition, p, 0);
     vec3 c = vec3(0.0);
     if (pos.w > 0.5) {
-        vec4 own = texelFetch(uRendered, p, 0); // level 0 sits at the atlas origin
-        c = own.a > 0.0 ? own.rgb : eyeInterpolateCoarse(uReconstructed, 1, p).rgb;
+        c = eyeCombine(texelFetch(uRendered, p, 0), uReconstructed, 0, p, uInterpolate != 0).rgb; // level 0 at the atlas origin
         if (uIrradiance != 0) c *= texelFetch(gAlbedo, p, 0).rgb * kInvPi;
         if (uDetailAlpha > 0.0) {
             vec3 toEye = gFrame.cameraPos.xyz - pos.xyz;

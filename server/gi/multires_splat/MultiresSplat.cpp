@@ -1,0 +1,215 @@
+#include "gi/multires_splat/MultiresSplat.h"
+
+#include <algorithm>
+
+#include "core/Log.h"
+#include "gl/ShaderShared.h"
+
+namespace gis {
+
+TechniqueInfo MultiresSplat::info() {
+    std::vector<ParamSpec> specs = vplParamSpecs(VplKernel::Point);
+    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    specs.push_back({.name = "refinement",
+                     .type = ParamType::Enum,
+                     .defaultValue = 0,
+                     .help = "subsplat refinement: once per frame on geometry (diffuse) or per VPL on "
+                             "illumination differences (any BRDF)",
+                     .source = "000 §3.3 / §3.3.1",
+                     .options = {"geometry", "illumination"}});
+    specs.push_back(
+        {.name = "illum_threshold",
+         .type = ParamType::Float,
+         .defaultValue = 1e-4,
+         .min = 1e-7,
+         .max = 1.0,
+         .unit = "W/(m^2 sr)",
+         .help = "per-VPL refinement: subdivide where one VPL's radiance differs by more than this",
+         .source = "000 §3.3.1 (T, value not given; chosen)",
+         .logScale = true});
+    specs.push_back({.name = "phong_ks",
+                     .type = ParamType::Float,
+                     .defaultValue = 0.0,
+                     .min = 0.0,
+                     .max = 1.0,
+                     .help =
+                         "per-VPL refinement: specular weight of the receivers' normalised Phong BRDF (0 = "
+                         "Lambertian)",
+                     .source = "000 Fig. 6 (Phong Buddha)"});
+    specs.push_back({.name = "phong_exponent",
+                     .type = ParamType::Float,
+                     .defaultValue = 32.0,
+                     .min = 1.0,
+                     .max = 1000.0,
+                     .help = "per-VPL refinement: Phong exponent of the receivers' BRDF",
+                     .source = "eng",
+                     .logScale = true});
+    specs.push_back({.name = "max_subsplats",
+                     .type = ParamType::Int,
+                     .defaultValue = 4 << 20,
+                     .min = 1024,
+                     .max = 16 << 20,
+                     .unit = "items",
+                     .help = "capacity of each subsplat list (8 bytes an item); items beyond it are splatted "
+                             "unrefined and counted",
+                     .source = "000 Table 1 (N/A entries: excessive memory)",
+                     .logScale = true});
+    return {"multires_splat", "iteratively refined subsplats splatted from grid VPLs, upsampled", "000 §3",
+            ParamTable(std::move(specs))};
+}
+
+MultiresSplat::MultiresSplat() {
+    mSeed = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/seed.comp"}});
+    mRefine = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/refine.comp"}});
+    mAdvance = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/advance.comp"}});
+    mSplat = KernelPrograms({{GL_VERTEX_SHADER, "gi/multires_splat/splat.vert"},
+                             {GL_FRAGMENT_SHADER, "gi/multires_splat/splat.frag"}});
+    mCounters = gl::Buffer::create(sizeof(shader::SubsplatCounters), nullptr,
+                                   GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    mEmptyVao = gl::VertexArray::create();
+}
+
+void MultiresSplat::resize(int width, int height) {
+    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
+    mTarget = gl::Framebuffer::create();
+    mTarget.attachColor(0, mIndirect);
+    mTarget.finish(1, "multires_splat indirect");
+}
+
+void MultiresSplat::ensureCapacity(GLuint items) {
+    if (items == mCapacity) return;
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(items) * 2 * sizeof(GLuint);
+    mListA = gl::Buffer::create(bytes, nullptr, 0);
+    mListB = gl::Buffer::create(bytes, nullptr, 0);
+    mSplatList = gl::Buffer::create(bytes, nullptr, GL_MAP_READ_BIT);
+    mCapacity = items;
+}
+
+void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                            Counters& counters) {
+    const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
+    mEye.build(in, params, timer);
+    ensureCapacity(static_cast<GLuint>(params.getInt("max_subsplats")));
+    const bool perVpl = params.getEnum("refinement") == "illumination";
+    const int levels = static_cast<int>(mEye.levels().size());
+    const EyeLevel& coarsest = mEye.levels().back();
+
+    timer.begin("subsplat_refine");
+    const shader::SubsplatCounters zero{};
+    mCounters.upload(0, sizeof zero, &zero);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, mCounters.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.buffer().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, mSplatList.id());
+    glBindTextureUnit(6, mEye.flags().id());
+    mEye.bindPixels(in);
+    glBindTextureUnit(11, mEye.geoPosition().id());
+    glBindTextureUnit(12, mEye.geoNormal().id());
+    glBindTextureUnit(13, mEye.geoAlbedo().id());
+    if (vplCount > 0) {
+        const long long seedWanted =
+            static_cast<long long>(coarsest.width) * coarsest.height * (perVpl ? vplCount : 1);
+        const int seedItems = static_cast<int>(std::min<long long>(seedWanted, 1 << 30));
+        // The seed fills the "next" list; each level then advances (next -> input, indirect
+        // dispatch size) and refines.
+        const gl::Buffer* current = &mListB;
+        const gl::Buffer* next = &mListA;
+        glUseProgram(mSeed.id());
+        glUniform1i(mSeed.uniform("uItems"), seedItems);
+        glUniform1ui(mSeed.uniform("uCapacity"), mCapacity);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, next->id());
+        glDispatchCompute(static_cast<GLuint>((seedItems + GIS_SUBSPLAT_GROUP - 1) / GIS_SUBSPLAT_GROUP), 1,
+                          1);
+
+        glUseProgram(mRefine.id());
+        glUniform1ui(mRefine.uniform("uCapacity"), mCapacity);
+        glUniform1f(mRefine.uniform("uIllumThreshold"),
+                    static_cast<float>(params.getFloat("illum_threshold")));
+        glUniform1i(mRefine.uniform("uPerVpl"), perVpl ? 1 : 0);
+        glUniform1f(mRefine.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+        glUniform1f(mRefine.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
+        glUniform1f(mRefine.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
+        glUseProgram(mAdvance.id());
+        glUniform1i(mAdvance.uniform("uMode"), 0);
+        glUniform1ui(mAdvance.uniform("uCapacity"), mCapacity);
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, mCounters.id());
+        for (int level = levels - 1; level >= 0; --level) {
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            glUseProgram(mAdvance.id());
+            glDispatchCompute(1, 1, 1);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+            std::swap(current, next);
+            glUseProgram(mRefine.id());
+            glUniform1i(mRefine.uniform("uLevel"), level);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, current->id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, next->id());
+            glDispatchComputeIndirect(0);
+        }
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(mAdvance.id());
+        glUniform1i(mAdvance.uniform("uMode"), 1);
+        glUniform1ui(mAdvance.uniform("uCapacity"), mCapacity);
+        glUniform1ui(mAdvance.uniform("uInstances"), perVpl ? 1u : static_cast<GLuint>(vplCount));
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+    }
+    timer.end();
+
+    timer.begin("subsplat_splat");
+    if (vplCount > 0) {
+        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
+        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
+        const gl::Program& splat = mSplat.get(vplKernel(params));
+        glUseProgram(splat.id());
+        glUniform2i(splat.uniform("uAtlasSize"), mEye.atlasWidth(), mEye.atlasHeight());
+        glUniform1i(splat.uniform("uPerVpl"), perVpl ? 1 : 0);
+        glUniform1f(splat.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+        glUniform1f(splat.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
+        glUniform1f(splat.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
+        glBindVertexArray(mEmptyVao.id());
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCounters.id());
+        glDrawArraysIndirect(GL_POINTS,
+                             reinterpret_cast<const void*>(offsetof(shader::SubsplatCounters, draw)));
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+        glDisable(GL_BLEND);
+    }
+    timer.end();
+
+    mEye.reconstruct(in, params, !perVpl, mTarget, timer);
+    mEye.countReceivers(counters);
+
+    shader::SubsplatCounters c{};
+    glGetNamedBufferSubData(mCounters.id(), 0, sizeof c, &c);
+    double total = 0;
+    for (int l = 0; l < levels; ++l) {
+        const double n = c.perLevel[l / 4][l % 4];
+        counters["subsplats_l" + std::to_string(l)] = n;
+        total += n;
+    }
+    counters["subsplats_total"] = total;
+    counters["subsplat_capped"] = c.counts.w;
+    if (perVpl && vplCount > 0) counters["subsplats_per_vpl"] = total / vplCount;
+    counters["splat_points"] = perVpl ? total : total * vplCount;
+}
+
+std::vector<std::array<int, 3>> MultiresSplat::readSplatPatches() const {
+    shader::SubsplatCounters c{};
+    glGetNamedBufferSubData(mCounters.id(), 0, sizeof c, &c);
+    const GLuint n = std::min(c.counts.z, mCapacity);
+    std::vector<GLuint> items(static_cast<size_t>(n) * 2);
+    if (n > 0)
+        glGetNamedBufferSubData(mSplatList.id(), 0, static_cast<GLsizeiptr>(items.size() * sizeof(GLuint)),
+                                items.data());
+    std::vector<std::array<int, 3>> set;
+    set.reserve(n);
+    for (GLuint i = 0; i < n; ++i) {
+        const GLuint packed = items[2 * i + 1];
+        set.push_back({static_cast<int>(packed >> 28), static_cast<int>(packed & 0x3FFFu),
+                       static_cast<int>((packed >> 14) & 0x3FFFu)});
+    }
+    std::sort(set.begin(), set.end());
+    return set;
+}
+
+} // namespace gis

@@ -1,0 +1,69 @@
+// Technique `multires_splat`: one-bounce indirect light splatted from VPLs into a multiresolution
+// illumination buffer of iteratively refined subsplats, then reconstructed to full resolution.
+//
+// Paper: 000 (Nichols & Wyman 2009) §3-§5; digest S.3 preset multires_splat (VPL set A, receivers
+// R2, kernel K1 scatter, reconstruction U1, detail modulation C3 optional).
+//
+// Pipeline:
+//   1. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid (shared with rsm_gather)
+//   2. eye_mipmap / refine_flags / stencil_setup: the shared eye hierarchy (EyeHierarchy)
+//   3. subsplat_refine: the list starts with every covered texel of the coarsest level (16^2) and
+//      is refined level by level with compute append buffers (one pass per level, indirect
+//      dispatch, no CPU read-back). refinement=geometry: once per frame on the eye hierarchy's
+//      flags (diffuse only). refinement=illumination: one list per VPL, refined where the VPL's
+//      radiance differs across the 4 children by more than illum_threshold (any BRDF; Phong here).
+//   4. subsplat_splat: the list drawn as points into the flattened buffer, additive blending;
+//      geometry refinement draws it instanced once per VPL.
+//   5. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel (geometry).
+//
+// Parameters: the VPL ones (vpl_grid 16, kernel point, min_distance 0.1 m), the eye hierarchy's,
+// refinement geometry|illumination, illum_threshold (radiance), phong_ks [0, 1] (0 = Lambertian),
+// phong_exponent [1, 1000], max_subsplats (list capacity; items past it are splatted unrefined and
+// counted in subsplat_capped, so an explosion degrades resolution and never overruns memory).
+//
+// Why compute append buffers and not transform feedback: both need one pass per level; compute
+// lists need no geometry shader (slow on llvmpipe) and size the next pass on the GPU through
+// glDispatchComputeIndirect, so the CPU never waits for a count.
+//
+// Limits: no indirect visibility; the geometry list is correct for diffuse receivers only (000
+// §3.3); per-VPL refinement point-samples the children, so sharp highlights between the samples are
+// missed (000 §3.3.1); the receiver set must equal multires_gather's (tested).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "gi/Technique.h"
+#include "gi/common/EyeHierarchy.h"
+#include "gi/common/VplGrid.h"
+
+namespace gis {
+
+class MultiresSplat final : public Technique {
+public:
+    static TechniqueInfo info();
+    MultiresSplat();
+    void resize(int width, int height) override;
+    void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                 Counters& counters) override;
+    const gl::Texture* indirect() const override { return &mIndirect; }
+
+    EyeHierarchy& hierarchy() { return mEye; }
+    /// Test hook: the last frame's splat list as sorted (level, x, y) triples (geometry refinement).
+    std::vector<std::array<int, 3>> readSplatPatches() const;
+
+private:
+    void ensureCapacity(GLuint items);
+
+    VplGrid mVpls;
+    EyeHierarchy mEye;
+    gl::Program mSeed, mRefine, mAdvance;
+    KernelPrograms mSplat;
+    gl::Buffer mListA, mListB, mSplatList, mCounters;
+    GLuint mCapacity = 0;
+    gl::VertexArray mEmptyVao;
+    gl::Texture mIndirect;
+    gl::Framebuffer mTarget;
+};
+
+} // namespace gis
