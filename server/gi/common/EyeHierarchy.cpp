@@ -122,12 +122,16 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     mNormalMin = gl::Texture::create2D(GL_RGBA16F, aw, ah);
     mNormalMax = gl::Texture::create2D(GL_RGBA16F, aw, ah);
     mFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
+    mDiscFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
     mGeoFbo = gl::Framebuffer::create();
     const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
                                  &mDepthInfo,   &mNormalMin, &mNormalMax};
     for (int i = 0; i < 6; ++i) mGeoFbo.attachColor(i, *geo[i]);
-    mGeoFbo.attachColor(6, mFlags);
+    mGeoFbo.attachColor(6, mDiscFlags);
     mGeoFbo.finish(7, "eye hierarchy mipmaps");
+    mFlagsFbo = gl::Framebuffer::create();
+    mFlagsFbo.attachColor(0, mFlags);
+    mFlagsFbo.finish(1, "eye refinement flags");
     mReconFbo = gl::Framebuffer::create();
     mIllumination = gl::Texture::create2D(GL_RGBA32F, aw, ah);
     mReconstructed = gl::Texture::create2D(GL_RGBA32F, aw, ah);
@@ -145,6 +149,7 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
         glClearTexImage(t->id(), 0, GL_RGBA, GL_FLOAT, zero);
     const GLuint zeroU = 0;
     glClearTexImage(mFlags.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zeroU);
+    glClearTexImage(mDiscFlags.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zeroU);
     mWidth = width;
     mHeight = height;
     mCoarsest = coarsestSize;
@@ -187,7 +192,6 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
                                  &mDepthInfo,   &mNormalMin, &mNormalMax};
     for (int i = 0; i < 6; ++i) glBindTextureUnit(static_cast<GLuint>(i), geo[i]->id());
-    glColorMaski(6, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE); // the flags follow in their own pass
     for (size_t l = 1; l < mLevels.size(); ++l) {
         const gl::Program& program = l == 1 ? mReduceFromPixels : mReduce;
         glUseProgram(program.id());
@@ -198,17 +202,14 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     }
     timer.end();
 
-    // The flags read the statistics of whole levels (diagonal neighbours), so they follow the
-    // mipmap; only the coarser levels' column needs them (level 0 never refines).
+    // The diagonal rule reads neighbours' discontinuity marks, so the flags follow the mipmap.
     timer.begin("refine_flags");
     if (mLevels.size() > 1) {
-        glTextureBarrier();
+        glBindFramebuffer(GL_FRAMEBUFFER, mFlagsFbo.id());
         glUseProgram(mFlagsProgram.id());
-        for (GLuint i = 0; i < 6; ++i) glColorMaski(i, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-        glColorMaski(6, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-        glViewport(mWidth, 0, mAtlasWidth - mWidth, mAtlasHeight);
+        glBindTextureUnit(7, mDiscFlags.id());
+        glViewport(mWidth, 0, mAtlasWidth - mWidth, mAtlasHeight); // the level column only
         glDrawArrays(GL_TRIANGLES, 0, 3);
-        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
     timer.end();
 

@@ -80,9 +80,9 @@ private:
     gl::Buffer mUbo, mCounts;
     std::vector<EyeLevel> mLevels;
     int mWidth = 0, mHeight = 0, mCoarsest = 0, mAtlasWidth = 0, mAtlasHeight = 0;
-    gl::Texture mGeoPosition, mGeoNormal, mGeoAlbedo, mDepthInfo, mNormalMin, mNormalMax, mFlags;
+    gl::Texture mGeoPosition, mGeoNormal, mGeoAlbedo, mDepthInfo, mNormalMin, mNormalMax, mFlags, mDiscFlags;
     gl::Texture mIllumination, mStencil, mReconstructed;
-    gl::Framebuffer mGeoFbo, mIllumFbo, mReconFbo;
+    gl::Framebuffer mGeoFbo, mFlagsFbo, mIllumFbo, mReconFbo;
     std::array<unsigned, GIS_MAX_EYE_LEVELS> mLastCounts{};
 };
 

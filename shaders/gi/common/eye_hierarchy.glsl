@@ -29,6 +29,21 @@ float eyeFootprintPixels(int level, ivec2 t) {
     return float(n.x * n.y);
 }
 
+// 000 §3 step 5's ContainsDepth/NormalDiscontinuity for a patch of `level` >= 1 from its statistics:
+// partly background (an object edge), or depth or normal statistics beyond the thresholds.
+bool eyePatchDiscontinuous(int level, ivec2 t, float covered, vec4 depthInfo, vec3 normalMin, vec3 normalMax) {
+    if (level == 0 || covered <= 0.0) return false;           // one pixel, or empty: nothing to refine
+    if (covered < eyeFootprintPixels(level, t)) return true;  // object / background edge
+    int options = gEye.info.w;
+    bool depthDisc = (options & GIS_EYE_DEPTH_DERIVATIVE) != 0
+                         ? depthInfo.z > gEye.thresholds.y
+                         : (depthInfo.y - depthInfo.x) > gEye.thresholds.x * max(depthInfo.x, 1e-6);
+    bool normalDisc = (options & GIS_EYE_CURVATURE) != 0
+                          ? depthInfo.w > gEye.thresholds.w
+                          : any(greaterThan(normalMax - normalMin, vec3(gEye.thresholds.z)));
+    return depthDisc || normalDisc;
+}
+
 // The receiver predicate (digest S.3 R2 == R3). A patch receives light when it has geometry, needs
 // no subdivision, and every ancestor was subdivided. 001's pseudo-code tests only the parent, which
 // equals the iterative refinement only when the refine test is monotone (a child never refines

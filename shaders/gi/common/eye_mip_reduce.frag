@@ -22,6 +22,7 @@ layout(location = 2) out vec4 outGeoAlbedo;
 layout(location = 3) out vec4 outDepthInfo;
 layout(location = 4) out vec4 outNormalMin;
 layout(location = 5) out vec4 outNormalMax;
+layout(location = 6) out uint outDiscFlags; // covered | discontinuous (the flags pass adds the diagonal rule)
 
 uniform int uLevel; // the level written (>= 1)
 
@@ -88,6 +89,8 @@ void main() {
     // Opposing normals can cancel: keep a child's normal rather than normalising ~0.
     float len = length(nrm);
     vec3 n = len > 1e-6 * max(count, 1.0) ? nrm / len : firstNormal;
+    bool discontinuous = eyePatchDiscontinuous(uLevel, t, count, depth, nmin, nmax);
+    outDiscFlags = (count > 0.0 ? GIS_EYE_FLAG_COVERED : 0u) | (discontinuous ? GIS_EYE_FLAG_DISCONTINUOUS : 0u);
     outGeoPosition = vec4(pos * inv, count);
     outGeoNormal = vec4(n, 0.0);
     outGeoAlbedo = vec4(alb * inv, 0.0);
