@@ -66,11 +66,14 @@ void Framebuffer::finish(int colorCount, const std::string& label) {
     GLenum buffers[8];
     GIS_ASSERT(colorCount >= 0 && colorCount <= 8);
     for (int i = 0; i < colorCount; ++i) buffers[i] = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i);
-    if (colorCount == 0) glNamedFramebufferDrawBuffer(id(), GL_NONE);
-    else glNamedFramebufferDrawBuffers(id(), colorCount, buffers);
+    if (colorCount == 0)
+        glNamedFramebufferDrawBuffer(id(), GL_NONE);
+    else
+        glNamedFramebufferDrawBuffers(id(), colorCount, buffers);
     GLenum status = glCheckNamedFramebufferStatus(id(), GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE)
-        throw Error("gl: framebuffer '" + label + "' is incomplete (status 0x" + std::to_string(status) + ")");
+        throw Error("gl: framebuffer '" + label + "' is incomplete (status 0x" + std::to_string(status) +
+                    ")");
 }
 
 VertexArray VertexArray::create() {
@@ -83,6 +86,12 @@ Query Query::create(GLenum target) {
     GLuint id = 0;
     glCreateQueries(target, 1, &id);
     return Query(id);
+}
+
+TransformFeedback TransformFeedback::create() {
+    GLuint id = 0;
+    glCreateTransformFeedbacks(1, &id);
+    return TransformFeedback(id);
 }
 
 Sampler Sampler::create() {

@@ -38,19 +38,37 @@ private:
     GLuint mId = 0;
 };
 
-struct BufferTraits { static void destroy(GLuint id) { glDeleteBuffers(1, &id); } };
-struct TextureTraits { static void destroy(GLuint id) { glDeleteTextures(1, &id); } };
-struct FramebufferTraits { static void destroy(GLuint id) { glDeleteFramebuffers(1, &id); } };
-struct VertexArrayTraits { static void destroy(GLuint id) { glDeleteVertexArrays(1, &id); } };
-struct ProgramTraits { static void destroy(GLuint id) { glDeleteProgram(id); } };
-struct QueryTraits { static void destroy(GLuint id) { glDeleteQueries(1, &id); } };
-struct SamplerTraits { static void destroy(GLuint id) { glDeleteSamplers(1, &id); } };
+struct BufferTraits {
+    static void destroy(GLuint id) { glDeleteBuffers(1, &id); }
+};
+struct TextureTraits {
+    static void destroy(GLuint id) { glDeleteTextures(1, &id); }
+};
+struct FramebufferTraits {
+    static void destroy(GLuint id) { glDeleteFramebuffers(1, &id); }
+};
+struct VertexArrayTraits {
+    static void destroy(GLuint id) { glDeleteVertexArrays(1, &id); }
+};
+struct ProgramTraits {
+    static void destroy(GLuint id) { glDeleteProgram(id); }
+};
+struct QueryTraits {
+    static void destroy(GLuint id) { glDeleteQueries(1, &id); }
+};
+struct TransformFeedbackTraits {
+    static void destroy(GLuint id) { glDeleteTransformFeedbacks(1, &id); }
+};
+struct SamplerTraits {
+    static void destroy(GLuint id) { glDeleteSamplers(1, &id); }
+};
 
 class Buffer : public Object<BufferTraits> {
 public:
     Buffer() = default;
     /// Immutable-size storage (glNamedBufferStorage with dynamic updates allowed).
-    static Buffer create(GLsizeiptr bytes, const void* data = nullptr, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
+    static Buffer create(GLsizeiptr bytes, const void* data = nullptr,
+                         GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
     GLsizeiptr size() const { return mSize; }
     void upload(GLintptr offset, GLsizeiptr bytes, const void* data);
 
@@ -104,6 +122,15 @@ class Query : public Object<QueryTraits> {
 public:
     Query() = default;
     static Query create(GLenum target);
+
+private:
+    using Object::Object;
+};
+
+class TransformFeedback : public Object<TransformFeedbackTraits> {
+public:
+    TransformFeedback() = default;
+    static TransformFeedback create();
 
 private:
     using Object::Object;

@@ -26,8 +26,9 @@ std::string readShaderFile(const std::string& path) {
 
 namespace {
 
-void expandInto(const std::string& path, ExpandedSource& out, std::set<std::string>& included, std::ostringstream& text,
-                bool isRoot, const std::vector<std::pair<std::string, std::string>>& defines) {
+void expandInto(const std::string& path, ExpandedSource& out, std::set<std::string>& included,
+                std::ostringstream& text, bool isRoot,
+                const std::vector<std::pair<std::string, std::string>>& defines) {
     const int fileIndex = static_cast<int>(out.files.size());
     out.files.push_back(path);
     std::istringstream in(readShaderFile(path));
@@ -62,7 +63,8 @@ void expandInto(const std::string& path, ExpandedSource& out, std::set<std::stri
     if (isRoot && !versionSeen) throw Error("gl: shader 'shaders/" + path + "' has no #version line");
 }
 
-GLuint compileStage(const ShaderStage& stage, const std::vector<std::pair<std::string, std::string>>& defines) {
+GLuint compileStage(const ShaderStage& stage,
+                    const std::vector<std::pair<std::string, std::string>>& defines) {
     ExpandedSource src = expandShader(stage.path, defines);
     GLuint shader = glCreateShader(stage.type);
     const char* text = src.text.c_str();
@@ -83,7 +85,8 @@ GLuint compileStage(const ShaderStage& stage, const std::vector<std::pair<std::s
 
 } // namespace
 
-ExpandedSource expandShader(const std::string& path, const std::vector<std::pair<std::string, std::string>>& defines) {
+ExpandedSource expandShader(const std::string& path,
+                            const std::vector<std::pair<std::string, std::string>>& defines) {
     ExpandedSource out;
     std::set<std::string> included;
     std::ostringstream text;
@@ -109,7 +112,8 @@ std::string mapShaderLog(const std::string& log, const std::vector<std::string>&
 }
 
 Program Program::build(const std::vector<ShaderStage>& stages,
-                       const std::vector<std::pair<std::string, std::string>>& defines) {
+                       const std::vector<std::pair<std::string, std::string>>& defines,
+                       const std::vector<std::string>& feedbackVaryings) {
     GLuint program = glCreateProgram();
     std::vector<GLuint> shaders;
     try {
@@ -121,6 +125,12 @@ Program Program::build(const std::vector<ShaderStage>& stages,
         for (GLuint s : shaders) glDeleteShader(s);
         glDeleteProgram(program);
         throw;
+    }
+    if (!feedbackVaryings.empty()) {
+        std::vector<const char*> names;
+        for (const auto& v : feedbackVaryings) names.push_back(v.c_str());
+        glTransformFeedbackVaryings(program, static_cast<GLsizei>(names.size()), names.data(),
+                                    GL_INTERLEAVED_ATTRIBS);
     }
     glLinkProgram(program);
     for (GLuint s : shaders) glDeleteShader(s);

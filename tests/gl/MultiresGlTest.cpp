@@ -47,7 +47,9 @@ void expectPartition(const PatchSet& set, int width, int height, double covered)
                 ++pixels;
             }
     }
-    if (covered >= 0) EXPECT_EQ(pixels, covered);
+    if (covered >= 0) {
+        EXPECT_EQ(pixels, covered);
+    }
 }
 
 struct SetCase {
@@ -71,11 +73,17 @@ TEST(Multires, StencilReceiversEqualIterativeRefinement) {
         {"builtin:crease", 128, 128, {{"coarsest_size", 8}, {"normal_threshold", 0.05}}},
         {"builtin:cornell-dense", 96, 96, {{"coarsest_size", 64}}},
         {"builtin:cornell-empty", 16, 16, nlohmann::json::object()}, // one level only
+        // 000's geometry shader + transform feedback lists must build the same set.
+        {"builtin:cornell", 97, 61, {{"list_builder", "transform_feedback"}}},
+        {"builtin:cornell-dense",
+         96,
+         96,
+         {{"list_builder", "transform_feedback"}, {"diagonal_refine", false}}},
     };
     bool sawCoarsest = false, sawFinest = false;
     for (const auto& c : cases) {
-        SCOPED_TRACE(std::string(c.scene) + " " + std::to_string(c.width) + "x" + std::to_string(c.height) + " " +
-                     c.params.dump());
+        SCOPED_TRACE(std::string(c.scene) + " " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                     " " + c.params.dump());
         renderScene(c.scene, "multires_splat", c.width, c.height, c.params);
         auto* splat = dynamic_cast<MultiresSplat*>(test::sharedRenderer().technique());
         ASSERT_NE(splat, nullptr);
@@ -117,6 +125,10 @@ TEST(Multires, SplatAndGatherAgree) {
     FrameOutput splat = renderScene("builtin:cornell", "multires_splat", 128, 112, params);
     FrameOutput gather = renderScene("builtin:cornell", "multires_gather", 128, 112, params);
     EXPECT_LT(relativeRmseOf(splat, gather), 1e-5);
+    nlohmann::json feedback = params;
+    feedback["list_builder"] = "transform_feedback";
+    FrameOutput splatTf = renderScene("builtin:cornell", "multires_splat", 128, 112, feedback);
+    EXPECT_LT(relativeRmseOf(splatTf, gather), 1e-5);
 }
 
 // Default thresholds trade a little error for far fewer receivers.
@@ -158,14 +170,17 @@ TEST(Multires, PerVplRefinementAndCap) {
 // multiresolution technique (and with extreme thresholds).
 TEST(Multires, StableOnEveryBuiltinScene) {
     const std::pair<int, int> sizes[] = {{512, 512}, {511, 383}};
-    const char* scenes[] = {"builtin:cornell", "builtin:cornell-empty", "builtin:crease", "builtin:cornell-dense"};
+    const char* scenes[] = {"builtin:cornell", "builtin:cornell-empty", "builtin:crease",
+                            "builtin:cornell-dense"};
     for (const char* technique : {"multires_gather", "multires_splat"}) {
         for (const char* scene : scenes)
             for (auto [w, h] : sizes) {
-                SCOPED_TRACE(std::string(technique) + " " + scene + " " + std::to_string(w) + "x" + std::to_string(h));
+                SCOPED_TRACE(std::string(technique) + " " + scene + " " + std::to_string(w) + "x" +
+                             std::to_string(h));
                 // The splat draws vpl_grid^2 points per receiver: keep it affordable on llvmpipe.
-                nlohmann::json params = std::string(technique) == "multires_splat" ? nlohmann::json{{"vpl_grid", 6}}
-                                                                                    : nlohmann::json::object();
+                nlohmann::json params = std::string(technique) == "multires_splat"
+                                            ? nlohmann::json{{"vpl_grid", 6}}
+                                            : nlohmann::json::object();
                 FrameOutput f = renderScene(scene, technique, w, h, params);
                 size_t bad = 0;
                 for (float v : f.linear) bad += !(std::isfinite(v) && v >= 0.0f);
@@ -175,8 +190,11 @@ TEST(Multires, StableOnEveryBuiltinScene) {
     for (const nlohmann::json& extreme :
          {nlohmann::json{{"depth_threshold", 0.0}, {"normal_threshold", 0.0}, {"coarsest_size", 1}},
           nlohmann::json{{"depth_threshold", 1.0}, {"normal_threshold", 2.0}, {"coarsest_size", 256}},
-          nlohmann::json{{"depth_metric", "derivative"}, {"depth_derivative_threshold", 0.0}, {"kernel", "point"},
-                         {"min_distance", 0.0}, {"detail_alpha", 1.0}}}) {
+          nlohmann::json{{"depth_metric", "derivative"},
+                         {"depth_derivative_threshold", 0.0},
+                         {"kernel", "point"},
+                         {"min_distance", 0.0},
+                         {"detail_alpha", 1.0}}}) {
         SCOPED_TRACE(extreme.dump());
         FrameOutput f = renderScene("builtin:crease", "multires_gather", 63, 47, extreme);
         for (float v : f.linear) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);

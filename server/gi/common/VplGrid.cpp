@@ -37,9 +37,15 @@ VplKernel vplKernel(const ParamSet& params) {
     return params.getEnum("kernel") == "disk" ? VplKernel::Disk : VplKernel::Point;
 }
 
-KernelPrograms::KernelPrograms(const std::vector<gl::ShaderStage>& stages) {
-    mPoint = gl::Program::build(stages, {{"GIS_VPL_KERNEL", "GIS_KERNEL_POINT"}});
-    mDisk = gl::Program::build(stages, {{"GIS_VPL_KERNEL", "GIS_KERNEL_DISK"}});
+KernelPrograms::KernelPrograms(const std::vector<gl::ShaderStage>& stages,
+                               const std::vector<std::pair<std::string, std::string>>& defines) {
+    auto with = [&](const char* kernel) {
+        auto all = defines;
+        all.emplace_back("GIS_VPL_KERNEL", kernel);
+        return all;
+    };
+    mPoint = gl::Program::build(stages, with("GIS_KERNEL_POINT"));
+    mDisk = gl::Program::build(stages, with("GIS_KERNEL_DISK"));
 }
 
 VplGrid::VplGrid() {

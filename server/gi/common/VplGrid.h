@@ -24,7 +24,8 @@ VplKernel vplKernel(const ParamSet& params);
 class KernelPrograms {
 public:
     KernelPrograms() = default;
-    explicit KernelPrograms(const std::vector<gl::ShaderStage>& stages);
+    explicit KernelPrograms(const std::vector<gl::ShaderStage>& stages,
+                            const std::vector<std::pair<std::string, std::string>>& defines = {});
     const gl::Program& get(VplKernel kernel) const { return kernel == VplKernel::Disk ? mDisk : mPoint; }
 
 private:

@@ -44,6 +44,13 @@ TechniqueInfo MultiresSplat::info() {
                      .help = "per-VPL refinement: Phong exponent of the receivers' BRDF",
                      .source = "eng",
                      .logScale = true});
+    specs.push_back({.name = "list_builder",
+                     .type = ParamType::Enum,
+                     .defaultValue = 0,
+                     .help = "how geometry refinement builds the subsplat lists: compute append buffers or a "
+                             "geometry shader with transform feedback (000)",
+                     .source = "000 §3 step 5 (transform feedback); measured in docs/multires.md",
+                     .options = {"compute", "transform_feedback"}});
     specs.push_back({.name = "max_subsplats",
                      .type = ParamType::Int,
                      .defaultValue = 4 << 20,
@@ -67,6 +74,96 @@ MultiresSplat::MultiresSplat() {
     mCounters = gl::Buffer::create(sizeof(shader::SubsplatCounters), nullptr,
                                    GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
     mEmptyVao = gl::VertexArray::create();
+    mRefineTf = gl::Program::build({{GL_VERTEX_SHADER, "gi/multires_splat/refine_tf.vert"},
+                                    {GL_GEOMETRY_SHADER, "gi/multires_splat/refine_tf.geom"}},
+                                   {}, {"gNext", "gl_NextBuffer", "gSplat"});
+    const std::vector<gl::ShaderStage> tfSplat = {{GL_VERTEX_SHADER, "gi/multires_splat/splat.vert"},
+                                                  {GL_FRAGMENT_SHADER, "gi/multires_splat/splat.frag"}};
+    mSplatTf = KernelPrograms(tfSplat, {{"GIS_ITEM_ATTRIBUTE", "1"}});
+    mItemVao = gl::VertexArray::create();
+    glEnableVertexArrayAttrib(mItemVao.id(), 0);
+    glVertexArrayAttribIFormat(mItemVao.id(), 0, 2, GL_UNSIGNED_INT, 0);
+    glVertexArrayAttribBinding(mItemVao.id(), 0, 0);
+}
+
+void MultiresSplat::ensureFeedbackLists() {
+    const auto& levels = mEye.levels();
+    const bool same =
+        levels.size() == mTfLevels.size() &&
+        std::equal(levels.begin(), levels.end(), mTfLevels.begin(), [](const EyeLevel& a, const EyeLevel& b) {
+            return a.width == b.width && a.height == b.height;
+        });
+    if (same) return;
+    mTfLevels = levels;
+    const size_t n = levels.size();
+    mTfo.clear();
+    mTfNext.clear();
+    mTfSplat.clear();
+    mTfWritten.clear();
+    const auto itemBytes = [](const EyeLevel& l) {
+        return static_cast<GLsizeiptr>(std::max(l.width * l.height, 1)) * 2 *
+               static_cast<GLsizeiptr>(sizeof(GLuint));
+    };
+    for (size_t l = 0; l < n; ++l) {
+        // A level's splat list holds at most its texels; the next list at most the level below's.
+        mTfSplat.push_back(gl::Buffer::create(itemBytes(levels[l]), nullptr, GL_MAP_READ_BIT));
+        mTfNext.push_back(gl::Buffer::create(itemBytes(l > 0 ? levels[l - 1] : levels[0]), nullptr, 0));
+        mTfo.push_back(gl::TransformFeedback::create());
+        glTransformFeedbackBufferBase(mTfo.back().id(), 0, mTfNext.back().id());
+        glTransformFeedbackBufferBase(mTfo.back().id(), 1, mTfSplat.back().id());
+        mTfWritten.push_back(gl::Query::create(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN));
+    }
+    const EyeLevel& c = levels.back();
+    std::vector<GLuint> seed;
+    for (int y = 0; y < c.height; ++y)
+        for (int x = 0; x < c.width; ++x) {
+            seed.push_back(0);
+            seed.push_back((static_cast<GLuint>(n - 1) << 28) | (static_cast<GLuint>(y) << 14) |
+                           static_cast<GLuint>(x));
+        }
+    mTfSeed = gl::Buffer::create(static_cast<GLsizeiptr>(seed.size() * sizeof(GLuint)), seed.data(), 0);
+    mTfSeedCount = static_cast<GLsizei>(seed.size() / 2);
+}
+
+void MultiresSplat::refineWithFeedback(const FrameInputs& in, Counters& counters) {
+    ensureFeedbackLists();
+    const int levels = static_cast<int>(mTfLevels.size());
+    glEnable(GL_RASTERIZER_DISCARD);
+    glUseProgram(mRefineTf.id());
+    glBindTextureUnit(6, mEye.flags().id());
+    mEye.bindPixels(in);
+    glBindVertexArray(mItemVao.id());
+    for (int level = levels - 1; level >= 0; --level) {
+        glUniform1i(mRefineTf.uniform("uLevel"), level);
+        glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, mTfo[level].id());
+        glBeginQueryIndexed(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, 1, mTfWritten[level].id());
+        glBeginTransformFeedback(GL_POINTS);
+        if (level == levels - 1) {
+            glVertexArrayVertexBuffer(mItemVao.id(), 0, mTfSeed.id(), 0, 2 * sizeof(GLuint));
+            glDrawArrays(GL_POINTS, 0, mTfSeedCount);
+        } else {
+            glVertexArrayVertexBuffer(mItemVao.id(), 0, mTfNext[level + 1].id(), 0, 2 * sizeof(GLuint));
+            glDrawTransformFeedbackStream(GL_POINTS, mTfo[level + 1].id(), 0);
+        }
+        glEndTransformFeedback();
+        glEndQueryIndexed(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, 1);
+    }
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
+    glDisable(GL_RASTERIZER_DISCARD);
+    (void)counters;
+}
+
+void MultiresSplat::splatFeedbackLists(int vplCount) {
+    // glDrawTransformFeedbackStreamInstanced(..., stream 1, ...) drew nothing on Mesa 22.3's llvmpipe
+    // (stream 0 draws work), so the splat lists are drawn with the counts from the queries: a CPU
+    // wait for the refinement that the compute lists avoid.
+    mTfCounts.assign(mTfLevels.size(), 0);
+    for (size_t level = 0; level < mTfLevels.size(); ++level) {
+        glGetQueryObjectuiv(mTfWritten[level].id(), GL_QUERY_RESULT, &mTfCounts[level]);
+        if (mTfCounts[level] == 0) continue;
+        glVertexArrayVertexBuffer(mItemVao.id(), 0, mTfSplat[level].id(), 0, 2 * sizeof(GLuint));
+        glDrawArraysInstanced(GL_POINTS, 0, static_cast<GLsizei>(mTfCounts[level]), vplCount);
+    }
 }
 
 void MultiresSplat::resize(int width, int height) {
@@ -91,6 +188,8 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     mEye.build(in, params, timer);
     ensureCapacity(static_cast<GLuint>(params.getInt("max_subsplats")));
     const bool perVpl = params.getEnum("refinement") == "illumination";
+    const bool feedback = !perVpl && params.getEnum("list_builder") == "transform_feedback";
+    mLastFeedback = feedback;
     const int levels = static_cast<int>(mEye.levels().size());
     const EyeLevel& coarsest = mEye.levels().back();
 
@@ -105,7 +204,9 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     glBindTextureUnit(11, mEye.geoPosition().id());
     glBindTextureUnit(12, mEye.geoNormal().id());
     glBindTextureUnit(13, mEye.geoAlbedo().id());
-    if (vplCount > 0) {
+    if (vplCount > 0 && feedback) {
+        refineWithFeedback(in, counters);
+    } else if (vplCount > 0) {
         const long long seedWanted =
             static_cast<long long>(coarsest.width) * coarsest.height * (perVpl ? vplCount : 1);
         const int seedItems = static_cast<int>(std::min<long long>(seedWanted, 1 << 30));
@@ -158,20 +259,25 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     if (vplCount > 0) {
         glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
         glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
-        const gl::Program& splat = mSplat.get(vplKernel(params));
+        const gl::Program& splat = (feedback ? mSplatTf : mSplat).get(vplKernel(params));
         glUseProgram(splat.id());
         glUniform2i(splat.uniform("uAtlasSize"), mEye.atlasWidth(), mEye.atlasHeight());
         glUniform1i(splat.uniform("uPerVpl"), perVpl ? 1 : 0);
         glUniform1f(splat.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
         glUniform1f(splat.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
         glUniform1f(splat.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
-        glBindVertexArray(mEmptyVao.id());
         glEnable(GL_BLEND);
         glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
-        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCounters.id());
-        glDrawArraysIndirect(GL_POINTS,
-                             reinterpret_cast<const void*>(offsetof(shader::SubsplatCounters, draw)));
-        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+        if (feedback) {
+            glBindVertexArray(mItemVao.id());
+            splatFeedbackLists(vplCount);
+        } else {
+            glBindVertexArray(mEmptyVao.id());
+            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCounters.id());
+            glDrawArraysIndirect(GL_POINTS,
+                                 reinterpret_cast<const void*>(offsetof(shader::SubsplatCounters, draw)));
+            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+        }
         glDisable(GL_BLEND);
     }
     timer.end();
@@ -180,7 +286,12 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     mEye.countReceivers(counters);
 
     shader::SubsplatCounters c{};
-    glGetNamedBufferSubData(mCounters.id(), 0, sizeof c, &c);
+    if (feedback) {
+        if (vplCount == 0) mTfCounts.assign(mTfLevels.size(), 0);
+        for (size_t l = 0; l < mTfCounts.size(); ++l) c.perLevel[l / 4][l % 4] = mTfCounts[l];
+    } else {
+        glGetNamedBufferSubData(mCounters.id(), 0, sizeof c, &c);
+    }
     double total = 0;
     for (int l = 0; l < levels; ++l) {
         const double n = c.perLevel[l / 4][l % 4];
@@ -194,13 +305,25 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
 }
 
 std::vector<std::array<int, 3>> MultiresSplat::readSplatPatches() const {
-    shader::SubsplatCounters c{};
-    glGetNamedBufferSubData(mCounters.id(), 0, sizeof c, &c);
-    const GLuint n = std::min(c.counts.z, mCapacity);
-    std::vector<GLuint> items(static_cast<size_t>(n) * 2);
-    if (n > 0)
-        glGetNamedBufferSubData(mSplatList.id(), 0, static_cast<GLsizeiptr>(items.size() * sizeof(GLuint)),
-                                items.data());
+    std::vector<GLuint> items;
+    if (mLastFeedback) {
+        for (size_t l = 0; l < mTfCounts.size(); ++l) {
+            std::vector<GLuint> level(static_cast<size_t>(mTfCounts[l]) * 2);
+            if (!level.empty())
+                glGetNamedBufferSubData(mTfSplat[l].id(), 0,
+                                        static_cast<GLsizeiptr>(level.size() * sizeof(GLuint)), level.data());
+            items.insert(items.end(), level.begin(), level.end());
+        }
+    }
+    if (!mLastFeedback) {
+        shader::SubsplatCounters c{};
+        glGetNamedBufferSubData(mCounters.id(), 0, sizeof c, &c);
+        items.resize(static_cast<size_t>(std::min(c.counts.z, mCapacity)) * 2);
+        if (!items.empty())
+            glGetNamedBufferSubData(mSplatList.id(), 0,
+                                    static_cast<GLsizeiptr>(items.size() * sizeof(GLuint)), items.data());
+    }
+    const GLuint n = static_cast<GLuint>(items.size() / 2);
     std::vector<std::array<int, 3>> set;
     set.reserve(n);
     for (GLuint i = 0; i < n; ++i) {

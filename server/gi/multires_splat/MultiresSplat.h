@@ -21,9 +21,10 @@
 // phong_exponent [1, 1000], max_subsplats (list capacity; items past it are splatted unrefined and
 // counted in subsplat_capped, so an explosion degrades resolution and never overruns memory).
 //
-// Why compute append buffers and not transform feedback: both need one pass per level; compute
-// lists need no geometry shader (slow on llvmpipe) and size the next pass on the GPU through
-// glDispatchComputeIndirect, so the CPU never waits for a count.
+// list_builder: compute append buffers (default) or 000's geometry shader with transform feedback
+// (geometry refinement only; one TF object per level, stream 0 = next list, stream 1 = splat list,
+// each list sized by its level's texel count so it cannot overflow). Both build the same lists and
+// need one pass per level; the choice is measured in docs/multires.md.
 //
 // Limits: no indirect visibility; the geometry list is correct for diffuse receivers only (000
 // §3.3); per-VPL refinement point-samples the children, so sharp highlights between the samples are
@@ -54,6 +55,9 @@ public:
 
 private:
     void ensureCapacity(GLuint items);
+    void ensureFeedbackLists();
+    void refineWithFeedback(const FrameInputs& in, Counters& counters);
+    void splatFeedbackLists(int vplCount);
 
     VplGrid mVpls;
     EyeHierarchy mEye;
@@ -62,6 +66,18 @@ private:
     gl::Buffer mListA, mListB, mSplatList, mCounters;
     GLuint mCapacity = 0;
     gl::VertexArray mEmptyVao;
+    // Transform-feedback lists, one set per eye level.
+    gl::Program mRefineTf;
+    KernelPrograms mSplatTf;
+    gl::VertexArray mItemVao;
+    gl::Buffer mTfSeed;
+    GLsizei mTfSeedCount = 0;
+    std::vector<gl::TransformFeedback> mTfo;
+    std::vector<gl::Buffer> mTfNext, mTfSplat;
+    std::vector<gl::Query> mTfWritten;
+    std::vector<EyeLevel> mTfLevels;
+    bool mLastFeedback = false;
+    std::vector<GLuint> mTfCounts;
     gl::Texture mIndirect;
     gl::Framebuffer mTarget;
 };

@@ -5,7 +5,11 @@
 #include "common.glsl"
 #include "gi/common/eye_hierarchy.glsl"
 
+#if GIS_ITEM_ATTRIBUTE
+layout(location = 0) in uvec2 aItem; // transform-feedback lists are drawn as vertex buffers
+#else
 layout(std430, binding = 5) readonly buffer SplatList { uvec2 gSplat[]; };
+#endif
 
 uniform ivec2 uAtlasSize;
 uniform int uPerVpl;
@@ -14,7 +18,11 @@ flat out uint vVpl;
 flat out uint vPatch;
 
 void main() {
+#if GIS_ITEM_ATTRIBUTE
+    uvec2 item = aItem;
+#else
     uvec2 item = gSplat[gl_VertexID];
+#endif
     vVpl = uPerVpl != 0 ? item.x : uint(gl_InstanceID);
     vPatch = item.y;
     ivec2 t = ivec2(int(item.y & 0x3FFFu), int((item.y >> 14) & 0x3FFFu));
