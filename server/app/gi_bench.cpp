@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -69,8 +70,8 @@ int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
         if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
     } catch (...) {
     }
-    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
-                     text + "'"};
+    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "], got '" + text + "'"};
 }
 
 std::string defaultCacheDir() {
@@ -84,8 +85,9 @@ int compare(const std::vector<std::string>& args) {
     gis::ReferenceImage a = gis::readReferenceExr(args[0]);
     gis::ReferenceImage b = gis::readReferenceExr(args[1]);
     if (a.width != b.width || a.height != b.height)
-        throw gis::InputError(args[0], "is " + std::to_string(a.width) + "x" + std::to_string(a.height) + " but " +
-                                           args[1] + " is " + std::to_string(b.width) + "x" + std::to_string(b.height));
+        throw gis::InputError(args[0], "is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                                           " but " + args[1] + " is " + std::to_string(b.width) + "x" +
+                                           std::to_string(b.height));
     gis::ImageView test(a.rgb.data(), a.width, a.height, 3), ref(b.rgb.data(), b.width, b.height, 3);
     nlohmann::json out = gis::toJson(gis::compareImages(test, ref, gis::maskFromNonZero(ref)));
     out["test"] = args[0];
@@ -110,7 +112,8 @@ Config parseConfig(const std::string& spec) {
     std::string kv;
     while (std::getline(rest, kv, ',')) {
         auto eq = kv.find('=');
-        if (eq == std::string::npos || eq == 0) throw UsageError{"--config: expected name=value, got '" + kv + "'"};
+        if (eq == std::string::npos || eq == 0)
+            throw UsageError{"--config: expected name=value, got '" + kv + "'"};
         c.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
     }
     return c;
@@ -122,8 +125,8 @@ bool parseTiming(const std::string& text) {
     throw UsageError{"--timing must be query or finish, got '" + text + "'"};
 }
 
-std::vector<gis::FrameState> makeStates(const gis::Scene& scene, const std::vector<Config>& configs, int width,
-                                        int height) {
+std::vector<gis::FrameState> makeStates(const gis::Scene& scene, const std::vector<Config>& configs,
+                                        int width, int height) {
     std::vector<gis::FrameState> states;
     for (const auto& c : configs) {
         try {
@@ -150,20 +153,28 @@ int passes(const std::vector<std::string>& args) {
             return args[++i];
         };
         const std::string& a = args[i];
-        if (a == "--scene") sceneName = value();
+        if (a == "--scene")
+            sceneName = value();
         else if (a == "--size") {
             const std::string& s = value();
             auto x = s.find('x');
             if (x == std::string::npos) throw UsageError{"--size must look like 512x512"};
             width = parseInt("--size width", s.substr(0, x), 16, 4096);
             height = parseInt("--size height", s.substr(x + 1), 16, 4096);
-        } else if (a == "--config") configs.push_back(parseConfig(value()));
-        else if (a == "--baseline") baseline = {parseConfig(value())};
-        else if (a == "--frames") frames = parseInt("--frames", value(), 1, 1000);
-        else if (a == "--json") jsonPath = value();
-        else if (a == "--gl") gl = value();
-        else if (a == "--timing") timerQueries = parseTiming(value());
-        else throw UsageError{"unknown option '" + a + "' (see --help)"};
+        } else if (a == "--config")
+            configs.push_back(parseConfig(value()));
+        else if (a == "--baseline")
+            baseline = {parseConfig(value())};
+        else if (a == "--frames")
+            frames = parseInt("--frames", value(), 1, 1000);
+        else if (a == "--json")
+            jsonPath = value();
+        else if (a == "--gl")
+            gl = value();
+        else if (a == "--timing")
+            timerQueries = parseTiming(value());
+        else
+            throw UsageError{"unknown option '" + a + "' (see --help)"};
     }
     if (configs.empty()) configs = {parseConfig("multires_splat"), parseConfig("multires_gather")};
 
@@ -172,24 +183,29 @@ int passes(const std::vector<std::string>& args) {
     std::vector<gis::FrameState> baseStates = makeStates(*scene, baseline, width, height);
     auto backend = gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(gl);
     auto context = gis::gl::createContext(backend);
-    gis::FrameRenderer renderer(timerQueries);
-    renderer.setScene(scene);
+    // One renderer per configuration: a renderer switching techniques would rebuild the technique
+    // (shaders, buffers) on every interleaved frame.
+    std::vector<std::unique_ptr<gis::FrameRenderer>> renderers;
+    for (size_t i = 0; i < configs.size() + 1; ++i) {
+        renderers.push_back(std::make_unique<gis::FrameRenderer>(timerQueries));
+        renderers.back()->setScene(scene);
+    }
 
     std::vector<gis::FrameOutput> last(configs.size());
     std::vector<std::vector<nlohmann::json>> stats(configs.size());
-    for (size_t i = 0; i < configs.size(); ++i) last[i] = renderer.render(states[i], true); // warm-up
+    for (size_t i = 0; i < configs.size(); ++i) last[i] = renderers[i]->render(states[i], true); // warm-up
     for (int k = 0; k < frames; ++k) {
         for (size_t i = 0; i < configs.size(); ++i) {
             gis::logInfo("gi-bench: frame " + std::to_string(k + 1) + "/" + std::to_string(frames) + " of " +
                          configs[i].label);
-            last[i] = renderer.render(states[i], true);
+            last[i] = renderers[i]->render(states[i], true);
             stats[i].push_back(last[i].stats);
         }
     }
     gis::FrameOutput base;
     if (!baseStates.empty()) {
         gis::logInfo("gi-bench: baseline " + baseline.front().label);
-        base = renderer.render(baseStates.front(), true);
+        base = renderers.back()->render(baseStates.front(), true);
     }
 
     // Pass names in pipeline order, as they first appear.
@@ -197,7 +213,8 @@ int passes(const std::vector<std::string>& args) {
     nlohmann::json rows = nlohmann::json::array();
     for (size_t i = 0; i < configs.size(); ++i) {
         nlohmann::json s = gis::medianStats(stats[i]);
-        nlohmann::json row = {{"config", configs[i].label}, {"frame_ms", s["frame_ms"]}, {"counts", s["counts"]}};
+        nlohmann::json row = {
+            {"config", configs[i].label}, {"frame_ms", s["frame_ms"]}, {"counts", s["counts"]}};
         double total = 0;
         size_t insertAt = 0; // a new pass goes after the previous pass of its own pipeline
         for (const auto& p : s["passes"]) {
@@ -210,15 +227,17 @@ int passes(const std::vector<std::string>& args) {
         }
         row["total_ms"] = total;
         if (!baseStates.empty()) {
-            gis::ImageView test(last[i].linear.data(), width, height, 4), ref(base.linear.data(), width, height, 4);
+            gis::ImageView test(last[i].linear.data(), width, height, 4),
+                ref(base.linear.data(), width, height, 4);
             row["relative_rmse_vs_baseline"] = gis::relativeRmse(test, ref);
         }
         rows.push_back(row);
     }
 
-    std::printf("scene %s, %dx%d, GL %s (%s), timing %s, median of %d interleaved frames\n\n", sceneName.c_str(), width,
-                height, context->info().backend.c_str(), context->info().renderer.c_str(),
-                timerQueries ? "timer queries" : "glFinish per pass", frames);
+    std::printf("scene %s, %dx%d, GL %s (%s), timing %s, median of %d interleaved frames\n\n",
+                sceneName.c_str(), width, height, context->info().backend.c_str(),
+                context->info().renderer.c_str(), timerQueries ? "timer queries" : "glFinish per pass",
+                frames);
     std::printf("| pass (ms) |");
     for (const auto& c : configs) std::printf(" %s |", c.label.c_str());
     std::printf("\n|---|");
@@ -227,7 +246,8 @@ int passes(const std::vector<std::string>& args) {
     for (const auto& n : names) {
         std::printf("| %s |", n.c_str());
         for (const auto& row : rows)
-            row["passes"].contains(n) ? std::printf(" %.1f |", row["passes"][n].get<double>()) : std::printf(" - |");
+            row["passes"].contains(n) ? std::printf(" %.1f |", row["passes"][n].get<double>())
+                                      : std::printf(" - |");
         std::printf("\n");
     }
     const double first = std::max(rows[0]["total_ms"].get<double>(), 1e-9);
@@ -256,7 +276,8 @@ int passes(const std::vector<std::string>& args) {
         if (!any) break;
         std::printf("| receivers level %d |", l);
         for (const auto& row : rows)
-            row["counts"].contains(key) ? std::printf(" %.0f |", row["counts"][key].get<double>()) : std::printf(" - |");
+            row["counts"].contains(key) ? std::printf(" %.0f |", row["counts"][key].get<double>())
+                                        : std::printf(" - |");
         std::printf("\n");
     }
     if (!baseStates.empty()) {
@@ -267,7 +288,8 @@ int passes(const std::vector<std::string>& args) {
     if (!jsonPath.empty()) {
         std::ofstream f(jsonPath);
         if (!f) throw gis::InputError(jsonPath, "cannot open for writing");
-        f << nlohmann::json({{"scene", sceneName}, {"size", {width, height}}, {"rows", rows}}).dump(2) << "\n";
+        f << nlohmann::json({{"scene", sceneName}, {"size", {width, height}}, {"rows", rows}}).dump(2)
+          << "\n";
     }
     return 0;
 }
@@ -286,22 +308,32 @@ int table(const std::vector<std::string>& args) {
             return args[++i];
         };
         const std::string& a = args[i];
-        if (a == "--scene") sceneName = value();
+        if (a == "--scene")
+            sceneName = value();
         else if (a == "--size") {
             const std::string& s = value();
             auto x = s.find('x');
             if (x == std::string::npos) throw UsageError{"--size must look like 256x256"};
             width = parseInt("--size width", s.substr(0, x), 16, 4096);
             height = parseInt("--size height", s.substr(x + 1), 16, 4096);
-        } else if (a == "--config") configs.push_back(parseConfig(value()));
-        else if (a == "--reference") modes.push_back(value());
-        else if (a == "--spp") ro.spp = parseInt("--spp", value(), 1, 1000000);
-        else if (a == "--frames") frames = parseInt("--frames", value(), 1, 1000);
-        else if (a == "--cache-dir") cacheDir = value();
-        else if (a == "--json") jsonPath = value();
-        else if (a == "--gl") gl = value();
-        else if (a == "--timing") timerQueries = parseTiming(value());
-        else throw UsageError{"unknown option '" + a + "' (see --help)"};
+        } else if (a == "--config")
+            configs.push_back(parseConfig(value()));
+        else if (a == "--reference")
+            modes.push_back(value());
+        else if (a == "--spp")
+            ro.spp = parseInt("--spp", value(), 1, 1000000);
+        else if (a == "--frames")
+            frames = parseInt("--frames", value(), 1, 1000);
+        else if (a == "--cache-dir")
+            cacheDir = value();
+        else if (a == "--json")
+            jsonPath = value();
+        else if (a == "--gl")
+            gl = value();
+        else if (a == "--timing")
+            timerQueries = parseTiming(value());
+        else
+            throw UsageError{"unknown option '" + a + "' (see --help)"};
     }
     if (configs.empty()) configs = {parseConfig("none"), parseConfig("rsm_gather")};
     if (modes.empty()) modes = {"one-bounce-unoccluded", "one-bounce"};
@@ -335,8 +367,11 @@ int table(const std::vector<std::string>& args) {
         nlohmann::json s = gis::medianStats(stats);
         double gpu = 0;
         for (const auto& p : s["passes"]) gpu += p["gpu_ms"].get<double>();
-        nlohmann::json row = {{"config", configs[i].label}, {"frame_ms", s["frame_ms"]}, {"gpu_ms", gpu},
-                              {"counts", s["counts"]}, {"params", s["params"]}};
+        nlohmann::json row = {{"config", configs[i].label},
+                              {"frame_ms", s["frame_ms"]},
+                              {"gpu_ms", gpu},
+                              {"counts", s["counts"]},
+                              {"params", s["params"]}};
         gis::ImageView test(f.linear.data(), f.width, f.height, 4);
         for (size_t r = 0; r < refs.size(); ++r) {
             gis::ImageView ref(refs[r].rgb.data(), refs[r].width, refs[r].height, 3);
@@ -353,8 +388,8 @@ int table(const std::vector<std::string>& args) {
     for (size_t r = 0; r < modes.size(); ++r) std::printf("---|---|---|");
     std::printf("\n");
     for (const auto& row : rows) {
-        std::printf("| %s | %.1f | %.1f |", row["config"].get<std::string>().c_str(), row["frame_ms"].get<double>(),
-                    row["gpu_ms"].get<double>());
+        std::printf("| %s | %.1f | %.1f |", row["config"].get<std::string>().c_str(),
+                    row["frame_ms"].get<double>(), row["gpu_ms"].get<double>());
         for (const auto& m : modes) {
             const auto& e = row["error"][m];
             std::printf(" %.4f | %.4f | %.4f |", e["relative_rmse"].get<double>(), e["ssim"].get<double>(),
@@ -365,8 +400,8 @@ int table(const std::vector<std::string>& args) {
     if (!jsonPath.empty()) {
         std::ofstream f(jsonPath);
         if (!f) throw gis::InputError(jsonPath, "cannot open for writing");
-        f << nlohmann::json({{"scene", sceneName}, {"size", {width, height}}, {"reference_spp", ro.spp},
-                             {"rows", rows}})
+        f << nlohmann::json(
+                 {{"scene", sceneName}, {"size", {width, height}}, {"reference_spp", ro.spp}, {"rows", rows}})
                  .dump(2)
           << "\n";
     }

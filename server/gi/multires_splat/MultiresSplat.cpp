@@ -46,9 +46,10 @@ TechniqueInfo MultiresSplat::info() {
                      .logScale = true});
     specs.push_back({.name = "list_builder",
                      .type = ParamType::Enum,
-                     .defaultValue = 0,
+                     .defaultValue = 1,
                      .help = "how geometry refinement builds the subsplat lists: compute append buffers or a "
-                             "geometry shader with transform feedback (000)",
+                             "geometry shader with transform feedback (000; measured faster here). Per-VPL "
+                             "refinement always uses compute",
                      .source = "000 §3 step 5 (transform feedback); measured in docs/multires.md",
                      .options = {"compute", "transform_feedback"}});
     specs.push_back({.name = "max_subsplats",
@@ -186,8 +187,12 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
                             Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mEye.build(in, params, timer);
-    ensureCapacity(static_cast<GLuint>(params.getInt("max_subsplats")));
     const bool perVpl = params.getEnum("refinement") == "illumination";
+    // A once-per-frame list holds each texel at most once: no need for the per-VPL capacity.
+    long long texels = 0;
+    for (const EyeLevel& l : mEye.levels()) texels += static_cast<long long>(l.width) * l.height;
+    const long long cap = params.getInt("max_subsplats");
+    ensureCapacity(static_cast<GLuint>(perVpl ? cap : std::min(cap, texels)));
     const bool feedback = !perVpl && params.getEnum("list_builder") == "transform_feedback";
     mLastFeedback = feedback;
     const int levels = static_cast<int>(mEye.levels().size());

@@ -8,8 +8,7 @@
 //   1. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid (shared with rsm_gather)
 //   2. eye_mipmap / refine_flags / stencil_setup: the shared eye hierarchy (EyeHierarchy)
 //   3. subsplat_refine: the list starts with every covered texel of the coarsest level (16^2) and
-//      is refined level by level with compute append buffers (one pass per level, indirect
-//      dispatch, no CPU read-back). refinement=geometry: once per frame on the eye hierarchy's
+//      is refined level by level (one pass per level; see list_builder). refinement=geometry: once per frame on the eye hierarchy's
 //      flags (diffuse only). refinement=illumination: one list per VPL, refined where the VPL's
 //      radiance differs across the 4 children by more than illum_threshold (any BRDF; Phong here).
 //   4. subsplat_splat: the list drawn as points into the flattened buffer, additive blending;
@@ -21,10 +20,12 @@
 // phong_exponent [1, 1000], max_subsplats (list capacity; items past it are splatted unrefined and
 // counted in subsplat_capped, so an explosion degrades resolution and never overruns memory).
 //
-// list_builder: compute append buffers (default) or 000's geometry shader with transform feedback
-// (geometry refinement only; one TF object per level, stream 0 = next list, stream 1 = splat list,
-// each list sized by its level's texel count so it cannot overflow). Both build the same lists and
-// need one pass per level; the choice is measured in docs/multires.md.
+// list_builder: 000's geometry shader with transform feedback (default for geometry refinement; one
+// TF object per level, stream 0 = next list, stream 1 = splat list, each sized by its level's texel
+// count so it cannot overflow) or compute append buffers with indirect dispatch (always used by
+// per-VPL refinement: its lists need the cap and GPU-side counts, no CPU read-back). Both build the
+// same lists, one pass per level. Measured on llvmpipe, feedback refinement took 2.9 ms against
+// 5.2 ms at 512^2 (1.5 vs 2.3 at 256^2), though it waits on a query for the splat counts.
 //
 // Limits: no indirect visibility; the geometry list is correct for diffuse receivers only (000
 // §3.3); per-VPL refinement point-samples the children, so sharp highlights between the samples are
