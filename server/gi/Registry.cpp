@@ -6,6 +6,7 @@
 #include "gi/multires_gather/MultiresGather.h"
 #include "gi/multires_splat/MultiresSplat.h"
 #include "gi/rsm_gather/RsmGather.h"
+#include "gi/second_order/SecondOrder.h"
 
 namespace gis {
 
@@ -17,6 +18,7 @@ const std::vector<TechniqueEntry>& techniqueRegistry() {
         {MultiresGather::info(), [] { return std::make_unique<MultiresGather>(); }},
         {Isr::info(), [] { return std::make_unique<Isr>(); }},
         {HierIsr::info(), [] { return std::make_unique<HierIsr>(); }},
+        {SecondOrder::info(), [] { return std::make_unique<SecondOrder>(); }},
     };
     return registry;
 }

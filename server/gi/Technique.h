@@ -19,6 +19,10 @@
 
 namespace gis {
 
+namespace shader {
+struct FrameUniforms;
+}
+
 /// The frame pipeline's products a technique may read. Textures are owned by the renderer.
 struct FrameInputs {
     int width = 0, height = 0;
@@ -30,6 +34,8 @@ struct FrameInputs {
     const gl::Texture* rsmNormal = nullptr;   ///< RGBA16F, facing the light
     const gl::Texture* rsmFlux = nullptr;     ///< RGBA32F reflected flux per texel
     bool lightEnabled = true;
+    const gl::Texture* direct = nullptr;          ///< RGBA32F shadowed direct radiance plus emission
+    const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
 };
 
 using Counters = std::map<std::string, double>;

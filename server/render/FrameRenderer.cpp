@@ -270,6 +270,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.rsmNormal = &mRsmNormal;
     in.rsmFlux = &mRsmFlux;
     in.lightEnabled = lightOn;
+    in.direct = &mDirect;
+    in.frame = &u;
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 

@@ -1,0 +1,430 @@
+#include "gi/second_order/SecondOrder.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "gi/common/VplGrid.h"
+#include "gl/ShaderShared.h"
+
+namespace gis {
+namespace {
+
+constexpr int kMaxPositive = 1024;
+constexpr int kMaxNegative = 1024;
+// Candidate pixels examined per requested negative light: S_neg is zero on most of the image
+// (surfaces with every light in front of them), so the first negative_count back-lit candidates in
+// Halton order are kept out of this many. Fewer back-lit pixels give fewer negative lights, each
+// still standing for its share of the frustum's solid angle (unbiased).
+constexpr int kCandidatesPerNegative = 8;
+constexpr int kMaxCandidates = kCandidatesPerNegative * kMaxNegative;
+// The discontinuity threshold at which the fix-up is switched off (100% low resolution).
+constexpr double kNoFixupThreshold = 2.0;
+// A negative light's area is (solid angle) * d^2 / cos(view angle); the cosine is clamped here so a
+// sample on a surface seen edge-on stands for at most 10x its perpendicular footprint.
+constexpr float kMinCosView = 0.1f;
+
+// Stats block of second_order.glsl: active VPL slots, clamped pixels, negatives placed, valid positives.
+constexpr int kStatsWords = 4;
+
+glm::vec3 unproject(const glm::mat4& inverseViewProj, glm::vec3 ndc, bool* ok) {
+    const glm::vec4 p = inverseViewProj * glm::vec4(ndc, 1.0f);
+    if (!(std::abs(p.w) > 1e-20f)) {
+        *ok = false;
+        return glm::vec3(0.0f);
+    }
+    return glm::vec3(p) / p.w;
+}
+
+bool finite(glm::vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+} // namespace
+
+TechniqueInfo SecondOrder::info() {
+    std::vector<ParamSpec> specs = {
+        {.name = "positive_count",
+         .type = ParamType::Int,
+         .defaultValue = 256,
+         .min = 0,
+         .max = kMaxPositive,
+         .unit = "lights",
+         .help = "indirect lights: the first Halton sphere points inside the spot cone, looked up in the RSM",
+         .source = "003 §3.1, Table 1 (100-450)"},
+        {.name = "negative_count",
+         .type = ParamType::Int,
+         .defaultValue = 128,
+         .min = 0,
+         .max = kMaxNegative,
+         .unit = "lights",
+         .help =
+             "negative indirect lights placed on back-lit camera-visible points (0 = no indirect shadows)",
+         .source = "003 §3.3, Table 1 (half the positive count)"},
+        {.name = "discontinuity_threshold",
+         .type = ParamType::Float,
+         .defaultValue = 0.05,
+         .min = 0.0,
+         .max = kNoFixupThreshold,
+         .unit = "",
+         .help = "full-resolution fix-up where 1 - n.n' or plane distance / eye distance to a low-res "
+                 "neighbour reaches this; 0 = all full resolution, 2 = no fix-up",
+         .source = "003 §3.5 (no value given; chosen, docs/second_order.md)"},
+        {.name = "lowres_factor",
+         .type = ParamType::Int,
+         .defaultValue = 2,
+         .min = 1,
+         .max = 8,
+         .unit = "px per side",
+         .help = "full-resolution pixels per low-resolution texel side",
+         .source = "003 §3.5 (2x2)"},
+        {.name = "min_distance",
+         .type = ParamType::Float,
+         .defaultValue = 0.1,
+         .min = 0.0,
+         .max = 1.0,
+         .unit = "m",
+         .help = "distance clamp of the 1/d^2 falloff of positive and negative lights",
+         .source = "003 §3.2 (no clamp given; chosen as for the other point kernels)"},
+    };
+    return {"second_order",
+            "Halton indirect lights with negative lights for indirect shadows, low-res + fix-up",
+            "003 §3.1-3.5", ParamTable(std::move(specs))};
+}
+
+SecondOrder::SecondOrder() {
+    const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
+    mPlacePositive = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_positive.comp"}});
+    mPlaceNegative = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_negative.comp"}});
+    mLowGeometry =
+        gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/lowres_gbuffer.frag"}});
+    mGather = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/gather.frag"}},
+                                 {{"GIS_VPL_KERNEL", "GIS_KERNEL_POINT"}});
+    mDiscontinuity =
+        gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/discontinuity.frag"}});
+    mResolve = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/resolve.frag"}});
+    mEmptyVao = gl::VertexArray::create();
+    mSamples = gl::Buffer::create(kMaxPositive * sizeof(glm::vec4));
+    mCandidates = gl::Buffer::create(kMaxCandidates * sizeof(glm::ivec4));
+    mVpls = gl::Buffer::create((kMaxPositive + kMaxNegative) * sizeof(shader::Vpl));
+    mStats =
+        gl::Buffer::create(kStatsWords * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    mFlaggedQuery = gl::Query::create(GL_SAMPLES_PASSED);
+    mCoveredQuery = gl::Query::create(GL_SAMPLES_PASSED);
+}
+
+void SecondOrder::resize(int width, int height) {
+    mLowPosition = gl::Texture::create2D(GL_RGBA32F, width, height);
+    mLowNormal = gl::Texture::create2D(GL_RGBA16F, width, height);
+    mLowIrradiance = gl::Texture::create2D(GL_RGBA32F, width, height);
+    mFlag = gl::Texture::create2D(GL_R8, width, height);
+    mStencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, width, height);
+    mFullIrradiance = gl::Texture::create2D(GL_RGBA32F, width, height);
+    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
+
+    mLowGeometryFbo = gl::Framebuffer::create();
+    mLowGeometryFbo.attachColor(0, mLowPosition);
+    mLowGeometryFbo.attachColor(1, mLowNormal);
+    mLowGeometryFbo.finish(2, "second_order low-res G-buffer");
+    mLowIrradianceFbo = gl::Framebuffer::create();
+    mLowIrradianceFbo.attachColor(0, mLowIrradiance);
+    mLowIrradianceFbo.finish(1, "second_order low-res irradiance");
+    mFlagFbo = gl::Framebuffer::create();
+    mFlagFbo.attachColor(0, mFlag);
+    mFlagFbo.attachDepthStencil(mStencil);
+    mFlagFbo.finish(1, "second_order discontinuity");
+    mFixupFbo = gl::Framebuffer::create();
+    mFixupFbo.attachColor(0, mFullIrradiance);
+    mFixupFbo.attachDepthStencil(mStencil);
+    mFixupFbo.finish(1, "second_order fix-up");
+    mResolveFbo = gl::Framebuffer::create();
+    mResolveFbo.attachColor(0, mIndirect);
+    mResolveFbo.finish(1, "second_order indirect");
+}
+
+const halton::ConeSamples& SecondOrder::cone(ConeCache& cache, double cosHalfAngle, int count) {
+    if (cache.cosHalfAngle != cosHalfAngle || cache.count != count) {
+        cache.samples = halton::sampleCone(cosHalfAngle, count);
+        cache.cosHalfAngle = cosHalfAngle;
+        cache.count = count;
+    }
+    return cache.samples;
+}
+
+int SecondOrder::placePositive(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
+    const shader::FrameUniforms& f = *in.frame;
+    const int requested = std::clamp(mPositiveSlots, 0, kMaxPositive);
+    const double cosOuter = std::clamp(static_cast<double>(f.lightDir.w), -1.0, 1.0);
+    const halton::ConeSamples& samples = cone(mLightCone, cosOuter, requested);
+    counters["halton_draws"] = samples.draws;
+    counters["cone_capped"] = samples.capped ? 1 : 0;
+    const int count = static_cast<int>(samples.directions.size());
+    counters["positive_count"] = count;
+    if (count == 0) return 0;
+
+    // The cone's axis is the spot direction, so the accepted set turns with the light: lights move
+    // smoothly under rotation instead of popping in and out at the cone's edge.
+    const halton::Frame frame = halton::frameAround(glm::vec3(f.lightDir));
+    const glm::vec3 origin(f.lightPos);
+    std::vector<glm::vec4> uv(static_cast<size_t>(count), glm::vec4(0.0f));
+    for (int i = 0; i < count; ++i) {
+        const glm::vec3 d = frame.toWorld(samples.directions[static_cast<size_t>(i)]);
+        const glm::vec4 clip = f.lightViewProj * glm::vec4(origin + d, 1.0f);
+        if (!(clip.w > 1e-6f)) continue; // behind the light: no image point
+        const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+        if (!(std::abs(ndc.x) <= 1.0f && std::abs(ndc.y) <= 1.0f)) continue; // outside the RSM frustum
+        uv[static_cast<size_t>(i)] = glm::vec4(ndc * 0.5f + 0.5f, 1.0f, 0.0f);
+    }
+    mSamples.upload(0, static_cast<GLsizeiptr>(uv.size() * sizeof(glm::vec4)), uv.data());
+
+    timer.begin("vpl_place");
+    glUseProgram(mPlacePositive.id());
+    glUniform1i(mPlacePositive.uniform("uCount"), count);
+    glUniform1i(mPlacePositive.uniform("uRsmSize"), in.rsmSize);
+    const double coneSolidAngle = 2.0 * 3.14159265358979323846 * (1.0 - cosOuter);
+    glUniform1f(mPlacePositive.uniform("uSampleSolidAngle"), static_cast<float>(coneSolidAngle / count));
+    glBindTextureUnit(0, in.rsmPosition->id());
+    glBindTextureUnit(1, in.rsmNormal->id());
+    glBindTextureUnit(2, in.rsmFlux->id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mSamples.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+    timer.end();
+    return count;
+}
+
+int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, int positiveCount,
+                               gl::PassTimer& timer, Counters& counters) {
+    const shader::FrameUniforms& f = *in.frame;
+    const int target = std::min(mNegativeSlots * kCandidatesPerNegative, kMaxCandidates);
+    counters["negative_candidates"] = 0;
+    if (target <= 0 || positiveCount <= 0) return 0;
+
+    // The camera's frustum from its inverse view-projection: the axis, the four corner directions
+    // (their spherical quadrilateral is the frustum's solid angle) and the cone that encloses them.
+    const glm::mat4 inverse = glm::inverse(f.viewProj);
+    const glm::vec3 eye(f.cameraPos);
+    bool ok = true;
+    const glm::vec3 centre = unproject(inverse, {0, 0, 0}, &ok) - eye;
+    const glm::vec2 cornerNdc[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    glm::dvec3 corners[4];
+    for (int i = 0; i < 4; ++i) {
+        const glm::vec3 c = unproject(inverse, glm::vec3(cornerNdc[i], 0.0f), &ok) - eye;
+        const float len = glm::length(c);
+        ok = ok && finite(c) && len > 1e-20f;
+        corners[i] = ok ? glm::dvec3(c / len) : glm::dvec3(0, 0, 1);
+    }
+    const float centreLen = glm::length(centre);
+    if (!ok || !finite(centre) || !(centreLen > 1e-20f)) return 0;
+    const glm::dvec3 axis = glm::dvec3(centre / centreLen);
+    double cosCorner = 1.0;
+    for (const auto& c : corners) cosCorner = std::min(cosCorner, glm::dot(axis, c));
+    cosCorner = std::clamp(cosCorner - 1e-4, -1.0, 1.0); // margin: corner rays stay inside the cone
+    const double frustumSolidAngle = halton::frustumSolidAngle(corners);
+
+    // About 2/pi of an enclosing cone lies inside a square frustum, less for wide images: twice the
+    // target leaves room for aspect ratios up to about 3:1.
+    const halton::ConeSamples& samples = cone(mCameraCone, cosCorner, 2 * target);
+    const halton::Frame frame = halton::frameAround(glm::vec3(axis));
+    std::vector<glm::ivec4> pixels;
+    pixels.reserve(static_cast<size_t>(target));
+    for (const glm::vec3& local : samples.directions) {
+        if (static_cast<int>(pixels.size()) >= target) break;
+        const glm::vec4 clip = f.viewProj * glm::vec4(eye + frame.toWorld(local), 1.0f);
+        if (!(clip.w > 1e-6f)) continue;
+        const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+        if (!(std::abs(ndc.x) <= 1.0f && std::abs(ndc.y) <= 1.0f)) continue;
+        const int x = std::clamp(static_cast<int>((ndc.x * 0.5f + 0.5f) * static_cast<float>(in.width)), 0,
+                                 in.width - 1);
+        const int y = std::clamp(static_cast<int>((ndc.y * 0.5f + 0.5f) * static_cast<float>(in.height)), 0,
+                                 in.height - 1);
+        pixels.emplace_back(x, y, 1, 0);
+    }
+    const int candidates = static_cast<int>(pixels.size());
+    counters["negative_candidates"] = candidates;
+    if (candidates == 0) return 0;
+    mCandidates.upload(0, static_cast<GLsizeiptr>(pixels.size() * sizeof(glm::ivec4)), pixels.data());
+
+    timer.begin("negative_place");
+    glUseProgram(mPlaceNegative.id());
+    glUniform1i(mPlaceNegative.uniform("uPositiveCount"), positiveCount);
+    glUniform1i(mPlaceNegative.uniform("uNegativeCount"), mNegativeSlots);
+    glUniform1i(mPlaceNegative.uniform("uCandidateCount"), candidates);
+    glUniform1f(mPlaceNegative.uniform("uFrustumSolidAngle"), static_cast<float>(frustumSolidAngle));
+    glUniform1f(mPlaceNegative.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+    glUniform1f(mPlaceNegative.uniform("uMinCosView"), kMinCosView);
+    glBindTextureUnit(0, in.gPosition->id());
+    glBindTextureUnit(1, in.gNormal->id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mCandidates.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+    timer.end();
+    return mNegativeSlots;
+}
+
+void SecondOrder::gather(const gl::Program& program, int slots, float minDistance, Counters& counters) {
+    glUseProgram(program.id());
+    glUniform1f(program.uniform("uMinDistance"), minDistance);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
+    glBindVertexArray(mEmptyVao.id());
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE); // signed sums: negative lights carry negative flux
+    const GLint countLoc = program.uniform("uVplCount");
+    const GLint firstLoc = program.uniform("uBatchFirst");
+    int first = 0;
+    counters["vpl_batches"] = forEachVplBatch(mVpls, slots, [&](int count) {
+        glUniform1i(countLoc, count);
+        glUniform1i(firstLoc, first);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        first += count;
+    });
+    glDisable(GL_BLEND);
+}
+
+void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                          Counters& counters) {
+    const float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(mResolveFbo.id(), GL_COLOR, 0, zero);
+    for (const char* name : {"positive_count", "positive_valid", "halton_draws", "cone_capped",
+                             "negative_candidates", "negative_count", "vpl_count", "vpl_batches",
+                             "covered_pixels", "fixup_pixels", "negative_clamped_fraction"})
+        counters[name] = 0;
+    counters["lowres_fraction"] = 1;
+
+    mPositiveSlots = in.lightEnabled ? params.getInt("positive_count") : 0;
+    mNegativeSlots = std::clamp(params.getInt("negative_count"), 0, kMaxNegative);
+    if (!in.frame || !in.gPosition || !in.gNormal || !in.gAlbedo || !in.rsmPosition || in.rsmSize <= 0 ||
+        in.width <= 0 || in.height <= 0)
+        mPositiveSlots = 0;
+    if (mPositiveSlots <= 0) {
+        mPositiveSlots = mNegativeSlots = 0;
+        return; // no light: the indirect term is exactly 0
+    }
+
+    const GLuint clearStats[kStatsWords] = {};
+    mStats.upload(0, sizeof clearStats, clearStats);
+    mPositiveSlots = placePositive(in, timer, counters);
+    if (mPositiveSlots == 0) {
+        mNegativeSlots = 0;
+        return;
+    }
+    mNegativeSlots = placeNegative(in, params, mPositiveSlots, timer, counters);
+    const int slots = mPositiveSlots + mNegativeSlots;
+    const float minDistance = static_cast<float>(params.getFloat("min_distance"));
+    const int factor = std::clamp(params.getInt("lowres_factor"), 1, 8);
+    const int lowW = (in.width + factor - 1) / factor, lowH = (in.height + factor - 1) / factor;
+    const double threshold = params.getFloat("discontinuity_threshold");
+    const bool fixup = threshold < kNoFixupThreshold;
+    // Threshold 0 flags every covered pixel (discontinuity.frag), so no low-res value is ever used.
+    const bool lowres = threshold > 0.0;
+
+    if (lowres) {
+        timer.begin("lowres_gbuffer");
+        glBindFramebuffer(GL_FRAMEBUFFER, mLowGeometryFbo.id());
+        glViewport(0, 0, lowW, lowH);
+        glUseProgram(mLowGeometry.id());
+        glUniform1i(mLowGeometry.uniform("uFactor"), factor);
+        glBindTextureUnit(0, in.gPosition->id());
+        glBindTextureUnit(1, in.gNormal->id());
+        glBindVertexArray(mEmptyVao.id());
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        timer.end();
+
+        timer.begin("lowres_gather");
+        glBindFramebuffer(GL_FRAMEBUFFER, mLowIrradianceFbo.id());
+        glViewport(0, 0, lowW, lowH);
+        glClearNamedFramebufferfv(mLowIrradianceFbo.id(), GL_COLOR, 0, zero);
+        glBindTextureUnit(0, mLowPosition.id());
+        glBindTextureUnit(1, mLowNormal.id());
+        gather(mGather, slots, minDistance, counters);
+        timer.end();
+    }
+
+    GLuint flagged = 0;
+    glViewport(0, 0, in.width, in.height);
+    if (fixup) {
+        timer.begin("discontinuity");
+        glBindFramebuffer(GL_FRAMEBUFFER, mFlagFbo.id());
+        glClearNamedFramebufferfv(mFlagFbo.id(), GL_COLOR, 0, zero);
+        glClearNamedFramebufferfi(mFlagFbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
+        glUseProgram(mDiscontinuity.id());
+        glUniform1i(mDiscontinuity.uniform("uFactor"), factor);
+        glUniform2i(mDiscontinuity.uniform("uLowSize"), lowW, lowH);
+        glUniform1f(mDiscontinuity.uniform("uThreshold"), static_cast<float>(threshold));
+        glBindTextureUnit(0, in.gPosition->id());
+        glBindTextureUnit(1, in.gNormal->id());
+        glBindTextureUnit(2, mLowPosition.id());
+        glBindTextureUnit(3, mLowNormal.id());
+        glEnable(GL_STENCIL_TEST);
+        glStencilFunc(GL_ALWAYS, 1, 0xFF);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+        glBeginQuery(GL_SAMPLES_PASSED, mFlaggedQuery.id());
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glEndQuery(GL_SAMPLES_PASSED);
+        timer.end();
+
+        timer.begin("fixup_gather");
+        glBindFramebuffer(GL_FRAMEBUFFER, mFixupFbo.id());
+        glClearNamedFramebufferfv(mFixupFbo.id(), GL_COLOR, 0, zero);
+        glStencilFunc(GL_EQUAL, 1, 0xFF);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+        glBindTextureUnit(0, in.gPosition->id());
+        glBindTextureUnit(1, in.gNormal->id());
+        gather(mGather, slots, minDistance, counters);
+        glDisable(GL_STENCIL_TEST);
+        timer.end();
+    }
+
+    timer.begin("resolve");
+    glBindFramebuffer(GL_FRAMEBUFFER, mResolveFbo.id());
+    glUseProgram(mResolve.id());
+    glUniform1i(mResolve.uniform("uFactor"), factor);
+    glUniform2i(mResolve.uniform("uLowSize"), lowW, lowH);
+    glUniform1i(mResolve.uniform("uFixup"), fixup ? 1 : 0);
+    glUniform1i(mResolve.uniform("uHasDirect"), in.direct ? 1 : 0);
+    glBindTextureUnit(0, in.gPosition->id());
+    glBindTextureUnit(1, in.gAlbedo->id());
+    glBindTextureUnit(2, in.direct ? in.direct->id() : in.gAlbedo->id());
+    glBindTextureUnit(3, mFlag.id());
+    glBindTextureUnit(4, mFullIrradiance.id());
+    glBindTextureUnit(5, mLowIrradiance.id());
+    glBindTextureUnit(6, mLowPosition.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
+    glBindVertexArray(mEmptyVao.id());
+    glBeginQuery(GL_SAMPLES_PASSED, mCoveredQuery.id());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glEndQuery(GL_SAMPLES_PASSED);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    timer.end();
+
+    // Counters: waits for the frame's last pass (the composite reads its output next anyway).
+    GLuint covered = 0;
+    glGetQueryObjectuiv(mCoveredQuery.id(), GL_QUERY_RESULT, &covered);
+    if (fixup) glGetQueryObjectuiv(mFlaggedQuery.id(), GL_QUERY_RESULT, &flagged);
+    GLuint stats[kStatsWords] = {};
+    glGetNamedBufferSubData(mStats.id(), 0, sizeof stats, stats);
+    const double coveredD = static_cast<double>(covered);
+    counters["covered_pixels"] = covered;
+    counters["fixup_pixels"] = flagged;
+    counters["lowres_fraction"] = covered > 0 ? 1.0 - static_cast<double>(flagged) / coveredD : 1.0;
+    counters["negative_clamped_fraction"] = covered > 0 ? static_cast<double>(stats[1]) / coveredD : 0.0;
+    counters["vpl_count"] = stats[0];
+    counters["negative_count"] = stats[2];
+    counters["positive_valid"] = stats[3];
+}
+
+std::vector<shader::Vpl> SecondOrder::readVpls(int* positiveCount) const {
+    if (positiveCount) *positiveCount = mPositiveSlots;
+    std::vector<shader::Vpl> vpls(static_cast<size_t>(mPositiveSlots + mNegativeSlots));
+    if (!vpls.empty())
+        glGetNamedBufferSubData(mVpls.id(), 0, static_cast<GLsizeiptr>(vpls.size() * sizeof(shader::Vpl)),
+                                vpls.data());
+    return vpls;
+}
+
+} // namespace gis
