@@ -149,8 +149,10 @@ void parseSize(const std::string& text, int& w, int& h) {
 }
 
 void listTechniques() {
+    int width = 0;
+    for (const auto& e : gis::techniqueRegistry()) width = std::max(width, static_cast<int>(e.info.name.size()));
     for (const auto& e : gis::techniqueRegistry())
-        std::printf("%-14s %s [%s]\n", e.info.name.c_str(), e.info.description.c_str(), e.info.paper.c_str());
+        std::printf("%-*s  %s [%s]\n", width, e.info.name.c_str(), e.info.description.c_str(), e.info.paper.c_str());
 }
 
 void writeText(const std::string& path, const std::string& text) {
