@@ -14,6 +14,7 @@ const std::vector<TechniqueEntry>& techniqueRegistry() {
     static const std::vector<TechniqueEntry> registry = {
         {NoIndirect::info(), [] { return std::make_unique<NoIndirect>(); }},
         {RsmGather::info(), [] { return std::make_unique<RsmGather>(); }},
+        {RsmGather::ssbcInfo(), [] { return std::make_unique<RsmGather>(); }},
         {MultiresSplat::info(), [] { return std::make_unique<MultiresSplat>(); }},
         {MultiresGather::info(), [] { return std::make_unique<MultiresGather>(); }},
         {Isr::info(), [] { return std::make_unique<Isr>(); }},

@@ -2,12 +2,13 @@
 
 #include <algorithm>
 
+#include "gi/common/BiasCompensation.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
 
 std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel) {
-    return {
+    std::vector<ParamSpec> specs = {
         {.name = "vpl_grid",
          .type = ParamType::Int,
          .defaultValue = 16,
@@ -31,6 +32,8 @@ std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel) {
          .help = "point kernel only: distance clamp of the 1/d^2 falloff (bounds the r->0 singularity)",
          .source = "000 Fig. 13 (value not given; chosen)"},
     };
+    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
+    return specs;
 }
 
 VplKernel vplKernel(const ParamSet& params) {

@@ -16,7 +16,8 @@ namespace gis {
 
 enum class VplKernel { Point = 0, Disk = 1 }; ///< values match GIS_KERNEL_* in vpl_transport.glsl
 
-/// `vpl_grid`, `kernel` (point|disk, default as given) and `min_distance` (point kernel only).
+/// `vpl_grid`, `kernel` (point|disk, default as given), `min_distance` (point kernel only) and the
+/// K3 clamp / bias compensation parameters (biasCompensationParamSpecs, all off by default).
 std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel);
 VplKernel vplKernel(const ParamSet& params);
 

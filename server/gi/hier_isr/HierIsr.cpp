@@ -99,6 +99,7 @@ TechniqueInfo HierIsr::info() {
          .source = "001 §3.5, Figs. 12-13"},
     };
     for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
     return {"hier_isr", "hierarchical image-space radiosity: per-receiver cuts through the light tree",
             "001 §3.5", ParamTable(std::move(specs))};
 }
@@ -131,6 +132,7 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
         glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
         glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
         glUseProgram(mGather.id());
+        setVplClamp(mGather, params);
         glUniform1i(mGather.uniform("uStartLevel"), s.startLevel);
         glUniform1i(mGather.uniform("uLeafLevel"), s.leafLevel);
         glUniform1i(mGather.uniform("uRefineMode"), static_cast<int>(s.mode));
@@ -165,6 +167,7 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     counters["nodes_visited_max"] = stats[2];
     counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
     counters["cut_size_max"] = stats[5];
+    mSsbc.apply(in, params, mIndirect, timer, counters);
 }
 
 } // namespace gis

@@ -59,6 +59,7 @@
 #include <glm/glm.hpp>
 
 #include "gi/Technique.h"
+#include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/LightTree.h"
 
@@ -98,6 +99,7 @@ public:
 private:
     LightTree mTree;
     EyeHierarchy mEye;
+    BiasCompensation mSsbc;
     gl::Program mGather;
     gl::VertexArray mEmptyVao;
     gl::Buffer mStats;

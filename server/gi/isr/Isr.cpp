@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "gi/common/BiasCompensation.h"
 #include "gi/common/VplGrid.h"
 
 namespace gis {
@@ -46,6 +47,7 @@ TechniqueInfo Isr::info() {
          .source = "001 §3.4 (no value given); 000 Figs. 11-12 eye-space quality setting"},
     };
     for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
     return {"isr", "image-space radiosity: per-frame light-space patches gathered at stencil receivers",
             "001 §3.4", ParamTable(std::move(specs))};
 }
@@ -130,6 +132,7 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
         glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
         glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
         glUseProgram(mGather.id());
+        setVplClamp(mGather, params);
         glBindTextureUnit(0, mEye.geoPosition().id());
         glBindTextureUnit(1, mEye.geoNormal().id());
         mEye.bindPixels(in);
@@ -151,6 +154,7 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
 
     mEye.reconstruct(in, params, true, mTarget, timer);
     mEye.countReceivers(counters);
+    mSsbc.apply(in, params, mIndirect, timer, counters);
 }
 
 std::vector<shader::Vpl> Isr::readVpls() const {

@@ -44,6 +44,7 @@
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/LightTree.h"
 
@@ -67,6 +68,7 @@ private:
 
     LightTree mTree;
     EyeHierarchy mEye;
+    BiasCompensation mSsbc;
     gl::Program mSelect, mGather;
     gl::VertexArray mEmptyVao;
     gl::Buffer mVpls, mCounts;

@@ -34,6 +34,7 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
         const gl::Program& gather = mGather.get(vplKernel(params));
         glUseProgram(gather.id());
         glUniform1f(gather.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+        setVplClamp(gather, params);
         glBindTextureUnit(0, mEye.geoPosition().id());
         glBindTextureUnit(1, mEye.geoNormal().id());
         mEye.bindPixels(in);
@@ -54,6 +55,7 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
 
     mEye.reconstruct(in, params, true, mTarget, timer);
     mEye.countReceivers(counters);
+    mSsbc.apply(in, params, mIndirect, timer, counters);
 }
 
 } // namespace gis

@@ -22,6 +22,7 @@
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/VplGrid.h"
 
@@ -41,6 +42,7 @@ private:
     VplGrid mVpls;
     EyeHierarchy mEye;
     KernelPrograms mGather;
+    BiasCompensation mSsbc;
     gl::VertexArray mEmptyVao;
     gl::Texture mIndirect;
     gl::Framebuffer mTarget;

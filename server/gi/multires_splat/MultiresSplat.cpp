@@ -232,6 +232,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
                     static_cast<float>(params.getFloat("illum_threshold")));
         glUniform1i(mRefine.uniform("uPerVpl"), perVpl ? 1 : 0);
         glUniform1f(mRefine.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+        setVplClamp(mRefine, params);
         glUniform1f(mRefine.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
         glUniform1f(mRefine.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
         glUseProgram(mAdvance.id());
@@ -269,6 +270,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
         glUniform2i(splat.uniform("uAtlasSize"), mEye.atlasWidth(), mEye.atlasHeight());
         glUniform1i(splat.uniform("uPerVpl"), perVpl ? 1 : 0);
         glUniform1f(splat.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+        setVplClamp(splat, params);
         glUniform1f(splat.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
         glUniform1f(splat.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
         glEnable(GL_BLEND);
@@ -307,6 +309,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     counters["subsplat_capped"] = c.counts.w;
     if (perVpl && vplCount > 0) counters["subsplats_per_vpl"] = total / vplCount;
     counters["splat_points"] = perVpl ? total : total * vplCount;
+    mSsbc.apply(in, params, mIndirect, timer, counters);
 }
 
 std::vector<std::array<int, 3>> MultiresSplat::readSplatPatches() const {

@@ -8,9 +8,9 @@
 //   1. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid (shared with rsm_gather)
 //   2. eye_mipmap / refine_flags / stencil_setup: the shared eye hierarchy (EyeHierarchy)
 //   3. subsplat_refine: the list starts with every covered texel of the coarsest level (16^2) and
-//      is refined level by level (one pass per level; see list_builder). refinement=geometry: once per frame on the eye hierarchy's
-//      flags (diffuse only). refinement=illumination: one list per VPL, refined where the VPL's
-//      radiance differs across the 4 children by more than illum_threshold (any BRDF; Phong here).
+//      is refined level by level (one pass per level; see list_builder). refinement=geometry: once per frame
+//      on the eye hierarchy's flags (diffuse only). refinement=illumination: one list per VPL, refined where
+//      the VPL's radiance differs across the 4 children by more than illum_threshold (any BRDF; Phong here).
 //   4. subsplat_splat: the list drawn as points into the flattened buffer, additive blending;
 //      geometry refinement draws it instanced once per VPL.
 //   5. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel (geometry).
@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "gi/Technique.h"
+#include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/VplGrid.h"
 
@@ -62,6 +63,7 @@ private:
 
     VplGrid mVpls;
     EyeHierarchy mEye;
+    BiasCompensation mSsbc;
     gl::Program mSeed, mRefine, mAdvance;
     KernelPrograms mSplat;
     gl::Buffer mListA, mListB, mSplatList, mCounters;

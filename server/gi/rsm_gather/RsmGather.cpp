@@ -11,6 +11,19 @@ TechniqueInfo RsmGather::info() {
             ParamTable(vplParamSpecs(VplKernel::Point))};
 }
 
+TechniqueInfo RsmGather::ssbcInfo() {
+    // 002's configuration on rsm_gather's pipeline: the K3 clamp on and one compensation step
+    // (docs/ssbc.md). Only the defaults differ, so `rsm_gather --param clamp_b=..,ssbc_iterations=1`
+    // renders the same image.
+    std::vector<ParamSpec> specs = vplParamSpecs(VplKernel::Point);
+    for (auto& s : specs) {
+        if (s.name == "clamp_b") s.defaultValue = kSsbcDefaultClampB;
+        if (s.name == "ssbc_iterations") s.defaultValue = 1;
+    }
+    return {"ssbc", "clamped grid-VPL gather (K3) with screen-space bias compensation", "002 §3-4",
+            ParamTable(std::move(specs))};
+}
+
 RsmGather::RsmGather() {
     mGather = KernelPrograms(
         {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/rsm_gather/gather.frag"}});
@@ -37,6 +50,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         const gl::Program& gather = mGather.get(vplKernel(params));
         glUseProgram(gather.id());
         glUniform1f(gather.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
+        setVplClamp(gather, params);
         glBindTextureUnit(0, in.gPosition->id());
         glBindTextureUnit(1, in.gNormal->id());
         glBindTextureUnit(2, in.gAlbedo->id());
@@ -50,6 +64,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         glDisable(GL_BLEND);
     }
     timer.end();
+    mSsbc.apply(in, params, mIndirect, timer, counters);
 }
 
 } // namespace gis

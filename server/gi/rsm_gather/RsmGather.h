@@ -17,12 +17,15 @@
 //   vpl_grid      VPLs per side, [1, 256] (clamped to rsm_size), default 16 (256 VPLs)
 //   kernel        point (000 Eq. 2, default) or disk (001 Eq. 1: bounded, needs no clamp)
 //   min_distance  point kernel: distance clamp of the 1/d^2 falloff, [0, 1] m, default 0.1 m
+//   clamp_b, ssbc_*  K3 clamp and bias compensation (BiasCompensation.h), off by default; the
+//                 `ssbc` preset (002) is this pipeline with clamp_b 10 and ssbc_iterations 1
 //
 // Limits: no indirect visibility (light leaks behind occluders, as in 000/001); VPLs are diffuse;
 // grid sampling ignores flux (000 suggests importance sampling as future work).
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/BiasCompensation.h"
 #include "gi/common/VplGrid.h"
 #include "gl/Shader.h"
 
@@ -31,6 +34,9 @@ namespace gis {
 class RsmGather final : public Technique {
 public:
     static TechniqueInfo info();
+    /// The `ssbc` preset (002): this pipeline with clamp_b = kSsbcDefaultClampB, ssbc_iterations 1.
+    static TechniqueInfo ssbcInfo();
+    static constexpr double kSsbcDefaultClampB = 10.0; // 1/m^2: r = 1/sqrt(b) = 0.32 m
     RsmGather();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
@@ -40,6 +46,7 @@ public:
 private:
     VplGrid mVpls;
     KernelPrograms mGather;
+    BiasCompensation mSsbc;
     gl::Texture mIndirect;
     gl::Framebuffer mTarget;
     gl::VertexArray mEmptyVao;

@@ -88,6 +88,7 @@ TechniqueInfo SecondOrder::info() {
          .help = "distance clamp of the 1/d^2 falloff of positive and negative lights",
          .source = "003 §3.2 (no clamp given; chosen as for the other point kernels)"},
     };
+    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
     return {"second_order",
             "Halton indirect lights with negative lights for indirect shadows, low-res + fix-up",
             "003 §3.1-3.5", ParamTable(std::move(specs))};
@@ -316,6 +317,7 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
     mNegativeSlots = placeNegative(in, params, mPositiveSlots, timer, counters);
     const int slots = mPositiveSlots + mNegativeSlots;
     const float minDistance = static_cast<float>(params.getFloat("min_distance"));
+    setVplClamp(mGather, params);
     const int factor = std::clamp(params.getInt("lowres_factor"), 1, 8);
     const int lowW = (in.width + factor - 1) / factor, lowH = (in.height + factor - 1) / factor;
     const double threshold = params.getFloat("discontinuity_threshold");
@@ -416,6 +418,7 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
     counters["vpl_count"] = stats[0];
     counters["negative_count"] = stats[2];
     counters["positive_valid"] = stats[3];
+    mSsbc.apply(in, params, mIndirect, timer, counters);
 }
 
 std::vector<shader::Vpl> SecondOrder::readVpls(int* positiveCount) const {

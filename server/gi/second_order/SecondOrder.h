@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "gi/Technique.h"
+#include "gi/common/BiasCompensation.h"
 #include "gi/second_order/Halton.h"
 #include "gl/Shader.h"
 
@@ -83,6 +84,7 @@ private:
 
     ConeCache mLightCone, mCameraCone;
     gl::Program mPlacePositive, mPlaceNegative, mLowGeometry, mGather, mDiscontinuity, mResolve;
+    BiasCompensation mSsbc;
     gl::VertexArray mEmptyVao;
     gl::Buffer mSamples, mCandidates, mVpls, mStats;
     gl::Query mFlaggedQuery, mCoveredQuery;

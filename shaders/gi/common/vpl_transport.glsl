@@ -10,8 +10,22 @@
 // K2, disk-to-point form factor (001 Eq. 1, Wallace et al.): the VPL is a disk of area A (001 Eq. 3)
 // with radiosity Phi/A, so  E = Phi cos_l cos_r / (pi d^2 + A). Bounded by Phi/A as d -> 0, so it
 // needs no clamp; A = 0 degrades to the unclamped point kernel, still finite by the d^2 guard.
+//
+// K3, bounded geometry term (002 G_b; digest S.1): with clamp_b = b > 0 both kernels above become
+// E = Phi/pi * min(G, b), G = cos_l cos_r / d^2 unclamped (no dmin, no disk area), so the energy the
+// clamp removes is exactly Phi/pi * max(G - b, 0), the residual that bias compensation restores.
+// uVplInvClampB carries 1/b (m^2); an unset uniform reads 0, which leaves K1/K2 bit-identical (the
+// factor is exactly 1), so programs that never set it keep their default images. min(G, b) is
+// written G / max(1, G/b): branch-free inside the per-VPL loop, finite because G is (d^2 guard).
 #define GIS_KERNEL_POINT 0
 #define GIS_KERNEL_DISK 1
+
+uniform float uVplInvClampB; // 1/b (m^2); 0: no K3 clamp
+
+// min(G, b) / G for G = cosR cosL / d2 (1 when the clamp is off).
+float vplClampFactor(float cosR, float cosL, float d2) {
+    return 1.0 / max(1.0, cosR * cosL / d2 * uVplInvClampB);
+}
 
 vec3 vplIrradiance(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplNormal, vec3 vplFlux,
                    float minDistance) {
@@ -21,7 +35,8 @@ vec3 vplIrradiance(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplN
     vec3 w = toVpl * inversesqrt(d2);
     float cosR = max(dot(receiverNormal, w), 0.0);
     float cosL = max(dot(vplNormal, -w), 0.0);
-    return vplFlux * (kInvPi * cosR * cosL / max(d2, minDistance * minDistance));
+    float dmin2 = uVplInvClampB > 0.0 ? 0.0 : minDistance * minDistance;
+    return vplFlux * (kInvPi * cosR * cosL / max(d2, dmin2) * vplClampFactor(cosR, cosL, d2));
 }
 
 vec3 vplIrradianceDisk(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplNormal, vec3 vplFlux,
@@ -32,7 +47,8 @@ vec3 vplIrradianceDisk(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 
     vec3 w = toVpl * inversesqrt(d2);
     float cosR = max(dot(receiverNormal, w), 0.0);
     float cosL = max(dot(vplNormal, -w), 0.0);
-    return vplFlux * (cosR * cosL / (kPi * d2 + max(area, 0.0)));
+    float a = uVplInvClampB > 0.0 ? 0.0 : max(area, 0.0);
+    return vplFlux * (cosR * cosL / (kPi * d2 + a) * vplClampFactor(cosR, cosL, d2));
 }
 
 // The kernel the program was built for: GIS_VPL_KERNEL is defined per program variant (a uniform
