@@ -16,6 +16,7 @@
 #include "core/Param.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
+#include "gl/Shader.h"
 
 namespace gis {
 
@@ -36,6 +37,10 @@ struct FrameInputs {
     bool lightEnabled = true;
     const gl::Texture* direct = nullptr;          ///< RGBA32F shadowed direct radiance plus emission
     const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
+    /// Draws the scene's triangles (world-space positions at attribute 0) with `program` bound,
+    /// `instances` times; techniques see geometry only through this (VPL shadow maps).
+    std::function<void(const gl::Program& program, int instances)> drawGeometry;
+    float sceneExtent = 1.0f; ///< diagonal of the scene's bounds (m), > 0
 };
 
 using Counters = std::map<std::string, double>;
@@ -53,7 +58,8 @@ public:
     virtual void resize(int width, int height) = 0;
     /// Renders the indirect radiance for this frame into indirect(); records passes in `timer` and
     /// counts (VPLs, receivers, ...) in `counters`.
-    virtual void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer, Counters& counters) = 0;
+    virtual void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
+                         Counters& counters) = 0;
     /// Linear RGB radiance to add to the direct light, or nullptr when the technique adds none.
     virtual const gl::Texture* indirect() const = 0;
 };

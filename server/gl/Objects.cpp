@@ -19,6 +19,21 @@ void Buffer::upload(GLintptr offset, GLsizeiptr bytes, const void* data) {
     glNamedBufferSubData(id(), offset, bytes, data);
 }
 
+Texture Texture::create2DArray(GLenum internalFormat, int width, int height, int layers) {
+    GIS_ASSERT(width > 0 && height > 0 && layers > 0);
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+    glTextureStorage3D(id, 1, internalFormat, width, height, layers);
+    Texture t(id);
+    t.mWidth = width;
+    t.mHeight = height;
+    t.mLevels = 1;
+    t.mFormat = internalFormat;
+    t.setFilter(GL_NEAREST, GL_NEAREST);
+    t.setWrap(GL_CLAMP_TO_EDGE);
+    return t;
+}
+
 Texture Texture::create2D(GLenum internalFormat, int width, int height, int levels) {
     GIS_ASSERT(width > 0 && height > 0 && levels > 0);
     GLuint id = 0;

@@ -81,6 +81,7 @@ class Texture : public Object<TextureTraits> {
 public:
     Texture() = default;
     static Texture create2D(GLenum internalFormat, int width, int height, int levels = 1);
+    static Texture create2DArray(GLenum internalFormat, int width, int height, int layers);
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     GLenum format() const { return mFormat; }

@@ -25,7 +25,8 @@ glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
 
 glm::vec3 upFor(glm::vec3 forward, glm::vec3 preferred) {
     glm::vec3 up = safeNormalize(preferred, {0, 1, 0});
-    if (std::abs(glm::dot(up, forward)) > 0.999f) up = std::abs(forward.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
+    if (std::abs(glm::dot(up, forward)) > 0.999f)
+        up = std::abs(forward.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
     return up;
 }
 
@@ -189,14 +190,18 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     u.viewProj = cameraViewProj(state.camera, state.width, state.height);
     u.lightViewProj = lightViewProj(state.light, mScene->bounds, &tanHalf);
     u.cameraPos = glm::vec4(state.camera.position, 0.0f);
-    const bool lightOn = state.lightEnabled && state.light.intensity > 0.0f && std::isfinite(state.light.intensity);
+    const bool lightOn =
+        state.lightEnabled && state.light.intensity > 0.0f && std::isfinite(state.light.intensity);
     u.lightPos = glm::vec4(state.light.position, lightOn ? state.light.intensity : 0.0f);
-    u.lightDir = glm::vec4(safeNormalize(state.light.direction, {0, -1, 0}), std::cos(state.light.outerConeAngle));
-    u.lightColor = glm::vec4(glm::max(state.light.color, glm::vec3(0.0f)), std::cos(state.light.innerConeAngle));
+    u.lightDir =
+        glm::vec4(safeNormalize(state.light.direction, {0, -1, 0}), std::cos(state.light.outerConeAngle));
+    u.lightColor =
+        glm::vec4(glm::max(state.light.color, glm::vec3(0.0f)), std::cos(state.light.innerConeAngle));
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
     u.rsmInfo = glm::vec4(rsmSize, tanHalf, mShadowSize, fp.getInt("pcf_radius"));
-    u.toneInfo = glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
-                           lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
+    u.toneInfo =
+        glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
+                  lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 
@@ -272,6 +277,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.lightEnabled = lightOn;
     in.direct = &mDirect;
     in.frame = &u;
+    in.drawGeometry = [this](const gl::Program& program, int instances) {
+        mSceneGpu->draw(program, false, instances);
+    };
+    in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 
@@ -299,7 +308,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     gl::logErrors("frame");
 
     nlohmann::json passJson = nlohmann::json::array();
-    for (const auto& p : passes) passJson.push_back({{"name", p.name}, {"gpu_ms", p.gpuMs}, {"cpu_ms", p.cpuMs}});
+    for (const auto& p : passes)
+        passJson.push_back({{"name", p.name}, {"gpu_ms", p.gpuMs}, {"cpu_ms", p.cpuMs}});
     nlohmann::json countJson = nlohmann::json::object();
     countJson["triangles"] = mSceneGpu->triangleCount();
     countJson["pixels"] = state.width * state.height;

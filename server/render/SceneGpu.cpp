@@ -1,5 +1,7 @@
 #include "render/SceneGpu.h"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "core/Error.h"
@@ -43,15 +45,19 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         mTriangles += mesh.indices.size() / 3;
         if (d.indexCount > 0) mDraws.push_back(d);
     }
-    if (vertices.empty() || indices.empty()) throw Error("render: scene '" + scene.name + "' has no triangles");
+    if (vertices.empty() || indices.empty())
+        throw Error("render: scene '" + scene.name + "' has no triangles");
 
-    mVertices = gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0);
-    mIndices = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(), 0);
+    mVertices =
+        gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0);
+    mIndices = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)),
+                                  indices.data(), 0);
     mVao = gl::VertexArray::create();
     const GLuint vao = mVao.id();
     glVertexArrayVertexBuffer(vao, 0, mVertices.id(), 0, sizeof(Vertex));
     glVertexArrayElementBuffer(vao, mIndices.id());
-    const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal), offsetof(Vertex, texcoord)};
+    const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal),
+                               offsetof(Vertex, texcoord)};
     const GLint sizes[3] = {3, 3, 2};
     for (GLuint a = 0; a < 3; ++a) {
         glEnableVertexArrayAttrib(vao, a);
@@ -60,9 +66,11 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     }
 
     for (const TextureImage& image : scene.textures) {
-        int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(std::max(image.width, image.height), 1))));
+        int levels =
+            1 + static_cast<int>(std::floor(std::log2(std::max(std::max(image.width, image.height), 1))));
         gl::Texture t = gl::Texture::create2D(GL_SRGB8_ALPHA8, image.width, image.height, levels);
-        glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+        glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                            image.rgba.data());
         glGenerateTextureMipmap(t.id());
         t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
         t.setWrap(GL_REPEAT);
@@ -71,7 +79,7 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     gl::checkErrors("scene upload");
 }
 
-void SceneGpu::draw(const gl::Program& program, bool withMaterials) const {
+void SceneGpu::draw(const gl::Program& program, bool withMaterials, int instances) const {
     glBindVertexArray(mVao.id());
     const GLint baseColor = program.uniform("uBaseColor");
     const GLint emissive = program.uniform("uEmissive");
@@ -81,12 +89,15 @@ void SceneGpu::draw(const gl::Program& program, bool withMaterials) const {
             const Material& m = mMaterials[static_cast<size_t>(d.material)];
             glUniform4f(baseColor, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
             glUniform3f(emissive, m.emissive.r, m.emissive.g, m.emissive.b);
-            const bool textured = m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());
+            const bool textured =
+                m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());
             glUniform1i(hasTexture, textured ? 1 : 0);
             if (textured) glBindTextureUnit(0, mTextures[static_cast<size_t>(m.baseColorTexture)].id());
         }
-        glDrawElementsBaseVertex(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
-                                 reinterpret_cast<const void*>(static_cast<uintptr_t>(d.firstIndex) * 4), d.baseVertex);
+        glDrawElementsInstancedBaseVertex(
+            GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(static_cast<uintptr_t>(d.firstIndex) * 4), std::max(instances, 1),
+            d.baseVertex);
     }
 }
 

@@ -14,8 +14,9 @@ class SceneGpu {
 public:
     /// Uploads everything; throws gis::Error on GL failure (a load boundary).
     explicit SceneGpu(const Scene& scene);
-    /// Draws every mesh with `program` bound; sets the material uniforms when `withMaterials`.
-    void draw(const gl::Program& program, bool withMaterials) const;
+    /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
+    /// when `withMaterials`.
+    void draw(const gl::Program& program, bool withMaterials, int instances = 1) const;
     std::size_t triangleCount() const { return mTriangles; }
 
 private:

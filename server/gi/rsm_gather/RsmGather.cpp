@@ -6,16 +6,23 @@
 
 namespace gis {
 
+namespace {
+std::vector<ParamSpec> withShadows(std::vector<ParamSpec> specs) {
+    for (auto& s : vplShadowParamSpecs()) specs.push_back(std::move(s));
+    return specs;
+}
+} // namespace
+
 TechniqueInfo RsmGather::info() {
     return {"rsm_gather", "full-resolution gather from VPLs on a regular RSM grid", "000 §3, Eq. 2",
-            ParamTable(vplParamSpecs(VplKernel::Point))};
+            ParamTable(withShadows(vplParamSpecs(VplKernel::Point)))};
 }
 
 TechniqueInfo RsmGather::ssbcInfo() {
     // 002's configuration on rsm_gather's pipeline: the K3 clamp on and one compensation step
     // (docs/ssbc.md). Only the defaults differ, so `rsm_gather --param clamp_b=..,ssbc_iterations=1`
     // renders the same image.
-    std::vector<ParamSpec> specs = vplParamSpecs(VplKernel::Point);
+    std::vector<ParamSpec> specs = withShadows(vplParamSpecs(VplKernel::Point));
     for (auto& s : specs) {
         if (s.name == "clamp_b") s.defaultValue = kSsbcDefaultClampB;
         if (s.name == "ssbc_iterations") s.defaultValue = 1;
@@ -40,6 +47,7 @@ void RsmGather::resize(int width, int height) {
 void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                         Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
+    mShadows.render(in, params, mVpls.buffer(), vplCount, timer, counters);
 
     timer.begin("vpl_gather");
     glBindFramebuffer(GL_FRAMEBUFFER, mTarget.id());
@@ -51,15 +59,19 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         glUseProgram(gather.id());
         glUniform1f(gather.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
         setVplClamp(gather, params);
+        mShadows.bind(gather, in, params);
         glBindTextureUnit(0, in.gPosition->id());
         glBindTextureUnit(1, in.gNormal->id());
         glBindTextureUnit(2, in.gAlbedo->id());
         glBindVertexArray(mEmptyVao.id());
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);
+        int first = 0;
         counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
             glUniform1i(gather.uniform("uVplCount"), count);
+            glUniform1i(gather.uniform("uVplFirst"), first);
             glDrawArrays(GL_TRIANGLES, 0, 3);
+            first += count;
         });
         glDisable(GL_BLEND);
     }

@@ -27,6 +27,7 @@
 #include "gi/Technique.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/VplGrid.h"
+#include "gi/common/VplShadows.h"
 #include "gl/Shader.h"
 
 namespace gis {
@@ -45,6 +46,7 @@ public:
 
 private:
     VplGrid mVpls;
+    VplShadows mShadows;
     KernelPrograms mGather;
     BiasCompensation mSsbc;
     gl::Texture mIndirect;

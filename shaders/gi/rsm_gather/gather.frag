@@ -3,6 +3,8 @@
 // irradiance of every VPL in the current batch. Batches are accumulated with additive blending.
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
+#define GIS_VPL_SHADOW_LOOKUP 1
+#include "gi/common/vpl_shadow.glsl"
 
 layout(binding = 0) uniform sampler2D gPosition;
 layout(binding = 1) uniform sampler2D gNormal;
@@ -13,6 +15,7 @@ layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
 };
 
 uniform int uVplCount;       // VPLs in this batch
+uniform int uVplFirst;       // index of the batch's first VPL (its shadow map layers)
 uniform float uMinDistance;  // m, point kernel only
 
 layout(location = 0) out vec4 outRadiance;
@@ -27,7 +30,8 @@ void main() {
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     vec3 e = vec3(0.0);
     for (int i = 0; i < uVplCount; ++i) {
-        e += vplIrradianceSelected(pos.xyz, n, gVpls[i], uMinDistance);
+        Vpl v = gVpls[i];
+        e += vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vplVisibility(uVplFirst + i, v.position.xyz, pos.xyz, n);
     }
     vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
     outRadiance = vec4(max(sanitize(albedo * kInvPi * e), vec3(0.0)), 1.0);

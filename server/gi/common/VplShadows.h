@@ -1,0 +1,41 @@
+// Optional VPL visibility for the VPL transport: a cube shadow map per VPL (6 layers of one depth
+// array), all rendered by one instanced draw of the scene with vertex-shader layer selection.
+// Chosen over imperfect shadow maps: the scenes here are small enough that exact shadow maps of
+// 32^2 per face cost tens of milliseconds on llvmpipe (docs/ssbc.md), and they need no point
+// sampling of the scene. GL limits the array to GL_MAX_ARRAY_TEXTURE_LAYERS / 6 VPLs; VPLs beyond
+// that are unshadowed and the count is reported (counter vpl_shadowed).
+//
+// Parameters (vplShadowParamSpecs): vpl_shadows (off), vpl_shadow_size (texels per face, 32),
+// vpl_shadow_bias (fraction of the VPL-receiver distance, 0.02).
+#pragma once
+
+#include <vector>
+
+#include "core/Param.h"
+#include "gi/Technique.h"
+#include "gl/Objects.h"
+#include "gl/PassTimer.h"
+#include "gl/Shader.h"
+
+namespace gis {
+
+std::vector<ParamSpec> vplShadowParamSpecs();
+
+class VplShadows {
+public:
+    VplShadows();
+    /// Renders the shadow maps of the first VPLs of `vpls` ("vpl_shadows" pass) when the parameter
+    /// is on; returns the number of VPLs that have one (0 when off).
+    int render(const FrameInputs& in, const ParamSet& params, const gl::Buffer& vpls, int vplCount,
+               gl::PassTimer& timer, Counters& counters);
+    /// Sets the lookup uniforms of vpl_shadow.glsl on `program` (bound) and binds the maps at unit 7.
+    void bind(const gl::Program& program, const FrameInputs& in, const ParamSet& params) const;
+
+private:
+    gl::Program mProgram;
+    gl::Texture mMaps;
+    gl::Framebuffer mFbo;
+    int mSize = 0, mLayers = 0, mShadowed = 0, mMaxLayers = 0;
+};
+
+} // namespace gis

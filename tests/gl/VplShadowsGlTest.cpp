@@ -1,0 +1,95 @@
+// VPL visibility (cube shadow maps per VPL), the option that lets bias compensation and the VPL
+// techniques be compared with indirect shadows on and off.
+#include <cmath>
+#include <string>
+
+#include "GlTestSupport.h"
+#include "analysis/Metrics.h"
+#include "reference/ReferenceRenderer.h"
+
+using namespace gis;
+using gis::test::renderScene;
+
+namespace {
+
+double relativeRmseRgba(const std::vector<float>& test, const std::vector<float>& referenceRgb, int w,
+                        int h) {
+    std::vector<float> rgb(static_cast<size_t>(w) * h * 3);
+    for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
+        for (size_t c = 0; c < 3; ++c) rgb[i * 3 + c] = test[i * 4 + c];
+    return relativeRmse(ImageView{rgb.data(), w, h, 3}, ImageView{referenceRgb.data(), w, h, 3},
+                        maskFromNonZero(ImageView{referenceRgb.data(), w, h, 3}));
+}
+
+double sum(const std::vector<float>& v) {
+    double s = 0;
+    for (float x : v) s += x;
+    return s;
+}
+
+} // namespace
+
+// With visibility the grid-VPL gather moves towards the one-bounce reference (light blocked by the
+// boxes) and away from the unoccluded one, and it only ever removes light.
+TEST(VplShadows, MoveTheGatherTowardsOneBounceWithVisibility) {
+    const int w = 64, h = 64;
+    const Scene scene = loadScene("builtin:cornell");
+    FrameState state = makeFrameState(scene, "rsm_gather");
+    state.width = w;
+    state.height = h;
+    ReferenceRenderer reference(scene);
+    const ReferenceImage occluded = reference.render(state, {.mode = "one-bounce", .spp = 256, .seed = 3});
+    const ReferenceImage open =
+        reference.render(state, {.mode = "one-bounce-unoccluded", .spp = 256, .seed = 3});
+
+    const FrameOutput plain = renderScene("builtin:cornell", "rsm_gather", w, h, {{"vpl_grid", 8}});
+    const FrameOutput shadowed =
+        renderScene("builtin:cornell", "rsm_gather", w, h, {{"vpl_grid", 8}, {"vpl_shadows", true}});
+    EXPECT_EQ(shadowed.stats["counts"]["vpl_shadowed"].get<double>(), 64);
+
+    const double plainToOccluded = relativeRmseRgba(plain.linear, occluded.rgb, w, h);
+    const double shadowedToOccluded = relativeRmseRgba(shadowed.linear, occluded.rgb, w, h);
+    const double plainToOpen = relativeRmseRgba(plain.linear, open.rgb, w, h);
+    const double shadowedToOpen = relativeRmseRgba(shadowed.linear, open.rgb, w, h);
+    std::printf("rel. RMSE vs one-bounce: %.4f -> %.4f; vs unoccluded: %.4f -> %.4f\n", plainToOccluded,
+                shadowedToOccluded, plainToOpen, shadowedToOpen);
+    EXPECT_LT(shadowedToOccluded, plainToOccluded);
+    EXPECT_GT(shadowedToOpen, plainToOpen);
+
+    size_t brighter = 0;
+    for (size_t i = 0; i < plain.linear.size(); ++i) {
+        ASSERT_TRUE(std::isfinite(shadowed.linear[i]) && shadowed.linear[i] >= 0.0f);
+        brighter += shadowed.linear[i] > plain.linear[i] * 1.0001f + 1e-6f;
+    }
+    EXPECT_EQ(brighter, 0u) << "visibility can only remove light";
+    EXPECT_LT(sum(shadowed.linear), sum(plain.linear));
+}
+
+// Nothing occludes inside the empty box: shadows may only nibble at creases (the bias).
+TEST(VplShadows, EmptyBoxIsNearlyUnchanged) {
+    const FrameOutput plain = renderScene("builtin:cornell-empty", "rsm_gather", 64, 48, {{"vpl_grid", 8}});
+    const FrameOutput shadowed =
+        renderScene("builtin:cornell-empty", "rsm_gather", 64, 48, {{"vpl_grid", 8}, {"vpl_shadows", true}});
+    const double change =
+        relativeRmse(ImageView{shadowed.linear.data(), 64, 48, 4}, ImageView{plain.linear.data(), 64, 48, 4});
+    EXPECT_LT(change, 0.02);
+}
+
+// Every built-in scene, extreme settings, and bias compensation on top: finite and non-negative.
+TEST(VplShadows, StableWithCompensationAndExtremes) {
+    for (const char* scene : {"builtin:cornell", "builtin:crease", "builtin:cornell-dense"}) {
+        SCOPED_TRACE(scene);
+        for (const nlohmann::json& p :
+             {nlohmann::json{
+                  {"vpl_grid", 6}, {"vpl_shadows", true}, {"vpl_shadow_size", 8}, {"vpl_shadow_bias", 0.0}},
+              nlohmann::json{
+                  {"vpl_grid", 6}, {"vpl_shadows", true}, {"vpl_shadow_bias", 0.5}, {"vpl_shadow_size", 16}},
+              nlohmann::json{
+                  {"vpl_grid", 6}, {"vpl_shadows", true}, {"ssbc_iterations", 1}, {"clamp_b", 10.0}}}) {
+            // 65k triangles x 6 faces x VPLs: one configuration of the dense scene is enough.
+            if (std::string(scene) == "builtin:cornell-dense" && p.contains("vpl_shadow_size")) continue;
+            const FrameOutput f = renderScene(scene, "rsm_gather", 63, 47, p);
+            for (float v : f.linear) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
+        }
+    }
+}
