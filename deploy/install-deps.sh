@@ -19,8 +19,8 @@ PACKAGES=(
     libembree-dev libtbb-dev
     # network
     libwebsockets-dev
-    # tests and benchmarks
-    libgtest-dev libgmock-dev libbenchmark-dev
+    # tests and benchmarks (gnuplot-nox: gi-bench report's plots)
+    libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
     # end-to-end and browser tests
     nodejs npm chromium
 )

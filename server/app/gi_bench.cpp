@@ -4,6 +4,10 @@
 //                               side and prints the error-versus-time table (Markdown and JSON)
 //   passes [options]            per-pass times of configurations rendered interleaved in one run,
 //                               their ratios, receiver counts and the error against a GL baseline
+//   sweep [options]             every technique over its parameter grid: time and error per point,
+//                               appended to CSV and JSON Lines, resumable (BenchSweep.cpp)
+//   report [options]            docs/accuracy.md from a sweep: plots, Pareto fronts, paper tables and
+//                               presets/presets.json (BenchReport.cpp)
 // Exit codes: 0 success, 1 runtime failure, 2 bad usage.
 #include <algorithm>
 #include <cstdio>
@@ -18,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/Metrics.h"
+#include "app/BenchCommon.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "gl/Platform.h"
@@ -27,10 +32,14 @@
 
 namespace {
 
+using namespace gis::bench;
+
 constexpr int kMaxEyeLevels = 16;
 constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
        gi-bench table [options]
        gi-bench passes [options]
+       gi-bench sweep [options]     (gi-bench sweep --help)
+       gi-bench report [options]    (gi-bench report --help)
 
 compare  prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
          size; pixels black in the reference are left out) as JSON.
@@ -57,28 +66,12 @@ passes   renders every configuration --frames times, interleaved (frame k of eac
          each configuration against that GL configuration (rendered once, untimed).
   --scene, --size, --config, --frames, --gl, --timing, --json as for table (default size 512x512)
   --baseline SPEC         GL configuration the errors are measured against
+
+sweep    runs each technique over its parameter grid and appends time and error per point to CSV
+         and JSON Lines; see gi-bench sweep --help.
+report   writes docs/accuracy.md, its plots and presets/presets.json from a sweep; see
+         gi-bench report --help.
 )";
-
-struct UsageError {
-    std::string message;
-};
-
-int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
-    try {
-        size_t used = 0;
-        long v = std::stol(text, &used);
-        if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
-    } catch (...) {
-    }
-    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                     "], got '" + text + "'"};
-}
-
-std::string defaultCacheDir() {
-    if (const char* d = std::getenv("GI_CACHE_DIR"); d && *d) return d;
-    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/gi-render";
-    return "/tmp/gi-render-cache";
-}
 
 int compare(const std::vector<std::string>& args) {
     if (args.size() != 2) throw UsageError{"compare needs two files: TEST.exr REFERENCE.exr"};
@@ -96,52 +89,6 @@ int compare(const std::vector<std::string>& args) {
     return 0;
 }
 
-struct Config {
-    std::string technique;
-    std::vector<std::pair<std::string, std::string>> params;
-    std::string label;
-};
-
-Config parseConfig(const std::string& spec) {
-    Config c;
-    c.label = spec;
-    auto colon = spec.find(':');
-    c.technique = spec.substr(0, colon);
-    if (colon == std::string::npos) return c;
-    std::stringstream rest(spec.substr(colon + 1));
-    std::string kv;
-    while (std::getline(rest, kv, ',')) {
-        auto eq = kv.find('=');
-        if (eq == std::string::npos || eq == 0)
-            throw UsageError{"--config: expected name=value, got '" + kv + "'"};
-        c.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-    }
-    return c;
-}
-
-bool parseTiming(const std::string& text) {
-    if (text == "query") return true;
-    if (text == "finish") return false;
-    throw UsageError{"--timing must be query or finish, got '" + text + "'"};
-}
-
-std::vector<gis::FrameState> makeStates(const gis::Scene& scene, const std::vector<Config>& configs,
-                                        int width, int height) {
-    std::vector<gis::FrameState> states;
-    for (const auto& c : configs) {
-        try {
-            gis::FrameState s = gis::makeFrameState(scene, c.technique);
-            for (const auto& [k, v] : c.params) gis::setParamFromString(s, k, v, "--config " + c.label);
-            s.width = width;
-            s.height = height;
-            states.push_back(std::move(s));
-        } catch (const gis::InputError& e) {
-            throw UsageError{e.what()};
-        }
-    }
-    return states;
-}
-
 int passes(const std::vector<std::string>& args) {
     std::string sceneName = "builtin:cornell", jsonPath, gl;
     int width = 512, height = 512, frames = 5;
@@ -155,13 +102,9 @@ int passes(const std::vector<std::string>& args) {
         const std::string& a = args[i];
         if (a == "--scene")
             sceneName = value();
-        else if (a == "--size") {
-            const std::string& s = value();
-            auto x = s.find('x');
-            if (x == std::string::npos) throw UsageError{"--size must look like 512x512"};
-            width = parseInt("--size width", s.substr(0, x), 16, 4096);
-            height = parseInt("--size height", s.substr(x + 1), 16, 4096);
-        } else if (a == "--config")
+        else if (a == "--size")
+            parseSize("--size", value(), width, height);
+        else if (a == "--config")
             configs.push_back(parseConfig(value()));
         else if (a == "--baseline")
             baseline = {parseConfig(value())};
@@ -310,13 +253,9 @@ int table(const std::vector<std::string>& args) {
         const std::string& a = args[i];
         if (a == "--scene")
             sceneName = value();
-        else if (a == "--size") {
-            const std::string& s = value();
-            auto x = s.find('x');
-            if (x == std::string::npos) throw UsageError{"--size must look like 256x256"};
-            width = parseInt("--size width", s.substr(0, x), 16, 4096);
-            height = parseInt("--size height", s.substr(x + 1), 16, 4096);
-        } else if (a == "--config")
+        else if (a == "--size")
+            parseSize("--size", value(), width, height);
+        else if (a == "--config")
             configs.push_back(parseConfig(value()));
         else if (a == "--reference")
             modes.push_back(value());
@@ -358,15 +297,10 @@ int table(const std::vector<std::string>& args) {
     renderer.setScene(scene);
     nlohmann::json rows = nlohmann::json::array();
     for (size_t i = 0; i < configs.size(); ++i) {
-        gis::FrameOutput f = renderer.render(states[i], true);
-        std::vector<nlohmann::json> stats;
-        for (int k = 0; k < frames; ++k) {
-            f = renderer.render(states[i], true);
-            stats.push_back(f.stats);
-        }
-        nlohmann::json s = gis::medianStats(stats);
-        double gpu = 0;
-        for (const auto& p : s["passes"]) gpu += p["gpu_ms"].get<double>();
+        Measurement m = measure(renderer, states[i], frames);
+        const gis::FrameOutput& f = m.last;
+        const nlohmann::json& s = m.stats;
+        const double gpu = sumPassMs(s);
         nlohmann::json row = {{"config", configs[i].label},
                               {"frame_ms", s["frame_ms"]},
                               {"gpu_ms", gpu},
@@ -419,7 +353,10 @@ int run(int argc, char** argv) {
     if (command == "compare") return compare(args);
     if (command == "table") return table(args);
     if (command == "passes") return passes(args);
-    throw UsageError{"unknown command '" + command + "': use compare, table or passes (see --help)"};
+    if (command == "sweep") return sweep(args);
+    if (command == "report") return report(args);
+    throw UsageError{"unknown command '" + command +
+                     "': use compare, table, passes, sweep or report (see --help)"};
 }
 
 } // namespace

@@ -20,6 +20,7 @@
 #include "render/FrameParams.h"
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
+#include "render/Presets.h"
 #include "scene/SceneLoader.h"
 
 namespace {
@@ -30,6 +31,8 @@ Renders a scene with a global-illumination technique and writes the image and pe
 
   --scene NAME          builtin:NAME or a .gltf/.glb file (default builtin:cornell)
   --technique NAME      GI technique (default rsm_gather; see --list-techniques)
+  --preset NAME         start from the technique's preset: interactive, balanced or final
+                        (presets/presets.json or $GI_PRESETS; docs/accuracy.md); --param overrides it
   --param NAME=VALUE    set a frame or technique parameter (repeatable; see --list-params)
   --size WxH            image size in pixels, 16..4096 each (default 512x512)
   --out FILE            write the image: .png, .jpg (tone-mapped) or .exr (linear radiance)
@@ -68,6 +71,7 @@ struct UsageError {
 struct Options {
     std::string scene = "builtin:cornell";
     std::string technique = "rsm_gather";
+    std::string preset;
     std::vector<std::pair<std::string, std::string>> params;
     int width = 512, height = 512;
     std::string out, stats;
@@ -192,6 +196,7 @@ int run(int argc, char** argv) {
             return 0;
         } else if (a == "--scene") o.scene = value(i);
         else if (a == "--technique") o.technique = value(i);
+        else if (a == "--preset") o.preset = value(i);
         else if (a == "--param") {
             const std::string& kv = value(i);
             auto eq = kv.find('=');
@@ -248,6 +253,7 @@ int run(int argc, char** argv) {
     gis::FrameState state;
     try {
         state = gis::makeFrameState(*scene, o.technique);
+        if (!o.preset.empty()) gis::applyPreset(state, o.preset);
         for (const auto& [k, v] : o.params) gis::setParamFromString(state, k, v, "--param " + k);
     } catch (const gis::InputError& e) {
         throw UsageError{e.what()};

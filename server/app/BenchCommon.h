@@ -1,0 +1,70 @@
+// Helpers shared by gi-bench's subcommands (gi_bench.cpp, BenchSweep.cpp, BenchReport.cpp).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "render/FrameRenderer.h"
+#include "render/FrameState.h"
+#include "scene/Scene.h"
+
+namespace gis::bench {
+
+/// Bad command-line usage: main prints it and exits 2.
+struct UsageError {
+    std::string message;
+};
+
+int parseInt(const std::string& flag, const std::string& text, int lo, int hi);
+double parseDouble(const std::string& flag, const std::string& text, double lo, double hi);
+/// "WxH", each side 16..4096.
+void parseSize(const std::string& flag, const std::string& text, int& width, int& height);
+/// Comma-separated list, empty items dropped.
+std::vector<std::string> splitList(const std::string& text);
+/// "a, b, c" for error messages listing valid choices.
+std::string joinList(const std::vector<std::string>& items);
+/// $GI_CACHE_DIR, else ~/.cache/gi-render.
+std::string defaultCacheDir();
+/// "query" (timer queries) or "finish" (glFinish around each pass).
+bool parseTiming(const std::string& text);
+
+/// Walks argv-style arguments: `value()` returns the argument after the current flag.
+struct ArgCursor {
+    const std::vector<std::string>& args;
+    size_t i = 0;
+    const std::string& value() {
+        if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+        return args[++i];
+    }
+};
+
+/// technique[:name=value,...] as given to --config.
+struct Config {
+    std::string technique;
+    std::vector<std::pair<std::string, std::string>> params;
+    std::string label;
+};
+Config parseConfig(const std::string& spec);
+std::vector<FrameState> makeStates(const Scene& scene, const std::vector<Config>& configs, int width,
+                                   int height);
+
+/// One warm-up frame, then up to `frames` timed ones. With maxFrameMs > 0 a configuration whose warm-up
+/// frame already took longer is timed by that frame alone (`overBudget`), which bounds the cost of a
+/// slow point to one frame.
+struct Measurement {
+    nlohmann::json stats; ///< medianStats of the timed frames
+    FrameOutput last;     ///< the last frame, with linear radiance
+    int frames = 0;
+    bool overBudget = false;
+};
+Measurement measure(FrameRenderer& renderer, const FrameState& state, int frames, double maxFrameMs = 0);
+/// Sum of the stats' per-pass GPU milliseconds.
+double sumPassMs(const nlohmann::json& stats);
+
+int sweep(const std::vector<std::string>& args);
+int report(const std::vector<std::string>& args);
+
+} // namespace gis::bench

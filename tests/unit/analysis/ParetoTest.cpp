@@ -1,0 +1,86 @@
+#include <gtest/gtest.h>
+
+#include "analysis/Pareto.h"
+#include "analysis/SweepGrid.h"
+#include "core/Error.h"
+
+namespace {
+
+using gis::TradeoffPoint;
+
+TEST(Pareto, KeepsOnlyUndominatedPointsOrderedByTime) {
+    std::vector<TradeoffPoint> pts = {{10, 0.5}, {20, 0.3}, {15, 0.6}, {40, 0.1}, {30, 0.3}, {5, 0.9}};
+    auto front = gis::paretoFront(pts);
+    EXPECT_EQ(front, (std::vector<std::size_t>{5, 0, 1, 3}));
+}
+
+TEST(Pareto, DuplicatesKeepTheFirst) {
+    std::vector<TradeoffPoint> pts = {{10, 0.5}, {10, 0.5}, {10, 0.4}};
+    EXPECT_EQ(gis::paretoFront(pts), (std::vector<std::size_t>{2}));
+    EXPECT_TRUE(gis::paretoFront({}).empty());
+}
+
+TEST(Pareto, KneeIsTheBendOfTheFront) {
+    // A sharp bend at 20 ms: far below the chord from (1, 1) to (1000, 0.01) in log-log space.
+    std::vector<TradeoffPoint> front = {{1, 1}, {20, 0.02}, {100, 0.015}, {1000, 0.01}};
+    EXPECT_EQ(gis::kneeOfFront(front), 1u);
+    EXPECT_EQ(gis::kneeOfFront({{1, 1}}), 0u);
+    EXPECT_EQ(gis::kneeOfFront({{1, 1}, {2, 0.5}}), 1u);
+}
+
+TEST(Pareto, PresetsFollowTheBudget) {
+    std::vector<TradeoffPoint> front = {{5, 0.9}, {30, 0.2}, {80, 0.1}, {300, 0.05}};
+    auto c = gis::choosePresets(front, 100);
+    EXPECT_EQ(c.interactive, 2u);
+    EXPECT_EQ(c.final, 3u);
+    EXPECT_GE(c.balanced, c.interactive);
+    EXPECT_LE(c.balanced, c.final);
+    // Nothing within the budget: the fastest point.
+    EXPECT_EQ(gis::choosePresets(front, 1).interactive, 0u);
+}
+
+gis::ParamTable table() {
+    using gis::ParamType;
+    return gis::ParamTable(
+        {{.name = "count", .type = ParamType::Int, .defaultValue = 4, .min = 1, .max = 16},
+         {.name = "mode", .type = ParamType::Enum, .defaultValue = 0, .options = {"a", "b", "c"}},
+         {.name = "on", .type = ParamType::Bool, .defaultValue = 1}});
+}
+
+TEST(SweepGrid, DefaultFirstThenOneKnobAtATimeWalkingOutward) {
+    auto grid = gis::oneAtATimeGrid(table(), 4);
+    ASSERT_FALSE(grid.empty());
+    EXPECT_TRUE(grid[0].knob.empty());
+    EXPECT_EQ(grid[0].params["count"], 4);
+    // count: sweep values 1, 6, 11, 16 -> above the default ascending, then below descending.
+    std::vector<int> counts;
+    for (const auto& p : grid)
+        if (p.knob == "count") counts.push_back(p.value.get<int>());
+    EXPECT_EQ(counts, (std::vector<int>{6, 11, 16, 1}));
+    int modes = 0, ons = 0;
+    for (const auto& p : grid) {
+        if (p.knob == "mode") ++modes;
+        if (p.knob == "on") {
+            ++ons;
+            EXPECT_EQ(p.params["on"], false);
+            EXPECT_EQ(p.params["count"], 4); // the other knobs stay at their defaults
+        }
+    }
+    EXPECT_EQ(modes, 2); // every option but the default
+    EXPECT_EQ(ons, 1);
+}
+
+TEST(SweepGrid, KnobsRestrictAndUnknownKnobsAreNamed) {
+    auto grid = gis::oneAtATimeGrid(table(), 3, {"mode"});
+    EXPECT_EQ(grid.size(), 3u);
+    try {
+        gis::oneAtATimeGrid(table(), 3, {"cuont"});
+        FAIL();
+    } catch (const gis::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("cuont"), std::string::npos);
+    }
+    EXPECT_EQ(gis::describeChanges(table(), grid[1].params), "mode=b");
+    EXPECT_EQ(gis::describeChanges(table(), grid[0].params), "defaults");
+}
+
+} // namespace
