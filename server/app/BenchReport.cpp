@@ -436,7 +436,7 @@ int report(const std::vector<std::string>& args) {
           "added later keep their defaults. `render/Presets.h` loads it (`presetParams(technique, name)`, "
           "`applyPreset`; `$GI_PRESETS` overrides the path); `gi-render --preset NAME` applies one before "
           "any "
-          "`--param`, and the server's adaptive quality steps between them.\n\n"
+          "`--param`; they are the steps the server's adaptive quality is to move between (gi-server does not read them yet).\n\n"
           "| technique | preset | parameters | mean frame ms | mean rel. RMSE |\n|---|---|---|---|---|\n";
     for (const auto& p : presets)
         md << "| " << p.technique << " | " << p.name << " | " << p.changes << " | " << fmt(p.timeMs) << " | "
