@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "GlTestSupport.h"
 #include "reference/ReferenceRenderer.h"
@@ -165,4 +166,92 @@ TEST(SsbcGl, ExtremesStayFiniteAndNonNegative) {
             EXPECT_TRUE(std::isfinite(counter(f, "ssbc_energy_added"))) << what;
             EXPECT_LE(counter(f, "ssbc_samples_max"), 16384.0) << what;
         }
+}
+
+namespace {
+
+// Sum over pixels of the mean RGB (radiance x pixels, the unit of ssbc_energy_added).
+double imageEnergy(const FrameOutput& f) {
+    double sum = 0;
+    for (size_t i = 0; i + 2 < f.linear.size(); i += 4)
+        sum += (static_cast<double>(f.linear[i]) + f.linear[i + 1] + f.linear[i + 2]) / 3.0;
+    return sum;
+}
+
+} // namespace
+
+TEST(SsbcGl, BlurAndHalfResolutionStayFiniteAndNonNegative) {
+    for (const char* scene : {"builtin:crease", "builtin:cornell"})
+        for (const auto& [w, h] : {std::pair{96, 96}, std::pair{63, 47}})
+            for (const auto& [blur, half] :
+                 {std::pair{true, false}, std::pair{false, true}, std::pair{true, true}}) {
+                const std::string what = std::string(scene) + " " + std::to_string(w) + "x" +
+                                         std::to_string(h) + " blur " + std::to_string(blur) + " half " +
+                                         std::to_string(half);
+                const FrameOutput f = renderScene(scene, "rsm_gather", w, h,
+                                                  {{"clamp_b", 10.0},
+                                                   {"ssbc_iterations", 2},
+                                                   {"ssbc_blur", blur},
+                                                   {"ssbc_half_resolution", half}});
+                expectFiniteNonNegative(f, what);
+                EXPECT_GT(counter(f, "ssbc_energy_added"), 0.0) << what;
+                EXPECT_EQ(counter(f, "ssbc_half_resolution"), half ? 1.0 : 0.0) << what;
+            }
+}
+
+TEST(SsbcGl, OptionsOffAreBitIdentical) {
+    const FrameOutput a =
+        renderScene(kCrease, "rsm_gather", 48, 48, {{"clamp_b", 10.0}, {"ssbc_iterations", 1}});
+    const FrameOutput b = renderScene(
+        kCrease, "rsm_gather", 48, 48,
+        {{"clamp_b", 10.0}, {"ssbc_iterations", 1}, {"ssbc_blur", false}, {"ssbc_half_resolution", false}});
+    ASSERT_EQ(a.linear.size(), b.linear.size());
+    for (size_t i = 0; i < a.linear.size(); ++i) ASSERT_EQ(a.linear[i], b.linear[i]) << i;
+}
+
+TEST(SsbcGl, BlurChangesLittleAndConservesEnergy) {
+    const FrameOutput off =
+        renderScene(kCrease, "rsm_gather", kW, kH, {{"clamp_b", 10.0}, {"ssbc_iterations", 0}});
+    const FrameOutput on =
+        renderScene(kCrease, "rsm_gather", kW, kH, {{"clamp_b", 10.0}, {"ssbc_iterations", 1}});
+    const FrameOutput blur = renderScene(kCrease, "rsm_gather", kW, kH,
+                                         {{"clamp_b", 10.0}, {"ssbc_iterations", 1}, {"ssbc_blur", true}});
+    const double added = imageEnergy(on) - imageEnergy(off);
+    const double addedBlur = imageEnergy(blur) - imageEnergy(off);
+    double moved = 0;
+    for (size_t i = 0; i + 2 < on.linear.size(); i += 4)
+        moved += std::abs(static_cast<double>(blur.linear[i]) - on.linear[i]) +
+                 std::abs(static_cast<double>(blur.linear[i + 1]) - on.linear[i + 1]) +
+                 std::abs(static_cast<double>(blur.linear[i + 2]) - on.linear[i + 2]);
+    moved /= 3.0;
+    std::printf("crease %dx%d compensation energy: sharp %.4f, blurred %.4f (ratio %.5f); |blurred - sharp| "
+                "%.4f (%.3f of the compensation, %.4f of the image)\n",
+                kW, kH, added, addedBlur, addedBlur / added, moved, moved / added, moved / imageEnergy(on));
+    ASSERT_GT(added, 0.0);
+    EXPECT_NEAR(addedBlur / added, 1.0, 0.02);
+    // The blur redistributes the compensation (a sharp ridge along the crease, so a good share of it
+    // moves by a pixel or two) but changes the image itself by little.
+    EXPECT_GT(moved, 0.0);
+    EXPECT_LT(moved, 0.6 * added);
+    EXPECT_LT(moved, 0.01 * imageEnergy(on));
+}
+
+TEST(SsbcGl, HalfResolutionRecoversFullResolutionEnergy) {
+    const FrameOutput off =
+        renderScene(kCrease, "rsm_gather", kW, kH, {{"clamp_b", 10.0}, {"ssbc_iterations", 0}});
+    const FrameOutput full =
+        renderScene(kCrease, "rsm_gather", kW, kH, {{"clamp_b", 10.0}, {"ssbc_iterations", 1}});
+    const FrameOutput half =
+        renderScene(kCrease, "rsm_gather", kW, kH,
+                    {{"clamp_b", 10.0}, {"ssbc_iterations", 1}, {"ssbc_half_resolution", true}});
+    const double added = imageEnergy(full) - imageEnergy(off);
+    const double addedHalf = imageEnergy(half) - imageEnergy(off);
+    std::printf("crease %dx%d compensation energy: full %.4f, half %.4f (ratio %.4f; counters %.4f / %.4f); "
+                "nearest-block fallbacks %.0f, samples per receiver %.1f / %.1f\n",
+                kW, kH, added, addedHalf, addedHalf / added, counter(full, "ssbc_energy_added"),
+                counter(half, "ssbc_energy_added"), counter(half, "ssbc_upsample_fallback"),
+                counter(full, "ssbc_samples_mean"), counter(half, "ssbc_samples_mean"));
+    ASSERT_GT(added, 0.0);
+    EXPECT_NEAR(addedHalf / added, 1.0, 0.1);
+    EXPECT_NEAR(counter(half, "ssbc_energy_added") / counter(full, "ssbc_energy_added"), 1.0, 0.1);
 }

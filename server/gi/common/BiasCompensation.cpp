@@ -82,6 +82,18 @@ std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB, int defa
          .help = "compensation mip levels including full resolution (7: 16^2 coarsest at 1024^2); the image "
                  "does not depend on it, the time does",
          .source = "002 §4.2 uses 64^2 at 1024^2 (5 levels); 7 measured faster here (docs/ssbc.md)"},
+        {.name = "ssbc_blur",
+         .type = ParamType::Bool,
+         .defaultValue = 0,
+         .help = "edge-preserving 5x5 cross-bilateral blur of the summed compensation only (normal and "
+                 "relative-distance falloffs, covered pixels only, energy conserving) before it is added",
+         .source = "002 §4.4 (optional bilateral Gaussian; kernel and falloffs chosen, docs/ssbc.md)"},
+        {.name = "ssbc_half_resolution",
+         .type = ParamType::Bool,
+         .defaultValue = 0,
+         .help = "integrate one receiver per 2x2 block (level-1 means) and upsample bilaterally (nearest "
+                 "block where all weights vanish); needs ssbc_levels >= 2",
+         .source = "002 §5 (bilateral upsampling; nearest-sample fallback instead of recomputation)"},
     };
 }
 
@@ -100,6 +112,8 @@ BiasCompensation::BiasCompensation() {
     mBase = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_base.comp"}});
     mReduce = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_reduce.comp"}});
     mIntegrate = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_integrate.comp"}});
+    mUpsample = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_upsample.comp"}});
+    mBlur = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_blur.comp"}});
 }
 
 void BiasCompensation::ensure(int width, int height, int levels) {
@@ -113,6 +127,19 @@ void BiasCompensation::ensure(int width, int height, int levels) {
     const GLsizeiptr slots = kMaxIterations + 1;
     mSums = gl::Buffer::create(slots * groupsFor(mPadW) * groupsFor(mPadH) * 4 * sizeof(float), nullptr,
                                GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    // Optional-mode targets, allocated with the rest (small next to the mip chains). The half-
+    // resolution chain needs a level 1, so it exists only with levels >= 2 (padded sizes even).
+    mAccum = gl::Texture::create2D(GL_RGBA32F, width, height, 1);
+    mBlurTmp = gl::Texture::create2D(GL_RGBA32F, width, height, 1);
+    if (levels >= 2) {
+        mHalf = gl::Texture::create2D(GL_RGBA32F, mPadW / 2, mPadH / 2, 1);
+        mHalfSums =
+            gl::Buffer::create(slots * groupsFor(mPadW / 2) * groupsFor(mPadH / 2) * 4 * sizeof(float),
+                               nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    } else {
+        mHalf = gl::Texture();
+        mHalfSums = gl::Buffer();
+    }
     mWidth = width;
     mHeight = height;
     mLevels = levels;
@@ -189,6 +216,18 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
     reduce(0, 0);
     timer.end();
 
+    // Optional modes: the blur needs the steps' sum on its own (it must not blur the technique's
+    // indirect light), so the steps then add into mAccum; half resolution needs a level 1.
+    const bool blur = params.has("ssbc_blur") && params.getBool("ssbc_blur");
+    const bool half =
+        params.has("ssbc_half_resolution") && params.getBool("ssbc_half_resolution") && levels >= 2;
+    const gl::Texture& target = blur ? mAccum : indirect;
+    if (blur) {
+        const float zero[4] = {0, 0, 0, 0};
+        glClearTexImage(mAccum.id(), 0, GL_RGBA, GL_FLOAT, zero);
+    }
+    const int halfGroupsX = half ? groupsFor(mPadW / 2) : 0, halfGroupsY = half ? groupsFor(mPadH / 2) : 0;
+
     const float r = static_cast<float>(1.0 / std::sqrt(b));
     for (int k = 1; k <= iterations; ++k) {
         const int src = (k - 1) & 1, dst = k & 1;
@@ -209,15 +248,60 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
                     static_cast<float>(params.getFloat("ssbc_discontinuity_angle")));
         glUniform1i(mIntegrate.uniform("uMaxVisited"), kMaxVisited);
         glUniform1i(mIntegrate.uniform("uSlot"), k);
+        glUniform1i(mIntegrate.uniform("uReceiverLevel"), half ? 1 : 0);
         glBindTextureUnit(0, mGeo.id());
         glBindTextureUnit(1, mNormal.id());
         glBindTextureUnit(2, mIllum[src].id());
         glBindTextureUnit(3, in.gAlbedo->id());
-        glBindImageTexture(0, indirect.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(0, target.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, mIllum[dst].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
+        if (half) {
+            // Half resolution: the integrate writes only mHalf, its counters go to mHalfSums.
+            glBindImageTexture(2, mHalf.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mHalfSums.id());
+            glDispatchCompute(static_cast<GLuint>(halfGroupsX), static_cast<GLuint>(halfGroupsY), 1);
+        } else {
+            glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
+        }
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                         GL_BUFFER_UPDATE_BARRIER_BIT);
+        timer.end();
+        if (half) {
+            timer.begin("ssbc_upsample_" + std::to_string(k));
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mSums.id());
+            glUseProgram(mUpsample.id());
+            glUniform1i(mUpsample.uniform("uSlot"), k);
+            glBindTextureUnit(0, mGeo.id());
+            glBindTextureUnit(1, mNormal.id());
+            glBindTextureUnit(2, mHalf.id());
+            glBindTextureUnit(3, in.gAlbedo->id());
+            glBindImageTexture(0, target.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+            glBindImageTexture(1, mIllum[dst].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+            glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                            GL_BUFFER_UPDATE_BARRIER_BIT);
+            timer.end();
+        }
+    }
+
+    if (blur) {
+        timer.begin("ssbc_blur");
+        glUseProgram(mBlur.id());
+        glBindTextureUnit(0, mGeo.id());
+        glBindTextureUnit(1, mNormal.id());
+        // Pass 0: mAccum / W -> mBlurTmp; pass 1: gather into the indirect radiance.
+        glUniform1i(mBlur.uniform("uPass"), 0);
+        glBindTextureUnit(2, mAccum.id());
+        glBindImageTexture(0, mBlurTmp.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glDispatchCompute(static_cast<GLuint>(groupsFor(in.width)), static_cast<GLuint>(groupsFor(in.height)),
+                          1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        glUniform1i(mBlur.uniform("uPass"), 1);
+        glBindTextureUnit(2, mBlurTmp.id());
+        glBindImageTexture(0, indirect.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glDispatchCompute(static_cast<GLuint>(groupsFor(in.width)), static_cast<GLuint>(groupsFor(in.height)),
+                          1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         timer.end();
     }
 
@@ -225,19 +309,39 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
     const size_t groups = static_cast<size_t>(groupsX) * static_cast<size_t>(groupsY);
     std::vector<float> sums(groups * 4 * static_cast<size_t>(iterations + 1));
     glGetNamedBufferSubData(mSums.id(), 0, static_cast<GLsizeiptr>(sums.size() * sizeof(float)), sums.data());
-    double clamped = 0, added = 0, visited = 0, covered = 0, maxVisited = 0;
+    double clamped = 0, added = 0, visited = 0, covered = 0, maxVisited = 0, fallback = 0;
     for (size_t g = 0; g < groups; ++g) clamped += sums[g * 4];
     for (int k = 1; k <= iterations; ++k) {
         double step = 0;
         for (size_t g = 0; g < groups; ++g) {
             const float* s = &sums[(static_cast<size_t>(k) * groups + g) * 4];
             step += s[0];
-            visited += s[1];
-            maxVisited = std::max(maxVisited, static_cast<double>(s[2]));
-            covered += s[3];
+            if (half) {
+                fallback += s[3]; // the upsampling's w: pixels that took the nearest block
+            } else {
+                visited += s[1];
+                maxVisited = std::max(maxVisited, static_cast<double>(s[2]));
+                covered += s[3];
+            }
         }
         counters["ssbc_energy_step" + std::to_string(k)] = step;
         added += step;
+    }
+    if (half) {
+        // Sample counts per half-resolution receiver, from the integrate's own sums.
+        const size_t halfGroups = static_cast<size_t>(halfGroupsX) * static_cast<size_t>(halfGroupsY);
+        std::vector<float> hs(halfGroups * 4 * static_cast<size_t>(iterations + 1));
+        glGetNamedBufferSubData(mHalfSums.id(), 0, static_cast<GLsizeiptr>(hs.size() * sizeof(float)),
+                                hs.data());
+        for (int k = 1; k <= iterations; ++k)
+            for (size_t g = 0; g < halfGroups; ++g) {
+                const float* s = &hs[(static_cast<size_t>(k) * halfGroups + g) * 4];
+                visited += s[1];
+                maxVisited = std::max(maxVisited, static_cast<double>(s[2]));
+                covered += s[3];
+            }
+        counters["ssbc_half_resolution"] = 1;
+        counters["ssbc_upsample_fallback"] = fallback;
     }
     counters["ssbc_clamped_energy"] = clamped;
     counters["ssbc_energy_added"] = added;

@@ -44,15 +44,27 @@
 //   ssbc_levels                mip levels incl. the full resolution, [1, 12], default 7 (16^2
 //                              coarsest at 1024^2; 002 §4.2 starts at 64^2, measured 2.6x slower
 //                              here because every pixel loops over the coarse texels in its disc)
+//   ssbc_blur                  false (default) | true: 002 §4.4's edge-preserving blur of the summed
+//                              compensation (not of the indirect light): the steps add into an
+//                              accumulator, a 5x5 cross-bilateral kernel (spatial Gaussian sigma
+//                              1.5 px x normal-chord and relative-distance falloffs, covered pixels
+//                              only) blurs it with per-source normalisation (energy conserved), then
+//                              it is added to the indirect radiance
+//   ssbc_half_resolution       false (default) | true: 002 §5: each step integrates one receiver per
+//                              2x2 block (its level-1 mean position and normal) and a bilateral
+//                              upsampling (4 nearest blocks, bilinear x the same edge falloffs, each
+//                              pixel's own albedo) brings it to full resolution; where every weight
+//                              vanishes the pixel takes its own block's value (nearest sample), not a
+//                              full-resolution recomputation. Needs ssbc_levels >= 2 (else full res)
 //
 // Passes: ssbc_mips (level 0 from the G-buffer and X_0, then the reductions), ssbc_integrate_k and
-// ssbc_mips_k (k >= 2, the previous compensation's mips). Counters: ssbc_samples_mean (samples
+// ssbc_mips_k (k >= 2, the previous compensation's mips); ssbc_upsample_k (half resolution),
+// ssbc_blur. Counters: ssbc_samples_mean (samples
 // visited per covered pixel and step), ssbc_samples_max, ssbc_energy_added (sum over pixels of the
 // mean RGB compensation, radiance x pixels), ssbc_energy_step<k>, ssbc_clamped_energy (the same sum
-// of the technique's clamped indirect), ssbc_energy_ratio (added / clamped), ssbc_levels.
-//
-// Left out (digest 002.2 items 8, 10): the edge-preserving blur of the compensation and the
-// half-resolution evaluation with bilateral upsampling.
+// of the technique's clamped indirect), ssbc_energy_ratio (added / clamped), ssbc_levels; with half
+// resolution ssbc_half_resolution (1 when it ran) and ssbc_upsample_fallback (pixels and steps that
+// took the nearest block), the sample counts then being per half-resolution receiver.
 #pragma once
 
 #include <vector>
@@ -66,7 +78,8 @@
 namespace gis {
 
 /// clamp_b, ssbc_iterations, ssbc_solid_angle, ssbc_discontinuity_angle, ssbc_grazing_angle,
-/// ssbc_levels; `defaultClampB` and `defaultIterations` let a preset (`ssbc`) turn them on.
+/// ssbc_input, ssbc_levels, ssbc_blur, ssbc_half_resolution; `defaultClampB` and `defaultIterations` let a
+/// preset (`ssbc`) turn them on.
 std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB = 0.0, int defaultIterations = 0);
 
 /// 1/b for vpl_transport.glsl's uVplInvClampB (0: clamp off).
@@ -86,9 +99,11 @@ private:
     void ensure(int width, int height, int levels);
     void reduce(int mode, int illumIndex);
 
-    gl::Program mBase, mReduce, mIntegrate;
+    gl::Program mBase, mReduce, mIntegrate, mUpsample, mBlur;
     gl::Texture mGeo, mNormal, mIllum[2];
-    gl::Buffer mSums;
+    gl::Texture mAccum, mBlurTmp; // ssbc_blur: summed compensation, and it over its kernel weight
+    gl::Texture mHalf;            // ssbc_half_resolution: one step's compensation per 2x2 block
+    gl::Buffer mSums, mHalfSums;  // per-group counter sums (full- and half-resolution dispatches)
     int mWidth = 0, mHeight = 0, mLevels = 0, mPadW = 0, mPadH = 0;
 };
 

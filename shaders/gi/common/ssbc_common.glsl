@@ -31,3 +31,16 @@ void ssbcGroupSum(vec4 mine, int slot) {
         gSsbcSums[slot * int(gl_NumWorkGroups.x * gl_NumWorkGroups.y) + int(gl_WorkGroupID.y * groups + gl_WorkGroupID.x)] = s;
     }
 }
+
+// Edge-stopping weight between two covered surface points (ssbc_blur and the half-resolution
+// upsampling): Gaussian falloffs in the normal chord |n_p - n_q| and in the relative eye distance,
+// with the discontinuity scales of ssbc_reduce.comp (chord 0.3, relative distance 0.1), so a 90-degree
+// crease (chord 1.41) or a depth step gets a weight below 1e-9. Symmetric in p and q, which the
+// energy-conserving blur needs. `eye` is the camera position.
+float ssbcEdgeWeight(vec3 posP, vec3 nP, vec3 posQ, vec3 nQ, vec3 eye) {
+    float chord = length(nP - nQ) / 0.3;
+    float dP = length(posP - eye), dQ = length(posQ - eye);
+    float rel = abs(dP - dQ) / max(0.1 * 0.5 * (dP + dQ), 1e-12);
+    float w = exp(-chord * chord - rel * rel);
+    return isBad(w) ? 0.0 : w;
+}

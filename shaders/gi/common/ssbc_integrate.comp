@@ -3,7 +3,11 @@
 // the step's input L, hierarchically refined (BiasCompensation.h lists the choices). The coarse
 // texels under the screen disc of radius r_s are iterated outside the stack (digest 002.6 item 8),
 // so the stack only holds one depth-first descent: 1 + 3 (levels - 1) entries.
-// Writes C to the next step's level 0 and adds it to the technique's indirect radiance.
+// Writes C to the next step's level 0 and adds it to the target (the technique's indirect radiance,
+// or the compensation accumulator when ssbc_blur is on).
+// Half resolution (ssbc_half_resolution, 002 §5): uReceiverLevel 1 makes each level-1 texel (a 2x2
+// block's area-weighted mean position and normal) one receiver; it writes (1/pi) sum without the
+// albedo to uHalfOut, and ssbc_upsample.comp brings it to full resolution with each pixel's albedo.
 #include "common.glsl"
 #include "gi/common/ssbc_common.glsl"
 
@@ -16,6 +20,7 @@ layout(binding = 3) uniform sampler2D gAlbedo;
 
 layout(rgba32f, binding = 0) uniform image2D uIndirect;          // += C
 layout(rgba32f, binding = 1) uniform writeonly image2D uNextIllum; // level 0 of the next step's input
+layout(rgba32f, binding = 2) uniform writeonly image2D uHalfOut;   // half resolution: (1/pi) sum, a = covered
 
 uniform float uB;             // clamp bound b (1/m^2), > 0
 uniform float uR;             // 1/sqrt(b) (m)
@@ -25,6 +30,7 @@ uniform float uSolidAngle;    // refine above this (sr)
 uniform float uDiscAngle;     // refine discontinuous samples above this (sr)
 uniform int uMaxVisited;      // per-pixel cap on samples visited (bounded frame time)
 uniform int uSlot;            // counter slot of this step
+uniform int uReceiverLevel;   // 0: every pixel is a receiver; 1: every 2x2 block (half resolution)
 
 const int kStack = 64; // >= 1 + 3 * 11 (12 levels at most)
 
@@ -32,13 +38,15 @@ uint packNode(int level, ivec2 t) { return uint(level) | (uint(t.x) << 4) | (uin
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    ivec2 size = ivec2(gFrame.viewport.xy);
+    int rl = uReceiverLevel;
+    // Image extent at the receiver level: ceil(W / 2^rl) x ceil(H / 2^rl).
+    ivec2 size = (ivec2(gFrame.viewport.xy) + (1 << rl) - 1) >> rl;
     vec4 stats = vec4(0.0);
     vec3 comp = vec3(0.0);
-    vec4 self = all(lessThan(p, size)) ? texelFetch(uGeo, p, 0) : vec4(0.0);
+    vec4 self = all(lessThan(p, size)) ? texelFetch(uGeo, p, rl) : vec4(0.0);
     if (self.w > 0.0) {
         vec3 y = self.xyz;
-        vec3 ny = texelFetch(uNormal, p, 0).xyz;
+        vec3 ny = texelFetch(uNormal, p, rl).xyz;
         float dist = length(gFrame.cameraPos.xyz - y);
         // r_s in pixels, clamped to the image (camera-near surfaces, digest 002.6 item 7).
         float rs = uR / max(uTanHalfFov * dist, 1e-6) * 0.5 * gFrame.viewport.y;
@@ -46,7 +54,7 @@ void main() {
         int coarse = uLevels - 1;
         float scale = float(1 << coarse);
         ivec2 cs = textureSize(uGeo, coarse);
-        vec2 pc = vec2(p) + 0.5;
+        vec2 pc = (vec2(p) + 0.5) * float(1 << rl); // receiver centre in full-resolution pixels
         ivec2 lo = max(ivec2(floor((pc - rs) / scale)), ivec2(0));
         ivec2 hi = min(ivec2(floor((pc + rs) / scale)), cs - 1);
         uint stack[kStack];
@@ -68,7 +76,10 @@ void main() {
                     vec4 g = texelFetch(uGeo, t, level);
                     float area = g.w;
                     if (!(area > 0.0)) continue;
-                    bool containsSelf = all(equal(p >> level, t));
+                    // Nodes at or above the receiver's level that contain it. A half-resolution
+                    // receiver's own four pixels (level 0) are ordinary samples: they are distinct
+                    // surfaces points at d > 0 from the block mean (d = 0 is skipped below).
+                    bool containsSelf = level >= rl && all(equal((p << rl) >> level, t));
                     if (level == 0 && containsSelf) continue; // the pixel itself (d = 0)
                     vec3 v = g.xyz - y;
                     float d2 = dot(v, v);
@@ -100,12 +111,21 @@ void main() {
                     if (gr > 0.0) sum += gr * area * texelFetch(uIllum, t, level).rgb;
                 }
             }
-        vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-        comp = max(sanitize(albedo * kInvPi * sum), vec3(0.0));
+        if (rl == 0) {
+            vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
+            comp = max(sanitize(albedo * kInvPi * sum), vec3(0.0));
+            vec4 current = imageLoad(uIndirect, p);
+            imageStore(uIndirect, p, vec4(max(sanitize(current.rgb), vec3(0.0)) + comp, current.a));
+        } else {
+            // The albedo varies inside a block: the upsampling applies each pixel's own.
+            comp = max(sanitize(kInvPi * sum), vec3(0.0));
+        }
         stats = vec4((comp.r + comp.g + comp.b) / 3.0, float(visited), float(visited), 1.0);
-        vec4 current = imageLoad(uIndirect, p);
-        imageStore(uIndirect, p, vec4(max(sanitize(current.rgb), vec3(0.0)) + comp, current.a));
     }
-    if (all(lessThan(p, imageSize(uNextIllum)))) imageStore(uNextIllum, p, vec4(comp, self.w > 0.0 ? 1.0 : 0.0));
+    if (rl == 0) {
+        if (all(lessThan(p, imageSize(uNextIllum)))) imageStore(uNextIllum, p, vec4(comp, self.w > 0.0 ? 1.0 : 0.0));
+    } else if (all(lessThan(p, imageSize(uHalfOut)))) {
+        imageStore(uHalfOut, p, vec4(comp, self.w > 0.0 ? 1.0 : 0.0));
+    }
     ssbcGroupSum(stats, uSlot);
 }
