@@ -28,6 +28,7 @@ const ui = {
     fps: $('fps'),
     statsLine: $('stats-line'),
     passes: $('passes'),
+    plan: $('plan'),
 };
 const ctx = ui.canvas.getContext('2d');
 
@@ -272,6 +273,22 @@ function showStats(header, stats, frameBytes) {
         const li = document.createElement('li');
         li.append(Object.assign(document.createElement('span'), { textContent: p.name }),
             Object.assign(document.createElement('span'), { textContent: `${formatMs(p.gpu_ms)} ms` }));
+        return li;
+    }));
+    showPlan(stats?.plan);
+}
+
+// The effect plan (frame parameter `effects`): each effect on or off, forced or decided, with the
+// server's reason as the tooltip.
+function showPlan(plan) {
+    const decisions = plan && plan.mode !== 'manual' ? plan.decisions ?? [] : [];
+    ui.plan.replaceChildren(...decisions.map((d) => {
+        const li = document.createElement('li');
+        li.title = d.reason ?? '';
+        li.append(Object.assign(document.createElement('span'), { textContent: d.effect }),
+            Object.assign(document.createElement('span'), {
+                textContent: `${d.enabled ? 'on' : 'off'}${d.forced ? ' (forced)' : ''}`,
+            }));
         return li;
     }));
 }

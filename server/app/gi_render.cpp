@@ -14,6 +14,7 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "encode/Encoder.h"
+#include "analysis/EffectPlan.h"
 #include "analysis/Metrics.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
@@ -43,6 +44,9 @@ Renders a scene with a global-illumination technique and writes the image and pe
   --list-techniques     list the techniques and exit
   --list-params TECH    list the frame parameters and TECH's parameters and exit
   --list-scenes         list the built-in scenes and exit
+  --explain             print the effect plan (which effects run, why, measured values, estimated
+                        cost; docs/effects.md); exits after it unless --out, --stats or --compare is
+                        given. --param effects=auto applies the plan, effect_NAME=on|off forces one
 
 Ground truth and error (CPU reference renderer, Embree):
   --reference MODE      render with the reference instead of GL: direct, one-bounce-unoccluded,
@@ -88,6 +92,7 @@ struct Options {
     std::string cacheDir;
     bool useCache = true;
     std::string compare;
+    bool explain = false;
 };
 
 std::string defaultCacheDir() {
@@ -209,6 +214,7 @@ int run(int argc, char** argv) {
         else if (a == "--gl") o.gl = value(i);
         else if (a == "--no-timer-queries") o.timerQueries = false;
         else if (a == "--quiet") o.quiet = true;
+        else if (a == "--explain") o.explain = true;
         else if (a == "--reference") o.referenceMode = value(i);
         else if (a == "--spp") o.reference.spp = parseInt("--spp", value(i), 1, 1000000);
         else if (a == "--time-budget") {
@@ -261,6 +267,21 @@ int run(int argc, char** argv) {
     state.width = o.width;
     state.height = o.height;
 
+    // Effect planning runs before GL (it needs only the scene) and never for a reference, which is
+    // the ground truth the plan is measured against.
+    const gis::ParamSet& fp = state.frameParams;
+    bool planning = o.explain || fp.getEnum("effects") == "auto";
+    for (const char* e : {"effect_direct", "effect_indirect", "effect_occlusion", "effect_compensation"})
+        planning = planning || fp.getEnum(e) != "auto";
+    if (planning && o.referenceMode.empty()) {
+        const gis::EffectPlan plan = gis::planEffects(*scene, state);
+        gis::applyEffectPlan(state, plan);
+        if (o.explain) {
+            std::cout << gis::describe(plan);
+            if (o.out.empty() && o.stats.empty() && o.compare.empty()) return 0;
+        }
+    }
+
     if (!o.referenceMode.empty()) {
         nlohmann::json summary = renderReference(o, *scene, state);
         if (!o.stats.empty()) writeText(o.stats, summary.dump(2));
@@ -307,12 +328,15 @@ int run(int argc, char** argv) {
     }
     if (!o.out.empty()) {
         gis::writeImageFile(o.out, frame.width, frame.height, frame.rgba8, frame.linear,
-                            {{"gi:technique", o.technique}, {"gi:scene", o.scene}, {"gi:params", summary["params"].dump()}});
+                            {{"gi:technique", state.technique},
+                             {"gi:scene", o.scene},
+                             {"gi:params", summary["params"].dump()}});
     }
     if (!o.stats.empty()) writeText(o.stats, summary.dump(2));
     if (!o.quiet) {
-        std::string line = "gi-render: " + o.technique + " " + std::to_string(o.width) + "x" + std::to_string(o.height) +
-                           " frame " + std::to_string(summary["frame_ms"].get<double>()) + " ms (median of " +
+        std::string line = "gi-render: " + state.technique + " " + std::to_string(o.width) + "x" +
+                           std::to_string(o.height) + " frame " +
+                           std::to_string(summary["frame_ms"].get<double>()) + " ms (median of " +
                            std::to_string(o.frames) + ")";
         for (const auto& p : summary["passes"])
             line += "\n  " + p["name"].get<std::string>() + ": " + std::to_string(p["gpu_ms"].get<double>()) + " ms";

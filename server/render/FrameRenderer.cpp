@@ -323,6 +323,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
                  {"passes", std::move(passJson)},
                  {"counts", std::move(countJson)},
                  {"params", std::move(params)}};
+    if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     return out;
 }
 

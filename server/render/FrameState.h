@@ -20,6 +20,9 @@ struct FrameState {
     std::string technique = "rsm_gather";
     ParamSet frameParams;     ///< frameParamTable(): exposure, tone map, shadow and RSM sizes
     ParamSet techniqueParams; ///< the technique's own table
+    /// The effect plan applied to this state (analysis/EffectPlan.h), copied into the stats as `plan`;
+    /// null when none was made. The renderer only reports it.
+    nlohmann::json plan;
 };
 
 } // namespace gis

@@ -19,6 +19,9 @@ constexpr glm::vec3 kWhite{0.725f, 0.71f, 0.68f};
 constexpr glm::vec3 kRed{0.63f, 0.065f, 0.05f};
 constexpr glm::vec3 kGreen{0.14f, 0.45f, 0.091f};
 constexpr glm::vec3 kGrey{0.8f};
+/// Albedo of the black walls: black velvet (about 0.5%), not exactly 0, so the bounce is negligible
+/// rather than absent.
+constexpr glm::vec3 kBlack{0.005f};
 
 int addMaterial(Scene& scene, const std::string& name, const glm::vec3& albedo) {
     scene.materials.push_back(Material{.name = name, .baseColor = glm::vec4(albedo, 1.0f)});
@@ -147,13 +150,16 @@ Mesh makeBumpySphere(const std::string& name, int material, const glm::vec3& bas
     return mesh;
 }
 
-enum class CornellContents { Boxes, Empty, Dense };
+enum class CornellContents { Boxes, Empty, Dense, Black };
 
 Scene makeCornell(CornellContents contents) {
     Scene scene;
-    const int white = addMaterial(scene, "white", kWhite);
-    const int red = addMaterial(scene, "red", kRed);
-    const int green = addMaterial(scene, "green", kGreen);
+    // The black variant is the empty box with every wall black: the light still lights the view, but
+    // nothing bounces it back (the diffuse-bounce decision's negative case).
+    const bool black = contents == CornellContents::Black;
+    const int white = addMaterial(scene, "white", black ? kBlack : kWhite);
+    const int red = addMaterial(scene, "red", black ? kBlack : kRed);
+    const int green = addMaterial(scene, "green", black ? kBlack : kGreen);
     const glm::vec3 x(2, 0, 0), y(0, 2, 0), z(0, 0, 2);
     scene.meshes.push_back(makeGrid("floor", white, {-1, 0, -1}, z, x));
     scene.meshes.push_back(makeGrid("ceiling", white, {-1, 2, -1}, x, z));
@@ -187,7 +193,7 @@ Scene makeCrease() {
 } // namespace
 
 std::vector<std::string> builtinSceneNames() {
-    return {"cornell", "cornell-empty", "cornell-dense", "crease"};
+    return {"cornell", "cornell-empty", "cornell-dense", "crease", "cornell-black"};
 }
 
 Scene makeBuiltinScene(const std::string& name) {
@@ -198,6 +204,8 @@ Scene makeBuiltinScene(const std::string& name) {
         scene = makeCornell(CornellContents::Empty);
     else if (name == "cornell-dense")
         scene = makeCornell(CornellContents::Dense);
+    else if (name == "cornell-black")
+        scene = makeCornell(CornellContents::Black);
     else if (name == "crease")
         scene = makeCrease();
     else {

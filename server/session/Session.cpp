@@ -1,5 +1,6 @@
 #include "session/Session.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/Error.h"
@@ -10,14 +11,21 @@
 #include "render/FrameParams.h"
 #include "render/FrameRenderer.h"
 #include "scene/SceneLoader.h"
+#if GIS_HAVE_EFFECTS
+#include "analysis/EffectPlan.h"
+#endif
 
 namespace gis {
 namespace {
 
 constexpr float kDegToRad = 0.017453292519943295f;
 
-glm::vec3 vec3From(const nlohmann::json& a) { return {a[0].get<float>(), a[1].get<float>(), a[2].get<float>()}; }
-nlohmann::json toJson(glm::vec3 v) { return {v.x, v.y, v.z}; }
+glm::vec3 vec3From(const nlohmann::json& a) {
+    return {a[0].get<float>(), a[1].get<float>(), a[2].get<float>()};
+}
+nlohmann::json toJson(glm::vec3 v) {
+    return {v.x, v.y, v.z};
+}
 
 nlohmann::json techniquesJson() {
     nlohmann::json list = nlohmann::json::array();
@@ -31,6 +39,42 @@ nlohmann::json techniquesJson() {
 
 } // namespace
 
+#if GIS_HAVE_EFFECTS
+namespace {
+bool wantsEffectPlan(const FrameState& state) {
+    const ParamSet& fp = state.frameParams;
+    if (fp.has("effects") && fp.getEnum("effects") != "manual") return true;
+    for (const char* e : {"effect_direct", "effect_indirect", "effect_occlusion", "effect_compensation"})
+        if (fp.has(e) && fp.getEnum(e) != "auto") return true;
+    return false;
+}
+
+// Camera and light rounded to a tenth of the scene's size and about 6 degrees: moving less than that
+// keeps the plan (it is an estimate from a few thousand rays anyway).
+std::string effectPlanKey(const Scene& scene, const FrameState& s) {
+    const float step = std::max(glm::length(scene.bounds.max - scene.bounds.min), 1e-3f) * 0.1f;
+    auto q = [](glm::vec3 v, float unit) {
+        return nlohmann::json::array(
+            {std::lround(v.x / unit), std::lround(v.y / unit), std::lround(v.z / unit)});
+    };
+    auto dir = [](glm::vec3 v) {
+        const float l = glm::length(v);
+        return l > 1e-12f ? v / l : glm::vec3(0.0f, 0.0f, -1.0f);
+    };
+    return nlohmann::json{
+        {"scene", scene.name},
+        {"technique", s.technique},
+        {"params", s.techniqueParams.toJson()},
+        {"frame", s.frameParams.toJson()},
+        {"camera", {q(s.camera.position, step), q(dir(s.camera.target - s.camera.position), 0.1f)}},
+        {"light",
+         {q(s.light.position, step), q(dir(s.light.direction), 0.1f), s.lightEnabled, s.light.intensity,
+          s.light.outerConeAngle}}}
+        .dump();
+}
+} // namespace
+#endif
+
 Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes, Wake wake)
     : mId(std::move(id)), mConfig(std::move(config)), mScenes(std::move(scenes)), mWake(std::move(wake)) {
     mScene = mScenes->get(mConfig.scene);
@@ -40,7 +84,9 @@ Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCach
     mDesired.height = mConfig.height;
 }
 
-Session::~Session() { stop(); }
+Session::~Session() {
+    stop();
+}
 
 nlohmann::json Session::stateJson() const {
     const Camera& c = mDesired.camera;
@@ -104,7 +150,9 @@ void Session::queueText(const nlohmann::json& msg) {
     if (mWake) mWake();
 }
 
-void Session::queueError(const ProtocolError& error) { queueText(errorMessage(error)); }
+void Session::queueError(const ProtocolError& error) {
+    queueText(errorMessage(error));
+}
 
 bool Session::popOutgoing(OutgoingMessage& out) {
     std::lock_guard lock(mMutex);
@@ -138,8 +186,8 @@ void Session::apply(const nlohmann::json& msg) {
     if (type == "hello") {
         if (msg["protocol"].get<int>() != kProtocolVersion)
             throw ProtocolError{"protocol_mismatch",
-                                "this server speaks protocol " + std::to_string(kProtocolVersion) + ", the client " +
-                                    std::to_string(msg["protocol"].get<int>()),
+                                "this server speaks protocol " + std::to_string(kProtocolVersion) +
+                                    ", the client " + std::to_string(msg["protocol"].get<int>()),
                                 "/protocol", type};
         return;
     }
@@ -155,7 +203,8 @@ void Session::apply(const nlohmann::json& msg) {
         if (msg.contains("fov_deg")) c.yfovRadians = msg["fov_deg"].get<float>() * kDegToRad;
         if (glm::length(c.target - c.position) < 1e-6f)
             throw ProtocolError{"invalid_message", "camera position and target must differ", "/target", type};
-        if (glm::length(c.up) < 1e-6f) throw ProtocolError{"invalid_message", "camera up must not be zero", "/up", type};
+        if (glm::length(c.up) < 1e-6f)
+            throw ProtocolError{"invalid_message", "camera up must not be zero", "/up", type};
         mDesired.camera = c;
         mDirty = true;
     } else if (type == "light") {
@@ -165,7 +214,8 @@ void Session::apply(const nlohmann::json& msg) {
             glm::vec3 d = vec3From(msg["direction"]);
             float len = glm::length(d);
             if (!(len > 1e-6f))
-                throw ProtocolError{"invalid_message", "light direction must not be zero", "/direction", type};
+                throw ProtocolError{"invalid_message", "light direction must not be zero", "/direction",
+                                    type};
             l.direction = d / len;
         }
         if (msg.contains("intensity")) l.intensity = msg["intensity"].get<float>();
@@ -202,8 +252,8 @@ void Session::apply(const nlohmann::json& msg) {
         bool known = name == mConfig.scene;
         for (const auto& n : builtinSceneNames()) known = known || name == "builtin:" + n;
         if (!known)
-            throw ProtocolError{"unknown_scene", "unknown scene '" + name + "': pick one from welcome.scenes", "/name",
-                                type};
+            throw ProtocolError{"unknown_scene", "unknown scene '" + name + "': pick one from welcome.scenes",
+                                "/name", type};
         mSceneRequest = name;
         mDirty = true;
     }
@@ -225,6 +275,10 @@ void Session::workerMain() {
     }
     std::uint32_t frameId = 0;
     std::shared_ptr<const Scene> scene = mScene;
+#if GIS_HAVE_EFFECTS
+    std::string planKey;
+    EffectPlan plan;
+#endif
     while (true) {
         FrameState state;
         std::string sceneRequest;
@@ -260,6 +314,18 @@ void Session::workerMain() {
             std::lock_guard lock(mMutex);
             state = mDesired;
         }
+#if GIS_HAVE_EFFECTS
+        // The effect plan (frame parameters `effects`, `effect_*`): measured again only when the
+        // scene, the parameters, or the camera or light change materially, never every frame.
+        if (wantsEffectPlan(state)) {
+            const std::string key = effectPlanKey(*scene, state);
+            if (key != planKey) {
+                plan = planEffects(*scene, state);
+                planKey = key;
+            }
+            applyEffectPlan(state, plan);
+        }
+#endif
 
         FrameOutput frame;
         try {
@@ -285,7 +351,8 @@ void Session::workerMain() {
         stats["bytes"] = jpeg.size() + kFrameHeaderSize;
         stats["codec"] = "jpeg";
         stats["scene"] = scene->name;
-        std::vector<std::uint8_t> message = makeFrameMessage(frameId, frame.width, frame.height, FrameCodec::Jpeg, jpeg);
+        std::vector<std::uint8_t> message =
+            makeFrameMessage(frameId, frame.width, frame.height, FrameCodec::Jpeg, jpeg);
         {
             std::lock_guard lock(mMutex);
             // Frames bypass the text cap: at most one is ever queued (one in flight).

@@ -282,6 +282,13 @@ test('gi-server streams frames over the gi-stream WebSocket', async (t) => {
         assert.equal(frame.stats.params?.vpl_grid, 8, 'stats.params.vpl_grid is 8');
         assert.equal(frame.stats.counts?.vpl_count, 64, 'stats.counts.vpl_count is 8^2');
         ack(frame);
+        // The effect plan: asked for through a frame parameter, reported in the stats.
+        send({ type: 'params', values: { effects: 'auto' } });
+        const planned = await receiveFrame('frame after effects=auto');
+        assert.equal(planned.stats.plan?.mode, 'auto', 'stats.plan.mode is auto');
+        assert.ok(Array.isArray(planned.stats.plan?.decisions) && planned.stats.plan.decisions.length >= 4,
+                  'stats.plan lists the decisions');
+        ack(planned);
         send({ type: 'ping', t: 42.5 });
         const pong = await inbox.nextOfType('pong', 'pong');
         assert.equal(pong.t, 42.5, 'pong echoes t');

@@ -23,8 +23,21 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
 }
 
 TEST(BuiltinScenes, NamesList) {
-    EXPECT_EQ(builtinSceneNames(),
-              (std::vector<std::string>{"cornell", "cornell-empty", "cornell-dense", "crease"}));
+    EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{"cornell", "cornell-empty", "cornell-dense",
+                                                             "crease", "cornell-black"}));
+}
+
+TEST(BuiltinScenes, CornellBlackIsTheEmptyBoxWithDarkWalls) {
+    const Scene black = makeBuiltinScene("cornell-black");
+    const Scene empty = makeBuiltinScene("cornell-empty");
+    ASSERT_EQ(black.meshes.size(), empty.meshes.size());
+    for (std::size_t i = 0; i < black.meshes.size(); ++i)
+        EXPECT_EQ(black.meshes[i].positions, empty.meshes[i].positions);
+    for (const Material& m : black.materials) {
+        EXPECT_GT(m.baseColor.r, 0.0f) << m.name; // dark, not absent
+        EXPECT_LE(glm::max(m.baseColor.r, glm::max(m.baseColor.g, m.baseColor.b)), 0.01f) << m.name;
+    }
+    EXPECT_EQ(black.lights.size(), 1u);
 }
 
 TEST(BuiltinScenes, EachBuildsAndValidates) {

@@ -1,0 +1,393 @@
+#include "analysis/EffectPlan.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "gi/Technique.h"
+#include "reference/RayScene.h"
+#include "reference/Sampling.h"
+#include "render/FrameRenderer.h"
+
+namespace gis {
+namespace {
+
+using reference::kInvPi;
+using reference::kPi;
+using reference::RayScene;
+using reference::Rng;
+using reference::SurfaceHit;
+
+// Frame-time model on llvmpipe (2 shared cores), fitted to glFinish pass timings of `ssbc` with
+// vpl_shadows at 256x256 (docs/effects.md): the gather per VPL-receiver pair (docs/ssbc.md, 512^2),
+// the visibility lookups per pair plus each VPL's cube shadow map per thousand triangles
+// (`vpl_shadows` pass), compensation per pixel (`ssbc_mips` + `ssbc_integrate_1`), and the light's
+// shadow map, RSM and direct passes per pixel. Only the size matters: decisions never read it.
+constexpr double kGatherNsPerPair = 1.6;
+constexpr double kShadowNsPerPair = 4.2;
+constexpr double kShadowMsPerVplPerKTri = 0.3;
+constexpr double kCompensationNsPerPixel = 1250.0;
+constexpr double kDirectNsPerPixel = 120.0;
+
+glm::vec3 facing(const glm::vec3& n, const glm::vec3& towards) {
+    return glm::dot(n, towards) < 0.0f ? -n : n;
+}
+
+bool finiteVec(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+double sumSq(const glm::dvec3& v) {
+    return glm::dot(v, v);
+}
+
+/// A point the transport reads: position, normal on the shaded side, geometric normal on that side.
+struct Point {
+    glm::vec3 p{0.0f}, n{0.0f}, ng{0.0f}, albedo{0.0f};
+};
+
+std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, format, a, b, c);
+    return buf;
+}
+
+/// The forced state of one effect from its frame parameter; "auto" when the table lacks it.
+std::string forcedMode(const FrameState& state, const std::string& effect) {
+    const std::string name = "effect_" + effect;
+    return state.frameParams.has(name) ? state.frameParams.getEnum(name) : "auto";
+}
+
+} // namespace
+
+const EffectDecision* EffectPlan::find(std::string_view effect) const {
+    for (const auto& d : decisions)
+        if (d.effect == effect) return &d;
+    return nullptr;
+}
+
+bool EffectPlan::enabled(std::string_view effect) const {
+    const EffectDecision* d = find(effect);
+    return d == nullptr || d->enabled;
+}
+
+EffectPlan planEffects(const Scene& scene, const FrameState& state, const EffectPlanOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    EffectPlan plan;
+    plan.mode = state.frameParams.has("effects") ? state.frameParams.getEnum("effects") : "manual";
+
+    const RayScene rays(scene);
+    const float eps = rays.epsilon();
+    const Light& light = state.light;
+    const bool lightOn = state.lightEnabled && light.intensity > 0.0f && std::isfinite(light.intensity) &&
+                         finiteVec(light.position) && light.type != LightType::Directional;
+    const glm::vec3 axis =
+        glm::length(light.direction) > 0.0f ? glm::normalize(light.direction) : glm::vec3(0.0f, -1.0f, 0.0f);
+    const glm::vec3 power =
+        lightOn ? light.intensity * glm::max(light.color, glm::vec3(0.0f)) : glm::vec3(0.0f);
+    const bool spot = light.type == LightType::Spot;
+    const float cosOuter = spot ? std::cos(light.outerConeAngle) : -1.0f;
+    const float cosInner = spot ? std::cos(light.innerConeAngle) : -1.0f;
+    auto spotFactor = [&](const glm::vec3& dirFromLight) {
+        if (!spot) return 1.0f;
+        const float t = std::clamp(
+            (glm::dot(axis, dirFromLight) - cosOuter) / std::max(cosInner - cosOuter, 1e-4f), 0.0f, 1.0f);
+        return t * t; // shaders/common.glsl spotFactor()
+    };
+    // Point-kernel singularity: receivers next to a VPL would dominate a few-hundred-sample estimate,
+    // so distances are floored at 2% of the scene radius (a G bound far above any clamp_b in use).
+    const float minDist = std::max(0.02f * scene.bounds.radius(), 1e-4f);
+
+    // 1. Receivers: one jittered sample per cell of a grid over the image, through the pipeline's own
+    //    projection (as the reference renderer), so they see exactly the GL frustum.
+    const int w = std::max(state.width, 1), h = std::max(state.height, 1);
+    const double aspect = static_cast<double>(w) / h;
+    const int gx = std::max(1, static_cast<int>(std::lround(std::sqrt(options.viewSamples * aspect))));
+    const int gy = std::max(1, options.viewSamples / gx);
+    const glm::dmat4 invViewProj =
+        glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
+    std::vector<Point> receivers;
+    receivers.reserve(static_cast<size_t>(gx) * gy);
+    std::vector<glm::vec3> emission;
+    for (int j = 0; j < gy; ++j)
+        for (int i = 0; i < gx; ++i) {
+            Rng rng(options.seed, static_cast<std::uint64_t>(j * gx + i), 0);
+            const double nx = 2.0 * (i + rng.uniform()) / gx - 1.0;
+            const double ny = 1.0 - 2.0 * (j + rng.uniform()) / gy;
+            glm::dvec4 nearP = invViewProj * glm::dvec4(nx, ny, -1.0, 1.0);
+            glm::dvec4 farP = invViewProj * glm::dvec4(nx, ny, 1.0, 1.0);
+            if (!(std::abs(nearP.w) > 1e-300) || !(std::abs(farP.w) > 1e-300)) continue;
+            const glm::vec3 o(glm::dvec3(nearP) / nearP.w), f(glm::dvec3(farP) / farP.w);
+            const float len = glm::length(f - o);
+            if (!(len > 0.0f)) continue;
+            const glm::vec3 dir = (f - o) / len;
+            SurfaceHit hit;
+            ++plan.rays;
+            if (!rays.intersect(o, dir, 0.0f, len, hit)) continue;
+            receivers.push_back({hit.position, facing(hit.shadingNormal, -dir),
+                                 facing(hit.geometricNormal, -dir), hit.albedo});
+            emission.push_back(hit.emission);
+        }
+    plan.receivers = static_cast<int>(receivers.size());
+
+    // 2. Light paths: stratified directions over the spot cone (uniform in solid angle), each hit a
+    //    VPL carrying flux rho * I c f(dir) * (cone solid angle / N), oriented towards the light (the
+    //    RSM's rule).
+    struct Vpl {
+        Point at;
+        glm::vec3 flux{0.0f};
+    };
+    std::vector<Vpl> vpls;
+    if (lightOn) {
+        const int n = std::max(options.vplSamples, 1);
+        const int side = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(n))));
+        const float coneSolidAngle = 2.0f * kPi * (1.0f - cosOuter);
+        const float perSample = coneSolidAngle / static_cast<float>(side * side);
+        glm::vec3 t, b;
+        reference::basisAround(axis, t, b);
+        for (int j = 0; j < side; ++j)
+            for (int i = 0; i < side; ++i) {
+                Rng rng(options.seed + 1, static_cast<std::uint64_t>(j * side + i), 1);
+                const float cosTheta =
+                    1.0f - (1.0f - cosOuter) * (static_cast<float>(j) + rng.uniform()) / side;
+                const float phi = 2.0f * kPi * (static_cast<float>(i) + rng.uniform()) / side;
+                const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
+                const glm::vec3 dir = cosTheta * axis + sinTheta * (std::cos(phi) * t + std::sin(phi) * b);
+                SurfaceHit hit;
+                ++plan.rays;
+                if (!rays.intersect(light.position, dir, 0.0f, std::numeric_limits<float>::infinity(), hit))
+                    continue;
+                const glm::vec3 flux = hit.albedo * power * spotFactor(dir) * perSample;
+                Vpl v{{hit.position, facing(hit.shadingNormal, -dir), facing(hit.geometricNormal, -dir),
+                       hit.albedo},
+                      flux};
+                vpls.push_back(v);
+            }
+    }
+    plan.vpls = static_cast<int>(vpls.size());
+
+    // 3. Per receiver: direct (hard shadow), one bounce without and with x-y visibility, and the part of
+    //    the unoccluded bounce the clamp min(G, b) removes.
+    const bool hasClamp = state.techniqueParams.has("clamp_b");
+    const double clampB = hasClamp ? state.techniqueParams.getFloat("clamp_b") : 0.0;
+    double truthSq = 0.0, indirectSq = 0.0, occlusionSq = 0.0, compensationSq = 0.0;
+    double pairsWeighted = 0.0, pairsOccludedWeighted = 0.0;
+    int lit = 0, reached = 0;
+    for (size_t r = 0; r < receivers.size(); ++r) {
+        const Point& x = receivers[r];
+        glm::dvec3 direct(emission[r]);
+        if (lightOn) {
+            const glm::vec3 d = light.position - x.p;
+            const float dist = glm::length(d);
+            if (dist > 1e-6f) {
+                const glm::vec3 l = d / dist;
+                const float cosX = glm::dot(x.n, l);
+                const float s = spotFactor(-l);
+                if (cosX > 0.0f && s > 0.0f) {
+                    const glm::vec3 origin = x.p + facing(x.ng, l) * eps;
+                    ++plan.rays;
+                    if (!rays.occluded(origin, l, 0.0f, glm::length(light.position - origin) - eps)) {
+                        direct += glm::dvec3(x.albedo * kInvPi * power * (s * cosX / (dist * dist)));
+                        ++lit;
+                    }
+                }
+            }
+        }
+        glm::dvec3 unoccluded(0.0), occluded(0.0), removed(0.0);
+        for (const Vpl& v : vpls) {
+            const glm::vec3 d = v.at.p - x.p;
+            const float dist = glm::length(d);
+            if (!(dist > 1e-6f)) continue;
+            const glm::vec3 l = d / dist;
+            const float cosX = glm::dot(x.n, l), cosY = -glm::dot(v.at.n, l);
+            if (!(cosX > 0.0f) || !(cosY > 0.0f)) continue;
+            const float dd = std::max(dist, minDist);
+            const double g = static_cast<double>(cosX) * cosY / (static_cast<double>(dd) * dd);
+            const glm::dvec3 e = glm::dvec3(x.albedo * kInvPi * v.flux * kInvPi) * g;
+            unoccluded += e;
+            if (clampB > 0.0 && g > clampB) removed += e * ((g - clampB) / g);
+            const glm::vec3 origin = x.p + facing(x.ng, l) * eps;
+            const float tfar = glm::length(v.at.p - origin) - 2.0f * eps;
+            ++plan.rays;
+            const bool blocked = tfar > eps && rays.occluded(origin, l, 0.0f, tfar);
+            if (!blocked) occluded += e;
+            const double weight = e.x + e.y + e.z;
+            pairsWeighted += weight;
+            if (blocked) pairsOccludedWeighted += weight;
+        }
+        if (glm::dot(glm::dvec3(unoccluded), glm::dvec3(1.0)) > 0.0 ||
+            glm::dot(direct, glm::dvec3(1.0)) > 0.0)
+            ++reached;
+        truthSq += sumSq(direct + occluded);
+        indirectSq += sumSq(occluded);
+        occlusionSq += sumSq(unoccluded - occluded);
+        compensationSq += sumSq(removed);
+    }
+    const double truthNorm = std::sqrt(truthSq);
+    auto relative = [&](double sq) { return truthNorm > 0.0 ? std::sqrt(sq) / truthNorm : 0.0; };
+
+    // Cost model inputs.
+    const double pixels = static_cast<double>(w) * h;
+    const bool hasGrid = state.techniqueParams.has("vpl_grid");
+    const double vplCount = hasGrid ? std::pow(state.techniqueParams.getInt("vpl_grid"), 2.0) : 256.0;
+    const double gatherMs = vplCount * pixels * kGatherNsPerPair * 1e-6;
+    const double triangles = static_cast<double>(scene.triangleCount());
+
+    auto decide = [&](EffectDecision d, bool measuredOn) {
+        const std::string mode = forcedMode(state, d.effect);
+        d.forced = mode != "auto";
+        d.enabled = d.forced ? mode == "on" : measuredOn;
+        d.applied = d.forced || plan.mode == "auto";
+        if (d.forced) d.reason = "forced " + mode + " (measured: " + d.reason + ")";
+        plan.decisions.push_back(std::move(d));
+    };
+
+    // Direct: off only when the light reaches no receiver, directly or after one bounce.
+    {
+        EffectDecision d{.effect = "direct"};
+        d.measurement = "fraction of view samples the light reaches (directly or by one bounce)";
+        d.value =
+            receivers.empty() ? 0.0 : static_cast<double>(reached) / static_cast<double>(receivers.size());
+        d.threshold = 0.0;
+        d.costMs = pixels * kDirectNsPerPixel * 1e-6;
+        if (!lightOn)
+            d.reason = "the light is off or has no intensity";
+        else if (receivers.empty())
+            d.reason = "no surface is in view";
+        else
+            d.reason = fmt("the light reaches %.1f%% of the view (%.1f%% directly)", 100.0 * d.value,
+                           100.0 * lit / static_cast<double>(receivers.size()));
+        const bool on = lightOn && d.value > d.threshold;
+        decide(std::move(d), on);
+    }
+    const bool directOn = plan.decisions.back().enabled;
+
+    // Diffuse bounce: dropping it removes the whole occluded one-bounce term from the image.
+    {
+        EffectDecision d{.effect = "indirect"};
+        d.measurement = "estimated relative RMSE of dropping the bounce";
+        d.value = relative(indirectSq);
+        d.threshold = options.indirectThreshold;
+        d.available = state.technique != "none";
+        d.costMs = d.available ? gatherMs : 0.0;
+        if (!directOn)
+            d.reason = "the light is off";
+        else if (vpls.empty())
+            d.reason = "the light hits no surface";
+        else
+            d.reason = fmt("the bounce is %.2f%% of the image (relative RMSE; threshold %.2f%%)",
+                           100.0 * d.value, 100.0 * d.threshold);
+        const bool on = directOn && d.value > d.threshold;
+        decide(std::move(d), on);
+    }
+    const bool indirectOn = plan.decisions.back().enabled;
+
+    // Indirect occlusion: what x-y visibility changes in the bounce.
+    {
+        EffectDecision d{.effect = "occlusion"};
+        d.measurement = "estimated relative RMSE of ignoring indirect visibility";
+        d.value = relative(occlusionSq);
+        d.threshold = options.occlusionThreshold;
+        d.available = state.techniqueParams.has("vpl_shadows");
+        d.costMs = d.available ? vplCount * pixels * kShadowNsPerPair * 1e-6 +
+                                     vplCount * triangles * 1e-3 * kShadowMsPerVplPerKTri
+                               : 0.0;
+        const double pairFraction = pairsWeighted > 0.0 ? pairsOccludedWeighted / pairsWeighted : 0.0;
+        d.reason = fmt("%.1f%% of the bounce's VPL-receiver transfer is occluded; ignoring it costs %.2f%% "
+                       "(threshold %.2f%%)",
+                       100.0 * pairFraction, 100.0 * d.value, 100.0 * d.threshold);
+        if (!indirectOn) d.reason = "the bounce is off";
+        if (!d.available) d.reason += "; the technique has no vpl_shadows";
+        const bool on = indirectOn && d.available && d.value > d.threshold;
+        decide(std::move(d), on);
+    }
+
+    // Bias compensation: the energy min(G, b) removes from the unoccluded bounce.
+    {
+        EffectDecision d{.effect = "compensation"};
+        d.measurement = "estimated relative RMSE of the energy clamp_b removes";
+        d.value = relative(compensationSq);
+        d.threshold = options.compensationThreshold;
+        d.available = state.techniqueParams.has("ssbc_iterations") && clampB > 0.0;
+        d.costMs = d.available ? pixels * kCompensationNsPerPixel * 1e-6 : 0.0;
+        if (!indirectOn)
+            d.reason = "the bounce is off";
+        else if (!hasClamp)
+            d.reason = "the technique has no clamp_b";
+        else if (!(clampB > 0.0))
+            d.reason = "clamp_b is 0: the kernel removes nothing";
+        else
+            d.reason = fmt("clamp_b %.3g removes %.2f%% (relative RMSE; threshold %.2f%%)", clampB,
+                           100.0 * d.value, 100.0 * d.threshold);
+        const bool on = indirectOn && d.available && d.value > d.threshold;
+        decide(std::move(d), on);
+    }
+
+    plan.analysisMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return plan;
+}
+
+void applyEffectPlan(FrameState& state, const EffectPlan& plan) {
+    for (const EffectDecision& d : plan.decisions) {
+        if (!d.applied) continue;
+        if (d.effect == "direct") {
+            // Forcing it on cannot light a scene without a spotlight; it only keeps the light as it is.
+            if (!d.enabled) state.lightEnabled = false;
+        } else if (d.effect == "indirect") {
+            if (!d.enabled && state.technique != "none") setTechnique(state, "none", "effect_indirect");
+        } else if (d.effect == "occlusion") {
+            if (state.techniqueParams.has("vpl_shadows"))
+                state.techniqueParams.set("vpl_shadows", d.enabled, "effect_occlusion");
+        } else if (d.effect == "compensation") {
+            if (state.techniqueParams.has("ssbc_iterations") && state.techniqueParams.has("clamp_b") &&
+                state.techniqueParams.getFloat("clamp_b") > 0.0) {
+                const int now = state.techniqueParams.getInt("ssbc_iterations");
+                state.techniqueParams.set("ssbc_iterations", d.enabled ? std::max(now, 1) : 0,
+                                          "effect_compensation");
+            }
+        }
+    }
+    state.plan = toJson(plan);
+}
+
+nlohmann::json toJson(const EffectPlan& plan) {
+    nlohmann::json decisions = nlohmann::json::array();
+    for (const auto& d : plan.decisions)
+        decisions.push_back({{"effect", d.effect},
+                             {"enabled", d.enabled},
+                             {"forced", d.forced},
+                             {"applied", d.applied},
+                             {"available", d.available},
+                             {"reason", d.reason},
+                             {"measurement", d.measurement},
+                             {"value", d.value},
+                             {"threshold", d.threshold},
+                             {"cost_ms", d.costMs}});
+    return {{"mode", plan.mode},           {"decisions", std::move(decisions)},
+            {"receivers", plan.receivers}, {"vpls", plan.vpls},
+            {"rays", plan.rays},           {"analysis_ms", plan.analysisMs}};
+}
+
+std::string describe(const EffectPlan& plan) {
+    std::string out = "effect plan (effects=" + plan.mode + "; " + std::to_string(plan.receivers) +
+                      " receivers, " + std::to_string(plan.vpls) + " VPLs, " + std::to_string(plan.rays) +
+                      " rays, " + fmt("%.1f ms", plan.analysisMs) + ")\n";
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-13s %-4s %-7s %-9s %10s %10s %9s  %s\n", "effect", "on", "forced",
+                  "applied", "value", "threshold", "cost ms", "reason");
+    out += line;
+    for (const auto& d : plan.decisions) {
+        std::snprintf(line, sizeof line, "  %-13s %-4s %-7s %-9s %10.5f %10.5f %9.1f  ", d.effect.c_str(),
+                      d.enabled ? "on" : "off", d.forced ? "yes" : "no", d.applied ? "yes" : "no", d.value,
+                      d.threshold, d.costMs);
+        out += line + d.reason + "\n";
+    }
+    return out;
+}
+
+} // namespace gis
