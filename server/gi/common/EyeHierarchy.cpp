@@ -93,7 +93,8 @@ std::vector<EyeLevel> eyeLevelLayout(int width, int height, int coarsestSize, in
 
 EyeHierarchy::EyeHierarchy() {
     // Every pass is a full-screen draw clipped by the viewport to one level: llvmpipe shades
-    // fragments far faster than it runs image load/store compute (measured 3x on the mipmap).
+    // fragments faster than it runs image load/store compute (the mipmap: 36 ms as compute, 23 ms
+    // as fragments at 512^2).
     const auto pass = [](const char* fragment) {
         return gl::Program::build(
             {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, fragment}});
@@ -168,6 +169,27 @@ void EyeHierarchy::uploadUniforms(const ParamSet& params) {
         glm::vec4(params.getFloat("depth_threshold"), params.getFloat("depth_derivative_threshold"),
                   params.getFloat("normal_threshold"), params.getFloat("curvature_threshold"));
     mUbo.upload(0, sizeof u, &u);
+}
+
+void EyeHierarchy::beginIlluminationPass(const FrameInputs& in, bool stencil) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, mIllumFbo.id());
+    glViewport(0, 0, mAtlasWidth, mAtlasHeight);
+    glBindTextureUnit(0, mGeoPosition.id());
+    glBindTextureUnit(1, mGeoNormal.id());
+    bindPixels(in);
+    glBindVertexArray(mEmptyVao.id());
+    if (stencil) {
+        glEnable(GL_STENCIL_TEST);
+        glStencilFunc(GL_EQUAL, 1, 0xFF);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    }
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+}
+
+void EyeHierarchy::endIlluminationPass() const {
+    glDisable(GL_BLEND);
+    glDisable(GL_STENCIL_TEST);
 }
 
 void EyeHierarchy::bindPixels(const FrameInputs& in) const {

@@ -56,13 +56,17 @@ public:
     const std::vector<EyeLevel>& levels() const { return mLevels; }
     int atlasWidth() const { return mAtlasWidth; }
     int atlasHeight() const { return mAtlasHeight; }
-    /// Illumination atlas (RGBA32F, alpha 1 where data) with the receiver stencil attached.
-    const gl::Framebuffer& illuminationTarget() const { return mIllumFbo; }
     const gl::Texture& illumination() const { return mIllumination; }
     const gl::Texture& geoPosition() const { return mGeoPosition; }
     const gl::Texture& geoNormal() const { return mGeoNormal; }
     const gl::Texture& geoAlbedo() const { return mGeoAlbedo; }
     const gl::Texture& flags() const { return mFlags; }
+    /// State every pass that lights receivers shares: the illumination atlas as target, the atlas
+    /// geometry at units 0 and 1, the G-buffer (level 0) via bindPixels, an empty VAO, additive rgb
+    /// with alpha marking data, and (`stencil`) the receiver stencil test. Undone by
+    /// endIlluminationPass().
+    void beginIlluminationPass(const FrameInputs& in, bool stencil) const;
+    void endIlluminationPass() const;
     /// Binds the hierarchy's uniform block at GIS_UBO_EYE (every pass using eye_hierarchy.glsl).
     void bindUniforms() const;
     /// Binds the G-buffer (level 0) at units 8, 9, 10 as eye_pixel.glsl expects.

@@ -107,15 +107,11 @@ TechniqueInfo HierIsr::info() {
 HierIsr::HierIsr() {
     mGather = gl::Program::build(
         {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/hier_isr/gather.frag"}});
-    mEmptyVao = gl::VertexArray::create();
     mStats = gl::Buffer::create(6 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
 }
 
 void HierIsr::resize(int width, int height) {
-    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-    mTarget = gl::Framebuffer::create();
-    mTarget.attachColor(0, mIndirect);
-    mTarget.finish(1, "hier_isr indirect");
+    mIndirect.resize(width, height, "hier_isr indirect");
 }
 
 void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
@@ -129,8 +125,6 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     if (mTree.valid()) {
         const LightCutSettings s = lightCutSettings(mTree.levels(), params.getInt("hier_coarsest"),
                                                     params.getInt("max_depth"), params.getFloat("tau"));
-        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
-        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
         glUseProgram(mGather.id());
         setVplClamp(mGather, params);
         glUniform1i(mGather.uniform("uStartLevel"), s.startLevel);
@@ -139,22 +133,13 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
         glUniform1f(mGather.uniform("uTau"), s.tau);
         mTree.bind();
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, mStats.id());
-        glBindTextureUnit(0, mEye.geoPosition().id());
-        glBindTextureUnit(1, mEye.geoNormal().id());
-        mEye.bindPixels(in);
-        glBindVertexArray(mEmptyVao.id());
-        glEnable(GL_STENCIL_TEST);
-        glStencilFunc(GL_EQUAL, 1, 0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        mEye.beginIlluminationPass(in, true);
         glDrawArrays(GL_TRIANGLES, 0, 3);
-        glDisable(GL_BLEND);
-        glDisable(GL_STENCIL_TEST);
+        mEye.endIlluminationPass();
     }
     timer.end();
 
-    mEye.reconstruct(in, params, true, mTarget, timer);
+    mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);
 
     GLuint stats[6] = {};
@@ -167,7 +152,7 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     counters["nodes_visited_max"] = stats[2];
     counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
     counters["cut_size_max"] = stats[5];
-    mSsbc.apply(in, params, mIndirect, timer, counters);
+    mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
 } // namespace gis

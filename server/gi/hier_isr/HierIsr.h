@@ -59,6 +59,7 @@
 #include <glm/glm.hpp>
 
 #include "gi/Technique.h"
+#include "gi/common/IndirectTarget.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/LightTree.h"
@@ -91,7 +92,7 @@ public:
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
-    const gl::Texture* indirect() const override { return &mIndirect; }
+    const gl::Texture* indirect() const override { return &mIndirect.texture; }
 
     /// Test hook: the light tree of the last frame.
     const LightTree& tree() const { return mTree; }
@@ -101,10 +102,8 @@ private:
     EyeHierarchy mEye;
     BiasCompensation mSsbc;
     gl::Program mGather;
-    gl::VertexArray mEmptyVao;
     gl::Buffer mStats;
-    gl::Texture mIndirect;
-    gl::Framebuffer mTarget;
+    IndirectTarget mIndirect;
 };
 
 } // namespace gis

@@ -58,14 +58,10 @@ Isr::Isr() {
     mGather = gl::Program::build({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
                                   {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}},
                                  {{"GIS_VPL_KERNEL", "GIS_KERNEL_DISK"}});
-    mEmptyVao = gl::VertexArray::create();
 }
 
 void Isr::resize(int width, int height) {
-    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-    mTarget = gl::Framebuffer::create();
-    mTarget.attachColor(0, mIndirect);
-    mTarget.finish(1, "isr indirect");
+    mIndirect.resize(width, height, "isr indirect");
 }
 
 int Isr::select(const ParamSet& params, gl::PassTimer& timer, Counters& counters) {
@@ -129,32 +125,21 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
 
     timer.begin("vpl_gather");
     if (mVplCount > 0) {
-        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
-        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
         glUseProgram(mGather.id());
         setVplClamp(mGather, params);
-        glBindTextureUnit(0, mEye.geoPosition().id());
-        glBindTextureUnit(1, mEye.geoNormal().id());
-        mEye.bindPixels(in);
-        glBindVertexArray(mEmptyVao.id());
-        glEnable(GL_STENCIL_TEST);
-        glStencilFunc(GL_EQUAL, 1, 0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        mEye.beginIlluminationPass(in, true);
         const GLint countLoc = mGather.uniform("uVplCount");
         counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
             glUniform1i(countLoc, count);
             glDrawArrays(GL_TRIANGLES, 0, 3);
         });
-        glDisable(GL_BLEND);
-        glDisable(GL_STENCIL_TEST);
+        mEye.endIlluminationPass();
     }
     timer.end();
 
-    mEye.reconstruct(in, params, true, mTarget, timer);
+    mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);
-    mSsbc.apply(in, params, mIndirect, timer, counters);
+    mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
 std::vector<shader::Vpl> Isr::readVpls() const {

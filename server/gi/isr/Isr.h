@@ -44,6 +44,7 @@
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/IndirectTarget.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/LightTree.h"
@@ -57,7 +58,7 @@ public:
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
-    const gl::Texture* indirect() const override { return &mIndirect; }
+    const gl::Texture* indirect() const override { return &mIndirect.texture; }
 
     /// Test hooks: the light tree, and the VPLs of the last frame read back (synchronises).
     const LightTree& tree() const { return mTree; }
@@ -70,11 +71,9 @@ private:
     EyeHierarchy mEye;
     BiasCompensation mSsbc;
     gl::Program mSelect, mGather;
-    gl::VertexArray mEmptyVao;
     gl::Buffer mVpls, mCounts;
     int mVplCount = 0;
-    gl::Texture mIndirect;
-    gl::Framebuffer mTarget;
+    IndirectTarget mIndirect;
 };
 
 } // namespace gis

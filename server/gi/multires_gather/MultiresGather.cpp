@@ -12,14 +12,10 @@ TechniqueInfo MultiresGather::info() {
 MultiresGather::MultiresGather() {
     mGather = KernelPrograms({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
                               {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}});
-    mEmptyVao = gl::VertexArray::create();
 }
 
 void MultiresGather::resize(int width, int height) {
-    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-    mTarget = gl::Framebuffer::create();
-    mTarget.attachColor(0, mIndirect);
-    mTarget.finish(1, "multires_gather indirect");
+    mIndirect.resize(width, height, "multires_gather indirect");
 }
 
 void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
@@ -29,33 +25,22 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
 
     timer.begin("vpl_gather");
     if (vplCount > 0) {
-        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
-        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
         const gl::Program& gather = mGather.get(vplKernel(params));
         glUseProgram(gather.id());
         glUniform1f(gather.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
         setVplClamp(gather, params);
-        glBindTextureUnit(0, mEye.geoPosition().id());
-        glBindTextureUnit(1, mEye.geoNormal().id());
-        mEye.bindPixels(in);
-        glBindVertexArray(mEmptyVao.id());
-        glEnable(GL_STENCIL_TEST);
-        glStencilFunc(GL_EQUAL, 1, 0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        mEye.beginIlluminationPass(in, true);
         counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
             glUniform1i(gather.uniform("uVplCount"), count);
             glDrawArrays(GL_TRIANGLES, 0, 3);
         });
-        glDisable(GL_BLEND);
-        glDisable(GL_STENCIL_TEST);
+        mEye.endIlluminationPass();
     }
     timer.end();
 
-    mEye.reconstruct(in, params, true, mTarget, timer);
+    mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);
-    mSsbc.apply(in, params, mIndirect, timer, counters);
+    mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
 } // namespace gis

@@ -22,6 +22,7 @@
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/IndirectTarget.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/VplGrid.h"
@@ -35,7 +36,7 @@ public:
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
-    const gl::Texture* indirect() const override { return &mIndirect; }
+    const gl::Texture* indirect() const override { return &mIndirect.texture; }
     EyeHierarchy& hierarchy() { return mEye; }
 
 private:
@@ -43,9 +44,7 @@ private:
     EyeHierarchy mEye;
     KernelPrograms mGather;
     BiasCompensation mSsbc;
-    gl::VertexArray mEmptyVao;
-    gl::Texture mIndirect;
-    gl::Framebuffer mTarget;
+    IndirectTarget mIndirect;
 };
 
 } // namespace gis

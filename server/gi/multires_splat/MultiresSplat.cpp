@@ -74,7 +74,6 @@ MultiresSplat::MultiresSplat() {
                              {GL_FRAGMENT_SHADER, "gi/multires_splat/splat.frag"}});
     mCounters = gl::Buffer::create(sizeof(shader::SubsplatCounters), nullptr,
                                    GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
-    mEmptyVao = gl::VertexArray::create();
     mRefineTf = gl::Program::build({{GL_VERTEX_SHADER, "gi/multires_splat/refine_tf.vert"},
                                     {GL_GEOMETRY_SHADER, "gi/multires_splat/refine_tf.geom"}},
                                    {}, {"gNext", "gl_NextBuffer", "gSplat"});
@@ -168,10 +167,7 @@ void MultiresSplat::splatFeedbackLists(int vplCount) {
 }
 
 void MultiresSplat::resize(int width, int height) {
-    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-    mTarget = gl::Framebuffer::create();
-    mTarget.attachColor(0, mIndirect);
-    mTarget.finish(1, "multires_splat indirect");
+    mIndirect.resize(width, height, "multires_splat indirect");
 }
 
 void MultiresSplat::ensureCapacity(GLuint items) {
@@ -263,8 +259,6 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
 
     timer.begin("subsplat_splat");
     if (vplCount > 0) {
-        glBindFramebuffer(GL_FRAMEBUFFER, mEye.illuminationTarget().id());
-        glViewport(0, 0, mEye.atlasWidth(), mEye.atlasHeight());
         const gl::Program& splat = (feedback ? mSplatTf : mSplat).get(vplKernel(params));
         glUseProgram(splat.id());
         glUniform2i(splat.uniform("uAtlasSize"), mEye.atlasWidth(), mEye.atlasHeight());
@@ -273,23 +267,21 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
         setVplClamp(splat, params);
         glUniform1f(splat.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
         glUniform1f(splat.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+        mEye.beginIlluminationPass(in, false); // every list item is a receiver: no stencil
         if (feedback) {
             glBindVertexArray(mItemVao.id());
             splatFeedbackLists(vplCount);
         } else {
-            glBindVertexArray(mEmptyVao.id());
             glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCounters.id());
             glDrawArraysIndirect(GL_POINTS,
                                  reinterpret_cast<const void*>(offsetof(shader::SubsplatCounters, draw)));
             glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
         }
-        glDisable(GL_BLEND);
+        mEye.endIlluminationPass();
     }
     timer.end();
 
-    mEye.reconstruct(in, params, !perVpl, mTarget, timer);
+    mEye.reconstruct(in, params, !perVpl, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);
 
     shader::SubsplatCounters c{};
@@ -309,7 +301,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     counters["subsplat_capped"] = c.counts.w;
     if (perVpl && vplCount > 0) counters["subsplats_per_vpl"] = total / vplCount;
     counters["splat_points"] = perVpl ? total : total * vplCount;
-    mSsbc.apply(in, params, mIndirect, timer, counters);
+    mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
 std::vector<std::array<int, 3>> MultiresSplat::readSplatPatches() const {

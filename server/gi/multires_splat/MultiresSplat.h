@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "gi/Technique.h"
+#include "gi/common/IndirectTarget.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/VplGrid.h"
@@ -49,7 +50,7 @@ public:
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
-    const gl::Texture* indirect() const override { return &mIndirect; }
+    const gl::Texture* indirect() const override { return &mIndirect.texture; }
 
     EyeHierarchy& hierarchy() { return mEye; }
     /// Test hook: the last frame's splat list as sorted (level, x, y) triples (geometry refinement).
@@ -68,7 +69,6 @@ private:
     KernelPrograms mSplat;
     gl::Buffer mListA, mListB, mSplatList, mCounters;
     GLuint mCapacity = 0;
-    gl::VertexArray mEmptyVao;
     // Transform-feedback lists, one set per eye level.
     gl::Program mRefineTf;
     KernelPrograms mSplatTf;
@@ -81,8 +81,7 @@ private:
     std::vector<EyeLevel> mTfLevels;
     bool mLastFeedback = false;
     std::vector<GLuint> mTfCounts;
-    gl::Texture mIndirect;
-    gl::Framebuffer mTarget;
+    IndirectTarget mIndirect;
 };
 
 } // namespace gis

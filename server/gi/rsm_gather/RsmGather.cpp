@@ -38,10 +38,7 @@ RsmGather::RsmGather() {
 }
 
 void RsmGather::resize(int width, int height) {
-    mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-    mTarget = gl::Framebuffer::create();
-    mTarget.attachColor(0, mIndirect);
-    mTarget.finish(1, "rsm_gather indirect");
+    mIndirect.resize(width, height, "rsm_gather indirect");
 }
 
 void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
@@ -50,10 +47,10 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
     mShadows.render(in, params, mVpls.buffer(), vplCount, timer, counters);
 
     timer.begin("vpl_gather");
-    glBindFramebuffer(GL_FRAMEBUFFER, mTarget.id());
+    glBindFramebuffer(GL_FRAMEBUFFER, mIndirect.framebuffer.id());
     glViewport(0, 0, in.width, in.height);
     const float zero[4] = {0, 0, 0, 0};
-    glClearNamedFramebufferfv(mTarget.id(), GL_COLOR, 0, zero);
+    glClearNamedFramebufferfv(mIndirect.framebuffer.id(), GL_COLOR, 0, zero);
     if (vplCount > 0) {
         const gl::Program& gather = mGather.get(vplKernel(params));
         glUseProgram(gather.id());
@@ -76,7 +73,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         glDisable(GL_BLEND);
     }
     timer.end();
-    mSsbc.apply(in, params, mIndirect, timer, counters);
+    mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
 } // namespace gis

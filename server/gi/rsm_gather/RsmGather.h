@@ -25,6 +25,7 @@
 #pragma once
 
 #include "gi/Technique.h"
+#include "gi/common/IndirectTarget.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/VplGrid.h"
 #include "gi/common/VplShadows.h"
@@ -42,15 +43,14 @@ public:
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
-    const gl::Texture* indirect() const override { return &mIndirect; }
+    const gl::Texture* indirect() const override { return &mIndirect.texture; }
 
 private:
     VplGrid mVpls;
     VplShadows mShadows;
     KernelPrograms mGather;
     BiasCompensation mSsbc;
-    gl::Texture mIndirect;
-    gl::Framebuffer mTarget;
+    IndirectTarget mIndirect;
     gl::VertexArray mEmptyVao;
 };
 

@@ -27,26 +27,32 @@ float vplClampFactor(float cosR, float cosL, float d2) {
     return 1.0 / max(1.0, cosR * cosL / d2 * uVplInvClampB);
 }
 
+// Distance and clamped cosines of a receiver-VPL pair; false when they coincide (no direction).
+bool vplPair(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplNormal, out float d2, out float cosR,
+             out float cosL) {
+    vec3 toVpl = vplPos - receiverPos;
+    d2 = dot(toVpl, toVpl);
+    cosR = 0.0;
+    cosL = 0.0;
+    if (!(d2 > 1e-20)) return false;
+    vec3 w = toVpl * inversesqrt(d2);
+    cosR = max(dot(receiverNormal, w), 0.0);
+    cosL = max(dot(vplNormal, -w), 0.0);
+    return true;
+}
+
 vec3 vplIrradiance(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplNormal, vec3 vplFlux,
                    float minDistance) {
-    vec3 toVpl = vplPos - receiverPos;
-    float d2 = dot(toVpl, toVpl);
-    if (!(d2 > 1e-20)) return vec3(0.0);
-    vec3 w = toVpl * inversesqrt(d2);
-    float cosR = max(dot(receiverNormal, w), 0.0);
-    float cosL = max(dot(vplNormal, -w), 0.0);
+    float d2, cosR, cosL;
+    if (!vplPair(receiverPos, receiverNormal, vplPos, vplNormal, d2, cosR, cosL)) return vec3(0.0);
     float dmin2 = uVplInvClampB > 0.0 ? 0.0 : minDistance * minDistance;
     return vplFlux * (kInvPi * cosR * cosL / max(d2, dmin2) * vplClampFactor(cosR, cosL, d2));
 }
 
 vec3 vplIrradianceDisk(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplNormal, vec3 vplFlux,
                        float area) {
-    vec3 toVpl = vplPos - receiverPos;
-    float d2 = dot(toVpl, toVpl);
-    if (!(d2 > 1e-20)) return vec3(0.0);
-    vec3 w = toVpl * inversesqrt(d2);
-    float cosR = max(dot(receiverNormal, w), 0.0);
-    float cosL = max(dot(vplNormal, -w), 0.0);
+    float d2, cosR, cosL;
+    if (!vplPair(receiverPos, receiverNormal, vplPos, vplNormal, d2, cosR, cosL)) return vec3(0.0);
     float a = uVplInvClampB > 0.0 ? 0.0 : max(area, 0.0);
     return vplFlux * (cosR * cosL / (kPi * d2 + a) * vplClampFactor(cosR, cosL, d2));
 }
