@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <unistd.h>
 
 #include "core/Error.h"
 #include "gi/Technique.h"
@@ -12,7 +13,8 @@
 namespace {
 
 std::string writeFile(const std::string& name, const std::string& text) {
-    auto path = std::filesystem::temp_directory_path() / name;
+    // CTest runs these tests in parallel processes: a shared file name would race.
+    auto path = std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + name);
     std::ofstream(path) << text;
     return path.string();
 }
@@ -67,7 +69,7 @@ TEST(Presets, AppliesThroughTheParameterValidation) {
 
 TEST(Presets, CommittedFileAppliesToEveryTechniqueItNames) {
     const std::string path = std::string(GIS_SOURCE_DIR) + "/presets/presets.json";
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no committed presets yet";
+    ASSERT_TRUE(std::filesystem::exists(path)) << path << " is committed with the accuracy report";
     auto presets = gis::loadPresets(path);
     gis::Scene scene = gis::loadScene("builtin:cornell");
     for (const auto& [technique, byName] : presets["techniques"].items()) {
