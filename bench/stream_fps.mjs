@@ -2,7 +2,8 @@
 // camera on every frame it acknowledges, and reports the frames per second the client saw, with the
 // median render, encode and round-trip times.
 // usage: node bench/stream_fps.mjs [--server build/release/bin/gi-server] [--size 512x512]
-//        [--technique rsm_gather] [--seconds 10] [--gl egl|osmesa] [--param name=value ...]
+//        [--technique rsm_gather] [--seconds 10] [--gl egl|osmesa] [--codec jpeg|webp|png]
+//        [--param name=value ...]
 import { spawn } from 'node:child_process';
 import net from 'node:net';
 import path from 'node:path';
@@ -11,7 +12,7 @@ import WebSocket from 'ws';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const opts = { server: path.join(root, 'build/release/bin/gi-server'), size: '512x512', technique: 'rsm_gather',
-               seconds: 10, gl: process.env.GI_GL || 'egl', params: {} };
+               seconds: 10, gl: process.env.GI_GL || 'egl', codec: 'jpeg', params: {} };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
     const key = argv[i].replace(/^--/, '');
@@ -51,7 +52,9 @@ const sendCamera = () => {
     ws.send(JSON.stringify({ type: 'camera', position: [3.9 * Math.sin(angle), 1, 3.9 * Math.cos(angle)], target: [0, 1, 0] }));
 };
 ws.on('open', () => {
-    ws.send(JSON.stringify({ type: 'resize', size: [width, height] }));
+    // Fixed quality: the benchmark measures the requested state, not the adaptive steps.
+    ws.send(JSON.stringify({ type: 'hello', protocol: 1, client: 'stream_fps', codecs: [opts.codec], adaptive: false,
+                             size: [width, height] }));
     if (Object.keys(opts.params).length) ws.send(JSON.stringify({ type: 'params', values: opts.params }));
 });
 ws.on('message', (data, isBinary) => {
@@ -77,7 +80,7 @@ ws.on('message', (data, isBinary) => {
         console.log(JSON.stringify({
             technique: opts.technique, size: [width, height], gl: opts.gl, params: opts.params,
             frames, fps: +(frames / elapsed).toFixed(2), median_render_ms: +median(render).toFixed(1),
-            median_encode_ms: +median(encode).toFixed(2), median_input_to_frame_ms: +median(roundTrip).toFixed(1),
+            median_encode_ms: +median(encode).toFixed(2), codec: lastStats.codec, median_input_to_frame_ms: +median(roundTrip).toFixed(1),
             bytes_per_frame: lastStats.bytes,
         }));
         ws.close();

@@ -18,8 +18,30 @@ export function streamUrl(location) {
 }
 
 /**
- * Handlers: onOpen(), onText(string), onBinary(ArrayBuffer), onState(state, detail) with state
- * one of 'connecting', 'open', 'waiting' (detail: ms until the next attempt) and 'closed'.
+ * What the page URL asks for: {view, token}, each a string or undefined. `#view=TOKEN` joins a
+ * session as a viewer; the server token may come as `#token=` (kept out of server logs and
+ * Referer headers) or `?token=`.
+ */
+export function pageOptions(location) {
+    const hash = new URLSearchParams(location.hash.replace(/^#/, ''));
+    const query = new URLSearchParams(location.search);
+    const pick = (value) => (value ? value : undefined);
+    return { view: pick(hash.get('view')), token: pick(hash.get('token') ?? query.get('token')) };
+}
+
+/**
+ * The view-only link for a session: this page with `#view=<view token>`. The query stays (a
+ * `?token=` there is what a viewer of a server with a token needs too); a `#token=` does not, so
+ * whoever shares a link decides whether the server token goes with it.
+ */
+export function shareLink(location, viewToken) {
+    return `${location.origin}${location.pathname}${location.search}#view=${encodeURIComponent(viewToken)}`;
+}
+
+/**
+ * Handlers: onOpen(), onText(string), onBinary(ArrayBuffer), onClose(code), onState(state, detail)
+ * with state one of 'connecting', 'open', 'waiting' (detail: ms until the next attempt) and
+ * 'closed'.
  */
 export class StreamConnection {
     constructor(url, handlers) {
@@ -50,9 +72,10 @@ export class StreamConnection {
             if (typeof e.data === 'string') this.handlers.onText?.(e.data);
             else this.handlers.onBinary?.(e.data);
         };
-        socket.onclose = () => {
+        socket.onclose = (e) => {
             if (socket !== this.socket) return;
             this.socket = null;
+            this.handlers.onClose?.(e.code);
             this.scheduleReconnect();
         };
         // onclose follows every error; the reconnect is scheduled there.
@@ -74,6 +97,15 @@ export class StreamConnection {
         this.retryTimer = setTimeout(() => this.connect(), delay);
     }
 
+    /**
+     * The server refused the connection for good (a bad token, another protocol version): when it
+     * closes the socket, stay closed instead of retrying.
+     */
+    stopReconnecting() {
+        this.stopped = true;
+        clearTimeout(this.retryTimer);
+    }
+
     get isOpen() {
         return this.socket !== null && this.socket.readyState === WebSocket.OPEN;
     }
@@ -85,12 +117,15 @@ export class StreamConnection {
         return true;
     }
 
+    /**
+     * A close the user asked for: status 1000 tells the server to end the session at once
+     * instead of keeping it for a resume (any other loss keeps it for the grace period).
+     */
     close() {
-        this.stopped = true;
-        clearTimeout(this.retryTimer);
+        this.stopReconnecting();
         const socket = this.socket;
         this.socket = null;
-        socket?.close();
+        socket?.close(1000, 'user closed');
         this.handlers.onState?.('closed');
     }
 }

@@ -1,17 +1,29 @@
-// App wiring: connection, frame display, side panel and stats.
+// App wiring: connection and session role, frame display, side panel and stats.
 
 import {
-    ackMsg, cameraMsg, CODEC_MIME, frameSizeFor, helloMsg, paramsMsg, parseFrameHeader,
-    parseServerMessage, resizeMsg, sceneMsg, techniqueMsg, validateClientMessage, validateParamValues,
+    ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, paramsMsg, parseFrameHeader, parseServerMessage,
+    qualityMsg, resizeMsg, sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
+    viewportFor,
 } from './protocol.js';
 import { CLIENT_SCHEMAS } from './schemas.js';
 import { OrbitCamera, attachOrbitControls } from './camera.js';
-import { StreamConnection, streamUrl } from './connection.js';
+import { StreamConnection, pageOptions, shareLink, streamUrl } from './connection.js';
 import { buildParamPanel } from './controls.js';
 
 const RESIZE_DEBOUNCE_MS = 200;
 const MESSAGE_HIDE_MS = 6000;
 const FPS_WINDOW_MS = 1000;
+// WebP first: about a third smaller than JPEG at the same quality; JPEG for browsers without it.
+const CODECS = ['webp', 'jpeg'];
+// Two frames in flight: the next frame travels while this one decodes, without building a queue.
+const MAX_IN_FLIGHT = 2;
+// sessionStorage, not localStorage: the token belongs to this tab's session (it survives a reload,
+// which then resumes the session) and another tab must start its own.
+const RESUME_KEY = 'gi-resume-token';
+
+// Errors after which the server closes the connection and retrying the same hello cannot help.
+const FATAL_ERRORS = new Set(['hello_required', 'protocol_mismatch', 'unauthorized', 'unknown_view_token',
+    'session_ended', 'idle_timeout']);
 
 const $ = (id) => document.getElementById(id);
 const ui = {
@@ -19,30 +31,40 @@ const ui = {
     viewport: $('viewport'),
     connDot: $('conn-dot'),
     connText: $('conn-text'),
+    role: $('role'),
     messages: $('messages'),
     scene: $('scene'),
     technique: $('technique'),
     techniqueInfo: $('technique-info'),
     params: $('params'),
+    adaptive: $('adaptive'),
     resetCamera: $('reset-camera'),
+    snapshot: $('snapshot'),
+    share: $('share'),
+    shareUrl: $('share-url'),
+    sessionToggle: $('session-toggle'),
     fps: $('fps'),
     statsLine: $('stats-line'),
+    qualityLine: $('quality-line'),
     passes: $('passes'),
     plan: $('plan'),
 };
 const ctx = ui.canvas.getContext('2d');
 
+const page = pageOptions(window.location);
 const state = {
+    viewer: page.view !== undefined, // joined with a view token: watch only
     welcome: null,
     techniques: new Map(), // name -> technique description from welcome
     technique: null,
     paramPanel: null,
     lastParams: null, // the parameter values of the latest stats
-    lastSize: null, // the last size sent, "WxH"
+    lastSize: null, // the last viewport sent, "WxH@dpr"
     statsByFrame: new Map(),
     drawTimes: [],
     decoding: false,
     pending: null, // the newest frame that arrived while another was decoding
+    snapshotWanted: false, // a snapshot was asked for and has not arrived yet
 };
 
 const camera = new OrbitCamera();
@@ -50,6 +72,7 @@ const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
     onText: handleText,
     onBinary: handleBinary,
+    onClose: handleClose,
     onState: showConnectionState,
 });
 
@@ -66,15 +89,20 @@ function send(msg) {
     return connection.send(msg);
 }
 
+function currentViewport() {
+    return viewportFor(ui.viewport.clientWidth, ui.viewport.clientHeight, window.devicePixelRatio);
+}
+
 function sendCamera() {
-    send(cameraMsg(camera.toCamera()));
+    if (!state.viewer) send(cameraMsg(camera.toCamera()));
 }
 
 function sendResize(force = false) {
-    const [w, h] = frameSizeFor(ui.viewport.clientWidth, ui.viewport.clientHeight, window.devicePixelRatio);
-    const key = `${w}x${h}`;
+    if (state.viewer) return;
+    const { size, dpr } = currentViewport();
+    const key = `${size[0]}x${size[1]}@${dpr}`;
     if (!force && key === state.lastSize) return;
-    if (send(resizeMsg(w, h))) state.lastSize = key;
+    if (send(resizeMsg(size[0], size[1], dpr))) state.lastSize = key;
 }
 
 function sendParam(name, value) {
@@ -88,15 +116,27 @@ function sendParam(name, value) {
     send(paramsMsg({ [name]: value }));
 }
 
+/** hello for this page: a viewer names the view token, a controller its viewport and a resume token if it has one. */
+function buildHello() {
+    const common = { client: CLIENT_NAME, token: page.token, codecs: CODECS, max_in_flight: MAX_IN_FLIGHT };
+    if (state.viewer) return helloMsg({ ...common, view: page.view });
+    const { size, dpr } = currentViewport();
+    state.lastSize = `${size[0]}x${size[1]}@${dpr}`;
+    return helloMsg({ ...common, resume: sessionStorage.getItem(RESUME_KEY) ?? undefined, size, dpr });
+}
+
 // ---------------------------------------------------------------------------------------------
 // Receiving
 
 function handleOpen() {
-    state.lastSize = null;
     state.statsByFrame.clear();
     state.pending = null;
-    send(helloMsg());
-    sendResize(true);
+    state.snapshotWanted = false;
+    send(buildHello());
+}
+
+function handleClose(code) {
+    if (code === 1013) showMessage('the server is busy (session limit reached); retrying');
 }
 
 function handleText(text) {
@@ -108,29 +148,52 @@ function handleText(text) {
     switch (msg.type) {
     case 'welcome': handleWelcome(msg); break;
     case 'stats': handleStats(msg); break;
-    // Not in PROTOCOL.md v0 yet: the server sends the session state after a scene change.
     case 'state': applyState(msg.state ?? {}); break;
-    case 'error': showMessage(`${msg.code}${msg.where ? ` at ${msg.where}` : ''}: ${msg.message}`); break;
+    case 'error': handleError(msg); break;
     case 'pong': break;
     default: console.warn('unhandled server message', msg);
+    }
+}
+
+function handleError(msg) {
+    showMessage(`${msg.code}${msg.where ? ` at ${msg.where}` : ''}: ${msg.message}`);
+    if (msg.code === 'resume_failed') {
+        // The session is gone (grace period over, server restarted): the reconnect that follows
+        // the close starts a new one.
+        sessionStorage.removeItem(RESUME_KEY);
+        connection.markHealthy();
+    } else if (FATAL_ERRORS.has(msg.code)) {
+        if (msg.code === 'session_ended' || msg.code === 'idle_timeout') sessionStorage.removeItem(RESUME_KEY);
+        connection.stopReconnecting();
     }
 }
 
 function handleWelcome(msg) {
     connection.markHealthy();
     state.welcome = msg;
+    setRole(msg.role === 'viewer');
+    if (msg.resume_token) sessionStorage.setItem(RESUME_KEY, msg.resume_token);
     state.techniques = new Map((msg.techniques ?? []).map((t) => [t.name, t]));
     const s = msg.state ?? {};
     fillSelect(ui.scene, msg.scenes ?? [], s.scene);
     fillSelect(ui.technique, [...state.techniques.keys()], s.technique);
+    ui.adaptive.checked = msg.adaptive !== false;
     state.lastParams = s.params ?? null;
-    applyState(s);
+    applyState(s, { resumed: msg.resumed === true });
+    // A resumed session still has the viewport of before the outage (or the reload).
+    if (msg.resumed) sendResize(true);
 }
 
-/** Shows a session state (welcome.state); its camera becomes the one "Reset camera" returns to. */
-function applyState(s) {
+/**
+ * Shows a session state (welcome.state, state messages). A new session's camera becomes the one
+ * "Reset camera" returns to; a resumed one keeps the home it had.
+ */
+function applyState(s, { resumed = false } = {}) {
     if (s.scene !== undefined) ui.scene.value = s.scene;
-    if (s.camera) camera.setHome(s.camera);
+    if (s.camera) {
+        if (resumed) camera.set(s.camera);
+        else camera.setHome(s.camera);
+    }
     if (s.technique !== undefined) {
         ui.technique.value = s.technique;
         showTechnique(s.technique, s.params);
@@ -146,7 +209,6 @@ function handleStats(msg) {
         showTechnique(msg.technique, msg.params);
     }
     if (msg.scene && state.welcome?.scenes?.includes(msg.scene)) ui.scene.value = msg.scene;
-    if (msg.camera) camera.set(msg.camera);
     if (msg.params) {
         state.lastParams = msg.params;
         state.paramPanel?.update(msg.params);
@@ -161,10 +223,15 @@ function handleBinary(buffer) {
         showMessage(`bad frame from the server: ${e.message}`);
         return;
     }
+    // The snapshot is saved as it arrives: the draw queue below may skip frames.
+    if (state.snapshotWanted && state.statsByFrame.get(header.frame)?.snapshot) {
+        state.snapshotWanted = false;
+        saveSnapshot(header, buffer);
+    }
     const frame = { header, buffer, connection: connection.socket };
     if (state.decoding) {
-        // The server sends one frame at a time, so this only happens with a misbehaving server;
-        // keep the newest and acknowledge the skipped one so the stream cannot stall.
+        // With two frames in flight the next one can arrive while this one decodes; keep only the
+        // newest and acknowledge the skipped one so that its slot frees.
         if (state.pending) acknowledge(state.pending);
         state.pending = frame;
         return;
@@ -198,8 +265,63 @@ async function decodeAndDraw(frame) {
 }
 
 function acknowledge(frame) {
-    // An ack belongs to the session that sent the frame; after a reconnect it means nothing.
+    // An ack belongs to the connection that received the frame; after a reconnect it means nothing.
     if (frame.connection === connection.socket) send(ackMsg(frame.header.frame));
+}
+
+function saveSnapshot(header, buffer) {
+    const blob = new Blob([new Uint8Array(buffer, header.payloadOffset)], { type: CODEC_MIME[header.codec] });
+    const scene = (ui.scene.value || 'scene').replace(/[^A-Za-z0-9_-]+/g, '-');
+    const link = Object.assign(document.createElement('a'), {
+        href: URL.createObjectURL(blob),
+        download: `gi-${scene}-${state.technique ?? 'frame'}-${header.frame}.${header.codec}`,
+    });
+    link.click();
+    // The download has started from the object URL by the time the timer runs.
+    setTimeout(() => URL.revokeObjectURL(link.href), 1000);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Role and session controls
+
+/** Viewers watch: the steering controls are hidden and input on the view sends nothing. */
+function setRole(viewer) {
+    state.viewer = viewer;
+    document.body.classList.toggle('viewer', viewer);
+    ui.role.textContent = viewer ? 'viewing' : 'controlling';
+    ui.share.hidden = viewer;
+}
+
+async function copyShareLink() {
+    const token = state.welcome?.view_token;
+    if (!token) {
+        showMessage('no view token yet: wait for the connection');
+        return;
+    }
+    const link = shareLink(window.location, token);
+    try {
+        await navigator.clipboard.writeText(link);
+        showMessage('view-only link copied', 'info');
+    } catch {
+        // No clipboard (plain http on another host, or permission refused): show the link to copy by hand.
+        ui.shareUrl.value = link;
+        ui.shareUrl.hidden = false;
+        ui.shareUrl.select();
+    }
+}
+
+function requestSnapshot() {
+    if (send(snapshotMsg('png'))) state.snapshotWanted = true;
+}
+
+function toggleSession() {
+    if (connection.socket || ui.connDot.dataset.state === 'waiting') {
+        // A deliberate end: close with 1000 so the server frees the session now.
+        sessionStorage.removeItem(RESUME_KEY);
+        connection.close();
+    } else {
+        connection.connect();
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -234,10 +356,6 @@ function onTechniqueSelected() {
     showTechnique(name, defaults);
 }
 
-function onSceneSelected() {
-    send(sceneMsg(ui.scene.value));
-}
-
 // ---------------------------------------------------------------------------------------------
 // Stats and status
 
@@ -266,9 +384,15 @@ function showStats(header, stats, frameBytes) {
         `render ${formatMs(stats?.frame_ms)} ms`,
         `encode ${formatMs(stats?.encode_ms)} ms`,
         `${(bytes / 1024).toFixed(1)} KB`,
-        `${header.width}×${header.height} ${header.codec}`,
+        `${header.width}×${header.height} ${stats?.codec ?? header.codec}`,
         stats?.timing ? `(${stats.timing})` : '',
     ].filter(Boolean).join(' · ');
+    ui.qualityLine.textContent = [
+        `${stats?.quality ?? '–'}${stats?.refined ? ' (refined)' : ''}${stats?.snapshot ? ' snapshot' : ''}`,
+        `queue ${formatMs(stats?.queue_ms)} ms`,
+        `dropped ${stats?.dropped_frames ?? 0}`,
+        `viewers ${stats?.viewers ?? 0}`,
+    ].join(' · ');
     ui.passes.replaceChildren(...(stats?.passes ?? []).map((p) => {
         const li = document.createElement('li');
         li.append(Object.assign(document.createElement('span'), { textContent: p.name }),
@@ -298,11 +422,12 @@ function showConnectionState(connState, delayMs) {
     ui.connText.textContent = connState === 'waiting'
         ? `disconnected, retrying in ${(delayMs / 1000).toFixed(1)} s`
         : connState;
+    ui.sessionToggle.textContent = connState === 'closed' ? 'Connect' : 'Disconnect';
 }
 
-function showMessage(text) {
+function showMessage(text, kind = 'error') {
     const item = document.createElement('div');
-    item.className = 'message';
+    item.className = `message ${kind}`;
     item.textContent = text;
     ui.messages.append(item);
     // Older messages go first so that a burst of errors cannot fill the view.
@@ -322,13 +447,18 @@ function debounce(fn, ms) {
 }
 
 function start() {
+    setRole(state.viewer);
     attachOrbitControls(ui.canvas, camera, sendCamera);
     ui.resetCamera.addEventListener('click', () => {
         camera.reset();
         sendCamera();
     });
     ui.technique.addEventListener('change', onTechniqueSelected);
-    ui.scene.addEventListener('change', onSceneSelected);
+    ui.scene.addEventListener('change', () => send(sceneMsg(ui.scene.value)));
+    ui.adaptive.addEventListener('change', () => send(qualityMsg(ui.adaptive.checked)));
+    ui.snapshot.addEventListener('click', requestSnapshot);
+    ui.share.addEventListener('click', copyShareLink);
+    ui.sessionToggle.addEventListener('click', toggleSession);
     // The viewport changes size with the window and when the panel moves below it.
     new ResizeObserver(debounce(() => sendResize(), RESIZE_DEBOUNCE_MS)).observe(ui.viewport);
     setInterval(showFps, FPS_WINDOW_MS / 4);

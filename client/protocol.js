@@ -1,25 +1,35 @@
-// Wire protocol v0 (protocol/PROTOCOL.md): message builders, the binary frame header and the
+// Wire protocol v1 (protocol/PROTOCOL.md): message builders, the binary frame header and the
 // JSON-Schema subset validator. Pure functions without DOM access so node's test runner can load
 // this module as it is.
 
-export const PROTOCOL_VERSION = 0;
+export const PROTOCOL_VERSION = 1;
 export const SUBPROTOCOL = 'gi-stream';
-export const CLIENT_NAME = 'gi-web/0.1';
+export const CLIENT_NAME = 'gi-web/0.2';
 
 export const CLIENT_MESSAGE_TYPES = Object.freeze([
-    'hello', 'camera', 'light', 'technique', 'params', 'resize', 'scene', 'ack', 'ping',
+    'hello', 'camera', 'light', 'technique', 'params', 'resize', 'scene', 'quality', 'snapshot', 'ack', 'ping',
 ]);
 
-// The client never asks for more than this per side, even on high-DPI screens: the server's
-// render time grows with the pixel count and 1024 is plenty for a streamed preview.
-export const MAX_REQUEST_SIDE = 1024;
-export const MIN_FRAME_SIDE = 16;
+// The bounds of the resize/hello schemas; the server scales the product size x dpr down to its
+// own limits.max_size, so the client only has to stay inside the schema.
+export const MIN_VIEWPORT_SIDE = 16;
+export const MAX_VIEWPORT_SIDE = 8192;
+export const MIN_DPR = 0.25;
+export const MAX_DPR = 4;
 
 // ---------------------------------------------------------------------------------------------
 // Message builders
 
-export function helloMsg(client = CLIENT_NAME) {
-    return { type: 'hello', protocol: PROTOCOL_VERSION, client };
+const HELLO_FIELDS = ['client', 'token', 'resume', 'view', 'codecs', 'quality', 'max_in_flight', 'adaptive', 'size', 'dpr'];
+
+/** The opening message; only the fields given (not undefined) are sent, so the server's defaults apply to the rest. */
+export function helloMsg(fields = {}) {
+    const msg = { type: 'hello', protocol: PROTOCOL_VERSION };
+    for (const key of HELLO_FIELDS) {
+        const value = fields[key];
+        if (value !== undefined) msg[key] = Array.isArray(value) ? [...value] : value;
+    }
+    return msg;
 }
 
 export function cameraMsg({ position, target, up, fov_deg: fovDeg }) {
@@ -41,12 +51,24 @@ export function paramsMsg(values) {
     return { type: 'params', values: { ...values } };
 }
 
-export function resizeMsg(width, height) {
-    return { type: 'resize', size: [width, height] };
+/** Viewport size in CSS pixels; the server renders size x dpr. */
+export function resizeMsg(width, height, dpr) {
+    const msg = { type: 'resize', size: [width, height] };
+    if (dpr !== undefined) msg.dpr = dpr;
+    return msg;
 }
 
 export function sceneMsg(name) {
     return { type: 'scene', name };
+}
+
+export function qualityMsg(adaptive) {
+    return { type: 'quality', adaptive };
+}
+
+/** codec 'png' (the server's default) or 'webp'; both lossless. */
+export function snapshotMsg(codec) {
+    return codec === undefined ? { type: 'snapshot' } : { type: 'snapshot', codec };
 }
 
 export function ackMsg(frame) {
@@ -58,19 +80,15 @@ export function pingMsg(t) {
 }
 
 /**
- * The frame size to request for a canvas of cssWidth x cssHeight CSS pixels: device pixels,
- * scaled down (keeping the aspect ratio) so that neither side exceeds MAX_REQUEST_SIDE, and at
- * least MIN_FRAME_SIDE per side so that the request always passes the resize schema.
+ * The viewport to announce (hello, resize) for a canvas of cssWidth x cssHeight CSS pixels:
+ * {size: [w, h] whole CSS pixels, dpr}, both clamped into the schema's ranges so that the
+ * message is always valid. Capping the pixel count is the server's job (limits.max_size).
  */
-export function frameSizeFor(cssWidth, cssHeight, devicePixelRatio = 1) {
+export function viewportFor(cssWidth, cssHeight, devicePixelRatio = 1) {
+    const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
+    const side = (v) => clamp(Math.round(Number.isFinite(v) ? v : 0), MIN_VIEWPORT_SIDE, MAX_VIEWPORT_SIDE);
     const dpr = Number.isFinite(devicePixelRatio) && devicePixelRatio > 0 ? devicePixelRatio : 1;
-    let w = Math.max(cssWidth, 1) * dpr;
-    let h = Math.max(cssHeight, 1) * dpr;
-    const scale = Math.min(1, MAX_REQUEST_SIDE / Math.max(w, h));
-    w = Math.round(w * scale);
-    h = Math.round(h * scale);
-    const clampSide = (v) => Math.min(MAX_REQUEST_SIDE, Math.max(MIN_FRAME_SIDE, v));
-    return [clampSide(w), clampSide(h)];
+    return { size: [side(cssWidth), side(cssHeight)], dpr: clamp(dpr, MIN_DPR, MAX_DPR) };
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -78,8 +96,8 @@ export function frameSizeFor(cssWidth, cssHeight, devicePixelRatio = 1) {
 
 export const FRAME_MAGIC = 'GIFR';
 export const FRAME_HEADER_BYTES = 16;
-export const CODECS = Object.freeze({ 1: 'jpeg', 2: 'png' });
-export const CODEC_MIME = Object.freeze({ jpeg: 'image/jpeg', png: 'image/png' });
+export const CODECS = Object.freeze({ 1: 'jpeg', 2: 'png', 3: 'webp' });
+export const CODEC_MIME = Object.freeze({ jpeg: 'image/jpeg', png: 'image/png', webp: 'image/webp' });
 
 function asDataView(buffer) {
     if (buffer instanceof ArrayBuffer) return new DataView(buffer);
@@ -89,7 +107,7 @@ function asDataView(buffer) {
 
 /**
  * Parses and validates the 16-byte header of a binary frame. Returns
- * {frame, width, height, codec, payloadOffset}, codec being 'jpeg' or 'png'; throws an Error
+ * {frame, width, height, codec, payloadOffset}, codec being 'jpeg', 'png' or 'webp'; throws an Error
  * saying what is wrong on a frame that does not follow the protocol.
  */
 export function parseFrameHeader(buffer) {

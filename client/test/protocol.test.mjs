@@ -1,18 +1,20 @@
-// Client protocol tests: the shared vectors in protocol/vectors, the frame header and the orbit
-// camera math. Run: node --test client/test/
+// Client protocol tests: the shared vectors in protocol/vectors, the builders, the frame header,
+// the page URL options and the orbit camera math. Run: node --test client/test/
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import path from 'node:path';
 
 import {
-    ackMsg, buildFrameHeader, cameraMsg, CLIENT_MESSAGE_TYPES, frameSizeFor, helloMsg, lightMsg,
-    paramsMsg, parseFrameHeader, parseServerMessage, pingMsg, resizeMsg, sceneMsg, techniqueMsg,
-    validateClientMessage, validateJson, validateParamValues,
+    ackMsg, buildFrameHeader, cameraMsg, CLIENT_MESSAGE_TYPES, CODEC_MIME, CODECS, helloMsg, lightMsg,
+    paramsMsg, parseFrameHeader, parseServerMessage, pingMsg, PROTOCOL_VERSION, qualityMsg, resizeMsg,
+    sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateJson, validateParamValues, viewportFor,
 } from '../protocol.js';
 import { OrbitCamera, cameraBasis, orbitFromPosition, positionFromOrbit } from '../camera.js';
-import { backoffDelay, streamUrl } from '../connection.js';
+import { backoffDelay, pageOptions, shareLink, streamUrl } from '../connection.js';
 import { niceStep, sliderMapping, widgetKind } from '../controls.js';
 import { CLIENT_SCHEMAS } from '../schemas.js';
-import { loadProtocolSchemas, loadVectors } from '../tools/protocol-files.mjs';
+import { loadProtocolSchemas, loadVectors, PROTOCOL_DIR } from '../tools/protocol-files.mjs';
 
 const schemas = loadProtocolSchemas();
 
@@ -27,9 +29,15 @@ test('every client message type has a schema and the client carries the current 
         'client/schemas.js differs from protocol/schema; run node client/tools/update-schemas.mjs');
 });
 
+// The vectors protocol v1 added; listed so that losing one fails a test instead of shrinking it.
+const V1_VALID = ['hello_resume.json', 'hello_viewer.json', 'quality.json', 'resize_dpr.json', 'snapshot.json'];
+const V1_INVALID = ['hello_in_flight_range.json', 'hello_unknown_codec.json', 'quality_not_bool.json',
+    'resize_dpr_range.json', 'snapshot_lossy.json'];
+
 test('valid vectors are accepted', () => {
     const vectors = loadVectors('valid');
     assert.ok(vectors.length >= Object.keys(schemas).length, 'expected a valid vector per message type');
+    for (const name of V1_VALID) assert.ok(vectors.some((v) => v.name === name), `vectors/valid/${name} exists`);
     for (const { name, message } of vectors) {
         assert.equal(validateClientMessage(message, schemas), null, `vectors/valid/${name} rejected`);
     }
@@ -38,6 +46,7 @@ test('valid vectors are accepted', () => {
 test('invalid vectors are rejected', () => {
     const vectors = loadVectors('invalid');
     assert.ok(vectors.length > 0);
+    for (const name of V1_INVALID) assert.ok(vectors.some((v) => v.name === name), `vectors/invalid/${name} exists`);
     for (const { name, message } of vectors) {
         const problem = validateClientMessage(message, schemas);
         assert.ok(problem, `vectors/invalid/${name} accepted`);
@@ -92,27 +101,98 @@ test('parameter values are checked against the welcome schemas', () => {
     assert.equal(validateParamValues({ tonemap: 'aces' }, technique, frame).code, 'invalid_param');
 });
 
-test('message builders produce messages that validate', () => {
-    const built = [
-        helloMsg(), cameraMsg({ position: [0, 1, 3.9], target: [0, 1, 0], up: [0, 1, 0], fov_deg: 40 }),
-        cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] }), lightMsg({ intensity: 8, enabled: false }),
-        techniqueMsg('none'), paramsMsg({ vpl_grid: 8 }), resizeMsg(256, 256), sceneMsg('builtin:crease'),
-        ackMsg(0), pingMsg(), pingMsg(12.5),
-    ];
-    for (const msg of built) assert.equal(validateClientMessage(msg, schemas), null, JSON.stringify(msg));
-    assert.deepEqual(helloMsg('t'), { type: 'hello', protocol: 0, client: 't' });
+// One example call per builder, keyed by message type; the table test below checks it covers
+// every type of PROTOCOL.md.
+const BUILT = {
+    hello: [
+        helloMsg(),
+        helloMsg({ client: 'gi-web/test', codecs: ['webp', 'jpeg'], max_in_flight: 2, size: [800, 600], dpr: 2 }),
+        helloMsg({ token: 's3cret', resume: 'r-1234', quality: 80, adaptive: false }),
+        helloMsg({ view: 'v-abcd' }),
+    ],
+    camera: [cameraMsg({ position: [0, 1, 3.9], target: [0, 1, 0], up: [0, 1, 0], fov_deg: 40 }),
+        cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] })],
+    light: [lightMsg({ intensity: 8, enabled: false }), lightMsg({ direction: [0, -1, 0], cone_deg: 30 })],
+    technique: [techniqueMsg('none')],
+    params: [paramsMsg({ vpl_grid: 8, effects: 'auto', exposure: 0.5 })],
+    resize: [resizeMsg(256, 256), resizeMsg(640, 480, 1.5)],
+    scene: [sceneMsg('builtin:crease')],
+    quality: [qualityMsg(true), qualityMsg(false)],
+    snapshot: [snapshotMsg(), snapshotMsg('png'), snapshotMsg('webp')],
+    ack: [ackMsg(0), ackMsg(123456)],
+    ping: [pingMsg(), pingMsg(12.5)],
+};
+
+test('every builder produces messages that validate against their schema', () => {
+    for (const [type, messages] of Object.entries(BUILT)) {
+        for (const msg of messages) {
+            assert.equal(msg.type, type, JSON.stringify(msg));
+            assert.equal(validateJson(msg, schemas[type]), null, `${JSON.stringify(msg)} against schema/${type}.json`);
+            assert.equal(validateClientMessage(msg, schemas), null, JSON.stringify(msg));
+        }
+    }
+});
+
+test('builders send only the fields given', () => {
+    assert.equal(PROTOCOL_VERSION, 1);
+    assert.deepEqual(helloMsg(), { type: 'hello', protocol: 1 });
+    assert.deepEqual(helloMsg({ view: 'v-1', token: undefined, resume: undefined }), { type: 'hello', protocol: 1, view: 'v-1' });
+    const fields = { client: 'c', token: 't', resume: 'r', view: 'v', codecs: ['webp'], quality: 90,
+        max_in_flight: 3, adaptive: false, size: [320, 200], dpr: 1.25 };
+    assert.deepEqual(helloMsg(fields), { type: 'hello', protocol: 1, ...fields });
+    assert.deepEqual(helloMsg({ adaptive: false }).adaptive, false, 'false is a value, not a missing field');
+    assert.equal('unknown' in helloMsg({ unknown: 1 }), false, 'fields outside the schema are not copied');
+    assert.deepEqual(resizeMsg(640, 480), { type: 'resize', size: [640, 480] });
+    assert.deepEqual(resizeMsg(640, 480, 2), { type: 'resize', size: [640, 480], dpr: 2 });
+    assert.deepEqual(qualityMsg(false), { type: 'quality', adaptive: false });
+    assert.deepEqual(snapshotMsg(), { type: 'snapshot' });
+    assert.deepEqual(snapshotMsg('webp'), { type: 'snapshot', codec: 'webp' });
     assert.equal('up' in cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] }), false);
 });
 
-test('frame size requests stay within the resize schema and keep the aspect ratio', () => {
-    assert.deepEqual(frameSizeFor(800, 600, 1), [800, 600]);
-    assert.deepEqual(frameSizeFor(800, 600, 2), [1024, 768]);
-    assert.deepEqual(frameSizeFor(3000, 100, 1), [1024, 34]);
-    assert.deepEqual(frameSizeFor(5000, 10, 1), [1024, 16]);
-    assert.deepEqual(frameSizeFor(0, 0, 1), [16, 16]);
-    assert.deepEqual(frameSizeFor(300, 200, NaN), [300, 200]);
-    for (const [w, h, dpr] of [[1, 1, 1], [1920, 1080, 3], [375, 667, 2.625], [17, 4000, 1]]) {
-        assert.equal(validateClientMessage(resizeMsg(...frameSizeFor(w, h, dpr)), schemas), null, `${w}x${h}@${dpr}`);
+test('invalid builder input is caught by the schema before sending', () => {
+    const check = (msg) => validateClientMessage(msg, schemas);
+    assert.equal(check(helloMsg({ codecs: ['gif'] })).where, '/codecs/0');
+    assert.equal(check(helloMsg({ max_in_flight: 5 })).where, '/max_in_flight');
+    assert.equal(check(helloMsg({ dpr: 8 })).where, '/dpr');
+    assert.equal(check(resizeMsg(640, 480, 0.1)).where, '/dpr');
+    assert.equal(check(qualityMsg('yes')).where, '/adaptive');
+    assert.equal(check(snapshotMsg('jpeg')).where, '/codec');
+});
+
+/** The message types of PROTOCOL.md's "Client -> server" table (first column). */
+function documentedClientTypes() {
+    const doc = readFileSync(path.join(PROTOCOL_DIR, 'PROTOCOL.md'), 'utf8');
+    const section = doc.split(/^## /m).find((s) => s.startsWith('Client -> server'));
+    assert.ok(section, 'PROTOCOL.md has a "Client -> server" section');
+    return [...section.matchAll(/^\| `([a-z_]+)` \|/gm)].map((m) => m[1]);
+}
+
+test('every client message type in PROTOCOL.md has a builder, a schema and a valid vector', () => {
+    const documented = documentedClientTypes();
+    assert.ok(documented.length >= 11, `found ${documented.length} types in the table`);
+    assert.deepEqual([...documented].sort(), [...CLIENT_MESSAGE_TYPES].sort(), 'CLIENT_MESSAGE_TYPES matches the table');
+    const validVectorTypes = new Set(loadVectors('valid').map((v) => v.message.type));
+    for (const type of documented) {
+        assert.ok(BUILT[type]?.length > 0, `a builder for ${type}`);
+        assert.ok(schemas[type], `protocol/schema/${type}.json`);
+        assert.ok(CLIENT_SCHEMAS[type], `client/schemas.js has ${type}`);
+        assert.ok(validVectorTypes.has(type), `a valid vector of type ${type}`);
+    }
+});
+
+test('viewport announcements stay within the hello and resize schemas', () => {
+    assert.deepEqual(viewportFor(800, 600, 1), { size: [800, 600], dpr: 1 });
+    assert.deepEqual(viewportFor(800.4, 599.6, 2), { size: [800, 600], dpr: 2 });
+    assert.deepEqual(viewportFor(0, 0, 1), { size: [16, 16], dpr: 1 });
+    assert.deepEqual(viewportFor(20000, 100, 1), { size: [8192, 100], dpr: 1 });
+    assert.deepEqual(viewportFor(300, 200, NaN), { size: [300, 200], dpr: 1 });
+    assert.deepEqual(viewportFor(300, 200, 10), { size: [300, 200], dpr: 4 });
+    assert.deepEqual(viewportFor(300, 200, 0.1), { size: [300, 200], dpr: 0.25 });
+    for (const [w, h, dpr] of [[1, 1, 1], [1920, 1080, 3], [375, 667, 2.625], [17, 40000, 1], [NaN, 5, -1]]) {
+        const { size, dpr: d } = viewportFor(w, h, dpr);
+        assert.equal(validateClientMessage(resizeMsg(size[0], size[1], d), schemas), null, `${w}x${h}@${dpr}`);
+        assert.equal(validateClientMessage(helloMsg({ size, dpr: d }), schemas), null, `hello ${w}x${h}@${dpr}`);
     }
 });
 
@@ -130,6 +210,9 @@ test('parseFrameHeader reads a good header', () => {
         { frame: 298, width: 512, height: 384, codec: 'jpeg', payloadOffset: 16 });
     const png = frameWith(buildFrameHeader({ frame: 0xfffffffe, width: 65535, height: 16, codec: 'png' }));
     assert.deepEqual(parseFrameHeader(png), { frame: 0xfffffffe, width: 65535, height: 16, codec: 'png', payloadOffset: 16 });
+    const webp = new Uint8Array(frameWith(buildFrameHeader({ frame: 7, width: 320, height: 200, codec: 'webp' })));
+    assert.equal(webp[12], 3, 'WebP is codec 3 on the wire');
+    assert.deepEqual(parseFrameHeader(webp.buffer), { frame: 7, width: 320, height: 200, codec: 'webp', payloadOffset: 16 });
     // A typed-array view into a larger buffer (node's ws hands out Buffers like that).
     const padded = new Uint8Array(40);
     padded.set(new Uint8Array(png), 8);
@@ -144,12 +227,24 @@ test('parseFrameHeader rejects bad frames', () => {
     assert.throws(() => parseFrameHeader(new ArrayBuffer(15)), /too short/);
     assert.throws(() => parseFrameHeader(new ArrayBuffer(0)), /too short/);
     const badCodec = new Uint8Array(frameWith(good));
-    badCodec[12] = 3;
-    assert.throws(() => parseFrameHeader(badCodec.buffer), /codec/);
+    for (const id of [0, 4, 255]) {
+        badCodec[12] = id;
+        assert.throws(() => parseFrameHeader(badCodec.buffer), /codec/, `codec ${id}`);
+    }
+    assert.throws(() => buildFrameHeader({ frame: 1, width: 1, height: 1, codec: 'gif' }), /codec/);
     const zeroSize = new Uint8Array(frameWith(good));
     zeroSize[8] = zeroSize[9] = 0;
     assert.throws(() => parseFrameHeader(zeroSize.buffer), /size/);
     assert.throws(() => parseFrameHeader('GIFR'), TypeError);
+});
+
+test('frame codecs map 1/2/3 to JPEG/PNG/WebP with their MIME types', () => {
+    assert.deepEqual({ ...CODECS }, { 1: 'jpeg', 2: 'png', 3: 'webp' });
+    assert.deepEqual({ ...CODEC_MIME }, { jpeg: 'image/jpeg', png: 'image/png', webp: 'image/webp' });
+    for (const codec of Object.values(CODECS)) {
+        const header = buildFrameHeader({ frame: 1, width: 16, height: 16, codec });
+        assert.equal(parseFrameHeader(frameWith(header)).codec, codec, `${codec} round trip`);
+    }
 });
 
 test('parseServerMessage keeps JSON objects with a type only', () => {
@@ -206,6 +301,23 @@ test('reconnect backoff doubles from 0.5 s up to 8 s', () => {
     assert.deepEqual([0, 1, 2, 3, 4, 5, 9].map(backoffDelay), [500, 1000, 2000, 4000, 8000, 8000, 8000]);
     assert.equal(streamUrl({ protocol: 'https:', host: 'example.org:8443' }), 'wss://example.org:8443/ws');
     assert.equal(streamUrl({ protocol: 'http:', host: '127.0.0.1:8080' }), 'ws://127.0.0.1:8080/ws');
+});
+
+test('page URL options: view and token from the hash or the query', () => {
+    const at = (url) => pageOptions(new URL(url));
+    assert.deepEqual(at('http://h:8080/'), { view: undefined, token: undefined });
+    assert.deepEqual(at('http://h:8080/#view=v-123'), { view: 'v-123', token: undefined });
+    assert.deepEqual(at('http://h:8080/#token=s3cret'), { view: undefined, token: 's3cret' });
+    assert.deepEqual(at('http://h:8080/?token=q'), { view: undefined, token: 'q' });
+    assert.deepEqual(at('http://h:8080/?token=q#view=v-1&token=h'), { view: 'v-1', token: 'h' }, 'the hash wins');
+    assert.deepEqual(at('http://h:8080/#view='), { view: undefined, token: undefined }, 'empty means absent');
+});
+
+test('share links carry the view token and keep the query, not the hash', () => {
+    assert.equal(shareLink(new URL('http://h:8080/'), 'v-abc'), 'http://h:8080/#view=v-abc');
+    assert.equal(shareLink(new URL('https://h/app/index.html?token=t#token=x'), 'v-1'),
+        'https://h/app/index.html?token=t#view=v-1');
+    assert.equal(pageOptions(new URL(shareLink(new URL('http://h/'), 'v-a+b/c'))).view, 'v-a+b/c', 'round trip');
 });
 
 test('parameter widgets follow the schema', () => {

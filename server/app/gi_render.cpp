@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,7 @@
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
 #include "render/Presets.h"
+#include "render/RenderRequest.h"
 #include "scene/SceneLoader.h"
 
 namespace {
@@ -36,8 +39,14 @@ Renders a scene with a global-illumination technique and writes the image and pe
                         (presets/presets.json or $GI_PRESETS; docs/accuracy.md); --param overrides it
   --param NAME=VALUE    set a frame or technique parameter (repeatable; see --list-params)
   --size WxH            image size in pixels, 16..4096 each (default 512x512)
-  --out FILE            write the image: .png, .jpg (tone-mapped) or .exr (linear radiance)
+  --out FILE            write the image: .png, .jpg, .webp (tone-mapped) or .exr (linear radiance);
+                        the bytes equal the HTTP API's for the same request (PNG always, JPEG and
+                        WebP at the same --quality)
+  --quality N           JPEG and lossy WebP quality, 1..100 (default 90, as the API)
   --stats FILE          write the stats JSON (per-pass ms, counts, params); '-' for stdout
+  --request FILE        render a POST /api/render request (JSON; '-' for stdin) exactly as the server
+                        does: --out gets the encoded bytes, --stats the stats; scene, technique,
+                        preset, parameters, size, camera, light, format and compare come from the file
   --frames N            render a warm-up frame, then N frames, and report per-pass medians (default 1)
   --gl egl|osmesa       headless GL backend (default: $GI_GL, else egl)
   --no-timer-queries    time passes with glFinish on the CPU instead of GPU timer queries
@@ -63,9 +72,10 @@ Ground truth and error (CPU reference renderer, Embree):
   --quiet               only errors on stderr
   --help                this text
 
-Example:
+Examples:
   gi-render --scene builtin:cornell --technique rsm_gather --param vpl_grid=16 \
             --size 512x512 --out out.png --stats stats.json
+  echo '{"scene": "builtin:cornell", "params": {"vpl_grid": 16}}' | gi-render --request - --out out.png
 )";
 
 struct UsageError {
@@ -79,6 +89,9 @@ struct Options {
     std::vector<std::pair<std::string, std::string>> params;
     int width = 512, height = 512;
     std::string out, stats;
+    int quality = gis::kDefaultImageQuality;
+    std::string request;
+    std::vector<std::string> sceneFlags; ///< flags --request takes from its file instead
     int frames = 1;
     std::string gl;
     bool timerQueries = true;
@@ -132,7 +145,8 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
                     rgba8[i * 4 + c] = static_cast<std::uint8_t>(std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
                 rgba8[i * 4 + 3] = 255;
             }
-            gis::writeImageFile(o.out, image.width, image.height, rgba8, rgba, {{"gi:reference", ro.mode}});
+            gis::writeImageFile(o.out, image.width, image.height, rgba8, rgba, {{"gi:reference", ro.mode}},
+                                o.quality);
         }
     }
     return {{"reference", ro.mode},  {"size", {image.width, image.height}}, {"spp", image.spp},
@@ -174,6 +188,78 @@ void writeText(const std::string& path, const std::string& text) {
     f << text << "\n";
 }
 
+std::string requestName(const std::string& path) {
+    return path == "-" ? "stdin" : path;
+}
+
+nlohmann::json readRequest(const std::string& path) {
+    std::string text;
+    if (path == "-") {
+        text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    } else {
+        std::ifstream f(path, std::ios::binary);
+        if (!f) throw gis::InputError(path, "cannot read the request file");
+        text.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    }
+    nlohmann::json request = nlohmann::json::parse(text, nullptr, false);
+    if (request.is_discarded()) throw gis::InputError(requestName(path), "the request is not valid JSON");
+    return request;
+}
+
+/// --request: parseRenderRequest + executeRenderJob, the server's path, with the CLI's bounds.
+int runRequest(const Options& o) {
+    if (!o.sceneFlags.empty())
+        throw UsageError{
+            o.sceneFlags.front() +
+            " cannot be used with --request: the request file sets the scene, technique, preset, "
+            "parameters, size, format, quality and compare"};
+    gis::RenderLimits limits;
+    limits.maxWidth = limits.maxHeight = 4096; // --size's bounds
+    limits.maxReferenceSpp = 1000000;          // --spp's
+    limits.maxReferenceSeconds = 0;            // a local run may take as long as it likes
+    const nlohmann::json request = readRequest(o.request);
+    gis::RenderJob job;
+    try {
+        job = gis::parseRenderRequest(request, limits);
+    } catch (const gis::InputError& e) {
+        throw UsageError{requestName(o.request) + ": " + e.what()};
+    }
+    if (o.useCache) job.referenceCacheDir = o.cacheDir;
+    if (!o.out.empty() && gis::codecForPath(o.out) != job.codec) {
+        const std::string ext = job.codec == gis::ImageCodec::Jpeg ? "jpg" : gis::codecName(job.codec);
+        throw UsageError{"--out '" + o.out + "' does not match the request's format '" +
+                         gis::codecName(job.codec) + "': name it *." + ext};
+    }
+    gis::gl::Backend backend;
+    try {
+        backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);
+    } catch (const gis::InputError& e) {
+        throw UsageError{e.what()};
+    }
+    // Scene and state before GL, as on the flag path: bad input fails fast.
+    std::shared_ptr<const gis::Scene> scene = std::make_shared<gis::Scene>(gis::loadScene(job.scene));
+    gis::makeJobFrameState(*scene, job);
+
+    auto context = gis::gl::createContext(backend);
+    if (!o.quiet)
+        gis::logInfo("gl: " + context->info().backend + ", " + context->info().renderer + ", " +
+                     context->info().version);
+    gis::FrameRenderer renderer(o.timerQueries);
+    gis::RenderResult result =
+        gis::executeRenderJob(renderer, job, [&](const std::string&) { return scene; });
+    result.stats["gl"] = {{"backend", context->info().backend}, {"renderer", context->info().renderer}};
+    if (!o.out.empty()) gis::writeBinaryFile(o.out, result.image);
+    if (!o.stats.empty()) writeText(o.stats, result.stats.dump(2));
+    if (result.stats.contains("compare") && o.stats != "-")
+        std::cout << result.stats["compare"].dump(2) << "\n";
+    if (!o.quiet)
+        gis::logInfo("gi-render: " + job.technique + " " + std::to_string(job.width) + "x" +
+                     std::to_string(job.height) + " frame " +
+                     std::to_string(result.stats["frame_ms"].get<double>()) + " ms, " +
+                     gis::codecName(job.codec) + " " + std::to_string(result.image.size()) + " bytes");
+    return 0;
+}
+
 int run(int argc, char** argv) {
     Options o;
     std::vector<std::string> args(argv + 1, argv + argc);
@@ -181,8 +267,14 @@ int run(int argc, char** argv) {
         if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
         return args[++i];
     };
+    // Flags whose settings a --request file carries (or that do not apply to one frame of it).
+    static const std::vector<std::string> kRequestConflicts = {
+        "--scene",   "--technique", "--preset", "--param",       "--size", "--quality",   "--frames",
+        "--explain", "--reference", "--spp",    "--time-budget", "--seed", "--max-depth", "--compare"};
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
+        if (std::find(kRequestConflicts.begin(), kRequestConflicts.end(), a) != kRequestConflicts.end())
+            o.sceneFlags.push_back(a);
         if (a == "--help" || a == "-h") {
             std::cout << kUsage;
             return 0;
@@ -210,6 +302,10 @@ int run(int argc, char** argv) {
         } else if (a == "--size") parseSize(value(i), o.width, o.height);
         else if (a == "--out") o.out = value(i);
         else if (a == "--stats") o.stats = value(i);
+        else if (a == "--quality")
+            o.quality = parseInt("--quality", value(i), 1, 100);
+        else if (a == "--request")
+            o.request = value(i);
         else if (a == "--frames") o.frames = parseInt("--frames", value(i), 1, 10000);
         else if (a == "--gl") o.gl = value(i);
         else if (a == "--no-timer-queries") o.timerQueries = false;
@@ -244,9 +340,9 @@ int run(int argc, char** argv) {
         }
         if (!o.compare.empty()) throw UsageError{"--compare compares a GL frame: it cannot be used with --reference"};
     }
-    if (!o.out.empty() && !(o.out.ends_with(".png") || o.out.ends_with(".jpg") || o.out.ends_with(".jpeg") ||
-                            o.out.ends_with(".exr")))
-        throw UsageError{"--out must end in .png, .jpg or .exr, got '" + o.out + "'"};
+    if (!o.request.empty()) return runRequest(o);
+    if (!o.out.empty() && !gis::codecForPath(o.out) && !gis::imageFileNeedsLinear(o.out))
+        throw UsageError{"--out must end in .png, .jpg, .webp or .exr, got '" + o.out + "'"};
 
     // Validate everything that needs no GL before creating a context.
     gis::gl::Backend backend;
@@ -258,22 +354,29 @@ int run(int argc, char** argv) {
     auto scene = std::make_shared<gis::Scene>(gis::loadScene(o.scene));
     gis::FrameState state;
     try {
-        state = gis::makeFrameState(*scene, o.technique);
-        if (!o.preset.empty()) gis::applyPreset(state, o.preset);
-        for (const auto& [k, v] : o.params) gis::setParamFromString(state, k, v, "--param " + k);
+        // The flags become the RenderJob of the equivalent request, and the state comes from it as in
+        // executeRenderJob, so `--request` and the flags cannot drift apart. The flags are checked
+        // first on their own state, for errors that name the flag.
+        gis::RenderJob job;
+        job.scene = o.scene;
+        job.technique = o.technique;
+        job.preset = o.preset;
+        job.width = o.width;
+        job.height = o.height;
+        gis::FrameState typed = gis::makeFrameState(*scene, o.technique);
+        if (!o.preset.empty()) gis::applyPreset(typed, o.preset);
+        for (const auto& [k, v] : o.params) {
+            gis::setParamFromString(typed, k, v, "--param " + k);
+            job.params[k] = gis::paramsJson(typed)[k]; // the value as the parameter's type
+        }
+        state = gis::makeJobFrameState(*scene, job);
     } catch (const gis::InputError& e) {
         throw UsageError{e.what()};
     }
-    state.width = o.width;
-    state.height = o.height;
 
     // Effect planning runs before GL (it needs only the scene) and never for a reference, which is
     // the ground truth the plan is measured against.
-    const gis::ParamSet& fp = state.frameParams;
-    bool planning = o.explain || fp.getEnum("effects") == "auto";
-    for (const char* e : {"effect_direct", "effect_indirect", "effect_occlusion", "effect_compensation"})
-        planning = planning || fp.getEnum(e) != "auto";
-    if (planning && o.referenceMode.empty()) {
+    if ((o.explain || gis::effectPlanRequested(state)) && o.referenceMode.empty()) {
         const gis::EffectPlan plan = gis::planEffects(*scene, state);
         gis::applyEffectPlan(state, plan);
         if (o.explain) {
@@ -327,10 +430,9 @@ int run(int argc, char** argv) {
         std::cout << summary["compare"].dump(2) << "\n";
     }
     if (!o.out.empty()) {
+        // The same encoder and text chunks as executeRenderJob: a PNG equals the API's for the same request.
         gis::writeImageFile(o.out, frame.width, frame.height, frame.rgba8, frame.linear,
-                            {{"gi:technique", state.technique},
-                             {"gi:scene", o.scene},
-                             {"gi:params", summary["params"].dump()}});
+                            gis::renderImageMetadata(o.scene, state), o.quality);
     }
     if (!o.stats.empty()) writeText(o.stats, summary.dump(2));
     if (!o.quiet) {

@@ -1,24 +1,67 @@
 // Frame encoding: JPEG through libjpeg-turbo (the streaming path), PNG through libpng (lossless
-// stills), and image files (PNG, JPEG, EXR) through OpenImageIO.
+// stills), WebP through libwebp (lossy or lossless), and image files. Every tone-mapped file goes
+// through these encoders, never through a library that adds timestamps or its own metadata, so the
+// same frame gives the same bytes from gi-render and from the HTTP API.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace gis {
 
+/// The codecs of encoded frames; the values are the codec byte of the binary frame header
+/// (protocol/PROTOCOL.md).
+enum class ImageCodec : std::uint8_t { Jpeg = 1, Png = 2, Webp = 3 };
+
+/// "jpeg", "png" or "webp" (exactly these names). Throws InputError(where, ...) listing them.
+ImageCodec parseImageCodec(const std::string& name, const std::string& where = {});
+/// "jpeg", "png", "webp".
+const char* codecName(ImageCodec codec);
+/// "image/jpeg", "image/png", "image/webp".
+const char* codecMimeType(ImageCodec codec);
+/// The codec a file name's extension calls for (.jpg/.jpeg, .png, .webp, any case); nullopt otherwise.
+std::optional<ImageCodec> codecForPath(const std::string& path);
+
+/// Quality of the lossy codecs when nobody asks for another: the HTTP API's default and what image
+/// files written by writeImageFile use, so that both give the same bytes.
+constexpr int kDefaultImageQuality = 90;
+
+/// Text chunks of a PNG file, (keyword, text) in order. Keywords: 1..79 printable Latin-1 characters.
+using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
+
 /// RGBA8 rows top to bottom -> JPEG (alpha dropped). quality in [1, 100]. Throws gis::Error.
 std::vector<std::uint8_t> encodeJpeg(const std::uint8_t* rgba, int width, int height, int quality);
-/// RGBA8 rows top to bottom -> PNG (RGB, alpha dropped: frames are opaque). Throws gis::Error.
-std::vector<std::uint8_t> encodePng(const std::uint8_t* rgba, int width, int height);
+/// RGBA8 rows top to bottom -> PNG (RGB, alpha dropped: frames are opaque). `text` becomes tEXt
+/// chunks (iTXt for text that is not ASCII) before the image data. The bytes depend only on the
+/// arguments: no time chunk, fixed compression settings. Throws gis::Error.
+std::vector<std::uint8_t> encodePng(const std::uint8_t* rgba, int width, int height,
+                                    const ImageMetadata& text = {});
+/// RGBA8 rows top to bottom -> lossy WebP (RGB, alpha dropped) at quality 1..100 (clamped).
+/// Deterministic (single-threaded encoder). Throws gis::Error.
+std::vector<std::uint8_t> encodeWebp(const std::uint8_t* rgba, int width, int height, int quality);
+/// RGBA8 rows top to bottom -> lossless WebP (RGB, alpha dropped). Throws gis::Error.
+std::vector<std::uint8_t> encodeWebpLossless(const std::uint8_t* rgba, int width, int height);
 
-/// Writes a tone-mapped RGBA8 image (.png, .jpg/.jpeg) or linear radiance (.exr, from `linear`,
-/// RGBA float) chosen by the file extension. `metadata` pairs go into the file header where the
-/// format supports it. Throws gis::InputError naming the path for unknown extensions or I/O errors.
+/// Encodes with `codec`: JPEG and WebP lossy at `quality` (1..100, clamped), PNG lossless with
+/// `pngText` (ignored by the other codecs). Throws gis::Error.
+std::vector<std::uint8_t> encodeImage(ImageCodec codec, const std::uint8_t* rgba, int width, int height,
+                                      int quality, const ImageMetadata& pngText = {});
+
+/// Writes a tone-mapped RGBA8 image or linear radiance, chosen by the file extension:
+///  - .png: encodePng with `metadata` as text chunks;
+///  - .jpg/.jpeg and .webp: encodeJpeg and encodeWebp (lossy) at `quality` (metadata dropped);
+///  - .exr: linear radiance from `linear` (RGBA float) through OpenImageIO, `metadata` in the header.
+/// The first three write exactly the bytes encodeImage returns. Throws gis::InputError naming the path
+/// for unknown extensions or I/O errors.
 void writeImageFile(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgba8,
-                    const std::vector<float>& linear,
-                    const std::vector<std::pair<std::string, std::string>>& metadata = {});
+                    const std::vector<float>& linear, const ImageMetadata& metadata = {},
+                    int quality = kDefaultImageQuality);
+
+/// Writes `bytes` to `path` as they are (binary). Throws gis::InputError naming the path.
+void writeBinaryFile(const std::string& path, const std::vector<std::uint8_t>& bytes);
 
 /// True when `path` ends in an extension writeImageFile needs linear data for (.exr).
 bool imageFileNeedsLinear(const std::string& path);

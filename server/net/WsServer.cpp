@@ -2,26 +2,45 @@
 
 #include <libwebsockets.h>
 
+#include <unistd.h>
+
+#include <chrono>
 #include <climits>
 #include <condition_variable>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
+#include <random>
 #include <thread>
 #include <vector>
 
 #include "core/Error.h"
 #include "core/Log.h"
 #include "gi/Technique.h"
+#include "net/Metrics.h"
+#include "net/RateLimiter.h"
 #include "render/FrameParams.h"
+#include "render/FrameRenderer.h"
+#include "render/RenderRequest.h"
 #include "scene/SceneLoader.h"
+#include "session/GlWorkerPool.h"
+#include "session/RenderGate.h"
 
 namespace gis {
 namespace {
 
-/// Joins finished sessions' render threads away from the service thread.
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+constexpr const char* kServerName = "gi-server/0.2.0";
+constexpr std::size_t kMaxViewersPerSession = 32;
+constexpr std::size_t kMaxRenderRequestBytes = 1 << 20;
+constexpr std::size_t kMaxDirectMessages = 64;
+
+/// Runs teardown work (joining render threads, deleting upload sandboxes) away from the loop.
 class Reaper {
 public:
     Reaper() : mThread([this] { loop(); }) {}
@@ -33,10 +52,10 @@ public:
         mCv.notify_all();
         mThread.join();
     }
-    void retire(std::shared_ptr<Session> s) {
+    void retire(std::function<void()> work) {
         {
             std::lock_guard lock(mMutex);
-            mQueue.push_back(std::move(s));
+            mQueue.push_back(std::move(work));
         }
         mCv.notify_all();
     }
@@ -47,11 +66,11 @@ private:
         while (true) {
             mCv.wait(lock, [&] { return mStop || !mQueue.empty(); });
             while (!mQueue.empty()) {
-                auto s = std::move(mQueue.front());
+                auto work = std::move(mQueue.front());
                 mQueue.pop_front();
                 lock.unlock();
-                s->stop();
-                s.reset();
+                work();
+                work = nullptr;
                 lock.lock();
             }
             if (mStop) return;
@@ -59,27 +78,56 @@ private:
     }
     std::mutex mMutex;
     std::condition_variable mCv;
-    std::deque<std::shared_ptr<Session>> mQueue;
+    std::deque<std::function<void()>> mQueue;
     bool mStop = false;
     std::thread mThread;
 };
 
-struct Connection {
-    std::shared_ptr<Session> session;
-    std::string rx;
-    bool rxTooLarge = false;
-    std::vector<unsigned char> tx; // LWS_PRE headroom + message
-};
+std::string randomToken(const char* prefix) {
+    static std::mutex mutex;
+    static std::random_device device;
+    std::lock_guard lock(mutex);
+    static const char* hex = "0123456789abcdef";
+    std::string out = prefix;
+    for (int i = 0; i < 4; ++i) {
+        const std::uint32_t v = device();
+        for (int b = 0; b < 8; ++b) out += hex[(v >> (4 * b)) & 0xf];
+    }
+    return out;
+}
 
-struct HttpReply {
-    std::vector<unsigned char> body; // LWS_PRE headroom + body
-};
+bool sameSecret(const std::string& a, const std::string& b) {
+    // Constant time in the length of the expected secret: no early exit on the first difference.
+    unsigned diff = a.size() == b.size() ? 0u : 1u;
+    for (std::size_t i = 0; i < b.size(); ++i)
+        diff |= static_cast<unsigned>(b[i] ^ (i < a.size() ? a[i] : 0));
+    return diff == 0;
+}
 
-// Per-connection storage lws allocates (zeroed, plain memory): pointers to our objects only.
-struct PerSession {
-    Connection* connection;
-    HttpReply* reply;
-};
+std::string header(lws* wsi, lws_token_indexes token) {
+    const int len = lws_hdr_total_length(wsi, token);
+    if (len <= 0) return {};
+    std::string out(static_cast<std::size_t>(len) + 1, '\0');
+    if (lws_hdr_copy(wsi, out.data(), len + 1, token) < 0) return {};
+    out.resize(static_cast<std::size_t>(len));
+    return out;
+}
+
+std::string customHeader(lws* wsi, const char* name) {
+    const int nameLen = static_cast<int>(std::strlen(name));
+    const int len = lws_hdr_custom_length(wsi, name, nameLen);
+    if (len <= 0) return {};
+    std::string out(static_cast<std::size_t>(len) + 1, '\0');
+    if (lws_hdr_custom_copy(wsi, out.data(), len + 1, name, nameLen) < 0) return {};
+    out.resize(static_cast<std::size_t>(len));
+    return out;
+}
+
+std::string urlArg(lws* wsi, const char* name) {
+    char buf[512];
+    const char* v = lws_get_urlarg_by_name(wsi, name, buf, sizeof buf);
+    return v ? std::string(v) : std::string();
+}
 
 std::string mimeType(const std::string& path) {
     auto ext = path.substr(path.find_last_of('.') + 1);
@@ -100,124 +148,799 @@ nlohmann::json techniquesJson() {
                         {"description", e.info.description},
                         {"paper", e.info.paper},
                         {"params_schema", e.info.params.jsonSchema()}});
-    return {{"techniques", list}, {"frame_params_schema", frameParamTable().jsonSchema()}};
+    return list;
 }
+
+std::string base64(const std::vector<std::uint8_t>& data) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((data.size() + 2) / 3 * 4);
+    for (std::size_t i = 0; i < data.size(); i += 3) {
+        const std::uint32_t n = (std::uint32_t(data[i]) << 16) |
+                                (i + 1 < data.size() ? data[i + 1] << 8 : 0) |
+                                (i + 2 < data.size() ? data[i + 2] : 0);
+        out += table[(n >> 18) & 63];
+        out += table[(n >> 12) & 63];
+        out += i + 1 < data.size() ? table[(n >> 6) & 63] : '=';
+        out += i + 2 < data.size() ? table[n & 63] : '=';
+    }
+    return out;
+}
+
+/// One HTTP response, written in two writable callbacks: headers, then the body.
+struct HttpResponse {
+    unsigned status = 200;
+    std::string contentType = "application/json";
+    std::vector<std::pair<std::string, std::string>> headers; ///< ("x-gi-stats:", value)
+    std::string body;
+};
+
+HttpResponse jsonResponse(unsigned status, const nlohmann::json& body) {
+    return {status, "application/json", {}, body.dump()};
+}
+
+HttpResponse errorResponse(unsigned status, const std::string& code, const std::string& message,
+                           const std::string& where = {}) {
+    nlohmann::json body = {{"error", code}, {"message", message}};
+    if (!where.empty()) body["where"] = where;
+    return jsonResponse(status, body);
+}
+
+struct HttpExchange {
+    std::string uri;
+    bool post = false;
+    std::string body;
+    bool bodyTooLarge = false;
+    std::size_t bodyLimit = 0;
+    std::uint64_t jobId = 0; ///< awaiting a render when non-zero
+    bool ready = false;
+    bool headersSent = false;
+    HttpResponse response;
+    std::string endpoint; ///< for metrics
+};
+
+struct SessionEntry;
+
+struct Connection {
+    lws* wsi = nullptr;
+    Clock::time_point opened = Clock::now();
+    bool helloDone = false;
+    bool headerAuth = false;
+    std::string rx;
+    bool rxTooLarge = false;
+    std::vector<unsigned char> tx;  // LWS_PRE headroom + message
+    std::deque<std::string> direct; // replies from the network layer (welcome, errors, pong)
+    std::unique_ptr<RateLimiter> limiter;
+    Clock::time_point lastRateError{};
+    std::shared_ptr<ClientLink> link;
+    std::shared_ptr<SessionEntry> entry;
+    int peerCloseCode = 0;
+    bool closing = false;
+    int closeCode = 1000;
+    std::string closeReason;
+};
+
+struct SessionEntry {
+    std::shared_ptr<Session> session;
+    std::string resumeToken, viewToken;
+    Connection* controller = nullptr;
+    Clock::time_point detachedAt{};
+    bool ended = false;
+};
+
+// Per-connection storage lws allocates (zeroed, plain memory): pointers and flags only.
+struct PerSession {
+    Connection* connection;
+    HttpExchange* http;
+    bool headerAuth;
+};
+
+struct Housekeeping {
+    lws_sorted_usec_list_t sul; // first member: the callback gets this address back
+    WsServer::Impl* self;
+};
 
 } // namespace
 
 struct WsServer::Impl {
     ServerConfig config;
-    std::string clientRoot; // realpath of config.clientDir
+    std::string clientRoot;
+    std::string uploadRoot;
+    bool ownsUploadRoot = false;
     lws_context* context = nullptr;
     std::atomic<bool> stop{false};
+    Clock::time_point started = Clock::now();
     std::shared_ptr<SceneCache> scenes = std::make_shared<SceneCache>();
+    std::shared_ptr<const Scene> defaultScene; // keeps the default scene cached between sessions
+    std::shared_ptr<const SceneCatalog> catalog;
+    std::unique_ptr<RenderGate> gate;
+    std::unique_ptr<GlWorkerPool> workers;
+    MetricsRegistry metrics;
     std::map<lws*, std::unique_ptr<Connection>> connections;
+    std::map<std::string, std::shared_ptr<SessionEntry>> sessions; // by id
     std::unique_ptr<Reaper> reaper = std::make_unique<Reaper>();
     std::uint64_t nextSessionId = 1;
     lws_protocols protocols[3];
+    Housekeeping housekeeping{};
+
+    // Finished HTTP render jobs, handed from workers to the loop.
+    std::mutex doneMutex;
+    std::map<std::uint64_t, HttpResponse> done;
+    std::map<std::uint64_t, lws*> awaiting;
+    std::uint64_t nextJobId = 1;
 
     static Impl* from(lws* wsi) { return static_cast<Impl*>(lws_context_user(lws_get_context(wsi))); }
 
+    // --- metrics ----------------------------------------------------------------------------
+    void countError(const std::string& code) {
+        metrics.counter("gis_errors_total", "error messages sent to clients, by code", {{"code", code}})
+            .inc();
+    }
+    void countHttp(const std::string& endpoint, unsigned status) {
+        metrics
+            .counter("gis_http_requests_total", "HTTP requests by endpoint and status",
+                     {{"endpoint", endpoint}, {"status", std::to_string(status)}})
+            .inc();
+    }
+    void onFrame(const FrameReport& r) {
+        metrics.counter("gis_frames_total", "frames rendered, by quality step", {{"quality", r.quality}})
+            .inc();
+        metrics.histogram("gis_frame_ms", "frame render time", defaultLatencyBucketsMs()).observe(r.frameMs);
+        metrics
+            .histogram("gis_admission_wait_ms", "time a render waited for a render slot",
+                       defaultLatencyBucketsMs())
+            .observe(r.queueMs);
+        metrics.histogram("gis_encode_ms", "frame encoding time", defaultLatencyBucketsMs())
+            .observe(r.encodeMs);
+        for (const auto& [pass, ms] : r.passMs)
+            metrics
+                .histogram("gis_pass_ms", "per-pass render time", defaultLatencyBucketsMs(), {{"pass", pass}})
+                .observe(ms);
+        if (r.dropped)
+            metrics.counter("gis_frames_dropped_total", "frames a client skipped (window full or replaced)")
+                .inc(static_cast<double>(r.dropped));
+    }
+    void updateGauges() {
+        std::size_t controllers = 0, viewers = 0, detached = 0;
+        for (const auto& [id, e] : sessions) {
+            if (e->controller)
+                ++controllers;
+            else
+                ++detached;
+            viewers += e->session->viewerCount();
+        }
+        metrics.gauge("gis_sessions", "open sessions (including those waiting for a resume)")
+            .set(static_cast<double>(sessions.size()));
+        metrics.gauge("gis_sessions_detached", "sessions waiting for their controller to resume")
+            .set(static_cast<double>(detached));
+        metrics.gauge("gis_clients", "attached clients by role", {{"role", "controller"}})
+            .set(static_cast<double>(controllers));
+        metrics.gauge("gis_clients", "attached clients by role", {{"role", "viewer"}})
+            .set(static_cast<double>(viewers));
+        metrics.gauge("gis_renders_active", "renders holding a render slot").set(gate->active());
+        metrics.gauge("gis_render_queue_depth", "renders waiting for a render slot").set(gate->waiting());
+        metrics.gauge("gis_http_render_queue", "POST /api/render jobs waiting for a worker")
+            .set(static_cast<double>(workers->queued()));
+        metrics.gauge("gis_uptime_seconds", "seconds since the server started")
+            .set(std::chrono::duration<double>(Clock::now() - started).count());
+    }
+
+    // --- access control -----------------------------------------------------------------------
+    bool originAllowed(lws* wsi) {
+        const std::string origin = header(wsi, WSI_TOKEN_ORIGIN);
+        if (origin.empty()) return true; // not a browser: the token (if any) decides
+        const std::string host = header(wsi, WSI_TOKEN_HOST);
+        if (origin == "http://" + host || origin == "https://" + host) return true;
+        for (const auto& o : config.allowOrigins)
+            if (origin == o) return true;
+        return false;
+    }
+    bool bearerOk(lws* wsi) {
+        if (config.token.empty()) return true;
+        const std::string auth = header(wsi, WSI_TOKEN_HTTP_AUTHORIZATION);
+        return auth.rfind("Bearer ", 0) == 0 && sameSecret(auth.substr(7), config.token);
+    }
+
     // --- HTTP -------------------------------------------------------------------------------
-    int replyJson(lws* wsi, PerSession* pss, unsigned status, const nlohmann::json& body) {
-        const std::string text = body.dump();
-        unsigned char headers[LWS_PRE + 1024];
-        unsigned char* start = headers + LWS_PRE;
-        unsigned char* p = start;
-        unsigned char* end = headers + sizeof headers - 1;
-        if (lws_add_http_common_headers(wsi, status, "application/json", text.size(), &p, end)) return 1;
-        if (lws_finalize_write_http_header(wsi, start, &p, end)) return 1;
-        delete pss->reply;
-        pss->reply = new HttpReply;
-        pss->reply->body.resize(LWS_PRE + text.size());
-        std::memcpy(pss->reply->body.data() + LWS_PRE, text.data(), text.size());
+    void respond(lws* wsi, PerSession* pss, HttpResponse response) {
+        if (!pss->http) pss->http = new HttpExchange;
+        countHttp(pss->http->endpoint.empty() ? "static" : pss->http->endpoint, response.status);
+        pss->http->response = std::move(response);
+        pss->http->ready = true;
         lws_callback_on_writable(wsi);
-        return 0;
+    }
+
+    int writeHttp(lws* wsi, PerSession* pss) {
+        HttpExchange* x = pss ? pss->http : nullptr;
+        if (!x || !x->ready) return 0;
+        HttpResponse& r = x->response;
+        if (!x->headersSent) {
+            std::size_t extra = 512 + r.contentType.size();
+            for (const auto& [k, v] : r.headers) extra += k.size() + v.size() + 8;
+            std::vector<unsigned char> buf(LWS_PRE + extra);
+            unsigned char* start = buf.data() + LWS_PRE;
+            unsigned char* p = start;
+            unsigned char* end = buf.data() + buf.size() - 1;
+            if (lws_add_http_common_headers(wsi, r.status, r.contentType.c_str(), r.body.size(), &p, end))
+                return -1;
+            for (const auto& [k, v] : r.headers)
+                if (lws_add_http_header_by_name(wsi, reinterpret_cast<const unsigned char*>(k.c_str()),
+                                                reinterpret_cast<const unsigned char*>(v.data()),
+                                                static_cast<int>(v.size()), &p, end))
+                    return -1;
+            if (lws_finalize_write_http_header(wsi, start, &p, end)) return -1;
+            x->headersSent = true;
+            lws_callback_on_writable(wsi);
+            return 0;
+        }
+        std::vector<unsigned char> body(LWS_PRE + r.body.size());
+        std::memcpy(body.data() + LWS_PRE, r.body.data(), r.body.size());
+        const int n = lws_write(wsi, body.data() + LWS_PRE, r.body.size(), LWS_WRITE_HTTP_FINAL);
+        delete pss->http;
+        pss->http = nullptr;
+        if (n < 0) return -1;
+        return lws_http_transaction_completed(wsi) ? -1 : 0;
     }
 
     int serveFile(lws* wsi, PerSession* pss, const std::string& uri) {
         std::string path = uri == "/" ? "/index.html" : uri;
-        if (path.find("..") != std::string::npos || path.find('\\') != std::string::npos || path[0] != '/')
-            return replyJson(wsi, pss, HTTP_STATUS_BAD_REQUEST, {{"error", "bad path"}});
+        if (path.find("..") != std::string::npos || path.find('\\') != std::string::npos || path[0] != '/') {
+            respond(wsi, pss, errorResponse(400, "bad_path", "paths may not contain '..' or backslashes"));
+            return 0;
+        }
         char resolved[PATH_MAX];
         const std::string full = config.clientDir + path;
-        if (!realpath(full.c_str(), resolved) || std::string(resolved).rfind(clientRoot + "/", 0) != 0)
-            return replyJson(wsi, pss, HTTP_STATUS_NOT_FOUND, {{"error", "not found"}, {"path", uri}});
+        if (!realpath(full.c_str(), resolved) || std::string(resolved).rfind(clientRoot + "/", 0) != 0) {
+            respond(wsi, pss, errorResponse(404, "not_found", "no such file: " + uri));
+            return 0;
+        }
+        countHttp("static", 200);
         int n = lws_serve_http_file(wsi, resolved, mimeType(resolved).c_str(), nullptr, 0);
         if (n < 0 || (n > 0 && lws_http_transaction_completed(wsi))) return -1;
         return 0;
     }
 
+    nlohmann::json scenesJson() const {
+        nlohmann::json list = nlohmann::json::array();
+        for (const auto& n : catalog->list()) list.push_back(n);
+        return list;
+    }
+
+    int onHttpRequest(lws* wsi, PerSession* pss, const std::string& uri) {
+        const bool post = lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) > 0;
+        delete pss->http;
+        pss->http = new HttpExchange;
+        pss->http->uri = uri;
+        pss->http->post = post;
+        pss->http->endpoint =
+            uri.rfind("/api/", 0) == 0 || uri == "/metrics" || uri == "/healthz" ? uri : "static";
+        if (uri == "/healthz") {
+            respond(wsi, pss,
+                    jsonResponse(
+                        200, {{"status", "ok"},
+                              {"sessions", sessions.size()},
+                              {"renders_active", gate->active()},
+                              {"renders_waiting", gate->waiting()},
+                              {"uptime_s", std::chrono::duration<double>(Clock::now() - started).count()}}));
+            return 0;
+        }
+        const bool api = uri.rfind("/api/", 0) == 0 || uri == "/metrics";
+        if (api && !originAllowed(wsi)) {
+            respond(wsi, pss, errorResponse(403, "forbidden_origin", "this origin may not use the API"));
+            return 0;
+        }
+        if (api && !bearerOk(wsi)) {
+            HttpResponse r = errorResponse(401, "unauthorized", "send 'Authorization: Bearer <token>'");
+            r.headers.emplace_back("www-authenticate:", "Bearer");
+            respond(wsi, pss, std::move(r));
+            return 0;
+        }
+        if (post) {
+            if (uri == "/api/render") {
+                pss->http->bodyLimit = kMaxRenderRequestBytes;
+            } else if (uri == "/api/upload") {
+                if (config.maxUploadMb == 0) {
+                    respond(wsi, pss,
+                            errorResponse(403, "uploads_disabled", "this server does not accept uploads"));
+                    return 0;
+                }
+                pss->http->bodyLimit = static_cast<std::size_t>(config.maxUploadMb) << 20;
+            } else {
+                respond(wsi, pss, errorResponse(404, "not_found", "no POST endpoint " + uri));
+                return 0;
+            }
+            return 0; // the body follows (LWS_CALLBACK_HTTP_BODY)
+        }
+        if (uri == "/metrics") {
+            updateGauges();
+            respond(wsi, pss, {200, "text/plain; version=0.0.4; charset=utf-8", {}, metrics.render()});
+            return 0;
+        }
+        if (uri == "/api/techniques") {
+            respond(wsi, pss,
+                    jsonResponse(200, {{"techniques", techniquesJson()},
+                                       {"frame_params_schema", frameParamTable().jsonSchema()}}));
+            return 0;
+        }
+        if (uri == "/api/scenes") {
+            respond(wsi, pss, jsonResponse(200, {{"scenes", scenesJson()}}));
+            return 0;
+        }
+        if (uri == "/api/render" || uri == "/api/upload") {
+            HttpResponse r = errorResponse(405, "method_not_allowed", uri + " takes POST");
+            r.headers.emplace_back("allow:", "POST");
+            respond(wsi, pss, std::move(r));
+            return 0;
+        }
+        if (uri.rfind("/api/", 0) == 0) {
+            respond(wsi, pss, errorResponse(404, "not_found", "unknown API endpoint " + uri));
+            return 0;
+        }
+        return serveFile(wsi, pss, uri);
+    }
+
+    void onHttpBody(lws* wsi, PerSession* pss) {
+        HttpExchange* x = pss->http;
+        if (!x || x->ready) return; // already answered (auth, origin): the body is ignored
+        if (x->bodyTooLarge) {
+            respond(
+                wsi, pss,
+                errorResponse(413, "too_large",
+                              "the body exceeds " + std::to_string(x->bodyLimit) + " bytes for " + x->uri));
+            return;
+        }
+        if (x->uri == "/api/render")
+            startRender(wsi, pss);
+        else if (x->uri == "/api/upload")
+            handleUpload(wsi, pss);
+    }
+
+    void startRender(lws* wsi, PerSession* pss) {
+        HttpExchange* x = pss->http;
+        nlohmann::json request = nlohmann::json::parse(x->body, nullptr, false);
+        if (request.is_discarded() || !request.is_object()) {
+            respond(wsi, pss,
+                    errorResponse(400, "invalid_json", "the body must be a JSON object (see PROTOCOL.md)"));
+            return;
+        }
+        bool jsonReply = false;
+        if (auto it = request.find("response"); it != request.end()) {
+            if (!it->is_string() || (*it != "image" && *it != "json")) {
+                respond(wsi, pss,
+                        errorResponse(400, "invalid_request", "must be \"image\" or \"json\"", "/response"));
+                return;
+            }
+            jsonReply = *it == "json";
+            request.erase(it);
+        }
+        RenderLimits limits;
+        limits.maxWidth = config.session.limits.maxWidth;
+        limits.maxHeight = config.session.limits.maxHeight;
+        std::shared_ptr<RenderJob> job;
+        try {
+            job = std::make_shared<RenderJob>(parseRenderRequest(request, limits));
+        } catch (const InputError& e) {
+            respond(wsi, pss, errorResponse(400, "invalid_request", e.reason(), e.where()));
+            return;
+        }
+        const std::uint64_t id = nextJobId++;
+        auto catalogRef = catalog;
+        auto sceneCache = scenes;
+        lws_context* ctx = context;
+        auto finish = [this, id, ctx](HttpResponse r) {
+            {
+                std::lock_guard lock(doneMutex);
+                done[id] = std::move(r);
+            }
+            lws_cancel_service(ctx);
+        };
+        const long maxVpls = config.session.limits.maxVpls;
+        auto work = [job, jsonReply, catalogRef, sceneCache, finish, maxVpls](FrameRenderer& renderer,
+                                                                              double queueMs) {
+            try {
+                auto resolve = [&](const std::string& name) {
+                    try {
+                        return sceneCache->get(catalogRef->resolve(name));
+                    } catch (const InputError& e) {
+                        throw InputError("/scene", e.reason());
+                    }
+                };
+                const long vpls = maxVplEstimate(makeJobFrameState(*resolve(job->scene), *job));
+                if (vpls > maxVpls)
+                    throw InputError("/params", "these parameters ask for up to " + std::to_string(vpls) +
+                                                    " VPLs; the server allows " + std::to_string(maxVpls));
+                RenderResult result = executeRenderJob(renderer, *job, resolve);
+                result.stats["queue_ms"] = queueMs;
+                if (jsonReply) {
+                    finish(
+                        jsonResponse(200, {{"stats", result.stats}, {"image_base64", base64(result.image)}}));
+                } else {
+                    HttpResponse r{200, result.mimeType, {{"x-gi-stats:", result.stats.dump()}}, {}};
+                    r.body.assign(result.image.begin(), result.image.end());
+                    finish(std::move(r));
+                }
+            } catch (const InputError& e) {
+                finish(errorResponse(400, "invalid_request", e.reason(), e.where()));
+            } catch (const std::exception& e) {
+                finish(errorResponse(500, "render_failed", e.what()));
+            }
+        };
+        auto fail = [finish](const std::string& message) {
+            finish(errorResponse(500, "render_failed", message));
+        };
+        if (!workers->submit(work, fail)) {
+            HttpResponse r =
+                errorResponse(503, "busy", "every render slot and queue place is taken; retry shortly");
+            r.headers.emplace_back("retry-after:", "1");
+            respond(wsi, pss, std::move(r));
+            return;
+        }
+        x->jobId = id;
+        awaiting[id] = wsi;
+    }
+
+    void handleUpload(lws* wsi, PerSession* pss) {
+        HttpExchange* x = pss->http;
+        const std::string name = urlArg(wsi, "name=");
+        try {
+            SceneCatalog::checkUploadName(name);
+        } catch (const InputError& e) {
+            respond(wsi, pss, errorResponse(400, "invalid_name", e.reason(), "name"));
+            return;
+        }
+        const std::string token = customHeader(wsi, "x-gi-session:");
+        std::shared_ptr<SessionEntry> entry;
+        for (const auto& [id, e] : sessions)
+            if (!token.empty() && sameSecret(token, e->resumeToken)) entry = e;
+        if (!entry) {
+            respond(wsi, pss,
+                    errorResponse(404, "unknown_session",
+                                  "send the resume token of a live session in the X-GI-Session header"));
+            return;
+        }
+        if (x->body.size() < 12 || x->body.compare(0, 4, "glTF") != 0) {
+            respond(wsi, pss, errorResponse(400, "not_glb", "the body is not a binary glTF (.glb) file"));
+            return;
+        }
+        std::error_code ec;
+        const fs::path dir = entry->session->uploadDir();
+        fs::create_directories(dir, ec);
+        std::ofstream out(dir / name, std::ios::binary | std::ios::trunc);
+        out.write(x->body.data(), static_cast<std::streamsize>(x->body.size()));
+        if (ec || !out) {
+            respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
+            return;
+        }
+        respond(wsi, pss, jsonResponse(201, {{"scene", "upload:" + name}, {"bytes", x->body.size()}}));
+    }
+
     int onHttp(lws* wsi, lws_callback_reasons reason, PerSession* pss, void* in, size_t len) {
         switch (reason) {
         case LWS_CALLBACK_HTTP: {
-            std::string uri(static_cast<const char*>(in), strnlen(static_cast<const char*>(in), len ? len : 4096));
-            if (uri == "/healthz")
-                return replyJson(wsi, pss, HTTP_STATUS_OK, {{"status", "ok"}, {"sessions", connections.size()}});
-            if (uri == "/api/techniques") return replyJson(wsi, pss, HTTP_STATUS_OK, techniquesJson());
-            if (uri == "/api/scenes") {
-                nlohmann::json list = nlohmann::json::array();
-                for (const auto& n : builtinSceneNames()) list.push_back("builtin:" + n);
-                return replyJson(wsi, pss, HTTP_STATUS_OK, {{"scenes", list}});
+            if (!pss) return -1;
+            std::string uri(static_cast<const char*>(in),
+                            strnlen(static_cast<const char*>(in), len ? len : 4096));
+            return onHttpRequest(wsi, pss, uri);
+        }
+        case LWS_CALLBACK_HTTP_BODY:
+            if (pss && pss->http && !pss->http->ready) {
+                HttpExchange* x = pss->http;
+                if (x->body.size() + len > x->bodyLimit) {
+                    x->bodyTooLarge = true;
+                    x->body.clear();
+                } else if (!x->bodyTooLarge) {
+                    x->body.append(static_cast<const char*>(in), len);
+                }
             }
-            if (uri.rfind("/api/", 0) == 0)
-                return replyJson(wsi, pss, HTTP_STATUS_NOT_FOUND, {{"error", "unknown API endpoint"}, {"path", uri}});
-            return serveFile(wsi, pss, uri);
-        }
-        case LWS_CALLBACK_HTTP_WRITEABLE: {
-            if (!pss || !pss->reply) break;
-            auto& b = pss->reply->body;
-            int n = lws_write(wsi, b.data() + LWS_PRE, b.size() - LWS_PRE, LWS_WRITE_HTTP_FINAL);
-            delete pss->reply;
-            pss->reply = nullptr;
-            if (n < 0) return -1;
-            if (lws_http_transaction_completed(wsi)) return -1;
             return 0;
-        }
+        case LWS_CALLBACK_HTTP_BODY_COMPLETION:
+            if (pss) onHttpBody(wsi, pss);
+            return 0;
+        case LWS_CALLBACK_HTTP_WRITEABLE:
+            return writeHttp(wsi, pss);
         case LWS_CALLBACK_HTTP_DROP_PROTOCOL:
         case LWS_CALLBACK_CLOSED_HTTP:
-            if (pss) {
-                delete pss->reply;
-                pss->reply = nullptr;
+            if (pss && pss->http) {
+                if (pss->http->jobId) awaiting.erase(pss->http->jobId); // the result is discarded
+                delete pss->http;
+                pss->http = nullptr;
             }
             break;
-        default: break;
+        default:
+            break;
         }
         return lws_callback_http_dummy(wsi, reason, pss, in, len);
     }
 
+    void deliverFinishedJobs() {
+        std::map<std::uint64_t, HttpResponse> finished;
+        {
+            std::lock_guard lock(doneMutex);
+            finished.swap(done);
+        }
+        for (auto& [id, response] : finished) {
+            auto it = awaiting.find(id);
+            if (it == awaiting.end()) continue; // the client left
+            lws* wsi = it->second;
+            awaiting.erase(it);
+            auto* pss = static_cast<PerSession*>(lws_wsi_user(wsi));
+            if (!pss || !pss->http) continue;
+            pss->http->jobId = 0;
+            respond(wsi, pss, std::move(response));
+        }
+    }
+
     // --- WebSocket --------------------------------------------------------------------------
+    void sendDirect(Connection& c, const nlohmann::json& msg) {
+        if (msg.value("type", "") == "error") countError(msg.value("code", "unknown"));
+        if (c.direct.size() >= kMaxDirectMessages) return; // a client that never reads loses replies
+        c.direct.push_back(msg.dump());
+        lws_callback_on_writable(c.wsi);
+    }
+    void sendError(Connection& c, const ProtocolError& e) { sendDirect(c, errorMessage(e)); }
+    void closeWith(Connection& c, const ProtocolError& e, int code) {
+        sendError(c, e);
+        c.closing = true;
+        c.closeCode = code;
+        c.closeReason = e.code;
+        lws_callback_on_writable(c.wsi);
+    }
+
+    void endSession(const std::shared_ptr<SessionEntry>& entry, const std::string& code,
+                    const std::string& message) {
+        if (entry->ended) return;
+        entry->ended = true;
+        for (auto& [wsi, c] : connections) {
+            if (c->entry != entry) continue;
+            if (!code.empty()) closeWith(*c, {code, message, "", ""}, code == "idle_timeout" ? 1000 : 1001);
+            c->link.reset();
+            c->entry.reset();
+        }
+        sessions.erase(entry->session->id());
+        logInfo("net: session " + entry->session->id() + " ended (" + (code.empty() ? "closed" : code) +
+                ") after " + std::to_string(entry->session->framesRendered()) + " frames");
+        auto session = entry->session;
+        reaper->retire([session] {
+            session->stop();
+            std::error_code ec;
+            if (!session->uploadDir().empty()) fs::remove_all(session->uploadDir(), ec);
+        });
+    }
+
+    std::shared_ptr<SessionEntry> findEntry(const std::string& token, bool resume) {
+        for (const auto& [id, e] : sessions)
+            if (sameSecret(token, resume ? e->resumeToken : e->viewToken)) return e;
+        return nullptr;
+    }
+
+    nlohmann::json welcomeFor(const SessionEntry& entry, ClientRole role, bool resumed, int maxInFlight) {
+        const StreamOptions stream = entry.session->streamOptions();
+        const SessionLimits& l = config.session.limits;
+        nlohmann::json w = {{"type", "welcome"},
+                            {"protocol", kProtocolVersion},
+                            {"server", kServerName},
+                            {"session", entry.session->id()},
+                            {"role", roleName(role)},
+                            {"resumed", resumed},
+                            {"codec", codecName(stream.codec)},
+                            {"quality", stream.quality},
+                            {"max_in_flight", maxInFlight},
+                            {"adaptive", stream.adaptive},
+                            {"limits",
+                             {{"max_size", {l.maxWidth, l.maxHeight}},
+                              {"max_vpls", l.maxVpls},
+                              {"max_message_bytes", config.maxMessageBytes},
+                              {"messages_per_second", config.messagesPerSecond},
+                              {"resume_grace_s", config.resumeGraceS},
+                              {"idle_timeout_s", config.idleTimeoutS},
+                              {"interactive_scale", l.interactiveScale},
+                              {"settle_ms", l.settleMs},
+                              {"refine_budget_ms", l.refineBudgetMs}}},
+                            {"scenes", entry.session->sceneNames()},
+                            {"techniques", techniquesJson()},
+                            {"frame_params_schema", frameParamTable().jsonSchema()},
+                            {"state", entry.session->stateJson()}};
+        if (role == ClientRole::Controller) {
+            w["resume_token"] = entry.resumeToken;
+            w["view_token"] = entry.viewToken;
+        }
+        return w;
+    }
+
+    std::shared_ptr<ClientLink> makeLink(ClientRole role, int maxInFlight) {
+        lws_context* ctx = context;
+        return std::make_shared<ClientLink>(role, maxInFlight, [ctx] { lws_cancel_service(ctx); });
+    }
+
+    void onHello(Connection& c, const nlohmann::json& hello) {
+        if (hello["protocol"].get<int>() != kProtocolVersion) {
+            closeWith(c,
+                      {"protocol_mismatch",
+                       "this server speaks protocol " + std::to_string(kProtocolVersion) + ", the client " +
+                           std::to_string(hello["protocol"].get<int>()),
+                       "/protocol", "hello"},
+                      1002);
+            return;
+        }
+        if (!config.token.empty() && !c.headerAuth &&
+            !(hello.contains("token") && sameSecret(hello["token"].get<std::string>(), config.token))) {
+            closeWith(c,
+                      {"unauthorized",
+                       "this server needs its token in hello.token or an Authorization header", "/token",
+                       "hello"},
+                      1008);
+            return;
+        }
+        const int maxInFlight = hello.value("max_in_flight", 1);
+        StreamOptions stream;
+        stream.quality = hello.value("quality", config.jpegQuality);
+        stream.adaptive = hello.value("adaptive", true);
+        if (hello.contains("codecs")) stream.codec = parseImageCodec(hello["codecs"][0].get<std::string>());
+
+        if (hello.contains("view")) {
+            auto entry = findEntry(hello["view"], false);
+            if (!entry) {
+                closeWith(c, {"unknown_view_token", "no live session has this view token", "/view", "hello"},
+                          1008);
+                return;
+            }
+            if (entry->session->viewerCount() >= kMaxViewersPerSession) {
+                closeWith(c, {"busy", "this session has its maximum of viewers", "", "hello"}, 1013);
+                return;
+            }
+            c.link = makeLink(ClientRole::Viewer, maxInFlight);
+            c.entry = entry;
+            c.helloDone = true;
+            sendDirect(c, welcomeFor(*entry, ClientRole::Viewer, false, maxInFlight));
+            entry->session->attach(c.link);
+            logInfo("net: a viewer joined session " + entry->session->id());
+            return;
+        }
+        std::shared_ptr<SessionEntry> entry;
+        bool resumed = false;
+        if (hello.contains("resume")) {
+            entry = findEntry(hello["resume"], true);
+            if (!entry) {
+                closeWith(c,
+                          {"resume_failed",
+                           "the session has ended or the token is unknown; connect without resume", "/resume",
+                           "hello"},
+                          1008);
+                return;
+            }
+            if (entry->controller) {
+                // The old connection may be half-open and not noticed yet: the resume takes over.
+                Connection* old = entry->controller;
+                old->link.reset();
+                old->entry.reset();
+                closeWith(*old, {"session_ended", "another connection resumed this session", "", ""}, 1001);
+            }
+            resumed = true;
+        } else {
+            if (static_cast<int>(sessions.size()) >= config.maxSessions) {
+                closeWith(c,
+                          {"busy",
+                           "the server has reached its session limit (" + std::to_string(config.maxSessions) +
+                               "); try again later",
+                           "", "hello"},
+                          1013);
+                metrics.counter("gis_sessions_refused_total", "sessions refused at the session cap").inc();
+                return;
+            }
+            entry = std::make_shared<SessionEntry>();
+            const std::string id = "s" + std::to_string(nextSessionId++);
+            try {
+                entry->session = std::make_shared<Session>(id, config.session, scenes, catalog, gate.get(),
+                                                           (fs::path(uploadRoot) / id).string());
+            } catch (const std::exception& e) {
+                closeWith(c,
+                          {"render_failed", std::string("cannot start a session: ") + e.what(), "", "hello"},
+                          1011);
+                return;
+            }
+            entry->session->setObservers([this](const FrameReport& r) { onFrame(r); },
+                                         [this](const std::string& code) { countError(code); });
+            entry->resumeToken = randomToken("r-");
+            entry->viewToken = randomToken("v-");
+            sessions[id] = entry;
+            metrics.counter("gis_sessions_started_total", "sessions created").inc();
+        }
+        if (hello.contains("size")) {
+            try {
+                entry->session->resize(hello["size"][0], hello["size"][1], hello.value("dpr", 1.0));
+            } catch (const ProtocolError& e) {
+                sendError(c, e);
+            }
+        }
+        c.link = makeLink(ClientRole::Controller, maxInFlight);
+        c.entry = entry;
+        c.helloDone = true;
+        entry->controller = &c;
+        entry->detachedAt = {};
+        // Attach first so that welcome reports the negotiated stream; it still goes out before any
+        // frame (direct replies are written before the link's queue).
+        entry->session->attach(c.link, &stream);
+        sendDirect(c, welcomeFor(*entry, ClientRole::Controller, resumed, maxInFlight));
+        if (!resumed) entry->session->start();
+        logInfo("net: session " + entry->session->id() + (resumed ? " resumed" : " opened") + " (" +
+                std::to_string(sessions.size()) + " open)");
+    }
+
+    void onMessage(Connection& c, const std::string& text) {
+        nlohmann::json msg;
+        try {
+            msg = parseClientMessage(text);
+        } catch (const ProtocolError& e) {
+            if (!c.helloDone)
+                closeWith(c,
+                          {"hello_required", "the first message must be a valid hello: " + e.message, e.where,
+                           e.request},
+                          1008);
+            else
+                sendError(c, e);
+            return;
+        }
+        const std::string type = msg["type"];
+        if (!c.helloDone) {
+            if (type != "hello") {
+                closeWith(c, {"hello_required", "send hello first (protocol/PROTOCOL.md)", "/type", type},
+                          1008);
+                return;
+            }
+            onHello(c, msg);
+            return;
+        }
+        if (type == "hello") {
+            sendError(c, {"invalid_message", "hello was already accepted on this connection", "/type", type});
+            return;
+        }
+        if (type == "ping") {
+            nlohmann::json pong = {{"type", "pong"}};
+            if (msg.contains("t")) pong["t"] = msg["t"];
+            sendDirect(c, pong);
+            return;
+        }
+        if (!c.entry || !c.link) return; // the session ended; the close is on its way
+        if (type == "ack") {
+            c.entry->session->ack(c.link, msg["frame"].get<std::uint32_t>());
+            return;
+        }
+        if (c.link->role() == ClientRole::Viewer && type != "snapshot") {
+            sendError(c, {"read_only", "viewers cannot steer a shared session", "/type", type});
+            return;
+        }
+        try {
+            c.entry->session->apply(msg, c.link);
+        } catch (const ProtocolError& e) {
+            sendError(c, e);
+        }
+    }
+
     int onStream(lws* wsi, lws_callback_reasons reason, PerSession* pss, void* in, size_t len) {
         switch (reason) {
+        case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+            if (!originAllowed(wsi)) {
+                logWarn("net: refused a WebSocket from origin '" + header(wsi, WSI_TOKEN_ORIGIN) + "'");
+                countHttp("/ws", 403);
+                return 1;
+            }
+            if (pss) pss->headerAuth = !config.token.empty() && bearerOk(wsi);
+            break;
         case LWS_CALLBACK_ESTABLISHED: {
-            if (static_cast<int>(connections.size()) >= config.maxSessions) {
-                const char msg[] = "busy: the server has reached its session limit";
-                // 1013 "try again later" (RFC 6455 registry) is not in lws 4.1's enum.
-                lws_close_reason(wsi, static_cast<lws_close_status>(1013),
-                                 reinterpret_cast<unsigned char*>(const_cast<char*>(msg)), sizeof msg - 1);
-                logWarn("net: refused a session: " + std::to_string(connections.size()) + " sessions open");
-                return -1;
-            }
             auto conn = std::make_unique<Connection>();
-            lws_context* ctx = context;
-            try {
-                conn->session = std::make_shared<Session>("s" + std::to_string(nextSessionId++), config.session,
-                                                          scenes, [ctx] { lws_cancel_service(ctx); });
-                conn->session->start();
-            } catch (const std::exception& e) {
-                logError(std::string("net: cannot start a session: ") + e.what());
-                return -1;
-            }
-            pss->connection = conn.get();
-            logInfo("net: session " + conn->session->id() + " opened (" + std::to_string(connections.size() + 1) +
-                    " open)");
+            conn->wsi = wsi;
+            conn->headerAuth = pss && pss->headerAuth;
+            if (config.messagesPerSecond > 0)
+                conn->limiter =
+                    std::make_unique<RateLimiter>(config.messagesPerSecond, 2 * config.messagesPerSecond);
+            if (pss) pss->connection = conn.get();
             connections[wsi] = std::move(conn);
-            lws_callback_on_writable(wsi);
+            metrics.counter("gis_connections_total", "WebSocket connections accepted").inc();
             break;
         }
         case LWS_CALLBACK_RECEIVE: {
             Connection* c = pss ? pss->connection : nullptr;
-            if (!c) break;
+            if (!c || c->closing) break;
             if (!c->rxTooLarge) {
                 if (c->rx.size() + len > config.maxMessageBytes) {
                     c->rxTooLarge = true;
@@ -227,57 +950,158 @@ struct WsServer::Impl {
                 }
             }
             if (!lws_is_final_fragment(wsi) || lws_remaining_packet_payload(wsi) > 0) break;
-            if (c->rxTooLarge) {
-                c->session->queueError({"message_too_large",
-                                        "messages are limited to " + std::to_string(config.maxMessageBytes) + " bytes",
-                                        "", ""});
-            } else if (lws_frame_is_binary(wsi)) {
-                c->session->queueError({"binary_not_accepted", "clients send JSON text messages only", "", ""});
-            } else {
-                c->session->handleText(c->rx);
-            }
+            const std::string text = std::move(c->rx);
+            const bool tooLarge = c->rxTooLarge;
             c->rx.clear();
             c->rxTooLarge = false;
-            if (c->session->hasOutgoing()) lws_callback_on_writable(wsi);
+            if (c->limiter && !c->limiter->allow()) {
+                // One notice a second at most: answering every dropped message would be its own flood.
+                if (Clock::now() - c->lastRateError > std::chrono::seconds(1)) {
+                    c->lastRateError = Clock::now();
+                    sendError(*c, {"rate_limited",
+                                   "more than " + std::to_string(static_cast<int>(config.messagesPerSecond)) +
+                                       " messages per second; messages are being dropped",
+                                   "", ""});
+                }
+                break;
+            }
+            if (tooLarge)
+                sendError(*c, {"message_too_large",
+                               "messages are limited to " + std::to_string(config.maxMessageBytes) + " bytes",
+                               "", ""});
+            else if (lws_frame_is_binary(wsi))
+                sendError(*c, {"binary_not_accepted", "clients send JSON text messages only", "", ""});
+            else
+                onMessage(*c, text);
+            break;
+        }
+        case LWS_CALLBACK_WS_PEER_INITIATED_CLOSE: {
+            Connection* c = pss ? pss->connection : nullptr;
+            if (c && len >= 2) {
+                const auto* b = static_cast<const unsigned char*>(in);
+                c->peerCloseCode = (b[0] << 8) | b[1];
+            }
             break;
         }
         case LWS_CALLBACK_SERVER_WRITEABLE: {
             Connection* c = pss ? pss->connection : nullptr;
             if (!c) break;
-            OutgoingMessage m;
-            if (!c->session->popOutgoing(m)) break;
-            c->tx.resize(LWS_PRE + m.data.size());
-            std::memcpy(c->tx.data() + LWS_PRE, m.data.data(), m.data.size());
-            int n = lws_write(wsi, c->tx.data() + LWS_PRE, m.data.size(), m.binary ? LWS_WRITE_BINARY : LWS_WRITE_TEXT);
-            if (n < static_cast<int>(m.data.size())) {
-                logWarn("net: write failed on session " + c->session->id());
+            std::string text;
+            bool binary = false;
+            std::shared_ptr<const std::string> shared;
+            if (!c->direct.empty()) {
+                text = std::move(c->direct.front());
+                c->direct.pop_front();
+            } else if (c->closing) {
+                lws_close_reason(wsi, static_cast<lws_close_status>(c->closeCode),
+                                 reinterpret_cast<unsigned char*>(c->closeReason.data()),
+                                 c->closeReason.size());
+                return -1;
+            } else if (c->link) {
+                OutgoingMessage m;
+                if (!c->link->pop(m)) break;
+                binary = m.binary;
+                shared = std::move(m.data);
+            } else {
+                break;
+            }
+            const std::string& data = shared ? *shared : text;
+            c->tx.resize(LWS_PRE + data.size());
+            std::memcpy(c->tx.data() + LWS_PRE, data.data(), data.size());
+            const int n = lws_write(wsi, c->tx.data() + LWS_PRE, data.size(),
+                                    binary ? LWS_WRITE_BINARY : LWS_WRITE_TEXT);
+            if (n < static_cast<int>(data.size())) {
+                logWarn("net: write failed on a connection");
                 return -1;
             }
-            if (c->session->hasOutgoing()) lws_callback_on_writable(wsi);
+            metrics.counter("gis_bytes_sent_total", "bytes written to WebSocket clients")
+                .inc(static_cast<double>(n));
+            if (!c->direct.empty() || c->closing || (c->link && c->link->hasOutgoing()))
+                lws_callback_on_writable(wsi);
             break;
         }
         case LWS_CALLBACK_CLOSED: {
             auto it = connections.find(wsi);
-            if (it != connections.end()) {
-                logInfo("net: session " + it->second->session->id() + " closed after " +
-                        std::to_string(it->second->session->framesSent()) + " frames");
-                reaper->retire(std::move(it->second->session));
-                connections.erase(it);
+            if (it == connections.end()) break;
+            Connection& c = *it->second;
+            if (c.entry && c.link) {
+                auto entry = std::exchange(c.entry, nullptr);
+                auto link = std::exchange(c.link, nullptr);
+                if (link->role() == ClientRole::Viewer) {
+                    entry->session->detach(link);
+                } else if (entry->controller == &c) {
+                    entry->session->detach(link);
+                    entry->controller = nullptr;
+                    if (stop) {
+                        endSession(entry, "", ""); // the server is going down: no messages
+                    } else if (c.peerCloseCode == 1000 || config.resumeGraceS == 0) {
+                        endSession(entry, "session_ended", "the controller closed the session");
+                    } else {
+                        entry->detachedAt = Clock::now();
+                        logInfo("net: session " + entry->session->id() + " lost its controller; kept " +
+                                std::to_string(config.resumeGraceS) + " s for a resume");
+                    }
+                }
             }
+            connections.erase(it);
             if (pss) pss->connection = nullptr;
             break;
         }
         case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
-            for (auto& [w, c] : connections)
-                if (c->session->hasOutgoing()) lws_callback_on_writable(w);
+            onWake();
             break;
-        default: break;
+        default:
+            break;
         }
         return 0;
     }
 
+    void onWake() {
+        for (auto& [w, c] : connections)
+            if (!c->direct.empty() || (c->link && c->link->hasOutgoing())) lws_callback_on_writable(w);
+        deliverFinishedJobs();
+    }
+
+    void housekeep() {
+        const auto now = Clock::now();
+        for (auto& [w, c] : connections)
+            if (!c->helloDone && !c->closing && now - c->opened > std::chrono::seconds(config.helloTimeoutS))
+                closeWith(*c,
+                          {"hello_required", "no hello within " + std::to_string(config.helloTimeoutS) + " s",
+                           "", ""},
+                          1008);
+        std::vector<std::pair<std::shared_ptr<SessionEntry>, std::string>> expired;
+        for (const auto& [id, e] : sessions) {
+            if (!e->controller && e->detachedAt != Clock::time_point{} &&
+                now - e->detachedAt > std::chrono::seconds(config.resumeGraceS))
+                expired.emplace_back(e, "session_ended");
+            else if (e->session->idleSeconds() > config.idleTimeoutS)
+                expired.emplace_back(e, "idle_timeout");
+        }
+        for (auto& [e, code] : expired)
+            endSession(e, code,
+                       code == "idle_timeout"
+                           ? "no steering input for " + std::to_string(config.idleTimeoutS) + " s"
+                           : "the controller did not come back within " +
+                                 std::to_string(config.resumeGraceS) + " s");
+        updateGauges();
+        if (!stop) scheduleHousekeeping();
+    }
+
+    void scheduleHousekeeping() {
+        housekeeping.self = this;
+        lws_sul_schedule(
+            context, 0, &housekeeping.sul,
+            [](lws_sorted_usec_list_t* sul) { reinterpret_cast<Housekeeping*>(sul)->self->housekeep(); },
+            500 * LWS_US_PER_MS);
+    }
+
     static int httpCallback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len) {
         Impl* self = from(wsi);
+        if (self && reason == LWS_CALLBACK_EVENT_WAIT_CANCELLED) {
+            self->onWake();
+            return 0;
+        }
         return self ? self->onHttp(wsi, reason, static_cast<PerSession*>(user), in, len)
                     : lws_callback_http_dummy(wsi, reason, user, in, len);
     }
@@ -288,17 +1112,42 @@ struct WsServer::Impl {
 };
 
 WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
-    mImpl->config = std::move(config);
+    Impl& m = *mImpl;
+    m.config = std::move(config);
     char resolved[PATH_MAX];
-    if (!realpath(mImpl->config.clientDir.c_str(), resolved))
-        throw InputError("--client-dir", "directory '" + mImpl->config.clientDir + "' does not exist");
-    mImpl->clientRoot = resolved;
-    mImpl->config.clientDir = resolved;
+    if (!realpath(m.config.clientDir.c_str(), resolved))
+        throw InputError("--client-dir", "directory '" + m.config.clientDir + "' does not exist");
+    m.clientRoot = resolved;
+    m.config.clientDir = resolved;
+    m.catalog = std::make_shared<SceneCatalog>(m.config.sceneDirs, m.config.session.scene);
+    m.defaultScene = m.scenes->get(m.catalog->resolve(m.config.session.scene));
+    if (m.config.uploadDir.empty()) {
+        m.uploadRoot =
+            (fs::temp_directory_path() / ("gi-server-uploads-" + std::to_string(::getpid()))).string();
+        m.ownsUploadRoot = true;
+    } else {
+        m.uploadRoot = m.config.uploadDir;
+    }
+    std::error_code ec;
+    fs::create_directories(m.uploadRoot, ec);
+    if (ec) throw InputError("--upload-dir", "cannot create '" + m.uploadRoot + "': " + ec.message());
+    m.gate = std::make_unique<RenderGate>(m.config.renderSlots);
+    // API workers: up to the render slots (at most 4: each holds a GL context), sharing the gate.
+    m.workers =
+        std::make_unique<GlWorkerPool>(m.config.session.backend, std::clamp(m.config.renderSlots, 1, 4),
+                                       static_cast<std::size_t>(m.config.httpRenderQueue), m.gate.get());
 }
 
 WsServer::~WsServer() {
-    if (mImpl->context) lws_context_destroy(mImpl->context); // closes connections: sessions retire
-    mImpl->reaper.reset();                                    // joins every render thread
+    mImpl->stop = true;
+    if (mImpl->context) lws_context_destroy(mImpl->context); // closes connections: sessions end
+    for (auto& [id, e] : std::map(mImpl->sessions)) mImpl->endSession(e, "", "");
+    mImpl->workers.reset();
+    mImpl->reaper.reset(); // joins every render thread
+    if (mImpl->ownsUploadRoot) {
+        std::error_code ec;
+        fs::remove_all(mImpl->uploadRoot, ec);
+    }
 }
 
 void WsServer::listen() {
@@ -321,11 +1170,14 @@ void WsServer::listen() {
     info.protocols = mImpl->protocols;
     info.user = mImpl.get();
     info.options = LWS_SERVER_OPTION_VALIDATE_UTF8;
+    // Room for the X-GI-Stats response header and large Authorization headers.
+    info.max_http_header_data = 8192;
     mImpl->context = lws_create_context(&info);
     if (!mImpl->context)
         throw Error("net: cannot listen on " + mImpl->config.host + ":" + std::to_string(mImpl->config.port) +
                     " (address in use or not available?)");
     mPort = mImpl->config.port;
+    mImpl->scheduleHousekeeping();
 }
 
 void WsServer::run() {

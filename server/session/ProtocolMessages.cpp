@@ -1,5 +1,6 @@
 #include "session/ProtocolMessages.h"
 
+#include <algorithm>
 #include <map>
 #include <mutex>
 
@@ -28,24 +29,34 @@ const nlohmann::json* schemaFor(const std::string& type) {
 
 } // namespace
 
+const std::vector<std::string>& clientMessageTypes() {
+    static const std::vector<std::string> types = {"hello",    "camera", "light", "technique",
+                                                   "params",   "resize", "scene", "quality",
+                                                   "snapshot", "ack",    "ping"};
+    return types;
+}
+
 nlohmann::json parseClientMessage(std::string_view text) {
     nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
-    if (msg.is_discarded())
-        throw ProtocolError{"invalid_json", "the message is not valid JSON", "", ""};
+    if (msg.is_discarded()) throw ProtocolError{"invalid_json", "the message is not valid JSON", "", ""};
     if (!msg.is_object())
         throw ProtocolError{"invalid_message", "a message must be a JSON object with a 'type' field", "", ""};
     auto type = msg.find("type");
     if (type == msg.end() || !type->is_string())
         throw ProtocolError{"invalid_message", "missing string field 'type'", "/type", ""};
     const std::string t = *type;
-    const nlohmann::json* schema = schemaFor(t);
-    if (!schema)
-        throw ProtocolError{"unknown_type",
-                            "unknown message type '" + t +
-                                "' (known: hello, camera, light, technique, params, resize, scene, ack, ping)",
+    const auto& types = clientMessageTypes();
+    const nlohmann::json* schema =
+        std::find(types.begin(), types.end(), t) == types.end() ? nullptr : schemaFor(t);
+    if (!schema) {
+        std::string known;
+        for (const auto& k : types) known += (known.empty() ? "" : ", ") + k;
+        throw ProtocolError{"unknown_type", "unknown message type '" + t + "' (known: " + known + ")",
                             "/type", t};
+    }
     if (auto v = validateJson(msg, *schema))
-        throw ProtocolError{"invalid_message", (v->pointer.empty() ? "" : v->pointer + ": ") + v->message, v->pointer, t};
+        throw ProtocolError{"invalid_message", (v->pointer.empty() ? "" : v->pointer + ": ") + v->message,
+                            v->pointer, t};
     return msg;
 }
 
@@ -56,7 +67,7 @@ nlohmann::json errorMessage(const ProtocolError& e) {
     return m;
 }
 
-std::vector<std::uint8_t> makeFrameMessage(std::uint32_t frameId, int width, int height, FrameCodec codec,
+std::vector<std::uint8_t> makeFrameMessage(std::uint32_t frameId, int width, int height, ImageCodec codec,
                                            const std::vector<std::uint8_t>& payload) {
     std::vector<std::uint8_t> out(kFrameHeaderSize + payload.size(), 0);
     out[0] = 'G';

@@ -10,11 +10,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "encode/Encoder.h"
+
 namespace gis {
 
-constexpr int kProtocolVersion = 0;
+constexpr int kProtocolVersion = 1;
 constexpr std::size_t kFrameHeaderSize = 16;
-enum class FrameCodec : std::uint8_t { Jpeg = 1, Png = 2 };
 
 /// A request the server rejects; becomes an `error` message, the session survives.
 struct ProtocolError {
@@ -24,13 +25,15 @@ struct ProtocolError {
     std::string request; ///< the message type, when known
 };
 
+/// The message types a client may send (one schema each in protocol/schema).
+const std::vector<std::string>& clientMessageTypes();
 /// Parses and validates one client text message. Returns the parsed object; throws ProtocolError.
 nlohmann::json parseClientMessage(std::string_view text);
 
 nlohmann::json errorMessage(const ProtocolError& e);
 
 /// 16-byte header + payload, as documented.
-std::vector<std::uint8_t> makeFrameMessage(std::uint32_t frameId, int width, int height, FrameCodec codec,
+std::vector<std::uint8_t> makeFrameMessage(std::uint32_t frameId, int width, int height, ImageCodec codec,
                                            const std::vector<std::uint8_t>& payload);
 
 } // namespace gis

@@ -2,15 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/Timer.h"
-#include "encode/Encoder.h"
 #include "gi/Technique.h"
 #include "render/FrameParams.h"
 #include "render/FrameRenderer.h"
+#include "render/Presets.h"
+#include "render/StateJson.h"
 #include "scene/SceneLoader.h"
+#include "session/RenderGate.h"
 #if GIS_HAVE_EFFECTS
 #include "analysis/EffectPlan.h"
 #endif
@@ -18,23 +21,11 @@
 namespace gis {
 namespace {
 
-constexpr float kDegToRad = 0.017453292519943295f;
+using Clock = std::chrono::steady_clock;
 
-glm::vec3 vec3From(const nlohmann::json& a) {
-    return {a[0].get<float>(), a[1].get<float>(), a[2].get<float>()};
-}
-nlohmann::json toJson(glm::vec3 v) {
-    return {v.x, v.y, v.z};
-}
-
-nlohmann::json techniquesJson() {
-    nlohmann::json list = nlohmann::json::array();
-    for (const auto& e : techniqueRegistry())
-        list.push_back({{"name", e.info.name},
-                        {"description", e.info.description},
-                        {"paper", e.info.paper},
-                        {"params_schema", e.info.params.jsonSchema()}});
-    return list;
+const char* stepName(int step) {
+    static const char* names[] = {"interactive", "balanced", "final"};
+    return step >= 0 && step < 3 ? names[step] : "fixed";
 }
 
 } // namespace
@@ -75,8 +66,21 @@ std::string effectPlanKey(const Scene& scene, const FrameState& s) {
 } // namespace
 #endif
 
-Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes, Wake wake)
-    : mId(std::move(id)), mConfig(std::move(config)), mScenes(std::move(scenes)), mWake(std::move(wake)) {
+long maxVplEstimate(const FrameState& s) {
+    auto get = [](const ParamSet& p, const char* name) -> long { return p.has(name) ? p.getInt(name) : 0; };
+    long n = 0;
+    n = std::max(n, get(s.techniqueParams, "vpl_grid") * get(s.techniqueParams, "vpl_grid"));
+    n = std::max(n, get(s.techniqueParams, "isr_finest") * get(s.techniqueParams, "isr_finest"));
+    n = std::max(n, get(s.techniqueParams, "positive_count") + get(s.techniqueParams, "negative_count"));
+    if (s.technique == "hier_isr")
+        n = std::max(n, get(s.frameParams, "rsm_size") * get(s.frameParams, "rsm_size"));
+    return n;
+}
+
+Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes,
+                 std::shared_ptr<const SceneCatalog> catalog, RenderGate* gate, std::string uploadDir)
+    : mId(std::move(id)), mConfig(std::move(config)), mScenes(std::move(scenes)),
+      mCatalog(std::move(catalog)), mGate(gate), mUploadDir(std::move(uploadDir)) {
     mScene = mScenes->get(mConfig.scene);
     mSceneName = mConfig.scene;
     mDesired = makeFrameState(*mScene, mConfig.technique);
@@ -88,177 +92,220 @@ Session::~Session() {
     stop();
 }
 
-nlohmann::json Session::stateJson() const {
-    const Camera& c = mDesired.camera;
-    const Light& l = mDesired.light;
+void Session::setObservers(FrameObserver onFrame, ErrorObserver onError) {
+    std::lock_guard lock(mMutex);
+    mOnFrame = std::move(onFrame);
+    mOnError = std::move(onError);
+}
+
+nlohmann::json Session::stateJsonLocked() const {
     return {{"scene", mSceneName},
             {"technique", mDesired.technique},
             {"params", paramsJson(mDesired)},
             {"size", {mDesired.width, mDesired.height}},
-            {"camera",
-             {{"position", toJson(c.position)},
-              {"target", toJson(c.target)},
-              {"up", toJson(c.up)},
-              {"fov_deg", c.yfovRadians / kDegToRad}}},
-            {"light",
-             {{"position", toJson(l.position)},
-              {"direction", toJson(l.direction)},
-              {"intensity", l.intensity},
-              {"color", toJson(l.color)},
-              {"cone_deg", l.outerConeAngle / kDegToRad},
-              {"enabled", mDesired.lightEnabled}}}};
+            {"camera", cameraJson(mDesired.camera)},
+            {"light", lightJson(mDesired)}};
+}
+
+nlohmann::json Session::stateJson() const {
+    std::lock_guard lock(mMutex);
+    return stateJsonLocked();
+}
+
+StreamOptions Session::streamOptions() const {
+    std::lock_guard lock(mMutex);
+    return mStream;
+}
+
+double Session::idleSeconds() const {
+    std::lock_guard lock(mMutex);
+    return std::chrono::duration<double>(Clock::now() - mLastInput).count();
+}
+
+std::vector<std::string> Session::sceneNames() const {
+    return mCatalog ? mCatalog->list(mUploadDir) : std::vector<std::string>{mConfig.scene};
 }
 
 void Session::start() {
-    nlohmann::json scenes = nlohmann::json::array();
-    for (const auto& n : builtinSceneNames()) scenes.push_back("builtin:" + n);
-    if (mConfig.scene.rfind("builtin:", 0) != 0) scenes.push_back(mConfig.scene);
-    nlohmann::json welcome;
-    {
-        std::lock_guard lock(mMutex);
-        welcome = {{"type", "welcome"},
-                   {"protocol", kProtocolVersion},
-                   {"server", "gi-server/0.1.0"},
-                   {"session", mId},
-                   {"scenes", scenes},
-                   {"techniques", techniquesJson()},
-                   {"frame_params_schema", frameParamTable().jsonSchema()},
-                   {"state", stateJson()}};
-    }
-    queueText(welcome);
     mWorker = std::thread([this] { workerMain(); });
 }
 
 void Session::stop() {
-    {
-        std::lock_guard lock(mMutex);
-        mStop = true;
-    }
+    mStop = true;
+    if (mGate) mGate->wakeAll();
     mCv.notify_all();
     if (mWorker.joinable()) mWorker.join();
+    std::lock_guard lock(mMutex);
+    if (mController) mController->close();
+    for (auto& v : mViewers) v->close();
+    mController.reset();
+    mViewers.clear();
 }
 
-void Session::queueText(const nlohmann::json& msg) {
+void Session::attach(const std::shared_ptr<ClientLink>& link, const StreamOptions* options) {
     {
         std::lock_guard lock(mMutex);
-        if (mOutgoing.size() >= mConfig.maxQueuedMessages) {
-            ++mDroppedMessages;
-            return;
+        if (link->role() == ClientRole::Controller) {
+            if (mController && mController != link) mController->close();
+            mController = link;
+            if (options) mStream = *options;
+            // A new or resumed controller has seen nothing yet: render the current state for it.
+            markInput();
+        } else {
+            mViewers.push_back(link);
+            if (mLastFrame.bytes) {
+                nlohmann::json stats = mLastFrame.stats;
+                stats["viewers"] = mViewers.size();
+                stats["dropped_frames"] = 0;
+                link->offerFrame(mLastFrame.id, stats.dump(), mLastFrame.bytes);
+            }
         }
-        mOutgoing.push_back({false, msg.dump()});
     }
-    if (mWake) mWake();
+    mCv.notify_all();
 }
 
-void Session::queueError(const ProtocolError& error) {
-    queueText(errorMessage(error));
-}
-
-bool Session::popOutgoing(OutgoingMessage& out) {
-    std::lock_guard lock(mMutex);
-    if (mOutgoing.empty()) return false;
-    out = std::move(mOutgoing.front());
-    mOutgoing.pop_front();
-    return true;
-}
-
-bool Session::hasOutgoing() {
-    std::lock_guard lock(mMutex);
-    return !mOutgoing.empty();
-}
-
-void Session::handleText(std::string_view text) {
-    try {
-        apply(parseClientMessage(text));
-    } catch (const ProtocolError& e) {
-        queueError(e);
+void Session::detach(const std::shared_ptr<ClientLink>& link) {
+    {
+        std::lock_guard lock(mMutex);
+        if (mController == link) mController.reset();
+        std::erase(mViewers, link);
     }
+    link->close();
+    mCv.notify_all();
 }
 
-void Session::apply(const nlohmann::json& msg) {
+bool Session::hasController() const {
+    std::lock_guard lock(mMutex);
+    return mController != nullptr;
+}
+
+std::size_t Session::viewerCount() const {
+    std::lock_guard lock(mMutex);
+    return mViewers.size();
+}
+
+std::vector<std::shared_ptr<ClientLink>> Session::clients() const {
+    std::lock_guard lock(mMutex);
+    std::vector<std::shared_ptr<ClientLink>> out = mViewers;
+    if (mController) out.push_back(mController);
+    return out;
+}
+
+void Session::markInput() {
+    mDirty = true;
+    mNextStep = Step::Interactive;
+    mLastInput = Clock::now();
+}
+
+void Session::ack(const std::shared_ptr<ClientLink>& link, std::uint32_t id) {
+    link->ack(id);
+    mCv.notify_all();
+}
+
+void Session::resize(int cssWidth, int cssHeight, double dpr) {
+    const double w = std::max(1.0, std::round(cssWidth * dpr));
+    const double h = std::max(1.0, std::round(cssHeight * dpr));
+    // Scale down to fit the server's limit, keeping the aspect ratio; never below the 16 px minimum.
+    const double fit = std::min({1.0, mConfig.limits.maxWidth / w, mConfig.limits.maxHeight / h});
+    const int width = std::clamp(static_cast<int>(std::floor(w * fit)), 16, mConfig.limits.maxWidth);
+    const int height = std::clamp(static_cast<int>(std::floor(h * fit)), 16, mConfig.limits.maxHeight);
+    {
+        std::lock_guard lock(mMutex);
+        if (width == mDesired.width && height == mDesired.height) return;
+        mDesired.width = width;
+        mDesired.height = height;
+        markInput();
+    }
+    mCv.notify_all();
+}
+
+void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from) {
     const std::string type = msg["type"];
-    if (type == "ping") {
-        nlohmann::json pong = {{"type", "pong"}};
-        if (msg.contains("t")) pong["t"] = msg["t"];
-        queueText(pong);
+    if (type == "resize") {
+        resize(msg["size"][0], msg["size"][1], msg.value("dpr", 1.0));
         return;
     }
-    if (type == "hello") {
-        if (msg["protocol"].get<int>() != kProtocolVersion)
-            throw ProtocolError{"protocol_mismatch",
-                                "this server speaks protocol " + std::to_string(kProtocolVersion) +
-                                    ", the client " + std::to_string(msg["protocol"].get<int>()),
-                                "/protocol", type};
-        return;
-    }
-
     std::unique_lock lock(mMutex);
-    if (type == "ack") {
-        if (mInFlight && msg["frame"].get<std::uint32_t>() == mInFlightFrame) mInFlight = false;
-    } else if (type == "camera") {
-        Camera c = mDesired.camera;
-        c.position = vec3From(msg["position"]);
-        c.target = vec3From(msg["target"]);
-        if (msg.contains("up")) c.up = vec3From(msg["up"]);
-        if (msg.contains("fov_deg")) c.yfovRadians = msg["fov_deg"].get<float>() * kDegToRad;
-        if (glm::length(c.target - c.position) < 1e-6f)
-            throw ProtocolError{"invalid_message", "camera position and target must differ", "/target", type};
-        if (glm::length(c.up) < 1e-6f)
-            throw ProtocolError{"invalid_message", "camera up must not be zero", "/up", type};
-        mDesired.camera = c;
-        mDirty = true;
-    } else if (type == "light") {
-        Light l = mDesired.light;
-        if (msg.contains("position")) l.position = vec3From(msg["position"]);
-        if (msg.contains("direction")) {
-            glm::vec3 d = vec3From(msg["direction"]);
-            float len = glm::length(d);
-            if (!(len > 1e-6f))
-                throw ProtocolError{"invalid_message", "light direction must not be zero", "/direction",
-                                    type};
-            l.direction = d / len;
+    try {
+        if (type == "camera") {
+            applyCameraJson(mDesired, msg, "");
+        } else if (type == "light") {
+            applyLightJson(mDesired, msg, "");
+        } else if (type == "technique") {
+            FrameState next = mDesired;
+            try {
+                setTechnique(next, msg["name"], "/name");
+            } catch (const InputError& e) {
+                throw ProtocolError{"unknown_technique", e.reason(), "/name", type};
+            }
+            if (maxVplEstimate(next) > mConfig.limits.maxVpls)
+                throw ProtocolError{"limit_exceeded",
+                                    "technique '" + next.technique + "' asks for up to " +
+                                        std::to_string(maxVplEstimate(next)) +
+                                        " VPLs by default; the server allows " +
+                                        std::to_string(mConfig.limits.maxVpls),
+                                    "/name", type};
+            // Explicit technique parameters belonged to the previous technique.
+            for (auto it = mExplicit.begin(); it != mExplicit.end();)
+                it = next.frameParams.has(it.key()) ? std::next(it) : mExplicit.erase(it);
+            mDesired = std::move(next);
+        } else if (type == "params") {
+            FrameState next = mDesired;
+            try {
+                applyParams(next, msg["values"], "/values");
+            } catch (const InputError& e) {
+                throw ProtocolError{"invalid_param", e.reason(), e.where(), type};
+            }
+            if (maxVplEstimate(next) > mConfig.limits.maxVpls)
+                throw ProtocolError{"limit_exceeded",
+                                    "these parameters ask for up to " + std::to_string(maxVplEstimate(next)) +
+                                        " VPLs; the server allows " + std::to_string(mConfig.limits.maxVpls),
+                                    "/values", type};
+            mDesired = std::move(next);
+            for (const auto& [k, v] : msg["values"].items()) mExplicit[k] = v;
+        } else if (type == "scene") {
+            const std::string name = msg["name"];
+            if (mCatalog) {
+                try {
+                    (void)mCatalog->resolve(name, mUploadDir);
+                } catch (const InputError& e) {
+                    throw ProtocolError{"unknown_scene", e.reason(), "/name", type};
+                }
+            } else if (name != mConfig.scene) {
+                throw ProtocolError{"unknown_scene", "unknown scene '" + name + "'", "/name", type};
+            }
+            mSceneRequest = name;
+        } else if (type == "quality") {
+            mStream.adaptive = msg["adaptive"].get<bool>();
+        } else if (type == "snapshot") {
+            mSnapshotFor = from;
+            mSnapshotCodec = msg.value("codec", "png") == "webp" ? ImageCodec::Webp : ImageCodec::Png;
+            lock.unlock();
+            mCv.notify_all();
+            return;
+        } else {
+            throw ProtocolError{"unknown_type", "'" + type + "' does not steer a session", "/type", type};
         }
-        if (msg.contains("intensity")) l.intensity = msg["intensity"].get<float>();
-        if (msg.contains("color")) l.color = vec3From(msg["color"]);
-        if (msg.contains("cone_deg")) {
-            float outer = msg["cone_deg"].get<float>() * kDegToRad;
-            // Keep the soft edge's proportion: inner/outer as the scene defined it.
-            float ratio = l.outerConeAngle > 0 ? l.innerConeAngle / l.outerConeAngle : 0.8f;
-            l.outerConeAngle = outer;
-            l.innerConeAngle = std::clamp(ratio, 0.0f, 0.99f) * outer;
-        }
-        if (msg.contains("enabled")) mDesired.lightEnabled = msg["enabled"].get<bool>();
-        mDesired.light = l;
-        mDirty = true;
-    } else if (type == "technique") {
-        try {
-            setTechnique(mDesired, msg["name"], "/name");
-        } catch (const InputError& e) {
-            throw ProtocolError{"unknown_technique", e.reason(), "/name", type};
-        }
-        mDirty = true;
-    } else if (type == "params") {
-        try {
-            if (!applyParams(mDesired, msg["values"], "/values").empty()) mDirty = true;
-        } catch (const InputError& e) {
-            throw ProtocolError{"invalid_param", e.reason(), e.where(), type};
-        }
-    } else if (type == "resize") {
-        mDesired.width = msg["size"][0];
-        mDesired.height = msg["size"][1];
-        mDirty = true;
-    } else if (type == "scene") {
-        const std::string name = msg["name"];
-        bool known = name == mConfig.scene;
-        for (const auto& n : builtinSceneNames()) known = known || name == "builtin:" + n;
-        if (!known)
-            throw ProtocolError{"unknown_scene", "unknown scene '" + name + "': pick one from welcome.scenes",
-                                "/name", type};
-        mSceneRequest = name;
-        mDirty = true;
+    } catch (const InputError& e) {
+        throw ProtocolError{"invalid_message", e.reason(), e.where(), type};
     }
+    markInput();
     lock.unlock();
     mCv.notify_all();
+}
+
+void Session::broadcastText(const nlohmann::json& msg) {
+    const std::string text = msg.dump();
+    for (const auto& c : clients()) c->pushText(text);
+}
+
+bool Session::readyLocked(Clock::time_point now) const {
+    if (!mSnapshotFor.expired()) return true;
+    if (!mController || mController->windowFull()) return false;
+    if (mDirty) return true;
+    if (!mStream.adaptive || mNextStep == Step::Done || mNextStep == Step::Interactive) return false;
+    return mNextStep != Step::Balanced ||
+           now >= mLastInput + std::chrono::milliseconds(mConfig.limits.settleMs);
 }
 
 void Session::workerMain() {
@@ -270,8 +317,16 @@ void Session::workerMain() {
         renderer->setScene(mScene);
     } catch (const std::exception& e) {
         logError("session " + mId + ": " + e.what());
-        queueError({"render_failed", std::string("the renderer could not start: ") + e.what(), "", ""});
+        broadcastText(errorMessage(
+            {"render_failed", std::string("the renderer could not start: ") + e.what(), "", ""}));
         return;
+    }
+    nlohmann::json presets;
+    try {
+        presets = loadPresets(defaultPresetsPath());
+    } catch (const std::exception& e) {
+        logWarn("session " + mId +
+                ": no presets, adaptive quality renders every step as requested: " + e.what());
     }
     std::uint32_t frameId = 0;
     std::shared_ptr<const Scene> scene = mScene;
@@ -279,19 +334,50 @@ void Session::workerMain() {
     std::string planKey;
     EffectPlan plan;
 #endif
-    while (true) {
+    while (!mStop) {
         FrameState state;
+        nlohmann::json explicitParams;
         std::string sceneRequest;
+        StreamOptions stream;
+        std::shared_ptr<ClientLink> snapshotFor;
+        ImageCodec snapshotCodec = ImageCodec::Png;
+        int step = -1; // -1: fixed; else Step
         {
             std::unique_lock lock(mMutex);
-            mCv.wait(lock, [&] { return mStop || (mDirty && !mInFlight); });
+            while (!mStop) {
+                const auto now = Clock::now();
+                if (readyLocked(now)) break;
+                if (mStream.adaptive && mNextStep == Step::Balanced && !mDirty && mController)
+                    mCv.wait_until(lock, mLastInput + std::chrono::milliseconds(mConfig.limits.settleMs));
+                else
+                    mCv.wait(lock);
+            }
             if (mStop) break;
-            mDirty = false;
+            snapshotFor = mSnapshotFor.lock();
+            mSnapshotFor.reset();
+            snapshotCodec = mSnapshotCodec;
+            stream = mStream;
+            if (snapshotFor) {
+                step = static_cast<int>(Step::Final);
+            } else if (!mStream.adaptive) {
+                mDirty = false;
+                mNextStep = Step::Done;
+            } else if (mDirty) {
+                mDirty = false;
+                step = static_cast<int>(Step::Interactive);
+                mNextStep = Step::Balanced;
+            } else {
+                step = static_cast<int>(mNextStep);
+                mNextStep = mNextStep == Step::Balanced ? Step::Final : Step::Done;
+            }
             sceneRequest = std::exchange(mSceneRequest, {});
+            explicitParams = mExplicit;
         }
         if (!sceneRequest.empty()) {
             try {
-                auto next = mScenes->get(sceneRequest);
+                const std::string path =
+                    mCatalog ? mCatalog->resolve(sceneRequest, mUploadDir) : sceneRequest;
+                auto next = mScenes->get(path);
                 renderer->setScene(next);
                 scene = next;
                 nlohmann::json stateMsg;
@@ -303,20 +389,57 @@ void Session::workerMain() {
                     mDesired.lightEnabled = fresh.lightEnabled;
                     mScene = next;
                     mSceneName = sceneRequest;
-                    stateMsg = {{"type", "state"}, {"state", stateJson()}};
+                    stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
                 }
-                queueText(stateMsg);
+                broadcastText(stateMsg);
             } catch (const std::exception& e) {
-                queueError({"scene_load_failed", e.what(), "/name", "scene"});
+                broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
+                if (mOnError) mOnError("scene_load_failed");
             }
         }
         {
             std::lock_guard lock(mMutex);
             state = mDesired;
         }
+        // Adaptive steps: the step's preset under the client's explicit parameters, smaller frames
+        // while interacting (protocol/PROTOCOL.md, "Adaptive quality").
+        double scale = 1.0;
+        if (step >= 0) {
+            static const char* presetNames[] = {"interactive", "balanced", "final"};
+            if (!presets.is_null()) {
+                try {
+                    FrameState preset = state;
+                    preset.techniqueParams.resetToDefaults();
+                    applyPreset(preset, presets, presetNames[step]);
+                    nlohmann::json techniqueExplicit = nlohmann::json::object();
+                    for (const auto& [k, v] : explicitParams.items())
+                        if (preset.techniqueParams.has(k)) techniqueExplicit[k] = v;
+                    preset.techniqueParams.apply(techniqueExplicit);
+                    if (maxVplEstimate(preset) <= mConfig.limits.maxVpls) state = std::move(preset);
+                } catch (const InputError&) {
+                    // No preset for this technique: the step renders the parameters as they are.
+                }
+            }
+            if (step == static_cast<int>(Step::Final) && state.frameParams.has("effects") &&
+                !explicitParams.contains("effects"))
+                state.frameParams.set("effects", "auto");
+            const std::string costKey = scene->name + "/" + state.technique + "/" + std::to_string(step);
+            if (step != static_cast<int>(Step::Interactive) && !snapshotFor &&
+                mConfig.limits.refineBudgetMs > 0) {
+                auto cost = mRefineMsPerPixel.find(costKey);
+                const double predictedMs =
+                    cost == mRefineMsPerPixel.end() ? 0.0 : cost->second * state.width * state.height;
+                if (predictedMs > mConfig.limits.refineBudgetMs) continue; // too slow to refine to
+            }
+            if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
+                scale = std::clamp(mConfig.limits.interactiveScale, 0.05, 1.0);
+                state.width = std::max(16, static_cast<int>(std::lround(state.width * scale)));
+                state.height = std::max(16, static_cast<int>(std::lround(state.height * scale)));
+            }
+        }
 #if GIS_HAVE_EFFECTS
-        // The effect plan (frame parameters `effects`, `effect_*`): measured again only when the
-        // scene, the parameters, or the camera or light change materially, never every frame.
+        // The effect plan: measured again only when the scene, the parameters, or the camera or light
+        // change materially, never every frame.
         if (wantsEffectPlan(state)) {
             const std::string key = effectPlanKey(*scene, state);
             if (key != planKey) {
@@ -326,43 +449,89 @@ void Session::workerMain() {
             applyEffectPlan(state, plan);
         }
 #endif
-
+        // Admission: at most the server's cap of renders at once, first come first served.
+        Stopwatch queueClock;
+        std::optional<RenderGate::Permit> permit;
+        if (mGate) {
+            permit = mGate->acquire(mStop);
+            if (!permit) break;
+        }
+        const double queueMs = queueClock.elapsedMs();
         FrameOutput frame;
         try {
             frame = renderer->render(state);
         } catch (const std::exception& e) {
-            queueError({"render_failed", e.what(), "", ""});
+            broadcastText(errorMessage({"render_failed", e.what(), "", ""}));
+            if (mOnError) mOnError("render_failed");
             continue;
         }
+        permit.reset();
+        if (step > static_cast<int>(Step::Interactive) && frame.width > 0 && frame.height > 0)
+            mRefineMsPerPixel[scene->name + "/" + state.technique + "/" + std::to_string(step)] =
+                frame.stats.value("frame_ms", 0.0) / (static_cast<double>(frame.width) * frame.height);
+        const ImageCodec codec = snapshotFor ? snapshotCodec : stream.codec;
         Stopwatch encodeClock;
-        std::vector<std::uint8_t> jpeg;
+        std::vector<std::uint8_t> encoded;
         try {
-            jpeg = encodeJpeg(frame.rgba8.data(), frame.width, frame.height, mConfig.jpegQuality);
+            encoded = snapshotFor && codec == ImageCodec::Webp
+                          ? encodeWebpLossless(frame.rgba8.data(), frame.width, frame.height)
+                          : encodeImage(codec, frame.rgba8.data(), frame.width, frame.height, stream.quality);
         } catch (const std::exception& e) {
-            queueError({"render_failed", e.what(), "", ""});
+            broadcastText(errorMessage({"render_failed", e.what(), "", ""}));
+            if (mOnError) mOnError("render_failed");
             continue;
         }
         const double encodeMs = encodeClock.elapsedMs();
         ++frameId;
+        ++mFramesRendered;
+        std::vector<std::uint8_t> message =
+            makeFrameMessage(frameId, frame.width, frame.height, codec, encoded);
+        auto shared = std::make_shared<const std::string>(message.begin(), message.end());
+
         nlohmann::json stats = frame.stats;
         stats["type"] = "stats";
         stats["frame"] = frameId;
+        stats["quality"] = stepName(step);
+        stats["refined"] = step == static_cast<int>(Step::Balanced) || step == static_cast<int>(Step::Final);
+        stats["scale"] = scale;
+        stats["snapshot"] = snapshotFor != nullptr;
+        stats["queue_ms"] = queueMs;
         stats["encode_ms"] = encodeMs;
-        stats["bytes"] = jpeg.size() + kFrameHeaderSize;
-        stats["codec"] = "jpeg";
-        stats["scene"] = scene->name;
-        std::vector<std::uint8_t> message =
-            makeFrameMessage(frameId, frame.width, frame.height, FrameCodec::Jpeg, jpeg);
+        stats["bytes"] = shared->size();
+        stats["codec"] = codecName(codec);
+        stats["scene"] = mSceneName.empty() ? scene->name : mSceneName;
+
+        FrameReport report;
+        report.quality = stepName(step);
+        report.snapshot = snapshotFor != nullptr;
+        report.frameMs = stats.value("frame_ms", 0.0);
+        report.queueMs = queueMs;
+        report.encodeMs = encodeMs;
+        report.bytes = shared->size();
+        if (stats.contains("passes"))
+            for (const auto& p : stats["passes"])
+                report.passMs.emplace_back(p.value("name", ""), p.value("gpu_ms", 0.0));
+        std::vector<std::shared_ptr<ClientLink>> targets;
+        if (snapshotFor)
+            targets.push_back(snapshotFor);
+        else
+            targets = clients();
+        const std::size_t viewers = viewerCount();
+        for (const auto& client : targets) {
+            stats["viewers"] = viewers;
+            stats["dropped_frames"] = client->droppedFrames();
+            if (client->offerFrame(frameId, stats.dump(), shared, snapshotFor != nullptr))
+                ++report.delivered;
+            else
+                ++report.dropped;
+        }
+        FrameObserver onFrame;
         {
             std::lock_guard lock(mMutex);
-            // Frames bypass the text cap: at most one is ever queued (one in flight).
-            mOutgoing.push_back({false, stats.dump()});
-            mOutgoing.push_back({true, std::string(message.begin(), message.end())});
-            mInFlight = true;
-            mInFlightFrame = frameId;
-            ++mFramesSent;
+            onFrame = mOnFrame;
+            if (!snapshotFor) mLastFrame = {frameId, stats, shared};
         }
-        if (mWake) mWake();
+        if (onFrame) onFrame(report);
     }
     renderer.reset(); // GL objects die while the context is still current
     context.reset();

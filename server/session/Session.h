@@ -1,92 +1,172 @@
-// One client's viewing session: its desired frame state, a render worker (thread + own GL context),
-// and the queue of messages going back to the client.
+// One viewing session: its desired frame state, a render worker (thread + own GL context), and the
+// clients attached to it (one controller, any number of viewers; session/ClientLink.h).
 //
-// Threads: the network thread calls handleText(), popOutgoing() and stop(); the worker renders.
-// Input coalesces (the latest camera wins: the desired state is overwritten, never queued). At most
-// one frame is in flight: the worker renders only when the state changed and the previous frame was
-// acknowledged. The worker calls `wake` after queueing output so the network loop can write.
+// Threads: the network thread calls attach/detach, apply, ack and the accessors; the worker renders.
+// Input coalesces (the latest camera wins: the desired state is overwritten, never queued). The
+// worker renders only when something changed (or a refinement step is due, or a snapshot was asked
+// for), the controller is attached and its window has room, and the global RenderGate admits it.
+// Every frame is encoded once and offered to every client; each client's window decides whether it
+// gets it (protocol/PROTOCOL.md, "Connection flow" and "Adaptive quality").
 #pragma once
 
+#include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "encode/Encoder.h"
 #include "gl/Platform.h"
 #include "render/FrameState.h"
+#include "session/ClientLink.h"
 #include "session/ProtocolMessages.h"
 #include "session/SceneCache.h"
+#include "session/SceneCatalog.h"
 
 namespace gis {
+
+class RenderGate;
+
+/// Server-wide limits a session enforces (protocol `welcome.limits`).
+struct SessionLimits {
+    int maxWidth = 2048, maxHeight = 2048; ///< px; larger requests are scaled down, aspect kept
+    long maxVpls = 65536;                  ///< upper bound on VPLs a parameter set may ask for
+    double interactiveScale = 0.5;         ///< (0, 1]: size factor of interactive frames
+    int settleMs = 250;                    ///< ms without input before refinement starts
+    /// ms; a refinement step whose predicted time (from the last one of its kind, scaled by the
+    /// pixel count) exceeds this is skipped, so input never waits long behind it. 0 = no limit.
+    int refineBudgetMs = 5000;
+};
 
 struct SessionConfig {
     gl::Backend backend = gl::Backend::Egl;
     std::string scene = "builtin:cornell";
     std::string technique = "rsm_gather";
     int width = 512, height = 512;
-    int jpegQuality = 85;              ///< [1, 100]
-    std::size_t maxQueuedMessages = 64; ///< text messages beyond this are dropped (counted)
+    SessionLimits limits;
 };
 
-struct OutgoingMessage {
-    bool binary = false;
-    std::string data;
+/// How the controller wants frames (from `hello`).
+struct StreamOptions {
+    ImageCodec codec = ImageCodec::Jpeg;
+    int quality = 85; ///< JPEG/WebP quality [1, 100]
+    bool adaptive = true;
+};
+
+/// What one rendered frame cost, for the server's metrics (called on the worker thread).
+struct FrameReport {
+    std::string quality; ///< interactive, balanced, final, fixed
+    bool snapshot = false;
+    double frameMs = 0, queueMs = 0, encodeMs = 0;
+    std::vector<std::pair<std::string, double>> passMs;
+    std::size_t bytes = 0;     ///< per client that got it
+    std::size_t delivered = 0; ///< clients the frame was sent to
+    std::size_t dropped = 0;   ///< clients that skipped it
 };
 
 class Session {
 public:
-    using Wake = std::function<void()>;
-    /// Loads the configured scene through `scenes`; throws gis::Error if it cannot.
-    Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes, Wake wake);
+    using FrameObserver = std::function<void(const FrameReport&)>;
+    using ErrorObserver = std::function<void(const std::string& code)>;
+
+    /// Loads the configured scene through `scenes`; throws gis::Error if it cannot. `gate` is the
+    /// server's admission cap (may be null: no cap). `uploadDir` is the session's sandbox (may be
+    /// empty: no uploads).
+    Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes,
+            std::shared_ptr<const SceneCatalog> catalog, RenderGate* gate, std::string uploadDir = {});
     ~Session();
     Session(const Session&) = delete;
     Session& operator=(const Session&) = delete;
 
     const std::string& id() const { return mId; }
-    /// Starts the render worker and queues the `welcome` message.
+    const std::string& uploadDir() const { return mUploadDir; }
+    void setObservers(FrameObserver onFrame, ErrorObserver onError);
+
+    /// Starts the render worker. Call once, after attaching the first controller.
     void start();
-    /// Handles one client text message; errors are queued as `error` messages.
-    void handleText(std::string_view text);
-    /// Queues an error produced by the network layer (oversize, binary input).
-    void queueError(const ProtocolError& error);
-    bool popOutgoing(OutgoingMessage& out);
-    bool hasOutgoing();
-    /// Stops and joins the worker; idempotent.
+    /// Stops and joins the worker (GL resources freed on it); detaches every client; idempotent.
     void stop();
 
-    std::uint64_t framesSent() const { return mFramesSent; }
+    /// Attaches a client. A controller replaces the previous one (which is closed) and sets the
+    /// stream options; the current state is rendered again for it.
+    void attach(const std::shared_ptr<ClientLink>& link, const StreamOptions* options = nullptr);
+    void detach(const std::shared_ptr<ClientLink>& link);
+    bool hasController() const;
+    std::size_t viewerCount() const;
+    /// Every attached client (the network layer closes them when the session ends).
+    std::vector<std::shared_ptr<ClientLink>> clients() const;
+
+    /// Applies one validated steering message (camera, light, technique, params, resize, scene,
+    /// quality, snapshot) from `from`. Throws ProtocolError; the state is unchanged then.
+    void apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    /// Sets the viewport (CSS px x dpr, capped by the limits); throws ProtocolError.
+    void resize(int cssWidth, int cssHeight, double dpr);
+    /// A client acknowledged frame `id`.
+    void ack(const std::shared_ptr<ClientLink>& link, std::uint32_t id);
+
+    /// The `state` object of protocol/PROTOCOL.md.
+    nlohmann::json stateJson() const;
+    StreamOptions streamOptions() const;
+    /// Seconds since the controller last steered (idle timeout).
+    double idleSeconds() const;
+    std::uint64_t framesRendered() const { return mFramesRendered.load(); }
+    /// The scenes this session may load (the catalogue plus its uploads).
+    std::vector<std::string> sceneNames() const;
 
 private:
-    void apply(const nlohmann::json& msg);
-    void queueText(const nlohmann::json& msg);
-    nlohmann::json stateJson() const; // requires mMutex
+    enum class Step { Interactive, Balanced, Final, Done };
+    struct Job;
+    nlohmann::json stateJsonLocked() const;
+    void markInput(); // requires mMutex
+    bool readyLocked(std::chrono::steady_clock::time_point now) const;
     void workerMain();
+    void broadcastText(const nlohmann::json& msg);
 
     const std::string mId;
     const SessionConfig mConfig;
     std::shared_ptr<SceneCache> mScenes;
-    Wake mWake;
+    std::shared_ptr<const SceneCatalog> mCatalog;
+    RenderGate* mGate;
+    const std::string mUploadDir;
+    FrameObserver mOnFrame;
+    ErrorObserver mOnError;
 
     mutable std::mutex mMutex;
     std::condition_variable mCv;
     FrameState mDesired;
+    nlohmann::json mExplicit = nlohmann::json::object(); ///< parameters the client set (win over presets)
     std::string mSceneName;
     std::shared_ptr<const Scene> mScene;
     std::string mSceneRequest;
+    StreamOptions mStream;
     bool mDirty = true;
-    bool mInFlight = false;
-    std::uint32_t mInFlightFrame = 0;
-    bool mStop = false;
-    std::deque<OutgoingMessage> mOutgoing;
-    std::size_t mDroppedMessages = 0;
-    std::uint64_t mFramesSent = 0;
+    Step mNextStep = Step::Done;
+    std::chrono::steady_clock::time_point mLastInput = std::chrono::steady_clock::now();
+    std::weak_ptr<ClientLink> mSnapshotFor;
+    ImageCodec mSnapshotCodec = ImageCodec::Png;
+    struct LastFrame {
+        std::uint32_t id = 0;
+        nlohmann::json stats;
+        std::shared_ptr<const std::string> bytes;
+    } mLastFrame; ///< replayed to a viewer that joins a still view
+    std::shared_ptr<ClientLink> mController;
+    std::vector<std::shared_ptr<ClientLink>> mViewers;
+    std::map<std::string, double> mRefineMsPerPixel; ///< worker only: technique + step -> measured cost
+    std::atomic<bool> mStop{false};
+    std::atomic<std::uint64_t> mFramesRendered{0};
     std::thread mWorker;
 };
+
+/// Upper bound on the VPLs a state's parameters ask for (vpl_grid^2, isr_finest^2, positive_count +
+/// negative_count, rsm_size^2 for light trees), for the server's VPL limit.
+long maxVplEstimate(const FrameState& state);
 
 } // namespace gis

@@ -1,4 +1,5 @@
 // The shared vectors in protocol/vectors: valid ones pass, invalid ones fail with an error code.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -80,7 +81,7 @@ TEST(Protocol, ErrorsCarryCodeAndPointer) {
 
 TEST(Protocol, FrameHeaderLayout) {
     std::vector<std::uint8_t> payload = {0xFF, 0xD8, 0xFF, 0xD9};
-    auto m = gis::makeFrameMessage(0x01020304u, 640, 480, gis::FrameCodec::Jpeg, payload);
+    auto m = gis::makeFrameMessage(0x01020304u, 640, 480, gis::ImageCodec::Jpeg, payload);
     ASSERT_EQ(m.size(), gis::kFrameHeaderSize + payload.size());
     EXPECT_EQ(std::string(m.begin(), m.begin() + 4), "GIFR");
     EXPECT_EQ(m[4], 0x04);
@@ -89,4 +90,20 @@ TEST(Protocol, FrameHeaderLayout) {
     EXPECT_EQ(m[10] | (m[11] << 8), 480);
     EXPECT_EQ(m[12], 1);
     EXPECT_EQ(m[16], 0xFF);
+}
+
+TEST(Protocol, EverySchemaIsAClientMessageTypeAndViceVersa) {
+    std::vector<std::string> schemas;
+    for (const auto& e : fs::directory_iterator(fs::path(GIS_SOURCE_DIR) / "protocol/schema"))
+        if (e.path().extension() == ".json") schemas.push_back(e.path().stem().string());
+    std::sort(schemas.begin(), schemas.end());
+    auto types = gis::clientMessageTypes();
+    std::sort(types.begin(), types.end());
+    EXPECT_EQ(schemas, types);
+}
+
+TEST(Protocol, FrameHeaderCarriesTheWebpCode) {
+    auto m = gis::makeFrameMessage(7, 16, 16, gis::ImageCodec::Webp, {1, 2, 3});
+    EXPECT_EQ(m[12], 3);
+    EXPECT_EQ(m.size(), gis::kFrameHeaderSize + 3);
 }

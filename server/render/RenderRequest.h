@@ -1,0 +1,103 @@
+// One-shot renders: the request of POST /api/render and gi-render --request (schema:
+// protocol/http/render_request.json), parsed into a RenderJob, rendered and encoded by
+// executeRenderJob. gi-render's flag path builds the same RenderJob and FrameState
+// (makeJobFrameState) and writes PNGs with the same encoder and text chunks (renderImageMetadata), so
+// a request and the equivalent command line give byte-identical PNGs.
+//
+// Library gis::render_job (not gis::render): it encodes, and compares with the CPU reference and
+// applies the effect plan when those optional layers are built, and those layers depend on gis::render.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "encode/Encoder.h"
+#include "render/FrameRenderer.h"
+#include "render/FrameState.h"
+#include "scene/Scene.h"
+
+namespace gis {
+
+/// What one request may ask for; the server's configuration (gi-render passes its own flags' bounds).
+struct RenderLimits {
+    int maxWidth = 2048;
+    int maxHeight = 2048;
+    bool allowCompare = true;        ///< false: a request with "compare" is refused
+    int maxReferenceSpp = 1024;      ///< compare.spp
+    double maxReferenceSeconds = 60; ///< cap on compare.time_budget_s, and the budget of a request that
+                                     ///< gives none (a reference at full spp can take hours); 0 = no cap
+};
+
+/// "compare": the CPU reference to measure the frame against (server/reference).
+struct RenderCompare {
+    std::string mode; ///< referenceModes()
+    int spp = 64;
+    double timeBudgetSeconds = 0; ///< 0 = none
+};
+
+/// Everything a one-shot render depends on besides the scene's contents. Parameters, camera and
+/// light are kept as the request's JSON (already validated) and applied on top of the scene's own
+/// state by makeJobFrameState, in that order: technique defaults, preset, params, camera, light.
+struct RenderJob {
+    std::string scene; ///< handed to the caller's scene resolver
+    std::string technique = "rsm_gather";
+    std::string preset;                               ///< "" = none
+    nlohmann::json params = nlohmann::json::object(); ///< {name: value}, frame and technique tables
+    int width = 512;
+    int height = 512;
+    std::optional<nlohmann::json> camera; ///< applyCameraJson object; absent = the scene's camera
+    std::optional<nlohmann::json> light;  ///< applyLightJson object; absent = the scene's spotlight
+    ImageCodec codec = ImageCodec::Png;
+    int quality = kDefaultImageQuality; ///< jpeg and webp
+    std::optional<RenderCompare> compare;
+    /// Set by the caller, never by a request: where references are cached ("" = render every time).
+    std::string referenceCacheDir;
+};
+
+/// The parsed schema (embedded in the binary), e.g. for the server to publish.
+const nlohmann::json& renderRequestSchema();
+
+/// Validates a request against the schema, the limits, the technique and parameter tables, the
+/// presets and the camera/light rules; everything but the scene's existence (the resolver's job).
+/// Throws InputError(JSON pointer of the offending field, what is wrong and how to fix it).
+RenderJob parseRenderRequest(const nlohmann::json& request, const RenderLimits& limits = {});
+
+/// The FrameState `job` renders in `scene` (before any effect plan). Throws InputError for a job that
+/// parseRenderRequest would have refused.
+FrameState makeJobFrameState(const Scene& scene, const RenderJob& job);
+
+/// True when the state's frame parameters ask for the effect plan (`effects` = auto or an
+/// `effect_*` forced); executeRenderJob then plans and applies it as gi-render does.
+bool effectPlanRequested(const FrameState& state);
+
+/// The PNG text chunks of a rendered frame: gi:technique, gi:scene, gi:params (paramsJson, compact).
+/// Only values the image depends on: no times, so equal requests give equal bytes.
+ImageMetadata renderImageMetadata(const std::string& sceneName, const FrameState& state);
+
+/// Whether this build can honour "compare" (the reference and analysis layers are built).
+bool renderJobsCanCompare();
+
+struct RenderResult {
+    std::vector<std::uint8_t> image; ///< the encoded file, exactly as written or sent
+    std::string mimeType;
+    /// FrameRenderer's stats plus "scene", "codec", "bytes", "encode_ms" and, with compare, "compare":
+    /// the metrics of analysis/Metrics.h and {"reference": {mode, spp, seconds, cache_hit, key}}.
+    nlohmann::json stats;
+};
+
+using SceneResolver = std::function<std::shared_ptr<const Scene>(const std::string& name)>;
+
+/// Resolves the scene (the resolver may refuse names: the server sandboxes them), builds the state,
+/// applies the effect plan when asked and available, renders one frame, encodes it and, with
+/// compare, renders or loads the reference and measures. Call on the thread where the renderer's GL
+/// context is current. Throws InputError for bad requests and scenes, gis::Error for failures.
+RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
+                              const SceneResolver& resolveScene);
+
+} // namespace gis

@@ -1,0 +1,337 @@
+// Shared pieces of the end-to-end tests: start a real gi-server, talk protocol v1 to it over a
+// WebSocket, make HTTP requests. Not a test file itself (node --test runs *.test.mjs only).
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import http from 'node:http';
+import net from 'node:net';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import WebSocket from 'ws';
+
+import { helloMsg, parseFrameHeader, SUBPROTOCOL } from '../../client/protocol.js';
+
+export const REPO = fileURLToPath(new URL('../../', import.meta.url));
+export const SERVER = path.resolve(REPO, process.env.GI_SERVER ?? 'build/ci/bin/gi-server');
+export const STARTUP_TIMEOUT_MS = 20000;
+export const FRAME_TIMEOUT_MS = 15000;
+export const REPLY_TIMEOUT_MS = 5000;
+
+export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+export function freePort() {
+    return new Promise((resolve, reject) => {
+        const probe = net.createServer();
+        probe.once('error', reject);
+        probe.listen(0, '127.0.0.1', () => {
+            const { port } = probe.address();
+            probe.close(() => resolve(port));
+        });
+    });
+}
+
+/**
+ * A raw HTTP request: node's http client sends the path as given (traversal attempts reach the
+ * server unchanged) and hands back the body as bytes. Resolves {status, headers, body: Buffer}.
+ */
+export function httpRequest(port, pathname, { method = 'GET', headers = {}, body, timeoutMs = 10000 } = {}) {
+    return new Promise((resolve, reject) => {
+        const req = http.request({ host: '127.0.0.1', port, path: pathname, method, headers, timeout: timeoutMs }, (res) => {
+            const chunks = [];
+            res.on('data', (c) => chunks.push(c));
+            res.on('end', () => resolve({ status: res.statusCode, headers: res.headers, body: Buffer.concat(chunks) }));
+        });
+        req.on('timeout', () => req.destroy(new Error(`${method} ${pathname} timed out`)));
+        req.on('error', reject);
+        req.end(body);
+    });
+}
+
+/** A gi-server process on a free port; `log` keeps the tail of its output for failure reports. */
+export class ServerProcess {
+    constructor(args) {
+        this.args = args;
+        this.log = '';
+        this.port = 0;
+        this.proc = null;
+    }
+
+    static async start(args) {
+        const server = new ServerProcess(args);
+        await server.launch();
+        return server;
+    }
+
+    get wsUrl() {
+        return `ws://127.0.0.1:${this.port}/ws`;
+    }
+
+    get exited() {
+        return this.proc.exitCode !== null || this.proc.signalCode !== null;
+    }
+
+    async launch() {
+        this.port = await freePort();
+        this.proc = spawn(SERVER, ['--host', '127.0.0.1', '--port', String(this.port), ...this.args],
+            { stdio: ['ignore', 'pipe', 'pipe'] });
+        const collect = (chunk) => {
+            this.log += chunk.toString();
+            if (this.log.length > 200000) this.log = this.log.slice(-100000);
+        };
+        this.proc.stdout.on('data', collect);
+        this.proc.stderr.on('data', collect);
+        await new Promise((resolve, reject) => {
+            this.proc.once('spawn', resolve);
+            this.proc.once('error', (e) => reject(new Error(`cannot start ${SERVER} (set GI_SERVER): ${e.message}`)));
+        });
+        await this.waitForHealthy();
+    }
+
+    async waitForHealthy() {
+        const deadline = Date.now() + STARTUP_TIMEOUT_MS;
+        let lastError = null;
+        while (Date.now() < deadline) {
+            if (this.exited) {
+                throw new Error(`gi-server ${this.args.join(' ')} exited (${this.proc.exitCode ?? this.proc.signalCode}) `
+                    + `during startup:\n${this.log}`);
+            }
+            try {
+                const res = await httpRequest(this.port, '/healthz', { timeoutMs: 1000 });
+                if (res.status === 200) return;
+                lastError = new Error(`/healthz answered ${res.status}`);
+            } catch (e) {
+                lastError = e;
+            }
+            await sleep(100);
+        }
+        throw new Error(`gi-server not healthy after ${STARTUP_TIMEOUT_MS} ms (${lastError?.message}):\n${this.log}`);
+    }
+
+    http(pathname, options) {
+        return httpRequest(this.port, pathname, options);
+    }
+
+    /** GET /healthz as JSON. */
+    async health() {
+        const res = await this.http('/healthz');
+        assert.equal(res.status, 200, '/healthz is 200');
+        return JSON.parse(res.body.toString());
+    }
+
+    /** Waits until /healthz reports `sessions` sessions: the server frees closed sessions asynchronously. */
+    async waitForSessions(sessions, timeoutMs = 5000) {
+        const deadline = Date.now() + timeoutMs;
+        let last = null;
+        while (Date.now() < deadline) {
+            last = (await this.health()).sessions;
+            if (last === sessions) return;
+            await sleep(50);
+        }
+        assert.fail(`/healthz sessions is ${last}, expected ${sessions} within ${timeoutMs} ms`);
+    }
+
+    stop() {
+        if (!this.proc || this.exited) return Promise.resolve();
+        return new Promise((resolve) => {
+            const killer = setTimeout(() => this.proc.kill('SIGKILL'), 3000);
+            this.proc.once('exit', () => {
+                clearTimeout(killer);
+                resolve();
+            });
+            this.proc.kill('SIGTERM');
+        });
+    }
+}
+
+/**
+ * Collects everything a socket receives, so that a test can wait for the next message of a kind
+ * without losing ones that arrive early. Text messages are parsed JSON; binary ones are
+ * {binary: Buffer}.
+ */
+export class Inbox {
+    constructor(socket) {
+        this.queue = [];
+        this.waiters = [];
+        this.closed = null;
+        socket.on('message', (data, isBinary) => {
+            const item = isBinary ? { binary: Buffer.from(data) } : JSON.parse(data.toString('utf8'));
+            this.queue.push(item);
+            this.flush();
+        });
+        socket.on('close', (code, reason) => {
+            this.closed = `socket closed (${code} ${reason})`;
+            for (const w of this.waiters.splice(0)) {
+                clearTimeout(w.timer);
+                w.reject(new Error(`${w.what}: ${this.closed}`));
+            }
+        });
+    }
+
+    flush() {
+        for (const w of [...this.waiters]) {
+            const i = this.queue.findIndex(w.match);
+            if (i < 0) continue;
+            const [item] = this.queue.splice(i, 1);
+            this.waiters.splice(this.waiters.indexOf(w), 1);
+            clearTimeout(w.timer);
+            w.resolve(item);
+        }
+    }
+
+    describe() {
+        return this.queue.map((m) => (m.binary ? `<binary ${m.binary.length} B>` : JSON.stringify(m).slice(0, 200)));
+    }
+
+    /** The first message (queued or yet to come) for which match(msg) holds. */
+    next(match, what, timeoutMs = REPLY_TIMEOUT_MS) {
+        return new Promise((resolve, reject) => {
+            const i = this.queue.findIndex(match);
+            if (i >= 0) {
+                resolve(this.queue.splice(i, 1)[0]);
+                return;
+            }
+            if (this.closed) {
+                reject(new Error(`${what}: ${this.closed}`));
+                return;
+            }
+            const waiter = { match, what, resolve, reject };
+            waiter.timer = setTimeout(() => {
+                this.waiters.splice(this.waiters.indexOf(waiter), 1);
+                reject(new Error(`${what}: nothing within ${timeoutMs} ms; unclaimed: [${this.describe().join(', ')}]`));
+            }, timeoutMs);
+            this.waiters.push(waiter);
+        });
+    }
+
+    nextOfType(type, what, timeoutMs) {
+        return this.next((m) => m.type === type, what, timeoutMs);
+    }
+
+    /** Drops everything received so far. */
+    clear() {
+        this.queue.length = 0;
+    }
+
+    /** Types of the messages nobody has waited for yet. */
+    unclaimed() {
+        return this.queue.map((m) => (m.binary ? 'binary' : m.type));
+    }
+}
+
+/**
+ * One protocol v1 connection. `Client.open(server, hello)` connects, sends hello (fields as for
+ * helloMsg) and waits for welcome; `Client.connect` only connects. With autoAck (the default)
+ * every binary frame is acknowledged as it arrives, so the server never waits for the test.
+ */
+export class Client {
+    constructor(url, { headers, autoAck = true } = {}) {
+        this.ws = new WebSocket(url, SUBPROTOCOL, headers ? { headers } : undefined);
+        this.inbox = new Inbox(this.ws);
+        this.autoAck = autoAck;
+        this.welcome = null;
+        this.closeCode = new Promise((resolve) => this.ws.on('close', (code) => resolve(code)));
+        this.ws.on('message', (data, isBinary) => {
+            if (isBinary && this.autoAck && data.length >= 16) this.send({ type: 'ack', frame: data.readUInt32LE(4) });
+        });
+        // Errors show up as a failed open or a close; without a listener ws would throw.
+        this.ws.on('error', () => {});
+    }
+
+    static async connect(server, options) {
+        const client = new Client(server.wsUrl ?? server, options);
+        await new Promise((resolve, reject) => {
+            client.ws.once('open', resolve);
+            client.ws.once('close', (code) => reject(new Error(`connection closed (${code}) before open`)));
+            client.ws.once('error', reject);
+        });
+        assert.equal(client.ws.protocol, SUBPROTOCOL, 'server selected the gi-stream sub-protocol');
+        return client;
+    }
+
+    static async open(server, hello = {}, options = {}) {
+        const client = await Client.connect(server, options);
+        client.send(helloMsg({ client: 'gi-e2e', ...hello }));
+        client.welcome = await client.inbox.nextOfType('welcome', `welcome (hello ${JSON.stringify(hello)})`);
+        return client;
+    }
+
+    send(msg) {
+        if (this.ws.readyState !== WebSocket.OPEN) return;
+        this.ws.send(typeof msg === 'string' ? msg : JSON.stringify(msg));
+    }
+
+    /**
+     * The next frame (stats, then the binary with the same id) for which match(stats) holds;
+     * frames that do not match are skipped. Checks that header and stats agree.
+     */
+    async frame(what, match = () => true, timeoutMs = FRAME_TIMEOUT_MS) {
+        const deadline = Date.now() + timeoutMs;
+        for (;;) {
+            const left = Math.max(1, deadline - Date.now());
+            const stats = await this.inbox.nextOfType('stats', `${what}: stats`, left);
+            const { binary } = await this.inbox.next((m) => m.binary !== undefined, `${what}: binary frame`, REPLY_TIMEOUT_MS);
+            const header = parseFrameHeader(binary);
+            assert.equal(header.frame, stats.frame, `${what}: frame id in the header equals stats.frame`);
+            assert.deepEqual([header.width, header.height], stats.size, `${what}: header size equals stats.size`);
+            const frame = { stats, header, payload: binary.subarray(header.payloadOffset) };
+            if (match(stats, frame)) return frame;
+        }
+    }
+
+    /** Sends `msg` and waits for an error reply with `code`; returns the error. */
+    async expectError(msg, code, what = JSON.stringify(msg).slice(0, 80)) {
+        this.send(msg);
+        const error = await this.inbox.nextOfType('error', `${what}: error reply`);
+        assert.equal(error.code, code, `${what}: error code (message: ${error.message})`);
+        assert.equal(typeof error.message, 'string', `${what}: error has a message`);
+        return error;
+    }
+
+    /** ping with a unique t and wait for its pong: proves the connection is alive and answering. */
+    async roundTrip(what = 'ping') {
+        const t = Math.random() * 1e6;
+        this.send({ type: 'ping', t });
+        const pong = await this.inbox.next((m) => m.type === 'pong' && m.t === t, `${what}: pong`);
+        assert.equal(pong.t, t);
+    }
+
+    /** Resolves the close code, or fails when the server does not close within timeoutMs. */
+    async closedByServer(what, timeoutMs = REPLY_TIMEOUT_MS) {
+        let timer;
+        const timeout = new Promise((_, reject) => {
+            timer = setTimeout(() => reject(new Error(`${what}: the server did not close the connection`)), timeoutMs);
+        });
+        try {
+            return await Promise.race([this.closeCode, timeout]);
+        } finally {
+            clearTimeout(timer);
+        }
+    }
+
+    /** A clean close (1000: the session ends at once); waits for the closing handshake. */
+    async close() {
+        if (this.ws.readyState === WebSocket.CLOSED) return;
+        if (this.ws.readyState !== WebSocket.CLOSING) this.ws.close(1000, 'test done');
+        let timer;
+        await Promise.race([this.closeCode, new Promise((resolve) => {
+            timer = setTimeout(() => {
+                this.ws.terminate();
+                resolve();
+            }, 3000);
+        })]);
+        clearTimeout(timer);
+    }
+
+    /** Drops the TCP connection without a close frame: a lost connection, as far as the server can tell. */
+    terminate() {
+        this.ws.terminate();
+        return this.closeCode;
+    }
+}
+
+export function isPng(bytes) {
+    return bytes.length > 8 && bytes.subarray(0, 8).equals(Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]));
+}
+
+export function isJpeg(bytes) {
+    return bytes.length > 4 && bytes[0] === 0xff && bytes[1] === 0xd8 && bytes.at(-2) === 0xff && bytes.at(-1) === 0xd9;
+}

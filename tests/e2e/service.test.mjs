@@ -1,0 +1,509 @@
+// Integration tests of gi-server as a service (protocol v1, PROTOCOL.md): the opening handshake,
+// authentication, every client message's effect, error handling, resume, viewers, limits,
+// adaptive quality and the HTTP API. Three servers, each started with the flags its tests need:
+//   main:   64x64 frames, --max-size 96x96, --settle-ms 150, --interactive-scale 0.5
+//   auth:   --token s3cret
+//   limits: --max-sessions 2, --rate-limit 20
+// Run: GI_SERVER=build/dev/bin/gi-server node --test tests/e2e/service.test.mjs
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+
+import { Client, isPng, REPO, SERVER, ServerProcess, sleep } from './helpers.mjs';
+
+const TOKEN = 's3cret';
+const SIZE = [64, 64];
+const MAX_SIZE = [96, 96];
+const COMMON = ['--scene', 'builtin:cornell', '--technique', 'none', '--size', `${SIZE[0]}x${SIZE[1]}`,
+    '--client-dir', path.join(REPO, 'client')];
+
+const servers = {};
+const clients = new Set(); // closed when their test ends, so no session outlives its test
+let anyFailed = false;
+let uploadDir = null;
+
+before(async () => {
+    uploadDir = mkdtempSync(path.join(os.tmpdir(), 'gi-e2e-upload-'));
+    const [main, auth, limits] = await Promise.all([
+        ServerProcess.start([...COMMON, '--max-size', `${MAX_SIZE[0]}x${MAX_SIZE[1]}`, '--settle-ms', '150',
+            '--interactive-scale', '0.5', '--resume-grace', '30', '--upload-dir', uploadDir]),
+        ServerProcess.start([...COMMON, '--token', TOKEN]),
+        ServerProcess.start([...COMMON, '--max-sessions', '2', '--rate-limit', '20']),
+    ]);
+    Object.assign(servers, { main, auth, limits });
+});
+
+after(async () => {
+    if (anyFailed) {
+        for (const [name, server] of Object.entries(servers)) console.error(`--- gi-server (${name}) log ---\n${server.log.slice(-4000)}`);
+    }
+    await Promise.all(Object.values(servers).map((s) => s.stop()));
+    if (uploadDir) rmSync(uploadDir, { recursive: true, force: true });
+});
+
+/**
+ * A test whose failure prints the server logs at the end; the connections it opened are closed
+ * with 1000 when it ends. (Not an afterEach hook: those run after every subtest too.)
+ */
+function check(name, fn) {
+    test(name, async (t) => {
+        try {
+            await fn(t);
+        } catch (e) {
+            anyFailed = true;
+            throw e;
+        } finally {
+            await Promise.all([...clients].map((c) => c.close()));
+            clients.clear();
+        }
+    });
+}
+
+/**
+ * A connection past welcome. Controllers default to SIZE and adaptive false (each frame exactly
+ * the requested state); a viewer's hello carries only what the test gives.
+ */
+async function open(server, hello = {}, options) {
+    const defaults = hello.view === undefined ? { size: SIZE, adaptive: false } : {};
+    const client = await Client.open(server, { ...defaults, ...hello }, options);
+    clients.add(client);
+    return client;
+}
+
+async function connect(server, options) {
+    const client = await Client.connect(server, options);
+    clients.add(client);
+    return client;
+}
+
+/**
+ * Waits until the session is quiet (no frame for quietMs) and returns the last frame seen, or
+ * `last` when none came. Frames from earlier changes must not be taken for the next change's.
+ */
+async function settle(client, last = null, quietMs = 400) {
+    for (;;) {
+        try {
+            last = await client.frame('settling', () => true, quietMs);
+        } catch (e) {
+            if (/nothing within/.test(e.message)) return last;
+            throw e;
+        }
+    }
+}
+
+/** A first frame, then quiet: the state every effect test starts from. */
+async function quietFrame(client) {
+    return settle(client, await client.frame('a frame'));
+}
+
+function isWebp(bytes) {
+    return bytes.length > 12 && bytes.subarray(0, 4).toString('latin1') === 'RIFF' && bytes.subarray(8, 12).toString('latin1') === 'WEBP';
+}
+
+function assertClose(actual, expected, what) {
+    assert.equal(actual?.length, expected.length, `${what}: ${JSON.stringify(actual)}`);
+    actual.forEach((v, i) => assert.ok(Math.abs(v - expected[i]) < 1e-5, `${what}[${i}]: ${v} vs ${expected[i]}`));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Opening handshake and authentication
+
+check('hello with another protocol version is refused with protocol_mismatch, then closed', async () => {
+    for (const protocol of [0, 2]) {
+        const client = await connect(servers.main);
+        const error = await client.expectError({ type: 'hello', protocol }, 'protocol_mismatch', `hello protocol ${protocol}`);
+        assert.ok(error.message.length > 0);
+        await client.closedByServer(`after protocol_mismatch (${protocol})`);
+    }
+});
+
+check('a first message other than hello is answered with hello_required, then closed', async () => {
+    const client = await connect(servers.main);
+    await client.expectError({ type: 'camera', position: [0, 1, 3], target: [0, 1, 0] }, 'hello_required');
+    await client.closedByServer('after hello_required');
+    const pinger = await connect(servers.main);
+    await pinger.expectError({ type: 'ping' }, 'hello_required', 'ping before hello');
+    await pinger.closedByServer('after hello_required (ping)');
+});
+
+check('with --token, hello without the token or with a wrong one is unauthorized; the right one works', async () => {
+    for (const token of [undefined, 'wrong']) {
+        const client = await connect(servers.auth);
+        const hello = { type: 'hello', protocol: 1, ...(token ? { token } : {}) };
+        await client.expectError(hello, 'unauthorized', `hello with token ${token}`);
+        await client.closedByServer(`after unauthorized (${token})`);
+    }
+    const good = await open(servers.auth, { token: TOKEN });
+    assert.equal(good.welcome.role, 'controller');
+    await good.frame('a frame with the right token');
+    // The token may come as the handshake's Authorization header instead.
+    const viaHeader = await open(servers.auth, {}, { headers: { Authorization: `Bearer ${TOKEN}` } });
+    assert.equal(viaHeader.welcome.type, 'welcome');
+    const wrongHeader = await connect(servers.auth, { headers: { Authorization: 'Bearer nope' } });
+    await wrongHeader.expectError({ type: 'hello', protocol: 1 }, 'unauthorized', 'wrong bearer header');
+});
+
+check('with --token, the HTTP API needs the bearer token; /healthz stays open', async () => {
+    const server = servers.auth;
+    assert.equal((await server.http('/api/techniques')).status, 401, '/api/techniques without a token');
+    assert.equal((await server.http('/api/techniques', { headers: { Authorization: 'Bearer nope' } })).status, 401,
+        '/api/techniques with a wrong token');
+    assert.equal((await server.http('/metrics')).status, 401, '/metrics without a token');
+    const body = JSON.stringify({ scene: 'builtin:cornell', technique: 'none', size: [16, 16] });
+    assert.equal((await server.http('/api/render', { method: 'POST', body, headers: { 'Content-Type': 'application/json' } })).status,
+        401, 'POST /api/render without a token');
+    const ok = await server.http('/api/techniques', { headers: { Authorization: `Bearer ${TOKEN}` } });
+    assert.equal(ok.status, 200, '/api/techniques with the token');
+    assert.ok(Array.isArray(JSON.parse(ok.body.toString()).techniques));
+    const health = await server.http('/healthz');
+    assert.equal(health.status, 200, '/healthz without a token');
+    assert.equal(JSON.parse(health.body.toString()).status, 'ok');
+});
+
+// ---------------------------------------------------------------------------------------------
+// Every client message
+
+check('every client message type has its effect', async (t) => {
+    // WebP first: the server supports it, so frames come as WebP (codec 3).
+    const client = await open(servers.main, { codecs: ['webp', 'jpeg'], max_in_flight: 1 });
+    assert.equal(client.welcome.codec, 'webp', 'welcome.codec is the first supported of hello.codecs');
+    assert.equal(client.welcome.adaptive, false);
+    let last = await quietFrame(client);
+    assert.equal(last.header.codec, 'webp', 'frames are WebP');
+    assert.ok(isWebp(last.payload), 'the payload is a RIFF/WEBP file');
+    assert.deepEqual(last.stats.size, SIZE, 'the hello size');
+    assert.equal(last.stats.quality, 'fixed', 'adaptive false renders fixed frames');
+
+    /** Sends msg and returns the first frame after `last` for which match holds. */
+    const frameAfter = async (msg, what, match = () => true) => {
+        last = await settle(client, last);
+        const before = last.stats.frame;
+        client.send(msg);
+        last = await client.frame(what, (stats) => stats.frame > before && match(stats));
+        return last;
+    };
+
+    await t.test('camera renders a new frame', async () => {
+        const previous = last;
+        await frameAfter({ type: 'camera', position: [1.2, 1.4, 3.2], target: [0, 1, 0], fov_deg: 45 }, 'after camera');
+        assert.ok(!last.payload.equals(previous.payload), 'a different image');
+    });
+
+    await t.test('light renders a new frame', async () => {
+        const previous = await settle(client, last);
+        await frameAfter({ type: 'light', intensity: 2, color: [1, 0.5, 0.5] }, 'after light');
+        assert.ok(!last.payload.equals(previous.payload), 'a different image');
+    });
+
+    await t.test('technique switches technique', async () => {
+        await frameAfter({ type: 'technique', name: 'rsm_gather' }, 'after technique', (s) => s.technique === 'rsm_gather');
+        assert.equal(typeof last.stats.params?.vpl_grid, 'number', 'rsm_gather parameters in the stats');
+        await client.expectError({ type: 'technique', name: 'no_such_technique' }, 'unknown_technique');
+    });
+
+    await t.test('params sets parameters', async () => {
+        await frameAfter({ type: 'params', values: { vpl_grid: 4 } }, 'after params', (s) => s.params?.vpl_grid === 4);
+        assert.equal(last.stats.counts?.vpl_count, 16, 'vpl_count is 4^2');
+    });
+
+    await t.test('resize renders size x dpr, capped to --max-size with the aspect kept', async () => {
+        await frameAfter({ type: 'resize', size: [40, 30], dpr: 1.5 }, 'after resize 40x30@1.5',
+            (s) => s.size[0] !== SIZE[0]);
+        assert.deepEqual(last.stats.size, [60, 45], '40x30 CSS pixels at dpr 1.5');
+        await frameAfter({ type: 'resize', size: [64, 32], dpr: 2 }, 'after resize 64x32@2', (s) => s.size[0] !== 60);
+        assert.deepEqual(last.stats.size, [96, 48], '128x64 scaled down to fit 96x96');
+        await frameAfter({ type: 'resize', size: SIZE }, 'after resize 64x64', (s) => s.size[1] !== 48);
+        assert.deepEqual(last.stats.size, SIZE, 'dpr defaults to 1');
+    });
+
+    await t.test('scene loads the scene and sends a state message', async () => {
+        client.send({ type: 'scene', name: 'builtin:cornell-empty' });
+        const state = await client.inbox.nextOfType('state', 'state after scene', 15000);
+        assert.equal(state.state?.scene, 'builtin:cornell-empty', 'state.scene');
+        assert.ok(Array.isArray(state.state?.camera?.position), 'state carries the reset camera');
+        last = await client.frame('frame of the new scene', (s) => s.scene === 'builtin:cornell-empty');
+        await client.expectError({ type: 'scene', name: 'builtin:no-such-scene' }, 'unknown_scene');
+        client.send({ type: 'scene', name: 'builtin:cornell' });
+        await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'builtin:cornell', 'state after scene back', 15000);
+    });
+
+    await t.test('quality turns adaptive quality on and off', async () => {
+        client.send({ type: 'quality', adaptive: true });
+        await frameAfter({ type: 'camera', position: [0.5, 1, 3.5], target: [0, 1, 0] }, 'adaptive frame',
+            (s) => s.quality === 'interactive');
+        client.send({ type: 'quality', adaptive: false });
+        await frameAfter({ type: 'camera', position: [0.4, 1, 3.6], target: [0, 1, 0] }, 'fixed frame',
+            (s) => s.quality === 'fixed');
+        assert.deepEqual(last.stats.size, SIZE, 'fixed frames are full size');
+    });
+
+    await t.test('snapshot sends one lossless full-size frame marked snapshot', async () => {
+        const full = (await settle(client, last)).stats.size;
+        await frameAfter({ type: 'snapshot' }, 'png snapshot', (s) => s.snapshot === true);
+        assert.equal(last.header.codec, 'png', 'codec 2 (PNG) by default');
+        assert.ok(isPng(last.payload), 'the payload is a PNG');
+        assert.deepEqual(last.stats.size, full, 'full size');
+        await frameAfter({ type: 'snapshot', codec: 'webp' }, 'webp snapshot', (s) => s.snapshot === true);
+        assert.equal(last.header.codec, 'webp', 'codec 3 (WebP) when asked for');
+        assert.ok(isWebp(last.payload), 'the payload is a WebP');
+    });
+
+    await t.test('ack frees the window: nothing is rendered while it is full', async () => {
+        last = await settle(client, last);
+        client.autoAck = false;
+        try {
+            client.send({ type: 'camera', position: [1, 1, 3.5], target: [0, 1, 0] });
+            const first = await client.frame('frame filling the window', (s) => s.frame > last.stats.frame);
+            client.send({ type: 'camera', position: [1.1, 1, 3.5], target: [0, 1, 0] });
+            await assert.rejects(client.inbox.nextOfType('stats', 'frame beyond max_in_flight 1', 800),
+                /nothing within/, 'no frame while the only slot is taken');
+            client.send({ type: 'ack', frame: first.stats.frame });
+            last = await client.frame('frame after the ack', (s) => s.frame > first.stats.frame);
+            client.send({ type: 'ack', frame: last.stats.frame });
+        } finally {
+            client.autoAck = true;
+        }
+    });
+
+    await t.test('ping is answered by pong with the same t', async () => {
+        client.send({ type: 'ping', t: 7.25 });
+        assert.equal((await client.inbox.nextOfType('pong', 'pong')).t, 7.25);
+        client.send({ type: 'ping' });
+        assert.equal((await client.inbox.nextOfType('pong', 'pong without t')).type, 'pong');
+    });
+
+    assert.deepEqual(client.inbox.unclaimed().filter((type) => type === 'error'), [], 'no unexpected errors');
+});
+
+check('bad messages get an error and the connection stays open', async () => {
+    const client = await open(servers.main);
+    const maxBytes = client.welcome.limits?.max_message_bytes;
+    assert.ok(Number.isInteger(maxBytes) && maxBytes > 0, `welcome.limits.max_message_bytes: ${maxBytes}`);
+    await client.expectError('{"type": "ping"', 'invalid_json', 'invalid JSON');
+    const wrongType = await client.expectError({ type: 'resize', size: [640, '480'] }, 'invalid_message', 'resize with a string');
+    assert.equal(wrongType.where, '/size/1');
+    assert.equal(wrongType.request, 'resize', 'error.request names the message type');
+    const short = await client.expectError({ type: 'camera', position: [0, 1], target: [0, 1, 0] }, 'invalid_message', 'short position');
+    assert.equal(short.where, '/position');
+    await client.expectError({ type: 'camera', position: 'here', target: [0, 1, 0] }, 'invalid_message', 'position a string');
+    const unknown = await client.expectError({ type: 'teleport' }, 'unknown_type', 'unknown type');
+    assert.equal(unknown.where, '/type');
+    await client.expectError(JSON.stringify({ type: 'ping', t: 1, pad: 'x'.repeat(maxBytes) }), 'message_too_large',
+        `a message over ${maxBytes} bytes`);
+    client.ws.send(Buffer.from([0x47, 0x49, 0x46, 0x52]), { binary: true });
+    await client.inbox.next((m) => m.type === 'error' && m.code === 'binary_not_accepted', 'binary message');
+    await client.roundTrip('ping after the bad messages');
+    const before = (await quietFrame(client)).stats.frame;
+    client.send({ type: 'camera', position: [0.3, 1.1, 3.4], target: [0, 1, 0] });
+    await client.frame('a frame after the bad messages', (s) => s.frame > before);
+});
+
+// ---------------------------------------------------------------------------------------------
+// Sessions: resume, viewers, limits
+
+check('a lost connection resumes with the resume token, state intact; after a close with 1000 it cannot', async () => {
+    const first = await open(servers.main);
+    const token = first.welcome.resume_token;
+    assert.equal(typeof token, 'string');
+    const camera = { position: [1.25, 1.5, 3.0], target: [0, 0.9, 0] };
+    const before = (await quietFrame(first)).stats.frame;
+    first.send({ type: 'camera', ...camera });
+    await first.frame('frame with the new camera', (s) => s.frame > before);
+    await first.terminate();
+    await sleep(300); // let the server see the dropped connection
+
+    const second = await open(servers.main, { resume: token });
+    assert.equal(second.welcome.resumed, true, 'welcome.resumed');
+    assert.equal(second.welcome.role, 'controller', 'the resumed client steers');
+    assert.equal(second.welcome.session, first.welcome.session, 'the same session');
+    assertClose(second.welcome.state?.camera?.position, camera.position, 'resumed camera position');
+    assertClose(second.welcome.state?.camera?.target, camera.target, 'resumed camera target');
+    const frame = await second.frame('a frame after resuming');
+    assert.deepEqual(frame.stats.size, SIZE);
+
+    await second.close(); // status 1000: the session ends now
+    const latest = second.welcome.resume_token ?? token;
+    const third = await connect(servers.main);
+    await third.expectError({ type: 'hello', protocol: 1, resume: latest }, 'resume_failed', 'resume after a clean close');
+    await third.closedByServer('after resume_failed');
+});
+
+check('a viewer receives the frames but cannot steer; it is told when the session ends', async (t) => {
+    const controller = await open(servers.main);
+    assert.equal(typeof controller.welcome.view_token, 'string');
+    await quietFrame(controller);
+    const viewer = await open(servers.main, { view: controller.welcome.view_token });
+    assert.equal(viewer.welcome.role, 'viewer', 'welcome.role');
+    // A viewer joining a still view gets the current frame at once, not a black canvas.
+    await viewer.frame('the current frame on joining');
+    assert.equal(viewer.welcome.resume_token, undefined, 'viewers get no resume token');
+    assert.equal(viewer.welcome.view_token, undefined, 'viewers get no view token');
+
+    // Subtests, so that one refusal the server gets wrong does not hide the others.
+    await t.test('the viewer gets the frames, the controller counts it', async () => {
+        controller.send({ type: 'camera', position: [-1, 1.2, 3.3], target: [0, 1, 0] });
+        const seen = await viewer.frame('the viewer gets a frame');
+        assert.ok(seen.payload.length > 0);
+        const counted = await controller.frame('controller frame counting the viewer', (s) => s.viewers >= 1);
+        assert.ok(counted.stats.viewers >= 1, 'stats.viewers');
+    });
+
+    await t.test('steering messages from the viewer are read_only', async () => {
+        for (const msg of [{ type: 'camera', position: [0, 1, 3], target: [0, 1, 0] }, { type: 'params', values: { exposure: 1 } },
+            { type: 'resize', size: [32, 32] }, { type: 'quality', adaptive: true }]) {
+            await viewer.expectError(msg, 'read_only', `viewer sends ${msg.type}`);
+        }
+        await viewer.roundTrip('viewer ping');
+    });
+
+    await t.test('a viewer may take a snapshot; only the viewer receives it', async () => {
+        viewer.send({ type: 'snapshot' });
+        const snap = await viewer.frame('the viewer snapshot', (s) => s.snapshot === true);
+        assert.equal(snap.header.codec, 'png');
+        await sleep(300);
+        assert.equal(controller.inbox.queue.findIndex((m) => m.type === 'stats' && m.snapshot === true), -1,
+            'the controller must not receive the viewer snapshot');
+    });
+
+    await t.test('an unknown view token is refused and closed', async () => {
+        const stranger = await connect(servers.main);
+        await stranger.expectError({ type: 'hello', protocol: 1, view: 'v-not-a-real-token' }, 'unknown_view_token');
+        await stranger.closedByServer('after unknown_view_token');
+    });
+
+    await t.test('when the controller closes with 1000 the viewer gets session_ended and is closed', async () => {
+        await controller.close();
+        await viewer.inbox.next((m) => m.type === 'error' && m.code === 'session_ended', 'session_ended for the viewer');
+        await viewer.closedByServer('viewer after session_ended');
+    });
+});
+
+check('beyond --max-sessions 2 a new session is refused with busy and close status 1013', async () => {
+    const server = servers.limits;
+    await server.waitForSessions(0);
+    const a = await open(server);
+    const b = await open(server);
+    assert.equal(b.welcome.role, 'controller');
+    const c = await connect(server);
+    await c.expectError({ type: 'hello', protocol: 1 }, 'busy', 'third session');
+    assert.equal(await c.closedByServer('after busy'), 1013, 'close status 1013 (try again later)');
+    await a.close();
+    await server.waitForSessions(1);
+    const d = await open(server);
+    assert.equal(d.welcome.role, 'controller', 'a slot freed by a clean close is available again');
+});
+
+check('over --rate-limit messages are dropped with rate_limited and the connection stays', async () => {
+    const server = servers.limits;
+    const client = await open(server);
+    assert.equal(client.welcome.limits?.messages_per_second, 20, 'welcome.limits.messages_per_second');
+    for (let i = 0; i < 200; ++i) client.send({ type: 'ping', t: i });
+    await client.inbox.next((m) => m.type === 'error' && m.code === 'rate_limited', 'rate_limited error');
+    await sleep(2500); // the bucket refills
+    client.inbox.clear();
+    await client.roundTrip('ping after the flood');
+});
+
+// ---------------------------------------------------------------------------------------------
+// Adaptive quality
+
+check('adaptive quality: interactive at half size while steering, then balanced and final without input', async () => {
+    const client = await open(servers.main, { adaptive: true });
+    assert.equal(client.welcome.adaptive, true);
+    assert.equal(client.welcome.limits?.interactive_scale, 0.5, 'welcome.limits.interactive_scale');
+    client.send({ type: 'technique', name: 'rsm_gather' });
+    client.send({ type: 'params', values: { vpl_grid: 4 } }); // parameters set by the client win over every preset
+    const interactive = await client.frame('interactive frame',
+        (s) => s.quality === 'interactive' && s.params?.vpl_grid === 4 && s.technique === 'rsm_gather');
+    assert.equal(interactive.stats.scale, 0.5, 'stats.scale');
+    assert.deepEqual(interactive.stats.size, SIZE.map((v) => v * 0.5), 'half the requested size');
+    assert.equal(interactive.stats.refined, false, 'interactive frames are not refined');
+
+    // No further input: the session refines on its own.
+    const steps = [];
+    let frame = interactive;
+    while (frame.stats.quality !== 'final') {
+        frame = await client.frame('refinement frame', (s) => s.frame > frame.stats.frame);
+        steps.push(frame.stats.quality);
+        assert.ok(steps.length <= 4, `refinement ends with final: ${steps}`);
+    }
+    assert.deepEqual(steps.filter((q) => q !== 'interactive'), ['balanced', 'final'], `balanced, then final: ${steps}`);
+    assert.equal(frame.stats.refined, true, 'final is refined');
+    assert.deepEqual(frame.stats.size, SIZE, 'final is full size');
+    await assert.rejects(client.inbox.nextOfType('stats', 'a frame after final', 600), /nothing within/,
+        'nothing is rendered after final without input');
+
+    client.send({ type: 'camera', position: [0.7, 1.1, 3.6], target: [0, 1, 0] });
+    const again = await client.frame('input restarts at interactive', (s) => s.frame > frame.stats.frame);
+    assert.equal(again.stats.quality, 'interactive');
+});
+
+// ---------------------------------------------------------------------------------------------
+// HTTP API
+
+check('POST /api/render returns the PNG gi-render writes for the same request', async () => {
+    const request = { scene: 'builtin:cornell', technique: 'rsm_gather', params: { vpl_grid: 4 }, size: [64, 64], format: 'png' };
+    const res = await servers.main.http('/api/render', {
+        method: 'POST', body: JSON.stringify(request), headers: { 'Content-Type': 'application/json' }, timeoutMs: 30000,
+    });
+    assert.equal(res.status, 200, `POST /api/render: ${res.body.toString().slice(0, 300)}`);
+    assert.match(res.headers['content-type'] ?? '', /^image\/png/);
+    assert.ok(isPng(res.body), 'the body is a PNG');
+    const stats = JSON.parse(res.headers['x-gi-stats'] ?? 'null');
+    assert.deepEqual(stats?.size, [64, 64], 'X-GI-Stats carries the stats');
+
+    const dir = mkdtempSync(path.join(os.tmpdir(), 'gi-e2e-render-'));
+    try {
+        const out = path.join(dir, 'file.png');
+        const render = spawnSync(path.join(path.dirname(SERVER), 'gi-render'), ['--scene', 'builtin:cornell',
+            '--technique', 'rsm_gather', '--param', 'vpl_grid=4', '--size', '64x64', '--out', out, '--quiet'],
+        { encoding: 'utf8', timeout: 30000 });
+        assert.equal(render.status, 0, `gi-render failed: ${render.error ?? ''}${render.stderr}`);
+        assert.ok(readFileSync(out).equals(res.body), 'byte-identical to gi-render --out');
+    } finally {
+        rmSync(dir, { recursive: true, force: true });
+    }
+});
+
+check('POST /api/render with a bad field is 400 naming the field', async () => {
+    const post = (body) => servers.main.http('/api/render', {
+        method: 'POST', body, headers: { 'Content-Type': 'application/json' },
+    });
+    for (const [request, where] of [
+        [{ scene: 'builtin:cornell', size: [8, 64] }, '/size/0'],
+        [{ scene: 'builtin:cornell', format: 'gif' }, '/format'],
+        [{ scene: 'builtin:cornell', bogus: 1 }, '/bogus'],
+        [{ scene: 'builtin:cornell', params: { vpl_grid: 'many' } }, '/params/vpl_grid'],
+    ]) {
+        const res = await post(JSON.stringify(request));
+        assert.equal(res.status, 400, `${JSON.stringify(request)}: status`);
+        const body = JSON.parse(res.body.toString());
+        assert.equal(typeof body.error, 'string', 'error code');
+        assert.equal(body.where, where, `${JSON.stringify(request)}: where`);
+    }
+    assert.equal((await post('{not json')).status, 400, 'invalid JSON');
+});
+
+check('GET /metrics is Prometheus text with the session and frame counters', async () => {
+    const client = await open(servers.main);
+    await client.frame('a frame to count');
+    const res = await servers.main.http('/metrics');
+    assert.equal(res.status, 200);
+    const text = res.body.toString();
+    for (const name of ['gis_sessions', 'gis_frames_total']) {
+        assert.match(text, new RegExp(`^${name}(\\{[^}]*\\})? `, 'm'), `a ${name} sample`);
+    }
+});
+
+check('POST /api/upload of a body that is not a .glb is 400', async () => {
+    const client = await open(servers.main);
+    const res = await servers.main.http('/api/upload?name=tiny.glb', {
+        method: 'POST', body: Buffer.from('not a glb'),
+        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
+    });
+    assert.equal(res.status, 400, `status (${res.body.toString().slice(0, 200)})`);
+    assert.equal(typeof JSON.parse(res.body.toString()).error, 'string', 'a JSON error');
+});

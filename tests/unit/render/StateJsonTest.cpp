@@ -1,0 +1,173 @@
+// Camera and light JSON (render/StateJson.h): what each field does, the errors' JSON pointers, all or
+// nothing on error, and the round trip through cameraJson/lightJson.
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "core/Error.h"
+#include "render/FrameState.h"
+#include "render/StateJson.h"
+#include "scene/SceneLoader.h"
+
+namespace {
+
+constexpr float kDegToRad = 0.017453292519943295f;
+
+gis::FrameState cornellState() {
+    static const gis::Scene scene = gis::loadScene("builtin:cornell");
+    return gis::makeFrameState(scene, "none");
+}
+
+/// The where() of the InputError `f` throws, "(none)" when it throws nothing.
+std::string whereOf(const std::function<void()>& f, std::string* message = nullptr) {
+    try {
+        f();
+    } catch (const gis::InputError& e) {
+        if (message) *message = e.reason();
+        return e.where();
+    }
+    return "(none)";
+}
+
+void expectVec(glm::vec3 actual, glm::vec3 expected, float eps = 1e-6f) {
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(actual[i], expected[i], eps) << "component " << i;
+}
+
+TEST(StateJson, CameraSetsEveryField) {
+    gis::FrameState s = cornellState();
+    gis::applyCameraJson(
+        s, {{"position", {1, 2, 3}}, {"target", {0, 1, 0}}, {"up", {0, 0, 1}}, {"fov_deg", 50}}, "/camera");
+    expectVec(s.camera.position, {1, 2, 3});
+    expectVec(s.camera.target, {0, 1, 0});
+    expectVec(s.camera.up, {0, 0, 1});
+    EXPECT_NEAR(s.camera.yfovRadians, 50 * kDegToRad, 1e-6f);
+}
+
+TEST(StateJson, CameraKeepsUpAndFovWhenAbsent) {
+    gis::FrameState s = cornellState();
+    const gis::Camera before = s.camera;
+    gis::applyCameraJson(s, {{"type", "camera"}, {"position", {1, 2, 3}}, {"target", {0, 1, 0}}}, "");
+    expectVec(s.camera.up, before.up);
+    EXPECT_EQ(s.camera.yfovRadians, before.yfovRadians);
+}
+
+TEST(StateJson, CameraErrorsNameTheField) {
+    gis::FrameState s = cornellState();
+    const gis::Camera before = s.camera;
+    std::string message;
+    EXPECT_EQ(whereOf(
+                  [&] {
+                      gis::applyCameraJson(s, {{"position", {0, 1, 3}}}, "/camera");
+                  },
+                  &message),
+              "/camera");
+    EXPECT_NE(message.find("target"), std::string::npos) << message;
+    EXPECT_EQ(whereOf(
+                  [&] {
+                      gis::applyCameraJson(s, {{"position", {0, 1, 3}}, {"target", {0, 1, 3}}}, "/camera");
+                  },
+                  &message),
+              "/camera/target");
+    EXPECT_NE(message.find("must differ"), std::string::npos) << message;
+    EXPECT_EQ(whereOf([&] {
+                  gis::applyCameraJson(s, {{"position", {0, 1, 3}}, {"target", {0, 1, 0}}, {"up", {0, 0, 0}}},
+                                       "/camera");
+              }),
+              "/camera/up");
+    EXPECT_EQ(whereOf([&] {
+                  gis::applyCameraJson(s, {{"position", {0, 1}}, {"target", {0, 1, 0}}}, "/camera");
+              }),
+              "/camera/position");
+    EXPECT_EQ(whereOf([&] {
+                  gis::applyCameraJson(s, {{"position", {0, "x", 1}}, {"target", {0, 1, 0}}}, "");
+              }),
+              "/position/1");
+    EXPECT_EQ(whereOf([&] {
+                  gis::applyCameraJson(s, {{"position", {0, 1, 3}}, {"target", {0, 1, 0}}, {"fov_deg", 179}},
+                                       "/camera");
+              }),
+              "/camera/fov_deg");
+    EXPECT_EQ(whereOf([&] { gis::applyCameraJson(s, nlohmann::json::array({1, 2}), "/camera"); }), "/camera");
+    // All or nothing: the failed calls changed nothing.
+    expectVec(s.camera.position, before.position);
+    expectVec(s.camera.target, before.target);
+    expectVec(s.camera.up, before.up);
+}
+
+TEST(StateJson, LightChangesOnlyTheGivenFields) {
+    gis::FrameState s = cornellState();
+    const gis::Light before = s.light;
+    gis::applyLightJson(s, {{"intensity", 3.5}, {"direction", {0, -0.5, 0}}}, "/light");
+    EXPECT_EQ(s.light.intensity, 3.5f);
+    expectVec(s.light.direction, {0, -1, 0}); // normalised
+    expectVec(s.light.position, before.position);
+    expectVec(s.light.color, before.color);
+    EXPECT_EQ(s.light.outerConeAngle, before.outerConeAngle);
+    EXPECT_TRUE(s.lightEnabled);
+    gis::applyLightJson(s, {{"enabled", false}, {"color", {1, 0.5, 0.25}}, {"position", {0, 1.5, 0}}},
+                        "/light");
+    EXPECT_FALSE(s.lightEnabled);
+    expectVec(s.light.color, {1, 0.5f, 0.25f});
+    expectVec(s.light.position, {0, 1.5f, 0});
+}
+
+TEST(StateJson, ConeKeepsTheInnerOuterRatio) {
+    gis::FrameState s = cornellState();
+    ASSERT_GT(s.light.outerConeAngle, 0.0f);
+    const float ratio = s.light.innerConeAngle / s.light.outerConeAngle;
+    gis::applyLightJson(s, {{"cone_deg", 30}}, "/light");
+    EXPECT_NEAR(s.light.outerConeAngle, 30 * kDegToRad, 1e-6f);
+    EXPECT_NEAR(s.light.innerConeAngle / s.light.outerConeAngle, std::min(ratio, 0.99f), 1e-5f);
+}
+
+TEST(StateJson, LightErrorsNameTheFieldAndChangeNothing) {
+    gis::FrameState s = cornellState();
+    const gis::Light before = s.light;
+    std::string message;
+    EXPECT_EQ(whereOf(
+                  [&] {
+                      gis::applyLightJson(s, {{"intensity", 9}, {"direction", {0, 0, 0}}}, "/light");
+                  },
+                  &message),
+              "/light/direction");
+    EXPECT_NE(message.find("must not be zero"), std::string::npos) << message;
+    EXPECT_EQ(whereOf([&] { gis::applyLightJson(s, {{"intensity", -1}}, "/light"); }), "/light/intensity");
+    EXPECT_EQ(whereOf([&] { gis::applyLightJson(s, {{"color", {1, 2, 0}}}, "/light"); }), "/light/color/1");
+    EXPECT_EQ(whereOf([&] { gis::applyLightJson(s, {{"cone_deg", 89}}, "/light"); }), "/light/cone_deg");
+    EXPECT_EQ(whereOf([&] { gis::applyLightJson(s, {{"enabled", 1}}, "/light"); }), "/light/enabled");
+    EXPECT_EQ(whereOf([&] {
+                  gis::applyLightJson(s, {{"enabled", false}, {"intensity", "bright"}}, "");
+              }),
+              "/intensity");
+    EXPECT_EQ(s.light.intensity, before.intensity);
+    EXPECT_TRUE(s.lightEnabled);
+}
+
+TEST(StateJson, JsonRoundTrips) {
+    gis::FrameState s = cornellState();
+    gis::applyCameraJson(s, {{"position", {0.5, 1.2, 3}}, {"target", {0, 0.9, 0}}, {"fov_deg", 45}}, "");
+    gis::applyLightJson(s, {{"cone_deg", 40}, {"intensity", 7}, {"enabled", false}}, "");
+    const nlohmann::json camera = gis::cameraJson(s.camera);
+    const nlohmann::json light = gis::lightJson(s);
+    for (const char* k : {"position", "target", "up", "fov_deg"}) EXPECT_TRUE(camera.contains(k)) << k;
+    for (const char* k : {"position", "direction", "intensity", "color", "cone_deg", "enabled"})
+        EXPECT_TRUE(light.contains(k)) << k;
+    EXPECT_NEAR(camera["fov_deg"].get<double>(), 45.0, 1e-4);
+    EXPECT_NEAR(light["cone_deg"].get<double>(), 40.0, 1e-4);
+    EXPECT_EQ(light["enabled"], false);
+
+    gis::FrameState t = cornellState();
+    gis::applyCameraJson(t, camera, "");
+    gis::applyLightJson(t, light, "");
+    expectVec(t.camera.position, s.camera.position);
+    expectVec(t.camera.target, s.camera.target);
+    expectVec(t.camera.up, s.camera.up);
+    EXPECT_NEAR(t.camera.yfovRadians, s.camera.yfovRadians, 1e-6f);
+    expectVec(t.light.position, s.light.position);
+    expectVec(t.light.direction, s.light.direction);
+    EXPECT_EQ(t.light.intensity, s.light.intensity);
+    EXPECT_NEAR(t.light.outerConeAngle, s.light.outerConeAngle, 1e-6f);
+    EXPECT_FALSE(t.lightEnabled);
+}
+
+} // namespace

@@ -1,0 +1,76 @@
+// Pacing per client: the window of unacknowledged frames, latest-wins replacement and the text cap.
+#include <gtest/gtest.h>
+
+#include "session/ClientLink.h"
+
+namespace {
+
+std::shared_ptr<const std::string> bytes(const char* s) {
+    return std::make_shared<const std::string>(s);
+}
+
+std::vector<std::string> drain(gis::ClientLink& link) {
+    std::vector<std::string> out;
+    gis::OutgoingMessage m;
+    while (link.pop(m)) out.push_back((m.binary ? "bin:" : "txt:") + *m.data);
+    return out;
+}
+
+} // namespace
+
+TEST(ClientLink, WindowLimitsFramesInFlightAndAckFreesIt) {
+    int wakes = 0;
+    gis::ClientLink link(gis::ClientRole::Controller, 2, [&] { ++wakes; });
+    EXPECT_TRUE(link.offerFrame(1, "s1", bytes("f1")));
+    EXPECT_EQ(drain(link), (std::vector<std::string>{"txt:s1", "bin:f1"}));
+    EXPECT_TRUE(link.offerFrame(2, "s2", bytes("f2")));
+    drain(link);
+    EXPECT_TRUE(link.windowFull());
+    EXPECT_FALSE(link.offerFrame(3, "s3", bytes("f3"))); // skipped, not queued
+    EXPECT_EQ(link.droppedFrames(), 1u);
+    EXPECT_FALSE(link.hasOutgoing());
+    link.ack(2); // acknowledging the latest frees the older one too
+    EXPECT_EQ(link.inFlight(), 0u);
+    EXPECT_TRUE(link.offerFrame(4, "s4", bytes("f4")));
+    EXPECT_EQ(wakes, 3);
+}
+
+TEST(ClientLink, UnsentFrameIsReplacedByANewerOne) {
+    gis::ClientLink link(gis::ClientRole::Viewer, 4, nullptr);
+    link.pushText("state");
+    link.offerFrame(1, "s1", bytes("f1"));
+    link.offerFrame(2, "s2", bytes("f2"));
+    EXPECT_EQ(drain(link), (std::vector<std::string>{"txt:state", "txt:s2", "bin:f2"}));
+    EXPECT_EQ(link.droppedFrames(), 1u);
+    EXPECT_EQ(link.inFlight(), 1u); // frame 1 left the window with its replacement
+}
+
+TEST(ClientLink, AHalfSentPairIsCompletedNotReplaced) {
+    gis::ClientLink link(gis::ClientRole::Controller, 4, nullptr);
+    link.offerFrame(1, "s1", bytes("f1"));
+    gis::OutgoingMessage m;
+    ASSERT_TRUE(link.pop(m)); // stats of frame 1 are on the wire
+    link.offerFrame(2, "s2", bytes("f2"));
+    EXPECT_EQ(drain(link), (std::vector<std::string>{"bin:f1", "txt:s2", "bin:f2"}));
+    EXPECT_EQ(link.droppedFrames(), 0u);
+}
+
+TEST(ClientLink, SnapshotsBypassTheWindowAndAreNeverReplaced) {
+    gis::ClientLink link(gis::ClientRole::Controller, 1, nullptr);
+    link.offerFrame(1, "s1", bytes("f1"));
+    EXPECT_TRUE(link.offerFrame(2, "snap", bytes("png"), true));
+    link.offerFrame(3, "s3", bytes("f3")); // replaces frame 1 (unsent), keeps the snapshot
+    EXPECT_EQ(drain(link), (std::vector<std::string>{"txt:snap", "bin:png", "txt:s3", "bin:f3"}));
+}
+
+TEST(ClientLink, TextCapAndCloseDropMessages) {
+    gis::ClientLink link(gis::ClientRole::Controller, 1, nullptr, 2);
+    EXPECT_TRUE(link.pushText("a"));
+    EXPECT_TRUE(link.pushText("b"));
+    EXPECT_FALSE(link.pushText("c"));
+    EXPECT_EQ(link.droppedText(), 1u);
+    link.close();
+    EXPECT_TRUE(link.closed());
+    EXPECT_FALSE(link.hasOutgoing());
+    EXPECT_FALSE(link.offerFrame(1, "s", bytes("f")));
+}
