@@ -56,8 +56,14 @@ public:
         {
             std::lock_guard lock(mMutex);
             mQueue.push_back(std::move(work));
+            ++mPending;
         }
         mCv.notify_all();
+    }
+    /// Teardowns queued or running: it should fall back to 0 soon after sessions end.
+    std::size_t pending() {
+        std::lock_guard lock(mMutex);
+        return mPending;
     }
 
 private:
@@ -72,6 +78,7 @@ private:
                 work();
                 work = nullptr;
                 lock.lock();
+                --mPending;
             }
             if (mStop) return;
         }
@@ -79,6 +86,7 @@ private:
     std::mutex mMutex;
     std::condition_variable mCv;
     std::deque<std::function<void()>> mQueue;
+    std::size_t mPending = 0;
     bool mStop = false;
     std::thread mThread;
 };
@@ -321,6 +329,8 @@ struct WsServer::Impl {
         metrics.gauge("gis_render_queue_depth", "renders waiting for a render slot").set(gate->waiting());
         metrics.gauge("gis_http_render_queue", "POST /api/render jobs waiting for a worker")
             .set(static_cast<double>(workers->queued()));
+        metrics.gauge("gis_teardowns_pending", "ended sessions whose render thread is still being joined")
+            .set(static_cast<double>(reaper->pending()));
         metrics.gauge("gis_uptime_seconds", "seconds since the server started")
             .set(std::chrono::duration<double>(Clock::now() - started).count());
     }
@@ -421,6 +431,7 @@ struct WsServer::Impl {
                               {"sessions", sessions.size()},
                               {"renders_active", gate->active()},
                               {"renders_waiting", gate->waiting()},
+                              {"teardowns_pending", reaper->pending()},
                               {"uptime_s", std::chrono::duration<double>(Clock::now() - started).count()}}));
             return 0;
         }

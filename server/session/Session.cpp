@@ -131,7 +131,12 @@ void Session::start() {
 }
 
 void Session::stop() {
-    mStop = true;
+    {
+        // Under the mutex: the worker tests mStop and then waits while holding it, so a store
+        // without the lock could fall between the two and the notify below would be lost.
+        std::lock_guard lock(mMutex);
+        mStop = true;
+    }
     if (mGate) mGate->wakeAll();
     mCv.notify_all();
     if (mWorker.joinable()) mWorker.join();
@@ -199,6 +204,9 @@ void Session::markInput() {
 
 void Session::ack(const std::shared_ptr<ClientLink>& link, std::uint32_t id) {
     link->ack(id);
+    // The worker reads the window while holding mMutex; passing through it orders this ack before
+    // the worker's next check or after its wait began, so the notify cannot be lost.
+    { std::lock_guard lock(mMutex); }
     mCv.notify_all();
 }
 
