@@ -11,6 +11,7 @@
 #include "render/FrameParams.h"
 #include "render/FrameRenderer.h"
 #include "render/Presets.h"
+#include "render/RenderRequest.h"
 #include "render/StateJson.h"
 #include "scene/SceneLoader.h"
 #include "session/RenderGate.h"
@@ -32,14 +33,6 @@ const char* stepName(int step) {
 
 #if GIS_HAVE_EFFECTS
 namespace {
-bool wantsEffectPlan(const FrameState& state) {
-    const ParamSet& fp = state.frameParams;
-    if (fp.has("effects") && fp.getEnum("effects") != "manual") return true;
-    for (const char* e : {"effect_direct", "effect_indirect", "effect_occlusion", "effect_compensation"})
-        if (fp.has(e) && fp.getEnum(e) != "auto") return true;
-    return false;
-}
-
 // Camera and light rounded to a tenth of the scene's size and about 6 degrees: moving less than that
 // keeps the plan (it is an estimate from a few thousand rays anyway).
 std::string effectPlanKey(const Scene& scene, const FrameState& s) {
@@ -448,7 +441,7 @@ void Session::workerMain() {
 #if GIS_HAVE_EFFECTS
         // The effect plan: measured again only when the scene, the parameters, or the camera or light
         // change materially, never every frame.
-        if (wantsEffectPlan(state)) {
+        if (effectPlanRequested(state)) {
             const std::string key = effectPlanKey(*scene, state);
             if (key != planKey) {
                 plan = planEffects(*scene, state);
