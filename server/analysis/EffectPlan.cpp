@@ -62,6 +62,124 @@ std::string forcedMode(const FrameState& state, const std::string& effect) {
     return state.frameParams.has(name) ? state.frameParams.getEnum(name) : "auto";
 }
 
+// The coarsest eye-space level worth starting the multiresolution refinement at (000 §3, 001 §3.2):
+// levels on which nearly every patch holds a depth or normal discontinuity split completely, so they
+// add a pass and save nothing, while starting finer than needed splits patches that could have stayed
+// whole. Measured on a regular grid of eye rays with the pipeline's own min-max tests and thresholds:
+// the start is the coarsest candidate level on which at least kMinWholeFraction of the patches need
+// no refinement. Candidates are powers of two from 4 to 64 patches along the longer side (the
+// parameter's unit), each patch at least 2x2 samples.
+constexpr double kMinWholeFraction = 0.10;
+constexpr int kLevelGrid = 128; // samples along the longer side
+
+EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, long long& rayCount) {
+    EffectDecision d{.effect = "levels"};
+    d.measurement = "coarsest eye level (patches along the longer side) with >= 10% of covered patches whole";
+    d.threshold = kMinWholeFraction;
+    const int w = std::max(state.width, 1), h = std::max(state.height, 1);
+    const int gx = w >= h ? kLevelGrid : std::max(2, kLevelGrid * w / h);
+    const int gy = w >= h ? std::max(2, kLevelGrid * h / w) : kLevelGrid;
+    const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
+    struct Sample {
+        bool hit = false;
+        float distance = 0.0f;
+        glm::vec3 normal{0.0f};
+    };
+    std::vector<Sample> grid(static_cast<size_t>(gx) * gy);
+    for (int j = 0; j < gy; ++j)
+        for (int i = 0; i < gx; ++i) {
+            const double nx = 2.0 * (i + 0.5) / gx - 1.0, ny = 1.0 - 2.0 * (j + 0.5) / gy;
+            const glm::dvec4 nearP = invViewProj * glm::dvec4(nx, ny, -1.0, 1.0);
+            const glm::dvec4 farP = invViewProj * glm::dvec4(nx, ny, 1.0, 1.0);
+            if (!(std::abs(nearP.w) > 1e-300) || !(std::abs(farP.w) > 1e-300)) continue;
+            const glm::vec3 o(glm::dvec3(nearP) / nearP.w), f(glm::dvec3(farP) / farP.w);
+            const float len = glm::length(f - o);
+            if (!(len > 0.0f)) continue;
+            const glm::vec3 dir = (f - o) / len;
+            SurfaceHit hit;
+            ++rayCount;
+            if (!rays.intersect(o, dir, 0.0f, len, hit)) continue;
+            Sample& s = grid[static_cast<size_t>(j) * gx + i];
+            s.hit = true;
+            s.distance = glm::length(hit.position - state.camera.position);
+            s.normal = facing(hit.shadingNormal, -dir);
+        }
+    const double depthThreshold =
+        state.techniqueParams.has("depth_threshold") ? state.techniqueParams.getFloat("depth_threshold") : 0.1;
+    const double normalThreshold =
+        state.techniqueParams.has("normal_threshold") ? state.techniqueParams.getFloat("normal_threshold") : 0.25;
+    const bool diagonal =
+        !state.techniqueParams.has("diagonal_refine") || state.techniqueParams.getBool("diagonal_refine");
+    // Whole fraction per candidate level, among the patches with geometry (empty ones are never lit).
+    std::string densities;
+    int chosen = 0;
+    const int longSide = std::max(gx, gy);
+    for (int level = 4; level <= 64 && level * 2 <= longSide; level *= 2) {
+        const int cell = std::max(1, longSide / level);
+        const int px = (gx + cell - 1) / cell, py = (gy + cell - 1) / cell;
+        std::vector<std::uint8_t> covered(static_cast<size_t>(px) * py, 0), disc(covered.size(), 0);
+        for (int cy = 0; cy < py; ++cy)
+            for (int cx = 0; cx < px; ++cx) {
+                bool anyHit = false, anyMiss = false;
+                float dMin = std::numeric_limits<float>::max(), dMax = 0.0f;
+                glm::vec3 nMin(2.0f), nMax(-2.0f);
+                for (int y = cy * cell; y < std::min((cy + 1) * cell, gy); ++y)
+                    for (int x = cx * cell; x < std::min((cx + 1) * cell, gx); ++x) {
+                        const Sample& s = grid[static_cast<size_t>(y) * gx + x];
+                        if (!s.hit) {
+                            anyMiss = true;
+                            continue;
+                        }
+                        anyHit = true;
+                        dMin = std::min(dMin, s.distance);
+                        dMax = std::max(dMax, s.distance);
+                        nMin = glm::min(nMin, s.normal);
+                        nMax = glm::max(nMax, s.normal);
+                    }
+                const glm::vec3 nRange = nMax - nMin;
+                const size_t k = static_cast<size_t>(cy) * px + cx;
+                covered[k] = anyHit;
+                // shaders/gi/common/eye_hierarchy.glsl eyePatchDiscontinuous: partial coverage, depth
+                // range beyond a fraction of the nearest, or a normal component's range.
+                disc[k] = anyHit && (anyMiss || dMax - dMin > depthThreshold * std::max(dMin, 1e-6f) ||
+                                     std::max({nRange.x, nRange.y, nRange.z}) > normalThreshold);
+            }
+        int patches = 0, whole = 0;
+        for (int cy = 0; cy < py; ++cy)
+            for (int cx = 0; cx < px; ++cx) {
+                const size_t k = static_cast<size_t>(cy) * px + cx;
+                if (!covered[k]) continue;
+                bool refine = disc[k];
+                // eye_flags.frag: a discontinuous diagonal neighbour refines too (000 §5.2).
+                for (int dy = -1; dy <= 1 && diagonal && !refine; dy += 2)
+                    for (int dx = -1; dx <= 1; dx += 2) {
+                        const int x = cx + dx, y = cy + dy;
+                        if (x >= 0 && y >= 0 && x < px && y < py && disc[static_cast<size_t>(y) * px + x]) refine = true;
+                    }
+                ++patches;
+                if (!refine) ++whole;
+            }
+        const double wholeFraction = patches > 0 ? static_cast<double>(whole) / patches : 1.0;
+        densities += (densities.empty() ? "" : ", ") + fmt("%.0f%%", 100.0 * wholeFraction) + " at " +
+                     std::to_string(level);
+        if (chosen == 0 && wholeFraction >= kMinWholeFraction) {
+            chosen = level;
+            d.value = level;
+        }
+    }
+    const int current = state.techniqueParams.getInt("coarsest_size");
+    if (chosen == 0) {
+        // Discontinuities everywhere down to the finest candidate: keep the configured start.
+        d.value = current;
+        d.reason = "patches left whole: " + densities + "; none reaches 10%, keeping coarsest_size " +
+                   std::to_string(current);
+    } else {
+        d.reason = "patches left whole: " + densities + "; coarser levels would split nearly all, so start at " +
+                   std::to_string(chosen) + " (configured " + std::to_string(current) + ")";
+    }
+    return d;
+}
+
 } // namespace
 
 const EffectDecision* EffectPlan::find(std::string_view effect) const {
@@ -327,6 +445,9 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         decide(std::move(d), on);
     }
 
+    // Multiresolution level limit: where the eye-space hierarchy should start refining.
+    if (state.techniqueParams.has("coarsest_size")) decide(planCoarsestLevel(rays, state, plan.rays), true);
+
     plan.analysisMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return plan;
@@ -343,6 +464,9 @@ void applyEffectPlan(FrameState& state, const EffectPlan& plan) {
         } else if (d.effect == "occlusion") {
             if (state.techniqueParams.has("vpl_shadows"))
                 state.techniqueParams.set("vpl_shadows", d.enabled, "effect_occlusion");
+        } else if (d.effect == "levels") {
+            if (state.techniqueParams.has("coarsest_size") && d.value >= 1.0)
+                state.techniqueParams.set("coarsest_size", static_cast<int>(d.value), "effects");
         } else if (d.effect == "compensation") {
             if (state.techniqueParams.has("ssbc_iterations") && state.techniqueParams.has("clamp_b") &&
                 state.techniqueParams.getFloat("clamp_b") > 0.0) {

@@ -115,3 +115,37 @@ TEST(EffectPlan, Deterministic) {
 }
 
 } // namespace
+
+// The multiresolution start follows the view's discontinuity density: the Cornell box's edges split
+// every 16^2 patch, so refinement starts at 32^2; a view filled by the flat back wall keeps even 4^2
+// patches whole, so it starts there. Other techniques get no levels decision.
+TEST(EffectPlan, MultiresLevelsFollowTheDiscontinuityDensity) {
+    auto multires = [](const std::string& scene, void (*edit)(FrameState&), const char* mode) {
+        Planned p{gis::makeBuiltinScene(scene), {}, {}};
+        p.state = gis::makeFrameState(p.scene, "multires_splat");
+        p.state.width = p.state.height = 256;
+        gis::applyParams(p.state, {{"effects", mode}}, "test");
+        if (edit) edit(p.state);
+        p.plan = gis::planEffects(p.scene, p.state);
+        return p;
+    };
+    const Planned box = multires("cornell", nullptr, "auto");
+    EXPECT_EQ(decision(box.plan, "levels").value, 32.0) << decision(box.plan, "levels").reason;
+    const Planned wall = multires(
+        "cornell-empty",
+        [](FrameState& s) {
+            s.camera.position = {0.0f, 1.0f, -0.5f}; // half a metre from the back wall, looking at it
+            s.camera.target = {0.0f, 1.0f, -1.0f};
+        },
+        "auto");
+    EXPECT_EQ(decision(wall.plan, "levels").value, 4.0) << decision(wall.plan, "levels").reason;
+
+    FrameState applied = box.state;
+    gis::applyEffectPlan(applied, box.plan);
+    EXPECT_EQ(applied.techniqueParams.getInt("coarsest_size"), 32);
+    const Planned manual = multires("cornell", nullptr, "manual");
+    FrameState untouched = manual.state;
+    gis::applyEffectPlan(untouched, manual.plan);
+    EXPECT_EQ(untouched.techniqueParams.getInt("coarsest_size"), 16) << "manual mode only reports";
+    EXPECT_EQ(plan("cornell").plan.find("levels"), nullptr) << "ssbc has no eye hierarchy";
+}
