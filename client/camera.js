@@ -1,20 +1,24 @@
-// Orbit camera: yaw/pitch/distance around a target, world +Y up (the built-in scenes' convention).
-// yaw = 0, pitch = 0 looks down -Z from +Z, the way the Cornell box's welcome camera does.
-// The math is pure; attachOrbitControls() binds it to pointer and wheel events.
+// The eye camera: orbit, pan, zoom and fly around a target, world +Y up (the built-in scenes'
+// convention). yaw = 0, pitch = 0 looks down -Z from +Z, the way the Cornell box's welcome camera
+// does. The math is pure; attachViewControls() binds it (and the light drags) to pointer, wheel,
+// touch and keyboard input.
+
+import { add, clamp, cross, length, normalize, roundVec, scale, sub } from './vec.js';
 
 const DEG = Math.PI / 180;
 // Keep the eye off the poles: at exactly +-90 degrees the look-at basis with up = +Y degenerates.
 export const MAX_PITCH = 89 * DEG;
 export const MIN_DISTANCE = 0.05;
 export const MAX_DISTANCE = 1e5;
+export const MIN_FOV_DEG = 1;
+export const MAX_FOV_DEG = 170;
 const ORBIT_RADIANS_PER_PIXEL = 0.005;
+const LOOK_RADIANS_PER_PIXEL = 0.003;
 const ZOOM_PER_WHEEL_UNIT = 0.001;
+const ZOOM_UNITS_PER_DRAG_PIXEL = 5;
 
-const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
-const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
-const length = (a) => Math.hypot(a[0], a[1], a[2]);
-const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
+/** What a one-finger or left-button drag does, picked in the Camera section. */
+export const DRAG_TOOLS = Object.freeze(['orbit', 'pan', 'zoom', 'fly', 'light-aim', 'light-move']);
 
 /** Position of an eye at {yaw, pitch, distance} (radians, metres) around `target`. */
 export function positionFromOrbit({ yaw, pitch, distance }, target) {
@@ -51,7 +55,7 @@ export class OrbitCamera {
     /** Adopts a protocol camera (welcome.state.camera); the up vector is taken to be +Y. */
     set(camera) {
         this.target = [...camera.target];
-        this.fovDeg = camera.fov_deg ?? this.fovDeg ?? 40;
+        this.fovDeg = clamp(camera.fov_deg ?? this.fovDeg ?? 40, MIN_FOV_DEG, MAX_FOV_DEG);
         const o = orbitFromPosition(camera.position, camera.target);
         this.yaw = o.yaw;
         this.pitch = clamp(o.pitch, -MAX_PITCH, MAX_PITCH);
@@ -68,8 +72,18 @@ export class OrbitCamera {
         this.set(this.home);
     }
 
+    /** A length that fits the scene: the home camera's distance to its target (fly speed, gizmo size). */
+    get sceneScale() {
+        return Math.max(MIN_DISTANCE, length(sub(this.home.position, this.home.target)));
+    }
+
     get position() {
         return positionFromOrbit(this, this.target);
+    }
+
+    /** Unit vector from the eye towards the target. */
+    get forward() {
+        return normalize(sub(this.target, this.position));
     }
 
     /** Drag by (dx, dy) pixels: the scene follows the cursor, as if grabbed (dragging down looks from above). */
@@ -78,9 +92,25 @@ export class OrbitCamera {
         this.pitch = clamp(this.pitch + dy * ORBIT_RADIANS_PER_PIXEL, -MAX_PITCH, MAX_PITCH);
     }
 
+    /**
+     * Fly mode's mouse look: the eye stays, the view turns (drag right looks right, drag down looks
+     * down); the target moves with the view at the same distance.
+     */
+    look(dx, dy) {
+        const eye = this.position;
+        this.yaw -= dx * LOOK_RADIANS_PER_PIXEL;
+        this.pitch = clamp(this.pitch + dy * LOOK_RADIANS_PER_PIXEL, -MAX_PITCH, MAX_PITCH);
+        this.target = sub(eye, positionFromOrbit(this, [0, 0, 0]));
+    }
+
     /** Wheel by `delta` units (deltaY); positive moves away. Exponential, so it feels the same at any distance. */
     zoom(delta) {
         this.distance = clamp(this.distance * Math.exp(delta * ZOOM_PER_WHEEL_UNIT), MIN_DISTANCE, MAX_DISTANCE);
+    }
+
+    /** Zoom by a vertical drag of `dy` pixels (down moves away). */
+    zoomDrag(dy) {
+        this.zoom(dy * ZOOM_UNITS_PER_DRAG_PIXEL);
     }
 
     /**
@@ -94,36 +124,114 @@ export class OrbitCamera {
         this.target = add(this.target, move);
     }
 
+    /** Fly: moves eye and target by `forward` metres along the view, `right` to the side and `up` along world +Y. */
+    move(forward, right, up) {
+        const f = this.forward;
+        const r = normalize(cross(f, [0, 1, 0]));
+        const step = add(add(scale(f, forward), scale(r, right)), [0, up, 0]);
+        this.target = add(this.target, step);
+    }
+
+    setFov(deg) {
+        this.fovDeg = clamp(deg, MIN_FOV_DEG, MAX_FOV_DEG);
+    }
+
     /** The protocol camera for a `camera` message. */
     toCamera() {
-        const round = (v) => Math.round(v * 1e5) / 1e5;
         return {
-            position: this.position.map(round),
-            target: this.target.map(round),
+            position: roundVec(this.position),
+            target: roundVec(this.target),
             up: [0, 1, 0],
-            fov_deg: this.fovDeg,
+            fov_deg: Math.round(this.fovDeg * 1000) / 1000,
         };
     }
 }
 
 /**
- * Binds mouse/touch input on `element` to `camera`: left drag orbits, shift-drag or right-drag
- * pans, the wheel or a two-finger pinch zooms. `onChange()` runs after every change.
+ * What a drag does: Ctrl (or Cmd) aims the light, Ctrl+Shift moves it; Shift, the right or the
+ * middle button pan; otherwise the drag tool picked in the Camera section ('fly' drags look around).
+ */
+export function gestureFor({ ctrlKey = false, metaKey = false, shiftKey = false, button = 0 }, tool) {
+    if (ctrlKey || metaKey) return shiftKey ? 'light-move' : 'light-aim';
+    if (shiftKey || button === 1 || button === 2) return 'pan';
+    if (tool === 'fly') return 'look';
+    return DRAG_TOOLS.includes(tool) ? tool : 'orbit';
+}
+
+/** Key codes (KeyboardEvent.code, so WASD stays where it is on any layout) the view reacts to. */
+export const MOTION_KEYS = Object.freeze(new Set([
+    'KeyW', 'KeyA', 'KeyS', 'KeyD', 'KeyQ', 'KeyE', 'ArrowLeft', 'ArrowRight', 'ArrowUp', 'ArrowDown',
+    'Equal', 'Minus', 'NumpadAdd', 'NumpadSubtract', 'PageUp', 'PageDown',
+]));
+const KEY_ORBIT_PIXELS_PER_S = 300;
+const KEY_ZOOM_UNITS_PER_S = 800;
+
+/**
+ * The camera motion of the keys held for `dt` seconds: {move: [forward, right, up] metres,
+ * turn: [dx, dy] pixels (orbit, or look in fly mode), zoom: wheel units}. W/S forward and back,
+ * A/D sideways, E/Q (or PageUp/PageDown) up and down; arrows orbit (fly: look); +/- zoom; Shift
+ * three times as fast. `speed` is metres per second.
+ */
+export function keyMotion(keys, tool, dt, speed, fast = false) {
+    const held = (...codes) => (codes.some((c) => keys.has(c)) ? 1 : 0);
+    const k = (fast ? 3 : 1) * dt;
+    const move = [
+        (held('KeyW') - held('KeyS')) * speed * k,
+        (held('KeyD') - held('KeyA')) * speed * k,
+        (held('KeyE', 'PageUp') - held('KeyQ', 'PageDown')) * speed * k,
+    ];
+    const sign = tool === 'fly' ? 1 : -1;
+    // Orbit: ArrowLeft moves the eye left around the target (like dragging right); fly: looks left.
+    const turn = [
+        sign * (held('ArrowRight') - held('ArrowLeft')) * KEY_ORBIT_PIXELS_PER_S * k,
+        (tool === 'fly' ? held('ArrowDown') - held('ArrowUp') : held('ArrowUp') - held('ArrowDown')) * KEY_ORBIT_PIXELS_PER_S * k,
+    ];
+    const zoom = (held('Minus', 'NumpadSubtract') - held('Equal', 'NumpadAdd')) * KEY_ZOOM_UNITS_PER_S * k;
+    return { move, turn, zoom };
+}
+
+/**
+ * Binds input on `element` (the frame canvas):
+ * - pointer drags: gestureFor() picks orbit, pan, zoom, look (fly), or a light drag, which goes
+ *   to onLight(gesture, dx, dy) instead of the camera;
+ * - two fingers: pinch zooms, moving both pans;
+ * - wheel: zoom (fly: moves forward and back);
+ * - keys while the canvas has focus: keyMotion(), and Home or R for onHome().
+ * Options: {camera, getTool(), onCamera(), onLight(gesture, dx, dy), onHome(), flySpeed()}.
  * Returns a function that removes the listeners.
  */
-export function attachOrbitControls(element, camera, onChange) {
-    const pointers = new Map(); // pointerId -> {x, y}
-    let pinchDistance = 0;
+export function attachViewControls(element, { camera, getTool, onCamera, onLight, onHome, flySpeed }) {
+    const pointers = new Map(); // pointerId -> {x, y, gesture}
+    let pinch = null; // {span, cx, cy}
+    const keys = new Set();
+    let keyFrame = 0;
+    let lastKeyTime = 0;
+    let shiftHeld = false;
 
-    const pinchSpan = () => {
+    const twoFingers = () => {
         const [a, b] = [...pointers.values()];
-        return Math.hypot(a.x - b.x, a.y - b.y);
+        return { span: Math.hypot(a.x - b.x, a.y - b.y), cx: (a.x + b.x) / 2, cy: (a.y + b.y) / 2 };
+    };
+
+    const apply = (gesture, dx, dy) => {
+        switch (gesture) {
+        case 'light-aim':
+        case 'light-move':
+            onLight?.(gesture, dx, dy);
+            return;
+        case 'pan': camera.pan(dx, dy, element.clientHeight); break;
+        case 'zoom': camera.zoomDrag(dy); break;
+        case 'look': camera.look(dx, dy); break;
+        default: camera.orbit(dx, dy);
+        }
+        onCamera();
     };
 
     const onPointerDown = (e) => {
-        element.setPointerCapture(e.pointerId);
-        pointers.set(e.pointerId, { x: e.clientX, y: e.clientY, button: e.button });
-        if (pointers.size === 2) pinchDistance = pinchSpan();
+        element.focus({ preventScroll: true });
+        element.setPointerCapture?.(e.pointerId);
+        pointers.set(e.pointerId, { x: e.clientX, y: e.clientY, gesture: gestureFor(e, getTool()) });
+        pinch = pointers.size === 2 ? twoFingers() : null;
     };
 
     const onPointerMove = (e) => {
@@ -133,45 +241,79 @@ export function attachOrbitControls(element, camera, onChange) {
         const dy = e.clientY - p.y;
         p.x = e.clientX;
         p.y = e.clientY;
-        if (pointers.size === 2) {
-            const span = pinchSpan();
-            if (pinchDistance > 0 && span > 0) camera.zoom(-Math.log(span / pinchDistance) / ZOOM_PER_WHEEL_UNIT);
-            pinchDistance = span;
-        } else if (e.shiftKey || p.button === 2 || p.button === 1) {
-            camera.pan(dx, dy, element.clientHeight);
-        } else {
-            camera.orbit(dx, dy);
+        if (pointers.size === 2 && pinch) {
+            const now = twoFingers();
+            if (pinch.span > 0 && now.span > 0) camera.zoom(-Math.log(now.span / pinch.span) / ZOOM_PER_WHEEL_UNIT);
+            camera.pan(now.cx - pinch.cx, now.cy - pinch.cy, element.clientHeight);
+            pinch = now;
+            onCamera();
+        } else if (pointers.size === 1) {
+            apply(p.gesture, dx, dy);
         }
-        onChange();
     };
 
     const onPointerUp = (e) => {
         pointers.delete(e.pointerId);
-        pinchDistance = 0;
+        pinch = null;
     };
 
     const onWheel = (e) => {
         e.preventDefault();
         // deltaMode 1 counts lines, 2 pages; bring both to roughly pixels.
         const unit = e.deltaMode === 1 ? 16 : e.deltaMode === 2 ? 400 : 1;
-        camera.zoom(e.deltaY * unit);
-        onChange();
+        if (getTool() === 'fly') camera.move(-e.deltaY * unit * 0.002 * camera.sceneScale, 0, 0);
+        else camera.zoom(e.deltaY * unit);
+        onCamera();
     };
 
+    const keyLoop = (time) => {
+        const dt = Math.min(0.1, Math.max(0, (time - lastKeyTime) / 1000));
+        lastKeyTime = time;
+        const tool = getTool();
+        const { move, turn, zoom } = keyMotion(keys, tool, dt, flySpeed(), shiftHeld);
+        if (move.some((v) => v !== 0)) camera.move(...move);
+        if (turn[0] !== 0 || turn[1] !== 0) {
+            if (tool === 'fly') camera.look(turn[0], turn[1]);
+            else camera.orbit(turn[0], turn[1]);
+        }
+        if (zoom !== 0) camera.zoom(zoom);
+        if (move.some((v) => v !== 0) || turn[0] !== 0 || turn[1] !== 0 || zoom !== 0) onCamera();
+        keyFrame = keys.size ? requestAnimationFrame(keyLoop) : 0;
+    };
+
+    const onKeyDown = (e) => {
+        shiftHeld = e.shiftKey;
+        if (e.ctrlKey || e.metaKey || e.altKey) return;
+        if (e.code === 'Home' || e.code === 'KeyR') {
+            e.preventDefault();
+            onHome?.();
+            return;
+        }
+        if (!MOTION_KEYS.has(e.code)) return;
+        e.preventDefault();
+        keys.add(e.code);
+        if (!keyFrame) {
+            lastKeyTime = performance.now();
+            keyFrame = requestAnimationFrame(keyLoop);
+        }
+    };
+
+    const onKeyUp = (e) => {
+        shiftHeld = e.shiftKey;
+        keys.delete(e.code);
+    };
+
+    const onBlur = () => keys.clear();
     const onContextMenu = (e) => e.preventDefault();
 
-    element.addEventListener('pointerdown', onPointerDown);
-    element.addEventListener('pointermove', onPointerMove);
-    element.addEventListener('pointerup', onPointerUp);
-    element.addEventListener('pointercancel', onPointerUp);
-    element.addEventListener('wheel', onWheel, { passive: false });
-    element.addEventListener('contextmenu', onContextMenu);
+    const listeners = [
+        ['pointerdown', onPointerDown], ['pointermove', onPointerMove], ['pointerup', onPointerUp],
+        ['pointercancel', onPointerUp], ['wheel', onWheel, { passive: false }], ['contextmenu', onContextMenu],
+        ['keydown', onKeyDown], ['keyup', onKeyUp], ['blur', onBlur],
+    ];
+    for (const [type, fn, opts] of listeners) element.addEventListener(type, fn, opts);
     return () => {
-        element.removeEventListener('pointerdown', onPointerDown);
-        element.removeEventListener('pointermove', onPointerMove);
-        element.removeEventListener('pointerup', onPointerUp);
-        element.removeEventListener('pointercancel', onPointerUp);
-        element.removeEventListener('wheel', onWheel);
-        element.removeEventListener('contextmenu', onContextMenu);
+        for (const [type, fn] of listeners) element.removeEventListener(type, fn);
+        cancelAnimationFrame(keyFrame);
     };
 }

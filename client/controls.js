@@ -1,160 +1,114 @@
-// Parameter widgets generated from the parameter schemas in welcome (a technique's params_schema
-// and frame_params_schema), so a parameter added on the server shows up here without client work.
+// Sidebar widgets on lil-gui: each sidebar section is a lil-gui root (its title bar collapses it),
+// and the parameter folders are generated from the server's parameter schemas through
+// params.js, so a parameter added on the server shows up here without client work.
 
-const SLIDER_STEPS = 1000;
+import GUI from 'lil-gui';
 
-/** The kind of widget a parameter schema gets: 'number', 'integer', 'boolean', 'enum' or 'text'. */
-export function widgetKind(schema) {
-    if (Array.isArray(schema.enum)) return 'enum';
-    if (schema.type === 'integer') return 'integer';
-    if (schema.type === 'number') return 'number';
-    if (schema.type === 'boolean') return 'boolean';
-    return 'text';
+import { controlSpec, paramHelp } from './params.js';
+
+export { GUI };
+
+/** A collapsible sidebar section titled `title`, appended to `container`. */
+export function makeSection(container, title, { id, closed = false } = {}) {
+    const gui = new GUI({ container, title, closeFolders: false });
+    gui.domElement.classList.add('section');
+    if (id) gui.domElement.dataset.section = id;
+    if (closed) gui.close();
+    return gui;
 }
 
-/** A round step of about 1/200 of the range (1, 2 or 5 times a power of ten). */
-export function niceStep(min, max) {
-    const raw = (max - min) / 200;
-    if (!(raw > 0) || !Number.isFinite(raw)) return 0.01;
-    const p = 10 ** Math.floor(Math.log10(raw));
-    const m = raw / p;
-    return (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10) * p;
+/** Appends `element` (a custom block: a list, a chart, a progress bar) to a section or folder. */
+export function addBlock(gui, element) {
+    gui.$children.append(element);
+    return element;
 }
 
-/** Slider position (0..SLIDER_STEPS) <-> value, logarithmic where the schema says x-log-scale. */
-export function sliderMapping(schema) {
-    const { minimum: min, maximum: max } = schema;
-    const log = schema['x-log-scale'] === true && min > 0;
-    const isInt = schema.type === 'integer';
-    const toValue = (pos) => {
-        const t = pos / SLIDER_STEPS;
-        const v = log ? min * (max / min) ** t : min + t * (max - min);
-        return isInt ? Math.round(v) : roundToStep(v, niceStep(min, max) / (log ? 100 : 1));
-    };
-    const toPosition = (v) => {
-        const t = log ? Math.log(v / min) / Math.log(max / min) : (v - min) / (max - min || 1);
-        return Math.round(Math.min(1, Math.max(0, t)) * SLIDER_STEPS);
-    };
-    return { toValue, toPosition, log };
-}
-
-function roundToStep(v, step) {
-    const digits = Math.max(0, -Math.floor(Math.log10(step)));
-    return Number((Math.round(v / step) * step).toFixed(digits));
-}
-
-function element(tag, props = {}, children = []) {
-    const el = document.createElement(tag);
-    Object.assign(el, props);
-    for (const c of children) el.append(c);
-    return el;
-}
-
-function labelText(name, schema) {
-    const unit = schema['x-unit'] ? ` (${schema['x-unit']})` : '';
-    return `${name}${unit}`;
-}
-
-function tooltip(schema) {
-    return [schema.description, schema['x-source'] ? `source: ${schema['x-source']}` : '']
-        .filter(Boolean)
-        .join('\n');
-}
-
-function numberControl(name, schema, onCommit) {
-    const isInt = schema.type === 'integer';
-    const hasRange = Number.isFinite(schema.minimum) && Number.isFinite(schema.maximum);
-    const step = isInt ? 1 : hasRange ? niceStep(schema.minimum, schema.maximum) : 'any';
-    const box = element('input', { type: 'number', step: String(step), name });
-    if (Number.isFinite(schema.minimum)) box.min = String(schema.minimum);
-    if (Number.isFinite(schema.maximum)) box.max = String(schema.maximum);
-    const parts = [];
-    let setValue = (v) => { box.value = String(v); };
-    if (hasRange) {
-        const map = sliderMapping(schema);
-        const slider = element('input', { type: 'range', min: '0', max: String(SLIDER_STEPS), step: '1' });
-        slider.setAttribute('aria-label', name);
-        slider.addEventListener('input', () => {
-            const v = map.toValue(Number(slider.value));
-            box.value = String(v);
-            onCommit(v);
-        });
-        setValue = (v) => {
-            box.value = String(v);
-            slider.value = String(map.toPosition(v));
-        };
-        parts.push(slider);
+/** Marks a controller for tests and styles (data-control) and gives it the help text. */
+export function describe(controller, id, help) {
+    controller.domElement.dataset.control = id;
+    if (help) {
+        controller.domElement.title = help;
+        // A button's help stays a tooltip: a line inside the button would break it.
+        if (controller.domElement.classList.contains('lil-function')) return controller;
+        const line = document.createElement('div');
+        line.className = 'control-help';
+        line.textContent = help;
+        controller.domElement.append(line);
     }
-    box.addEventListener('change', () => {
-        const v = Number(box.value);
-        if (box.value.trim() !== '' && Number.isFinite(v)) onCommit(isInt ? Math.round(v) : v);
-    });
-    parts.push(box);
-    return { inputs: parts, setValue, focusables: parts };
+    return controller;
 }
 
-function booleanControl(name, onCommit) {
-    const box = element('input', { type: 'checkbox', name });
-    box.addEventListener('change', () => onCommit(box.checked));
-    return { inputs: [box], setValue: (v) => { box.checked = Boolean(v); }, focusables: [box] };
-}
-
-function enumControl(name, schema, onCommit) {
-    const options = schema.enum.map((o) => element('option', { value: String(o), textContent: String(o) }));
-    const select = element('select', { name }, options);
-    // Enum values may be numbers in a schema; send them back as the type they were given in.
-    select.addEventListener('change', () => onCommit(schema.enum.find((o) => String(o) === select.value)));
-    return { inputs: [select], setValue: (v) => { select.value = String(v); }, focusables: [select] };
-}
-
-function textControl(name, onCommit) {
-    const box = element('input', { type: 'text', name });
-    box.addEventListener('change', () => onCommit(box.value));
-    return { inputs: [box], setValue: (v) => { box.value = String(v); }, focusables: [box] };
-}
-
-function controlFor(name, schema, onCommit) {
-    switch (widgetKind(schema)) {
-    case 'number':
-    case 'integer': return numberControl(name, schema, onCommit);
-    case 'boolean': return booleanControl(name, onCommit);
-    case 'enum': return enumControl(name, schema, onCommit);
-    default: return textControl(name, onCommit);
+/** A controller for a parameter spec (params.js controlSpec) on `holder[spec.name]`. */
+function addSpecController(gui, holder, spec) {
+    switch (spec.kind) {
+    case 'integer':
+    case 'number': {
+        if (spec.min !== undefined && spec.max !== undefined) {
+            return gui.add(holder, spec.name, spec.min, spec.max, spec.step);
+        }
+        const c = gui.add(holder, spec.name);
+        if (spec.min !== undefined) c.min(spec.min);
+        if (spec.max !== undefined) c.max(spec.max);
+        if (spec.step !== undefined) c.step(spec.step);
+        return c;
     }
+    case 'enum': return gui.add(holder, spec.name, spec.options);
+    default: return gui.add(holder, spec.name);
+    }
+}
+
+function isEditing(controller) {
+    const active = document.activeElement;
+    return active !== null && active !== document.body && controller.domElement.contains(active);
 }
 
 /**
- * Fills `container` with one row per parameter of each group ({title, schema}); `onChange(name,
- * value)` runs when the user sets a value. Returns {update(values)} to show values from the
- * server; a control the user is working with at that moment keeps what they typed.
+ * The generated parameter folders of the Technique section. build(groups, values, onChange)
+ * replaces them: groups are [{title, schema, closed}], onChange(name, value) runs when the user
+ * sets a value. update(values) shows values without calling onChange; a control the user is
+ * typing into keeps what they typed unless `force` (a refused value is put back).
  */
-export function buildParamPanel(container, groups, values, onChange) {
-    container.replaceChildren();
-    const controls = new Map();
-    for (const { title, schema } of groups) {
-        const props = Object.entries(schema?.properties ?? {});
-        if (props.length === 0) continue;
-        const fieldset = element('fieldset', { className: 'param-group' }, [element('legend', { textContent: title })]);
-        for (const [name, paramSchema] of props) {
-            const control = controlFor(name, paramSchema, (v) => onChange(name, v));
-            control.inputs.at(-1).id = `param-${name}`;
-            const label = element('label', { textContent: labelText(name, paramSchema), htmlFor: `param-${name}` });
-            const row = element('div', { className: `param param-${widgetKind(paramSchema)}`, title: tooltip(paramSchema) },
-                [label, element('div', { className: 'param-inputs' }, control.inputs)]);
-            fieldset.append(row);
-            controls.set(name, control);
-            control.setValue(values?.[name] ?? paramSchema.default ?? '');
-        }
-        container.append(fieldset);
+export class ParamPanel {
+    constructor(gui) {
+        this.gui = gui;
+        this.folders = [];
+        this.controls = new Map(); // name -> {controller, holder, spec}
     }
-    return {
-        update(newValues) {
-            for (const [name, v] of Object.entries(newValues ?? {})) {
-                const control = controls.get(name);
-                if (!control || control.focusables.includes(document.activeElement)) continue;
-                control.setValue(v);
+
+    build(groups, values, onChange) {
+        for (const folder of this.folders) folder.destroy();
+        this.folders = [];
+        this.controls.clear();
+        for (const { title, schema, closed } of groups) {
+            const props = Object.entries(schema?.properties ?? {});
+            if (props.length === 0) continue;
+            const folder = this.gui.addFolder(title);
+            folder.domElement.classList.add('param-folder');
+            for (const [name, paramSchema] of props) {
+                const spec = controlSpec(name, paramSchema, values?.[name]);
+                const holder = { [name]: spec.initial };
+                const controller = addSpecController(folder, holder, spec).name(spec.label);
+                describe(controller, `param-${name}`, paramHelp(paramSchema));
+                controller.domElement.dataset.param = name;
+                // Numbers report every slider step; the sender coalesces them per animation frame.
+                controller.onChange((v) => onChange(name, spec.kind === 'integer' ? Math.round(v) : v));
+                this.controls.set(name, { controller, holder, spec });
             }
-        },
-        has: (name) => controls.has(name),
-    };
+            if (closed) folder.close();
+            this.folders.push(folder);
+        }
+    }
+
+    update(values, { force = false } = {}) {
+        for (const [name, v] of Object.entries(values ?? {})) {
+            const c = this.controls.get(name);
+            if (!c || (!force && isEditing(c.controller)) || c.holder[name] === v) continue;
+            c.holder[name] = v;
+            c.controller.updateDisplay();
+        }
+    }
+
+    has(name) {
+        return this.controls.has(name);
+    }
 }

@@ -1,18 +1,32 @@
-// App wiring: connection and session role, frame display, side panel and stats.
+// App wiring: connection and session role, frame display, the sidebar sections, the stats overlay,
+// the light gizmo and the accuracy view. The pure pieces live in their own modules (protocol,
+// camera, light, params, stats, accuracy, messages, upload); this file talks to the DOM.
 
 import {
-    ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, paramsMsg, parseFrameHeader, parseServerMessage,
-    qualityMsg, resizeMsg, sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
+    ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, lightMsg, paramsMsg, parseFrameHeader, parseServerMessage,
+    pingMsg, qualityMsg, resizeMsg, sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
     viewportFor,
 } from './protocol.js';
-import { CLIENT_SCHEMAS } from './schemas.js';
-import { OrbitCamera, attachOrbitControls } from './camera.js';
+import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from './schemas.js';
+import { DRAG_TOOLS, MAX_FOV_DEG, MIN_FOV_DEG, OrbitCamera, attachViewControls } from './camera.js';
+import { aimLight, moveLight } from './light.js';
 import { StreamConnection, pageOptions, shareLink, streamUrl } from './connection.js';
-import { buildParamPanel } from './controls.js';
+import { ParamPanel, addBlock, describe, makeSection } from './controls.js';
+import { presetChanges, schemaDefaults } from './params.js';
+import { LatencyTracker, PassHistory, RateCounter, formatBytes, formatMs, networkMs } from './stats.js';
+import { PassChart } from './chart.js';
+import { LightGizmo } from './gizmo.js';
+import {
+    COMPARE_MODES, DEFAULT_COMPARE, buildCompareRequest, canCompare, diffImage, formatCompare, validateCompareRequest,
+    viewKey,
+} from './accuracy.js';
+import { describeError, describeHttpError } from './messages.js';
+import { uploadGlb, uploadName } from './upload.js';
 
 const RESIZE_DEBOUNCE_MS = 200;
-const MESSAGE_HIDE_MS = 6000;
-const FPS_WINDOW_MS = 1000;
+const MESSAGE_HIDE_MS = 8000;
+const PING_INTERVAL_MS = 2000;
+const CHART_WINDOW_S = 10;
 // WebP first: about a third smaller than JPEG at the same quality; JPEG for browsers without it.
 const CODECS = ['webp', 'jpeg'];
 // Two frames in flight: the next frame travels while this one decodes, without building a queue.
@@ -20,54 +34,97 @@ const MAX_IN_FLIGHT = 2;
 // sessionStorage, not localStorage: the token belongs to this tab's session (it survives a reload,
 // which then resumes the session) and another tab must start its own.
 const RESUME_KEY = 'gi-resume-token';
+const SETTINGS_KEY = 'gi-client-settings';
+const NARROW_QUERY = '(max-width: 760px)';
 
 // Errors after which the server closes the connection and retrying the same hello cannot help.
 const FATAL_ERRORS = new Set(['hello_required', 'protocol_mismatch', 'unauthorized', 'unknown_view_token',
     'session_ended', 'idle_timeout']);
 
+const TOOL_NAMES = {
+    orbit: 'orbit', pan: 'pan', zoom: 'zoom', fly: 'fly (WASD + look)', 'light-aim': 'aim light', 'light-move': 'move light',
+};
+
 const $ = (id) => document.getElementById(id);
 const ui = {
+    app: $('app'),
+    sidebar: $('sidebar'),
+    sections: $('sections'),
+    backdrop: $('backdrop'),
+    sidebarToggle: $('sidebar-toggle'),
     canvas: $('view'),
+    compareCanvas: $('compare-view'),
+    layerLabel: $('layer-label'),
+    gizmo: $('gizmo'),
     viewport: $('viewport'),
     connDot: $('conn-dot'),
     connText: $('conn-text'),
+    retryNow: $('retry-now'),
     role: $('role'),
-    messages: $('messages'),
-    scene: $('scene'),
-    technique: $('technique'),
-    techniqueInfo: $('technique-info'),
-    params: $('params'),
-    adaptive: $('adaptive'),
-    resetCamera: $('reset-camera'),
-    snapshot: $('snapshot'),
-    share: $('share'),
-    shareUrl: $('share-url'),
     sessionToggle: $('session-toggle'),
-    fps: $('fps'),
-    statsLine: $('stats-line'),
-    qualityLine: $('quality-line'),
-    passes: $('passes'),
-    plan: $('plan'),
+    messages: $('messages'),
+    overlay: $('overlay'),
+    ovRate: $('ov-rate'),
+    ovTimes: $('ov-times'),
+    ovBytes: $('ov-bytes'),
+    ovAccuracy: $('ov-accuracy'),
+    ovChart: $('ov-chart'),
+    ovLegend: $('ov-legend'),
+    dropHint: $('drop-hint'),
+    fileInput: $('file-input'),
 };
 const ctx = ui.canvas.getContext('2d');
 
 const page = pageOptions(window.location);
+
+function loadSettings() {
+    const defaults = {
+        tool: 'orbit', flySpeed: 0.5, overlay: true, chart: true, help: false, gizmo: true,
+        compareMode: DEFAULT_COMPARE.mode, compareSpp: DEFAULT_COMPARE.spp, compareMaxSide: DEFAULT_COMPARE.maxSide,
+        compareView: 'live', diffGain: 4,
+    };
+    try {
+        return { ...defaults, ...JSON.parse(localStorage.getItem(SETTINGS_KEY) ?? '{}') };
+    } catch {
+        return defaults;
+    }
+}
+const settings = loadSettings();
+function saveSettings() {
+    try {
+        localStorage.setItem(SETTINGS_KEY, JSON.stringify(settings));
+    } catch { /* private mode: settings last for this page only */ }
+}
+
 const state = {
     viewer: page.view !== undefined, // joined with a view token: watch only
     welcome: null,
     techniques: new Map(), // name -> technique description from welcome
     technique: null,
-    paramPanel: null,
-    lastParams: null, // the parameter values of the latest stats
-    lastSize: null, // the last viewport sent, "WxH@dpr"
-    statsByFrame: new Map(),
-    drawTimes: [],
+    scene: null,
+    scenes: [],
+    uploads: [], // upload:NAME scenes of this session
+    params: {}, // the session's own parameter values (what the panel shows)
+    light: null, // the session's spotlight as this client knows it
+    lightHome: null,
+    statsByFrame: new Map(), // frame -> {stats, arrivedAt}
+    lastDrawn: null, // {frame, width, height, stats}
+    framesDrawn: 0,
     decoding: false,
     pending: null, // the newest frame that arrived while another was decoding
     snapshotWanted: false, // a snapshot was asked for and has not arrived yet
+    rttMs: null,
+    decodeMs: null, // createImageBitmap time of the last frame
+    connState: 'connecting',
+    compare: null, // {request, key, result, image (canvas), at}
+    compareRunning: null, // {abort, started}
 };
 
 const camera = new OrbitCamera();
+const rate = new RateCounter(1000);
+const latency = new LatencyTracker();
+const passes = new PassHistory(CHART_WINDOW_S);
+const chart = new PassChart(ui.ovChart, ui.ovLegend, { windowS: CHART_WINDOW_S });
 const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
     onText: handleText,
@@ -76,6 +133,26 @@ const connection = new StreamConnection(streamUrl(window.location), {
     onState: showConnectionState,
 });
 
+// What the browser tests (tests/e2e/browser.test.mjs) and a curious user can read from the console.
+const hook = {
+    get framesDrawn() { return state.framesDrawn; },
+    get lastStats() { return state.lastDrawn?.stats ?? null; },
+    get lastFrame() { return state.lastDrawn?.frame ?? null; },
+    get connection() { return state.connState; },
+    get role() { return state.viewer ? 'viewer' : 'controller'; },
+    get session() { return state.welcome?.session ?? null; },
+    welcomes: 0, // welcome messages so far (a reconnect adds one)
+    resumed: null, // whether the last welcome resumed a session
+    states: [], // the last connection states, oldest first
+    get params() { return { ...state.params }; },
+    get light() { return state.light ? structuredClone(state.light) : null; },
+    get camera() { return camera.toCamera(); },
+    get compare() { return state.compare?.result ?? null; },
+    get rttMs() { return state.rttMs; },
+    get latencyMs() { return latency.typical; },
+};
+window.giClient = hook;
+
 // ---------------------------------------------------------------------------------------------
 // Sending
 
@@ -83,37 +160,93 @@ const connection = new StreamConnection(streamUrl(window.location), {
 function send(msg) {
     const problem = validateClientMessage(msg, CLIENT_SCHEMAS);
     if (problem) {
-        showMessage(`not sent (${problem.code}): ${problem.where || '/'}: ${problem.message}`);
+        showMessage(`Not sent (${problem.code}): ${problem.where || '/'}: ${problem.message}`);
         return false;
     }
     return connection.send(msg);
+}
+
+/** A steering message: sent, and counted as input for the latency. */
+function steer(msg) {
+    if (state.viewer) return false;
+    const sent = send(msg);
+    if (sent) latency.input(performance.now());
+    return sent;
 }
 
 function currentViewport() {
     return viewportFor(ui.viewport.clientWidth, ui.viewport.clientHeight, window.devicePixelRatio);
 }
 
-function sendCamera() {
-    if (!state.viewer) send(cameraMsg(camera.toCamera()));
-}
-
+let lastSize = null; // the last viewport sent, "WxH@dpr"
 function sendResize(force = false) {
     if (state.viewer) return;
     const { size, dpr } = currentViewport();
     const key = `${size[0]}x${size[1]}@${dpr}`;
-    if (!force && key === state.lastSize) return;
-    if (send(resizeMsg(size[0], size[1], dpr))) state.lastSize = key;
+    if (!force && key === lastSize) return;
+    if (send(resizeMsg(size[0], size[1], dpr))) lastSize = key;
 }
 
-function sendParam(name, value) {
+// Pointer moves and slider drags arrive faster than frames: coalesce them into one message of each
+// kind per animation frame.
+const outbox = { camera: false, light: null, params: null, frame: 0 };
+function flushOutbox() {
+    outbox.frame = 0;
+    if (outbox.camera) {
+        outbox.camera = false;
+        steer(cameraMsg(camera.toCamera()));
+    }
+    if (outbox.light) {
+        const changes = outbox.light;
+        outbox.light = null;
+        steer(lightMsg(changes));
+    }
+    if (outbox.params) {
+        const values = outbox.params;
+        outbox.params = null;
+        sendParamsNow(values);
+    }
+}
+function scheduleFlush() {
+    if (!outbox.frame) outbox.frame = requestAnimationFrame(flushOutbox);
+}
+
+function scheduleCamera() {
+    if (state.viewer) return;
+    outbox.camera = true;
+    scheduleFlush();
+    gizmo.render();
+    cameraGui.update();
+}
+
+function changeLight(changes) {
+    if (state.viewer || !state.light) return;
+    Object.assign(state.light, structuredClone(changes));
+    outbox.light = { ...(outbox.light ?? {}), ...changes };
+    scheduleFlush();
+    gizmo.render();
+    lightGui.update();
+}
+
+function queueParams(values) {
+    outbox.params = { ...(outbox.params ?? {}), ...values };
+    scheduleFlush();
+}
+
+/** Parameters are checked against the welcome schemas first: an invalid value never leaves the page. */
+function sendParamsNow(values) {
     const technique = state.techniques.get(state.technique);
-    const problem = validateParamValues({ [name]: value }, technique?.params_schema, state.welcome?.frame_params_schema);
+    const problem = validateParamValues(values, technique?.params_schema, state.welcome?.frame_params_schema);
     if (problem) {
-        showMessage(`${problem.where}: ${problem.message}`);
-        state.paramPanel?.update(state.lastParams ?? {});
+        showMessage(`Not sent: ${problem.where}: ${problem.message}`);
+        paramPanel.update(state.params, { force: true });
         return;
     }
-    send(paramsMsg({ [name]: value }));
+    if (steer(paramsMsg(values))) {
+        Object.assign(state.params, values);
+        paramPanel.update(values);
+        sceneGui.update();
+    }
 }
 
 /** hello for this page: a viewer names the view token, a controller its viewport and a resume token if it has one. */
@@ -121,7 +254,7 @@ function buildHello() {
     const common = { client: CLIENT_NAME, token: page.token, codecs: CODECS, max_in_flight: MAX_IN_FLIGHT };
     if (state.viewer) return helloMsg({ ...common, view: page.view });
     const { size, dpr } = currentViewport();
-    state.lastSize = `${size[0]}x${size[1]}@${dpr}`;
+    lastSize = `${size[0]}x${size[1]}@${dpr}`;
     return helloMsg({ ...common, resume: sessionStorage.getItem(RESUME_KEY) ?? undefined, size, dpr });
 }
 
@@ -132,31 +265,39 @@ function handleOpen() {
     state.statsByFrame.clear();
     state.pending = null;
     state.snapshotWanted = false;
+    latency.reset();
     send(buildHello());
+    sendPing();
 }
 
 function handleClose(code) {
-    if (code === 1013) showMessage('the server is busy (session limit reached); retrying');
+    if (code === 1013) showMessage(describeError({ code: 'busy' }));
 }
 
 function handleText(text) {
     const msg = parseServerMessage(text);
     if (!msg) {
-        showMessage('the server sent a message that is not a JSON object with a type');
+        showMessage('The server sent a message that is not a JSON object with a type.');
         return;
     }
     switch (msg.type) {
     case 'welcome': handleWelcome(msg); break;
-    case 'stats': handleStats(msg); break;
-    case 'state': applyState(msg.state ?? {}); break;
+    case 'stats':
+        state.statsByFrame.set(msg.frame, { stats: msg, arrivedAt: performance.now() });
+        // Stats whose frame never arrives (a reconnect in between) must not pile up.
+        for (const frame of state.statsByFrame.keys()) if (frame < msg.frame - 8) state.statsByFrame.delete(frame);
+        break;
+    case 'state': applyState(msg.state ?? {}, { fromServer: true }); break;
     case 'error': handleError(msg); break;
-    case 'pong': break;
+    case 'pong':
+        if (Number.isFinite(msg.t)) state.rttMs = performance.now() - msg.t;
+        break;
     default: console.warn('unhandled server message', msg);
     }
 }
 
 function handleError(msg) {
-    showMessage(`${msg.code}${msg.where ? ` at ${msg.where}` : ''}: ${msg.message}`);
+    showMessage(describeError(msg));
     if (msg.code === 'resume_failed') {
         // The session is gone (grace period over, server restarted): the reconnect that follows
         // the close starts a new one.
@@ -165,73 +306,74 @@ function handleError(msg) {
     } else if (FATAL_ERRORS.has(msg.code)) {
         if (msg.code === 'session_ended' || msg.code === 'idle_timeout') sessionStorage.removeItem(RESUME_KEY);
         connection.stopReconnecting();
+    } else if (msg.code === 'invalid_param' || msg.code === 'limit_exceeded') {
+        // The server kept its values: show them again (the next stats carry what it renders).
+        paramPanel.update(state.params, { force: true });
     }
 }
 
 function handleWelcome(msg) {
     connection.markHealthy();
+    hook.welcomes += 1;
+    hook.resumed = msg.resumed === true;
     state.welcome = msg;
     setRole(msg.role === 'viewer');
     if (msg.resume_token) sessionStorage.setItem(RESUME_KEY, msg.resume_token);
+    if (!msg.resumed) state.uploads = [];
     state.techniques = new Map((msg.techniques ?? []).map((t) => [t.name, t]));
-    const s = msg.state ?? {};
-    fillSelect(ui.scene, msg.scenes ?? [], s.scene);
-    fillSelect(ui.technique, [...state.techniques.keys()], s.technique);
-    ui.adaptive.checked = msg.adaptive !== false;
-    state.lastParams = s.params ?? null;
-    applyState(s, { resumed: msg.resumed === true });
+    state.scenes = msg.scenes ?? [];
+    techniqueGui.setTechniques([...state.techniques.keys()]);
+    techniqueGui.adaptive(msg.adaptive !== false);
+    shareGui.update();
+    applyState(msg.state ?? {}, { resumed: msg.resumed === true, fresh: true });
     // A resumed session still has the viewport of before the outage (or the reload).
     if (msg.resumed) sendResize(true);
 }
 
 /**
- * Shows a session state (welcome.state, state messages). A new session's camera becomes the one
- * "Reset camera" returns to; a resumed one keeps the home it had.
+ * Shows a session state (welcome.state, state messages). A new session's camera and light become
+ * the ones "Reset" returns to; a resumed one keeps the home it had.
  */
-function applyState(s, { resumed = false } = {}) {
-    if (s.scene !== undefined) ui.scene.value = s.scene;
+function applyState(s, { resumed = false, fresh = false } = {}) {
+    if (s.scene !== undefined) state.scene = s.scene;
+    sceneGui.setScenes();
     if (s.camera) {
         if (resumed) camera.set(s.camera);
         else camera.setHome(s.camera);
+        cameraGui.update();
     }
-    if (s.technique !== undefined) {
-        ui.technique.value = s.technique;
-        showTechnique(s.technique, s.params);
+    if (s.light) {
+        state.light = structuredClone(s.light);
+        if (!resumed || !state.lightHome) state.lightHome = structuredClone(s.light);
+        lightGui.update();
     }
-}
-
-function handleStats(msg) {
-    state.statsByFrame.set(msg.frame, msg);
-    // Stats whose frame never arrives (a reconnect in between) must not pile up.
-    for (const frame of state.statsByFrame.keys()) if (frame < msg.frame - 8) state.statsByFrame.delete(frame);
-    if (msg.technique && msg.technique !== state.technique && state.techniques.has(msg.technique)) {
-        ui.technique.value = msg.technique;
-        showTechnique(msg.technique, msg.params);
-    }
-    if (msg.scene && state.welcome?.scenes?.includes(msg.scene)) ui.scene.value = msg.scene;
-    if (msg.params) {
-        state.lastParams = msg.params;
-        state.paramPanel?.update(msg.params);
-    }
+    if (s.params) state.params = { ...s.params };
+    if (s.technique !== undefined || fresh) showTechnique(s.technique ?? state.technique);
+    else paramPanel.update(state.params);
+    sceneGui.update();
+    gizmo.render();
 }
 
 function handleBinary(buffer) {
+    const arrivedAt = performance.now();
     let header;
     try {
         header = parseFrameHeader(buffer);
     } catch (e) {
-        showMessage(`bad frame from the server: ${e.message}`);
+        showMessage(`Bad frame from the server: ${e.message}`);
         return;
     }
+    const entry = state.statsByFrame.get(header.frame);
+    state.statsByFrame.delete(header.frame);
     // The snapshot is saved as it arrives: the draw queue below may skip frames.
-    if (state.snapshotWanted && state.statsByFrame.get(header.frame)?.snapshot) {
+    if (state.snapshotWanted && entry?.stats?.snapshot) {
         state.snapshotWanted = false;
         saveSnapshot(header, buffer);
     }
-    const frame = { header, buffer, connection: connection.socket };
+    const frame = { header, buffer, entry, arrivedAt, socket: connection.socket };
     if (state.decoding) {
-        // With two frames in flight the next one can arrive while this one decodes; keep only the
-        // newest and acknowledge the skipped one so that its slot frees.
+        // At most one decode in flight: keep only the newest frame that waits, and acknowledge
+        // the one it replaces so its slot frees.
         if (state.pending) acknowledge(state.pending);
         state.pending = frame;
         return;
@@ -243,17 +385,22 @@ async function decodeAndDraw(frame) {
     state.decoding = true;
     const { header, buffer } = frame;
     try {
+        const started = performance.now();
         const payload = new Uint8Array(buffer, header.payloadOffset);
+        // createImageBitmap decodes off the main thread; the draw below is a copy.
         const bitmap = await createImageBitmap(new Blob([payload], { type: CODEC_MIME[header.codec] }));
-        if (ui.canvas.width !== header.width || ui.canvas.height !== header.height) {
-            ui.canvas.width = header.width;
-            ui.canvas.height = header.height;
+        const decodeMs = performance.now() - started;
+        if (frame.socket === connection.socket) {
+            if (ui.canvas.width !== header.width || ui.canvas.height !== header.height) {
+                ui.canvas.width = header.width;
+                ui.canvas.height = header.height;
+            }
+            ctx.drawImage(bitmap, 0, 0, header.width, header.height);
+            recordDraw(frame, decodeMs, buffer.byteLength);
         }
-        ctx.drawImage(bitmap, 0, 0, header.width, header.height);
         bitmap.close();
-        recordDraw(header, buffer.byteLength);
     } catch (e) {
-        showMessage(`frame ${header.frame} could not be decoded: ${e.message}`);
+        showMessage(`Frame ${header.frame} could not be decoded: ${e.message}`);
     } finally {
         // Acknowledge even a frame that failed to decode, else the server would wait forever.
         acknowledge(frame);
@@ -266,19 +413,91 @@ async function decodeAndDraw(frame) {
 
 function acknowledge(frame) {
     // An ack belongs to the connection that received the frame; after a reconnect it means nothing.
-    if (frame.connection === connection.socket) send(ackMsg(frame.header.frame));
+    if (frame.socket === connection.socket) send(ackMsg(frame.header.frame));
 }
 
 function saveSnapshot(header, buffer) {
     const blob = new Blob([new Uint8Array(buffer, header.payloadOffset)], { type: CODEC_MIME[header.codec] });
-    const scene = (ui.scene.value || 'scene').replace(/[^A-Za-z0-9_-]+/g, '-');
+    const scene = (state.scene || 'scene').replace(/[^A-Za-z0-9_-]+/g, '-');
     const link = Object.assign(document.createElement('a'), {
         href: URL.createObjectURL(blob),
         download: `gi-${scene}-${state.technique ?? 'frame'}-${header.frame}.${header.codec}`,
     });
+    document.body.append(link);
     link.click();
+    link.remove();
+    showMessage(`Snapshot saved: ${link.download} (${header.width}×${header.height}, lossless)`, 'info');
     // The download has started from the object URL by the time the timer runs.
     setTimeout(() => URL.revokeObjectURL(link.href), 1000);
+}
+
+function sendPing() {
+    if (connection.isOpen) send(pingMsg(performance.now()));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Stats
+
+function recordDraw(frame, decodeMs, frameBytes) {
+    const now = performance.now();
+    const stats = frame.entry?.stats ?? null;
+    state.framesDrawn += 1;
+    state.lastDrawn = { frame: frame.header.frame, width: frame.header.width, height: frame.header.height, stats };
+    ui.canvas.dataset.frame = String(frame.header.frame);
+    rate.tick(now);
+    if (stats && !stats.snapshot) {
+        latency.frameDrawn(frame.arrivedAt, now, stats, state.rttMs ?? 0);
+        passes.push(now / 1000, stats.passes);
+    }
+    // A viewer follows what the controller does; a controller's own choice is already shown (and
+    // frames of the previous choice may still be on their way).
+    if (state.viewer && stats?.technique && stats.technique !== state.technique && state.techniques.has(stats.technique)) {
+        state.params = { ...(stats.params ?? {}) };
+        showTechnique(stats.technique);
+    }
+    if (state.viewer && stats?.scene && stats.scene !== state.scene) {
+        state.scene = stats.scene;
+        sceneGui.setScenes();
+    }
+    const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
+    showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
+    sceneGui.showPlan(stats?.plan);
+    statsGui.showDetails(stats);
+    accuracyGui.frameDrawn();
+    gizmo.render();
+}
+
+function showRate() {
+    const now = performance.now();
+    const fps = rate.rate(now);
+    const lat = latency.typical;
+    ui.ovRate.textContent = `${fps.toFixed(0)} fps · input→frame ${lat === null ? '–' : formatMs(lat, 0)}`
+        + ` · decode ${formatMs(state.decodeMs)}`;
+    if (settings.chart && settings.overlay) {
+        passes.prune(now / 1000);
+        chart.update(passes.series(), now / 1000);
+    }
+}
+
+function showFrameStats(header, stats, { decodeMs, net, bytes }) {
+    const ms = (v) => (Number.isFinite(v) ? v.toFixed(1) : '–');
+    ui.ovTimes.textContent = `render ${ms(stats?.frame_ms)} · encode ${ms(stats?.encode_ms)} · net ${ms(net)} ms`;
+    state.decodeMs = decodeMs;
+    ui.ovBytes.textContent = [
+        `${formatBytes(bytes)}/frame`,
+        `${header.width}×${header.height} ${stats?.codec ?? header.codec}`,
+        `${stats?.quality ?? '–'}${stats?.refined ? ' (refined)' : ''}${stats?.snapshot ? ' snapshot' : ''}`,
+    ].join(' · ');
+    showAccuracyLine();
+}
+
+function showAccuracyLine() {
+    const result = state.compare?.result;
+    ui.ovAccuracy.hidden = !result;
+    if (!result) return;
+    const f = formatCompare(result);
+    const stale = accuracyGui.stale() ? ' (earlier view)' : '';
+    ui.ovAccuracy.textContent = `rel. RMSE ${f.relRmse} vs ${state.compare.request.compare.mode}${stale}`;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -289,33 +508,15 @@ function setRole(viewer) {
     state.viewer = viewer;
     document.body.classList.toggle('viewer', viewer);
     ui.role.textContent = viewer ? 'viewing' : 'controlling';
-    ui.share.hidden = viewer;
-}
-
-async function copyShareLink() {
-    const token = state.welcome?.view_token;
-    if (!token) {
-        showMessage('no view token yet: wait for the connection');
-        return;
-    }
-    const link = shareLink(window.location, token);
-    try {
-        await navigator.clipboard.writeText(link);
-        showMessage('view-only link copied', 'info');
-    } catch {
-        // No clipboard (plain http on another host, or permission refused): show the link to copy by hand.
-        ui.shareUrl.value = link;
-        ui.shareUrl.hidden = false;
-        ui.shareUrl.select();
-    }
-}
-
-function requestSnapshot() {
-    if (send(snapshotMsg('png'))) state.snapshotWanted = true;
+    for (const section of [techniqueGui.gui, lightGui.gui, cameraGui.gui, accuracyGui.gui]) section.show(!viewer);
+    sceneGui.setViewer(viewer);
+    shareGui.setViewer(viewer);
+    gizmo.enabled = !viewer;
+    gizmo.render();
 }
 
 function toggleSession() {
-    if (connection.socket || ui.connDot.dataset.state === 'waiting') {
+    if (connection.socket || state.connState === 'waiting') {
         // A deliberate end: close with 1000 so the server frees the session now.
         sessionStorage.removeItem(RESUME_KEY);
         connection.close();
@@ -324,104 +525,15 @@ function toggleSession() {
     }
 }
 
-// ---------------------------------------------------------------------------------------------
-// Panel
-
-function fillSelect(select, names, selected) {
-    select.replaceChildren(...names.map((n) => new Option(n, n)));
-    if (selected !== undefined) select.value = selected;
-}
-
-function showTechnique(name, values) {
-    state.technique = name;
-    const technique = state.techniques.get(name);
-    ui.techniqueInfo.textContent = technique
-        ? [technique.description, technique.paper ? `(${technique.paper})` : ''].filter(Boolean).join(' ')
-        : '';
-    const groups = [
-        { title: `${name ?? 'technique'} parameters`, schema: technique?.params_schema },
-        { title: 'frame parameters', schema: state.welcome?.frame_params_schema },
-    ];
-    // Frame parameters keep their values across a technique switch; the technique's reset.
-    const merged = { ...(state.lastParams ?? {}), ...(values ?? {}) };
-    state.paramPanel = buildParamPanel(ui.params, groups, merged, sendParam);
-}
-
-function onTechniqueSelected() {
-    const name = ui.technique.value;
-    if (!send(techniqueMsg(name))) return;
-    const technique = state.techniques.get(name);
-    const defaults = Object.fromEntries(
-        Object.entries(technique?.params_schema?.properties ?? {}).map(([k, s]) => [k, s.default]));
-    showTechnique(name, defaults);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Stats and status
-
-function recordDraw(header, frameBytes) {
-    state.drawTimes.push(performance.now());
-    const stats = state.statsByFrame.get(header.frame);
-    state.statsByFrame.delete(header.frame);
-    showStats(header, stats, frameBytes);
-}
-
-// Also runs on a timer so that the rate falls to 0 while nothing is drawn.
-function showFps() {
-    const now = performance.now();
-    while (state.drawTimes.length && state.drawTimes[0] < now - FPS_WINDOW_MS) state.drawTimes.shift();
-    ui.fps.textContent = `${state.drawTimes.length} fps`;
-}
-
-function formatMs(v) {
-    return typeof v === 'number' ? v.toFixed(1) : '–';
-}
-
-function showStats(header, stats, frameBytes) {
-    const bytes = stats?.bytes ?? frameBytes;
-    showFps();
-    ui.statsLine.textContent = [
-        `render ${formatMs(stats?.frame_ms)} ms`,
-        `encode ${formatMs(stats?.encode_ms)} ms`,
-        `${(bytes / 1024).toFixed(1)} KB`,
-        `${header.width}×${header.height} ${stats?.codec ?? header.codec}`,
-        stats?.timing ? `(${stats.timing})` : '',
-    ].filter(Boolean).join(' · ');
-    ui.qualityLine.textContent = [
-        `${stats?.quality ?? '–'}${stats?.refined ? ' (refined)' : ''}${stats?.snapshot ? ' snapshot' : ''}`,
-        `queue ${formatMs(stats?.queue_ms)} ms`,
-        `dropped ${stats?.dropped_frames ?? 0}`,
-        `viewers ${stats?.viewers ?? 0}`,
-    ].join(' · ');
-    ui.passes.replaceChildren(...(stats?.passes ?? []).map((p) => {
-        const li = document.createElement('li');
-        li.append(Object.assign(document.createElement('span'), { textContent: p.name }),
-            Object.assign(document.createElement('span'), { textContent: `${formatMs(p.gpu_ms)} ms` }));
-        return li;
-    }));
-    showPlan(stats?.plan);
-}
-
-// The effect plan (frame parameter `effects`): each effect on or off, forced or decided, with the
-// server's reason as the tooltip.
-function showPlan(plan) {
-    const decisions = plan && plan.mode !== 'manual' ? plan.decisions ?? [] : [];
-    ui.plan.replaceChildren(...decisions.map((d) => {
-        const li = document.createElement('li');
-        li.title = d.reason ?? '';
-        li.append(Object.assign(document.createElement('span'), { textContent: d.effect }),
-            Object.assign(document.createElement('span'), {
-                textContent: `${d.enabled ? 'on' : 'off'}${d.forced ? ' (forced)' : ''}`,
-            }));
-        return li;
-    }));
-}
-
 function showConnectionState(connState, delayMs) {
+    state.connState = connState;
+    hook.states.push(connState);
+    if (hook.states.length > 20) hook.states.shift();
     ui.connDot.dataset.state = connState;
     ui.connText.textContent = connState === 'waiting'
         ? `disconnected, retrying in ${(delayMs / 1000).toFixed(1)} s`
-        : connState;
+        : connState === 'open' ? 'connected' : connState;
+    ui.retryNow.hidden = connState !== 'waiting';
     ui.sessionToggle.textContent = connState === 'closed' ? 'Connect' : 'Disconnect';
 }
 
@@ -433,6 +545,683 @@ function showMessage(text, kind = 'error') {
     // Older messages go first so that a burst of errors cannot fill the view.
     while (ui.messages.children.length > 4) ui.messages.firstChild.remove();
     setTimeout(() => item.remove(), MESSAGE_HIDE_MS);
+}
+
+function block(tag, className, text) {
+    const el = document.createElement(tag);
+    if (className) el.className = className;
+    if (text !== undefined) el.textContent = text;
+    return el;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sidebar sections
+
+const sceneGui = (() => {
+    const gui = makeSection(ui.sections, 'Scene', { id: 'scene' });
+    const model = { scene: '', autoEffects: false, upload: () => ui.fileInput.click() };
+    let sceneCtl = describe(gui.add(model, 'scene', ['']).name('scene'), 'scene',
+        'built-in scenes, the server\'s scene directories and this session\'s uploads');
+    sceneCtl.onChange((name) => {
+        if (!name || name === state.scene) return;
+        flushOutbox();
+        if (steer(sceneMsg(name))) state.scene = name;
+    });
+    const uploadCtl = describe(gui.add(model, 'upload').name('Upload .glb…'), 'upload',
+        'or drop a .glb file on the view; it is loaded for this session only');
+    const progress = addBlock(gui, block('div', 'upload-progress block'));
+    progress.hidden = true;
+    const bar = progress.appendChild(Object.assign(document.createElement('progress'), { max: 1, value: 0 }));
+    const progressText = progress.appendChild(block('span', 'upload-text'));
+    const effectsCtl = describe(gui.add(model, 'autoEffects').name('plan effects'), 'auto-effects',
+        'effects = auto: the server measures which lighting effects this view needs and switches the rest off');
+    effectsCtl.onChange((on) => queueParams({ effects: on ? 'auto' : 'manual' }));
+    const planFolder = gui.addFolder('effect plan');
+    planFolder.domElement.dataset.folder = 'plan';
+    const plan = addBlock(planFolder, block('div', 'plan block'));
+    plan.dataset.block = 'plan';
+    const planSummary = plan.appendChild(block('p', 'plan-summary'));
+    const planList = plan.appendChild(block('ul', 'plan-list'));
+    let lastPlanKey = '';
+
+    return {
+        gui,
+        setScenes() {
+            const names = [...new Set([...state.scenes, ...state.uploads, ...(state.scene ? [state.scene] : [])])];
+            model.scene = state.scene ?? '';
+            sceneCtl.options(names.length ? names : ['']);
+            sceneCtl.updateDisplay();
+        },
+        update() {
+            model.autoEffects = state.params.effects === 'auto';
+            effectsCtl.updateDisplay();
+        },
+        setViewer(viewer) {
+            sceneCtl.disable(viewer);
+            uploadCtl.show(!viewer);
+            effectsCtl.show(!viewer);
+        },
+        progress(fraction, text) {
+            progress.hidden = fraction === null;
+            if (fraction !== null) bar.value = fraction;
+            progressText.textContent = text ?? '';
+        },
+        /** The effect plan of the frame on screen: each effect on or off, and why. */
+        showPlan(p) {
+            const key = `${state.params.effects}:${JSON.stringify(p ?? null)}`;
+            if (key === lastPlanKey) return;
+            lastPlanKey = key;
+            if (!p || p.mode === 'manual' || !Array.isArray(p.decisions)) {
+                planSummary.textContent = 'Manual: the technique\'s parameters decide which effects run. '
+                    + 'Turn on "plan effects" to let the server measure what this view needs.';
+                planList.replaceChildren();
+                return;
+            }
+            const why = state.params.effects === 'auto' ? 'planned for this view'
+                : 'planned by the final refinement step (adaptive quality)';
+            planSummary.textContent = `Effects ${why}, from ${p.rays ?? '?'} rays `
+                + `in ${Number.isFinite(p.analysis_ms) ? p.analysis_ms.toFixed(0) : '?'} ms:`;
+            planList.replaceChildren(...p.decisions.map((d) => {
+                const li = block('li', `decision ${d.enabled ? 'on' : 'off'}`);
+                li.dataset.effect = d.effect;
+                const head = li.appendChild(block('div', 'decision-head'));
+                head.append(block('span', 'decision-name', d.effect),
+                    block('span', 'badge', `${d.enabled ? 'on' : 'off'}${d.forced ? ', forced' : ''}`
+                        + `${d.available === false ? ', no knob' : ''}`));
+                li.append(block('div', 'decision-reason', d.reason ?? ''));
+                return li;
+            }));
+        },
+    };
+})();
+
+const techniqueGui = (() => {
+    const gui = makeSection(ui.sections, 'Technique & parameters', { id: 'technique' });
+    const model = {
+        technique: '', adaptive: true, help: settings.help,
+        reset: () => {
+            const technique = state.techniques.get(state.technique);
+            queueParams({ ...schemaDefaults(state.welcome?.frame_params_schema), ...schemaDefaults(technique?.params_schema) });
+            paramPanel.update({ ...state.params, ...outbox.params }, { force: true });
+        },
+    };
+    const techniqueCtl = describe(gui.add(model, 'technique', ['']).name('technique'), 'technique',
+        'the global-illumination technique; its parameters reset to their defaults');
+    techniqueCtl.onChange((name) => {
+        if (!name || name === state.technique) return;
+        flushOutbox(); // parameters still queued belong to the technique before
+        if (!steer(techniqueMsg(name))) return;
+        const technique = state.techniques.get(name);
+        Object.assign(state.params, schemaDefaults(technique?.params_schema));
+        showTechnique(name);
+    });
+    const info = addBlock(gui, block('p', 'technique-info block'));
+    describe(gui.add(model, 'adaptive').name('adaptive quality'), 'adaptive',
+        'render quickly while you steer, then refine the still view (balanced, then final preset)')
+        .onChange((on) => steer(qualityMsg(on)));
+    describe(gui.add(model, 'help').name('show help'), 'help', 'show each parameter\'s description, range and source')
+        .onChange((on) => {
+            settings.help = on;
+            saveSettings();
+            ui.sidebar.classList.toggle('show-help', on);
+        });
+    describe(gui.add(model, 'reset').name('Reset parameters'), 'reset-params', 'every parameter back to its default');
+    ui.sidebar.classList.toggle('show-help', settings.help);
+    return {
+        gui,
+        setTechniques(names) {
+            techniqueCtl.options(names.length ? names : ['']);
+        },
+        adaptive(on) {
+            model.adaptive = on;
+            gui.controllers.find((c) => c.property === 'adaptive')?.updateDisplay();
+        },
+        show(name) {
+            model.technique = name ?? '';
+            techniqueCtl.updateDisplay();
+            const t = state.techniques.get(name);
+            info.textContent = t ? [t.description, t.paper ? `(${t.paper})` : ''].filter(Boolean).join(' ') : '';
+        },
+    };
+})();
+
+// The generated parameter folders go at the end of the Technique section.
+const paramPanel = new ParamPanel(techniqueGui.gui);
+
+/** Rebuilds the parameter folders for technique `name` with the session's values. */
+function showTechnique(name) {
+    state.technique = name;
+    techniqueGui.show(name);
+    const technique = state.techniques.get(name);
+    paramPanel.build([
+        { title: `${name ?? 'technique'} parameters`, schema: technique?.params_schema },
+        { title: 'frame parameters', schema: state.welcome?.frame_params_schema, closed: true },
+    ], state.params, (param, value) => queueParams({ [param]: value }));
+}
+
+const lightGui = (() => {
+    const gui = makeSection(ui.sections, 'Light', { id: 'light' });
+    const model = {
+        enabled: true, intensity: 1, color: [1, 1, 1], cone_deg: 45, gizmo: settings.gizmo,
+        reset: () => {
+            if (state.lightHome) changeLight(structuredClone(state.lightHome));
+        },
+    };
+    const enabledCtl = describe(gui.add(model, 'enabled').name('on'), 'light-enabled', 'the spotlight on or off');
+    enabledCtl.onChange((v) => changeLight({ enabled: v }));
+    let intensityMax = 100;
+    const intensityCtl = describe(gui.add(model, 'intensity', 0, intensityMax, 0.1).name('intensity (cd)'),
+        'light-intensity', 'luminous intensity of the spotlight in candela');
+    intensityCtl.onChange((v) => changeLight({ intensity: v }));
+    const colorCtl = describe(gui.addColor(model, 'color', 1).name('colour'), 'light-color', 'the light\'s colour (linear RGB)');
+    colorCtl.onChange((v) => changeLight({ color: v.map((c) => Math.round(c * 1e4) / 1e4) }));
+    const coneCtl = describe(gui.add(model, 'cone_deg', 1, 85, 0.5).name('cone (deg)'), 'light-cone',
+        'outer half-angle of the spot cone, 1 to 85 degrees');
+    coneCtl.onChange((v) => changeLight({ cone_deg: v }));
+    describe(gui.add(model, 'gizmo').name('show gizmo'), 'light-gizmo',
+        'handles in the view: drag the disc to move the light, the small dot to aim it')
+        .onChange((on) => {
+            settings.gizmo = on;
+            saveSettings();
+            gizmo.visible = on;
+            gizmo.render();
+        });
+    describe(gui.add(model, 'reset').name('Reset light'), 'light-reset', 'back to the scene\'s own spotlight');
+    addBlock(gui, block('p', 'hint block',
+        'Drag the gizmo in the view, or Ctrl-drag to aim and Ctrl+Shift-drag to move the light '
+        + '(touch: pick "aim light" or "move light" as the drag tool under Camera).'));
+    return {
+        gui,
+        update() {
+            const l = state.light;
+            if (!l) return;
+            model.enabled = l.enabled !== false;
+            // The server's floats (60.000003814697266) shown as the numbers they stand for.
+            const round = (v, digits) => Math.round(v * 10 ** digits) / 10 ** digits;
+            model.intensity = round(l.intensity ?? model.intensity, 3);
+            if (model.intensity > intensityMax) {
+                intensityMax = Math.ceil(model.intensity * 4);
+                intensityCtl.max(intensityMax);
+            }
+            model.color = [...(l.color ?? [1, 1, 1])];
+            model.cone_deg = round(l.cone_deg ?? model.cone_deg, 2);
+            for (const c of [enabledCtl, intensityCtl, colorCtl, coneCtl]) c.updateDisplay();
+        },
+    };
+})();
+
+const cameraGui = (() => {
+    const gui = makeSection(ui.sections, 'Camera', { id: 'camera' });
+    const model = {
+        tool: DRAG_TOOLS.includes(settings.tool) ? settings.tool : 'orbit',
+        fov: 40,
+        speed: settings.flySpeed,
+        reset: () => resetCamera(),
+    };
+    const toolOptions = Object.fromEntries(DRAG_TOOLS.map((t) => [TOOL_NAMES[t], t]));
+    describe(gui.add(model, 'tool', toolOptions).name('drag tool'), 'drag-tool',
+        'what a drag (or one finger) does; Shift or right-drag always pans, Ctrl-drag aims the light')
+        .onChange((t) => {
+            settings.tool = t;
+            saveSettings();
+            ui.canvas.dataset.tool = t;
+        });
+    const fovCtl = describe(gui.add(model, 'fov', MIN_FOV_DEG, MAX_FOV_DEG, 1).name('field of view (deg)'), 'fov',
+        'vertical field of view');
+    fovCtl.onChange((v) => {
+        camera.setFov(v);
+        scheduleCamera();
+    });
+    describe(gui.add(model, 'speed', 0.05, 3, 0.05).name('fly speed'), 'fly-speed',
+        'WASD speed in scene sizes per second (Shift: three times as fast)')
+        .onChange((v) => {
+            settings.flySpeed = v;
+            saveSettings();
+        });
+    describe(gui.add(model, 'reset').name('Reset camera'), 'reset-camera', 'back to the scene\'s camera (Home or R)');
+    addBlock(gui, block('p', 'hint block',
+        'Drag: the tool above · Shift- or right-drag: pan · wheel or pinch: zoom · two fingers: pan · '
+        + 'W A S D: fly, E/Q: up/down · arrows: orbit (fly: look) · +/−: zoom · Home or R: reset. '
+        + 'Click the view first for the keys.'));
+    ui.canvas.dataset.tool = model.tool;
+    return {
+        gui,
+        tool: () => model.tool,
+        speed: () => model.speed * camera.sceneScale,
+        update() {
+            if (Math.abs(model.fov - camera.fovDeg) > 1e-9) {
+                model.fov = camera.fovDeg;
+                fovCtl.updateDisplay();
+            }
+        },
+    };
+})();
+
+function resetCamera() {
+    camera.reset();
+    scheduleCamera();
+}
+
+const statsGui = (() => {
+    const gui = makeSection(ui.sections, 'Stats', { id: 'stats' });
+    const model = { overlay: settings.overlay, chart: settings.chart };
+    const applyOverlay = () => {
+        ui.overlay.hidden = !settings.overlay;
+        ui.ovChart.hidden = !settings.chart;
+        ui.ovLegend.hidden = !settings.chart;
+    };
+    describe(gui.add(model, 'overlay').name('overlay'), 'stats-overlay', 'frame rate, latency and times over the view')
+        .onChange((on) => {
+            settings.overlay = on;
+            saveSettings();
+            applyOverlay();
+        });
+    describe(gui.add(model, 'chart').name('pass chart'), 'stats-chart', 'stacked per-pass GPU time, last 10 s')
+        .onChange((on) => {
+            settings.chart = on;
+            saveSettings();
+            applyOverlay();
+            if (on) chart.resize();
+        });
+    const details = addBlock(gui, block('div', 'stats-details block'));
+    details.dataset.block = 'stats-details';
+    applyOverlay();
+    const row = (label, value) => {
+        const div = block('div', 'kv');
+        div.append(block('span', 'k', label), block('span', 'v', value));
+        return div;
+    };
+    return {
+        gui,
+        showDetails(stats) {
+            if (!stats) return;
+            const changed = presetChanges(stats.params, state.params);
+            details.replaceChildren(
+                row('quality', `${stats.quality ?? '–'}${stats.refined ? ' (refined)' : ''}`
+                    + `${stats.scale !== undefined ? `, scale ${stats.scale}` : ''}`),
+                row('queue', formatMs(stats.queue_ms)),
+                row('readback', formatMs(stats.readback_ms)),
+                row('timing', stats.timing ?? '–'),
+                row('VPLs', String(stats.counts?.vpl_count ?? '–')),
+                row('triangles', String(stats.counts?.triangles ?? '–')),
+                row('dropped', String(stats.dropped_frames ?? 0)),
+                row('viewers', String(stats.viewers ?? 0)),
+                row('round trip', formatMs(state.rttMs)),
+                row('this frame differs', changed.length
+                    ? changed.map(([k, v]) => `${k}=${typeof v === 'number' ? Number(v.toPrecision(4)) : v}`).join(', ')
+                    : 'no (the panel\'s values)'),
+            );
+        },
+    };
+})();
+
+const accuracyGui = (() => {
+    const gui = makeSection(ui.sections, 'Accuracy', { id: 'accuracy', closed: false });
+    const model = {
+        mode: COMPARE_MODES.includes(settings.compareMode) ? settings.compareMode : DEFAULT_COMPARE.mode,
+        spp: settings.compareSpp,
+        maxSide: settings.compareMaxSide,
+        view: settings.compareView,
+        gain: settings.diffGain,
+        measure: () => measureAccuracy(),
+    };
+    const save = (key) => (v) => {
+        settings[key] = v;
+        saveSettings();
+    };
+    describe(gui.add(model, 'mode', COMPARE_MODES).name('reference'), 'compare-mode',
+        'the CPU reference the frame is measured against (one-bounce-unoccluded matches what the VPL techniques simulate)')
+        .onChange(save('compareMode'));
+    describe(gui.add(model, 'spp', 1, 64, 1).name('reference spp'), 'compare-spp',
+        'samples per pixel of the reference: more is less noisy and slower').onChange(save('compareSpp'));
+    describe(gui.add(model, 'maxSide', 32, 256, 16).name('size (px)'), 'compare-size',
+        'the longer side of the measured image; the current view\'s aspect is kept').onChange(save('compareMaxSide'));
+    const measureCtl = describe(gui.add(model, 'measure').name('Measure this view'), 'compare-run',
+        'render this view through POST /api/render with a CPU reference and report the error');
+    const progress = addBlock(gui, block('div', 'compare-progress block'));
+    progress.hidden = true;
+    progress.append(Object.assign(document.createElement('progress'), { className: 'busy' }));
+    const progressText = progress.appendChild(block('span', 'compare-progress-text'));
+    const result = addBlock(gui, block('div', 'compare-result block'));
+    result.dataset.block = 'compare-result';
+    result.textContent = 'Not measured yet. Measuring costs a few seconds of CPU time on the server.';
+    const views = { 'live stream': 'live', 'API render': 'api', reference: 'ref', difference: 'diff' };
+    const viewCtl = describe(gui.add(model, 'view', views).name('show'),
+        'compare-view', 'the live stream, the measured API render of the view, the CPU reference, or the difference '
+        + 'between render and reference');
+    viewCtl.onChange((v) => {
+        save('compareView')(v);
+        showCompareLayer();
+    });
+    describe(gui.add(model, 'gain', 1, 32, 1).name('difference gain'), 'compare-gain',
+        'the difference view multiplies |API render − reference| by this').onChange((v) => {
+        save('diffGain')(v);
+        showCompareLayer();
+    });
+    addBlock(gui, block('p', 'hint block',
+        'The server reports the error against its CPU reference but does not send the reference image: '
+        + '"API render" is the frame it measured, "difference" compares it with the stream.'));
+    return {
+        gui,
+        model,
+        running(text) {
+            progress.hidden = text === null;
+            progressText.textContent = text ?? '';
+            measureCtl.name(text === null ? 'Measure this view' : 'Cancel');
+        },
+        showResult(text, lines) {
+            result.replaceChildren();
+            if (text) result.append(block('p', '', text));
+            for (const [k, v] of lines ?? []) {
+                const div = block('div', 'kv');
+                div.append(block('span', 'k', k), block('span', 'v', v));
+                result.append(div);
+            }
+        },
+        /** True when the view on screen is no longer the one measured. */
+        stale() {
+            const current = currentCompareRequest();
+            return !current || !state.compare || viewKey(current) !== state.compare.key;
+        },
+        frameDrawn() {
+            if (model.view === 'diff' && state.compare) showCompareLayer();
+        },
+    };
+})();
+
+const shareGui = (() => {
+    const gui = makeSection(ui.sections, 'Share', { id: 'share' });
+    const model = {
+        copy: () => copyShareLink(),
+        snapshot: () => requestSnapshot(),
+    };
+    const copyCtl = describe(gui.add(model, 'copy').name('Copy view-only link'), 'share-link',
+        'a link that shows this view live without steering it');
+    const linkBox = addBlock(gui, block('div', 'share-box block'));
+    const linkInput = linkBox.appendChild(Object.assign(document.createElement('input'), {
+        type: 'text', readOnly: true, className: 'share-url', id: 'share-url',
+    }));
+    linkInput.setAttribute('aria-label', 'view-only link');
+    linkBox.hidden = true;
+    describe(gui.add(model, 'snapshot').name('Snapshot (PNG)'), 'snapshot',
+        'render the current view at final quality and full size, and save it losslessly');
+    return {
+        gui,
+        update() {
+            linkBox.hidden = true;
+        },
+        showLink(link) {
+            linkInput.value = link;
+            linkBox.hidden = false;
+            linkInput.select();
+        },
+        setViewer(viewer) {
+            copyCtl.show(!viewer);
+        },
+    };
+})();
+
+async function copyShareLink() {
+    const token = state.welcome?.view_token;
+    if (!token) {
+        showMessage('No view token yet: wait for the connection.');
+        return;
+    }
+    const link = shareLink(window.location, token);
+    // The link is always shown too: the clipboard may be refused (plain http on another host).
+    shareGui.showLink(link);
+    try {
+        await navigator.clipboard.writeText(link);
+        showMessage('View-only link copied.', 'info');
+    } catch {
+        showMessage('Copy the view-only link from the Share section.', 'info');
+    }
+}
+
+function requestSnapshot() {
+    if (send(snapshotMsg('png'))) {
+        state.snapshotWanted = true;
+        showMessage('Snapshot requested: rendering at final quality…', 'info');
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Accuracy
+
+/** The compare request for the frame on screen, or null when there is none to measure. */
+function currentCompareRequest() {
+    const drawn = state.lastDrawn;
+    if (!drawn?.stats || !state.light) return null;
+    const m = accuracyGui.model;
+    return buildCompareRequest({
+        scene: state.scene,
+        technique: drawn.stats.technique ?? state.technique,
+        params: drawn.stats.params ?? state.params,
+        camera: camera.toCamera(),
+        light: state.light,
+        frameSize: [drawn.width, drawn.height],
+        maxSide: m.maxSide,
+        mode: m.mode,
+        spp: m.spp,
+    });
+}
+
+function authHeaders() {
+    return page.token ? { Authorization: `Bearer ${page.token}` } : {};
+}
+
+async function measureAccuracy() {
+    if (state.compareRunning) {
+        state.compareRunning.abort.abort();
+        return;
+    }
+    if (!canCompare(state.scene)) {
+        showMessage('Uploaded scenes belong to this session\'s stream: the HTTP API cannot render them, '
+            + 'so they cannot be measured.');
+        return;
+    }
+    const request = currentCompareRequest();
+    if (!request) {
+        showMessage('No frame to measure yet.');
+        return;
+    }
+    const problem = validateCompareRequest(request, RENDER_REQUEST_SCHEMA);
+    if (problem) {
+        showMessage(`Not sent: ${problem.where}: ${problem.message}`);
+        return;
+    }
+    const abort = new AbortController();
+    const started = performance.now();
+    state.compareRunning = { abort, started };
+    const label = `${request.compare.mode}, ${request.compare.spp} spp, ${request.size[0]}×${request.size[1]}`;
+    const tick = () => accuracyGui.running(
+        `rendering the reference (${label}): ${((performance.now() - started) / 1000).toFixed(1)} s`);
+    tick();
+    const timer = setInterval(tick, 100);
+    try {
+        const res = await fetch('api/render', {
+            method: 'POST',
+            headers: { 'Content-Type': 'application/json', ...authHeaders() },
+            body: JSON.stringify(request),
+            signal: abort.signal,
+        });
+        const body = await res.json().catch(() => null);
+        if (!res.ok) throw new Error(describeHttpError(res.status, body));
+        const image = await canvasFromBase64Png(body.image_base64);
+        // The reference, tone-mapped like the frame (servers that predate it send none).
+        const reference = body.reference_base64 ? await canvasFromBase64Png(body.reference_base64) : null;
+        state.compare = {
+            request, key: viewKey(request), result: body.stats?.compare ?? null, stats: body.stats, image, reference,
+        };
+        const f = formatCompare(state.compare.result);
+        accuracyGui.showResult(null, f ? [
+            ['relative RMSE', f.relRmse], ['PSNR', f.psnr], ['SSIM', f.ssim], ['FLIP', f.flip],
+            ['reference', f.reference], ['frame time', formatMs(body.stats?.frame_ms)],
+            ['measured in', `${((performance.now() - started) / 1000).toFixed(1)} s`],
+        ] : [['result', 'the server sent no comparison']]);
+        showAccuracyLine();
+        showCompareLayer();
+    } catch (e) {
+        if (e.name === 'AbortError') accuracyGui.showResult('Cancelled.');
+        else {
+            accuracyGui.showResult(`Failed: ${e.message}`);
+            showMessage(`Accuracy: ${e.message}`);
+        }
+    } finally {
+        clearInterval(timer);
+        state.compareRunning = null;
+        accuracyGui.running(null);
+    }
+}
+
+async function canvasFromBase64Png(base64) {
+    const bytes = Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
+    const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
+    const canvas = document.createElement('canvas');
+    canvas.width = bitmap.width;
+    canvas.height = bitmap.height;
+    canvas.getContext('2d').drawImage(bitmap, 0, 0);
+    bitmap.close();
+    return canvas;
+}
+
+/**
+ * The accuracy layer over the stream: the API render, the CPU reference, or the difference between
+ * the two (without a reference: between the API render and the frame on screen).
+ */
+function showCompareLayer() {
+    const view = accuracyGui.model.view;
+    const reference = state.compare?.reference ?? null;
+    const image = view === 'ref' ? reference : state.compare?.image;
+    const visible = view !== 'live' && image && !state.viewer;
+    ui.compareCanvas.hidden = !visible;
+    ui.layerLabel.hidden = !visible;
+    if (!visible) return;
+    const { width, height } = image;
+    ui.compareCanvas.width = width;
+    ui.compareCanvas.height = height;
+    const out = ui.compareCanvas.getContext('2d', { willReadFrequently: true });
+    out.drawImage(image, 0, 0);
+    if (view === 'ref') {
+        const ref = state.compare.result?.reference ?? {};
+        ui.layerLabel.textContent = `CPU reference (${ref.mode ?? '?'}, ${ref.spp ?? '?'} spp, PNG ${width}×${height})`;
+        return;
+    }
+    if (view === 'api') {
+        ui.layerLabel.textContent = `API render of the measured view (PNG ${width}×${height}); rel. RMSE `
+            + `${formatCompare(state.compare.result)?.relRmse ?? '–'} vs the ${state.compare.request.compare.mode} reference`;
+        return;
+    }
+    const a = out.getImageData(0, 0, width, height).data;
+    out.drawImage(reference ?? ui.canvas, 0, 0, width, height);
+    const b = out.getImageData(0, 0, width, height).data;
+    const diff = diffImage(a, b, accuracyGui.model.gain);
+    out.putImageData(new ImageData(diff.data, width, height), 0, 0);
+    const what = reference ? '|API render − reference|' : '|stream − API render|';
+    ui.layerLabel.textContent = `${what} × ${accuracyGui.model.gain} (mean ${diff.meanAbs.toFixed(1)} of 255)`
+        + `${!reference && accuracyGui.stale() ? '; the view has changed since the measurement' : ''}`;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Uploads
+
+async function uploadFile(file) {
+    if (state.viewer) return;
+    const name = uploadName(file?.name);
+    if (!name) {
+        showMessage(`Only binary glTF (.glb) files can be uploaded, not "${file?.name ?? '?'}".`);
+        return;
+    }
+    const resumeToken = state.welcome?.resume_token;
+    if (!resumeToken || !connection.isOpen) {
+        showMessage('Connect first: an upload belongs to a session.');
+        return;
+    }
+    const size = formatBytes(file.size);
+    sceneGui.progress(0, `uploading ${name} (${size})`);
+    try {
+        const answer = await uploadGlb(file, name, {
+            resumeToken,
+            serverToken: page.token,
+            onProgress: (f) => sceneGui.progress(f, `uploading ${name}: ${(100 * f).toFixed(0)} % of ${size}`),
+        });
+        if (!state.uploads.includes(answer.scene)) state.uploads.push(answer.scene);
+        sceneGui.progress(1, `uploaded ${name}; loading it…`);
+        if (steer(sceneMsg(answer.scene))) state.scene = answer.scene;
+        sceneGui.setScenes();
+        setTimeout(() => sceneGui.progress(null), 3000);
+    } catch (e) {
+        sceneGui.progress(null);
+        showMessage(`Upload of ${name}: ${e.message}`);
+    }
+}
+
+function bindDragAndDrop() {
+    let depth = 0;
+    const hasFiles = (e) => [...(e.dataTransfer?.types ?? [])].includes('Files');
+    ui.viewport.addEventListener('dragenter', (e) => {
+        if (!hasFiles(e) || state.viewer) return;
+        e.preventDefault();
+        depth += 1;
+        ui.dropHint.hidden = false;
+    });
+    ui.viewport.addEventListener('dragover', (e) => {
+        if (!hasFiles(e) || state.viewer) return;
+        e.preventDefault();
+        e.dataTransfer.dropEffect = 'copy';
+    });
+    ui.viewport.addEventListener('dragleave', () => {
+        depth = Math.max(0, depth - 1);
+        if (depth === 0) ui.dropHint.hidden = true;
+    });
+    ui.viewport.addEventListener('drop', (e) => {
+        if (!hasFiles(e)) return;
+        e.preventDefault();
+        depth = 0;
+        ui.dropHint.hidden = true;
+        const file = e.dataTransfer.files?.[0];
+        if (file) uploadFile(file);
+    });
+    ui.fileInput.addEventListener('change', () => {
+        const file = ui.fileInput.files?.[0];
+        ui.fileInput.value = '';
+        if (file) uploadFile(file);
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Light gizmo and view input
+
+const gizmo = new LightGizmo(ui.gizmo, {
+    getCamera: () => (state.viewer ? null : camera.toCamera()),
+    getLight: () => state.light,
+    getFrameSize: () => [ui.canvas.width, ui.canvas.height],
+    onMove: (position) => changeLight({ position }),
+    onAim: (direction) => changeLight({ direction }),
+});
+gizmo.visible = settings.gizmo;
+
+function onLightDrag(gesture, dx, dy) {
+    if (!state.light) return;
+    const cam = camera.toCamera();
+    if (gesture === 'light-move') {
+        changeLight({ position: moveLight(state.light.position, cam, dx, dy, ui.canvas.clientHeight) });
+    } else {
+        changeLight({ direction: aimLight(state.light, cam, dx, dy, ui.canvas.clientHeight) });
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Layout: the sidebar collapses on wide screens and is a drawer on narrow ones
+
+const narrow = window.matchMedia(NARROW_QUERY);
+function setSidebar(open) {
+    ui.app.classList.toggle('sidebar-closed', !open);
+    ui.sidebarToggle.setAttribute('aria-expanded', String(open));
+    ui.backdrop.hidden = !(open && narrow.matches);
+}
+function sidebarOpen() {
+    return !ui.app.classList.contains('sidebar-closed');
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -448,20 +1237,29 @@ function debounce(fn, ms) {
 
 function start() {
     setRole(state.viewer);
-    attachOrbitControls(ui.canvas, camera, sendCamera);
-    ui.resetCamera.addEventListener('click', () => {
-        camera.reset();
-        sendCamera();
+    setSidebar(!narrow.matches);
+    narrow.addEventListener('change', () => setSidebar(!narrow.matches));
+    ui.sidebarToggle.addEventListener('click', () => setSidebar(!sidebarOpen()));
+    ui.backdrop.addEventListener('click', () => setSidebar(false));
+    attachViewControls(ui.canvas, {
+        camera,
+        getTool: () => cameraGui.tool(),
+        onCamera: scheduleCamera,
+        onLight: onLightDrag,
+        onHome: resetCamera,
+        flySpeed: () => cameraGui.speed(),
     });
-    ui.technique.addEventListener('change', onTechniqueSelected);
-    ui.scene.addEventListener('change', () => send(sceneMsg(ui.scene.value)));
-    ui.adaptive.addEventListener('change', () => send(qualityMsg(ui.adaptive.checked)));
-    ui.snapshot.addEventListener('click', requestSnapshot);
-    ui.share.addEventListener('click', copyShareLink);
     ui.sessionToggle.addEventListener('click', toggleSession);
-    // The viewport changes size with the window and when the panel moves below it.
-    new ResizeObserver(debounce(() => sendResize(), RESIZE_DEBOUNCE_MS)).observe(ui.viewport);
-    setInterval(showFps, FPS_WINDOW_MS / 4);
+    ui.retryNow.addEventListener('click', () => connection.connect());
+    bindDragAndDrop();
+    // The viewport changes size with the window and when the sidebar opens or closes.
+    new ResizeObserver(debounce(() => {
+        sendResize();
+        chart.resize();
+        gizmo.render();
+    }, RESIZE_DEBOUNCE_MS)).observe(ui.viewport);
+    setInterval(showRate, 250);
+    setInterval(sendPing, PING_INTERVAL_MS);
     connection.connect();
 }
 

@@ -47,10 +47,12 @@ if ((${#missing[@]})); then
     $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# Node packages for the end-to-end tests and the client, from the committed lock file.
+# Node packages for the end-to-end tests and the client, from the committed lock file. npm ci's
+# postinstall copies the client's browser libraries (lil-gui, uPlot) into the git-ignored
+# client/vendor/ (client/tools/vendor.mjs), so it runs again when that copy is missing.
 if [[ -f "$ROOT/package-lock.json" ]]; then
     stamp="$ROOT/node_modules/.install-stamp"
-    if [[ ! -f "$stamp" || "$ROOT/package-lock.json" -nt "$stamp" ]]; then
+    if [[ ! -f "$stamp" || "$ROOT/package-lock.json" -nt "$stamp" || ! -f "$ROOT/client/vendor/versions.json" ]]; then
         echo "install-deps: npm ci"
         (cd "$ROOT" && npm ci --no-audit --no-fund --loglevel=error)
         touch "$stamp"

@@ -12,9 +12,9 @@ import {
 } from '../protocol.js';
 import { OrbitCamera, cameraBasis, orbitFromPosition, positionFromOrbit } from '../camera.js';
 import { backoffDelay, pageOptions, shareLink, streamUrl } from '../connection.js';
-import { niceStep, sliderMapping, widgetKind } from '../controls.js';
-import { CLIENT_SCHEMAS } from '../schemas.js';
-import { loadProtocolSchemas, loadVectors, PROTOCOL_DIR } from '../tools/protocol-files.mjs';
+import { niceStep, widgetKind } from '../params.js';
+import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from '../schemas.js';
+import { loadProtocolSchemas, loadRenderRequestSchema, loadVectors, PROTOCOL_DIR } from '../tools/protocol-files.mjs';
 
 const schemas = loadProtocolSchemas();
 
@@ -27,6 +27,8 @@ test('every client message type has a schema and the client carries the current 
     assert.deepEqual(Object.keys(schemas).sort(), [...CLIENT_MESSAGE_TYPES].sort());
     assert.deepEqual(CLIENT_SCHEMAS, schemas,
         'client/schemas.js differs from protocol/schema; run node client/tools/update-schemas.mjs');
+    assert.deepEqual(RENDER_REQUEST_SCHEMA, loadRenderRequestSchema(),
+        'client/schemas.js differs from protocol/http/render_request.json; run node client/tools/update-schemas.mjs');
 });
 
 // The vectors protocol v1 added; listed so that losing one fails a test instead of shrinking it.
@@ -326,11 +328,6 @@ test('parameter widgets follow the schema', () => {
     assert.equal(widgetKind({ type: 'boolean' }), 'boolean');
     assert.equal(niceStep(-10, 10), 0.1);
     assert.equal(niceStep(0, 1), 0.005);
-    const linear = sliderMapping({ type: 'integer', minimum: 1, maximum: 256 });
-    assert.equal(linear.toValue(0), 1);
-    assert.equal(linear.toValue(1000), 256);
-    assert.equal(linear.toValue(linear.toPosition(128)), 128);
-    const log = sliderMapping({ type: 'number', minimum: 0.01, maximum: 100, 'x-log-scale': true });
-    assert.ok(log.log);
-    assert.ok(Math.abs(log.toValue(500) - 1) < 1e-9, 'log slider middle is the geometric mean');
+    assert.equal(niceStep(0, 10000), 50);
+    assert.equal(niceStep(1, 1), 0.01, 'an empty range still gets a step');
 });

@@ -1,4 +1,5 @@
-// Reads the shared protocol files (protocol/schema, protocol/vectors) for the JS tests.
+// Reads the shared protocol files (protocol/schema, protocol/http, protocol/vectors) for the JS tests
+// and client/tools/update-schemas.mjs.
 import { readFileSync, readdirSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import path from 'node:path';
@@ -19,6 +20,11 @@ export function loadProtocolSchemas() {
         schemas[path.basename(f.name, '.json')] = JSON.parse(readFileSync(f.path, 'utf8'));
     }
     return schemas;
+}
+
+/** protocol/http/render_request.json: the body of POST /api/render. */
+export function loadRenderRequestSchema() {
+    return JSON.parse(readFileSync(path.join(PROTOCOL_DIR, 'http', 'render_request.json'), 'utf8'));
 }
 
 /** [{name, message}] for protocol/vectors/<kind>/*.json, kind being 'valid' or 'invalid'. */

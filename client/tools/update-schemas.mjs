@@ -1,19 +1,24 @@
-// Regenerates client/schemas.js from protocol/schema/*.json; run after changing a schema:
+// Regenerates client/schemas.js from protocol/schema/*.json and protocol/http/render_request.json;
+// run after changing a schema:
 //   node client/tools/update-schemas.mjs
 // (protocol.test.mjs fails while the two differ.)
 import { writeFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
-import { loadProtocolSchemas } from './protocol-files.mjs';
+import { loadProtocolSchemas, loadRenderRequestSchema } from './protocol-files.mjs';
 
 const target = fileURLToPath(new URL('../schemas.js', import.meta.url));
 const schemas = loadProtocolSchemas();
 const body = Object.entries(schemas)
     .map(([type, schema]) => `    ${type}: ${JSON.stringify(schema)},`)
     .join('\n');
-writeFileSync(target, `// Generated from protocol/schema/*.json by client/tools/update-schemas.mjs; do not edit.
+writeFileSync(target, `// Generated from protocol/schema/*.json and protocol/http/render_request.json by
+// client/tools/update-schemas.mjs; do not edit.
 // A copy because gi-server serves only client/; client/test/protocol.test.mjs checks it is current.
 export const CLIENT_SCHEMAS = Object.freeze({
 ${body}
 });
+
+// POST /api/render (the accuracy view's requests).
+export const RENDER_REQUEST_SCHEMA = Object.freeze(${JSON.stringify(loadRenderRequestSchema())});
 `);
 console.log(`wrote ${target} (${Object.keys(schemas).length} schemas)`);

@@ -564,7 +564,12 @@ struct WsServer::Impl {
                 result.stats["queue_ms"] = queueMs;
                 if (jsonReply) {
                     finish(
-                        jsonResponse(200, {{"stats", result.stats}, {"image_base64", base64(result.image)}}));
+                        jsonResponse(200, result.referenceImage.empty()
+                                              ? nlohmann::json{{"stats", result.stats},
+                                                               {"image_base64", base64(result.image)}}
+                                              : nlohmann::json{{"stats", result.stats},
+                                                               {"image_base64", base64(result.image)},
+                                                               {"reference_base64", base64(result.referenceImage)}}));
                 } else {
                     HttpResponse r{200, result.mimeType, {{"x-gi-stats:", result.stats.dump()}}, {}};
                     r.body.assign(result.image.begin(), result.image.end());

@@ -89,6 +89,8 @@ struct RenderResult {
     /// FrameRenderer's stats plus "scene", "codec", "bytes", "encode_ms" and, with compare, "compare":
     /// the metrics of analysis/Metrics.h and {"reference": {mode, spp, seconds, cache_hit, key}}.
     nlohmann::json stats;
+    /// With compare: the reference, tone-mapped like the frame, as a PNG (empty otherwise).
+    std::vector<std::uint8_t> referenceImage;
 };
 
 using SceneResolver = std::function<std::shared_ptr<const Scene>(const std::string& name)>;

@@ -46,19 +46,37 @@ export function httpRequest(port, pathname, { method = 'GET', headers = {}, body
     });
 }
 
-/** A gi-server process on a free port; `log` keeps the tail of its output for failure reports. */
+/**
+ * A gi-server process, on a free port unless `port` is given; `log` keeps the tail of its output
+ * for failure reports. restart() stops it and starts it again on the same port.
+ */
 export class ServerProcess {
-    constructor(args) {
+    constructor(args, { port = 0 } = {}) {
         this.args = args;
         this.log = '';
-        this.port = 0;
+        this.port = port;
         this.proc = null;
     }
 
-    static async start(args) {
-        const server = new ServerProcess(args);
+    static async start(args, options) {
+        const server = new ServerProcess(args, options);
         await server.launch();
         return server;
+    }
+
+    /** Stops the server and starts a new process with the same arguments on the same port. */
+    async restart() {
+        await this.stop();
+        // The listening socket is closed with the process; retry briefly should the port be slow to free.
+        for (let attempt = 1; ; ++attempt) {
+            try {
+                await this.launch();
+                return;
+            } catch (e) {
+                if (attempt >= 5 || !this.exited) throw e;
+                await sleep(300 * attempt);
+            }
+        }
     }
 
     get wsUrl() {
@@ -70,7 +88,7 @@ export class ServerProcess {
     }
 
     async launch() {
-        this.port = await freePort();
+        if (!this.port) this.port = await freePort();
         this.proc = spawn(SERVER, ['--host', '127.0.0.1', '--port', String(this.port), ...this.args],
             { stdio: ['ignore', 'pipe', 'pipe'] });
         const collect = (chunk) => {
@@ -334,4 +352,59 @@ export function isPng(bytes) {
 
 export function isJpeg(bytes) {
     return bytes.length > 4 && bytes[0] === 0xff && bytes[1] === 0xd8 && bytes.at(-2) === 0xff && bytes.at(-1) === 0xd9;
+}
+
+/**
+ * A small binary glTF (.glb) for upload tests: a floor and a box, positions and normals, one
+ * material; the server adds its framing camera and default spotlight.
+ */
+export function makeGlb() {
+    const positions = [];
+    const normals = [];
+    const quad = (corners, normal) => {
+        for (const i of [0, 1, 2, 0, 2, 3]) {
+            positions.push(...corners[i]);
+            normals.push(...normal);
+        }
+    };
+    quad([[-2, 0, 2], [2, 0, 2], [2, 0, -2], [-2, 0, -2]], [0, 1, 0]);
+    const [x0, x1, y0, y1, z0, z1] = [-0.5, 0.5, 0, 1, -0.5, 0.5];
+    quad([[x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]], [0, 0, 1]);
+    quad([[x1, y0, z0], [x0, y0, z0], [x0, y1, z0], [x1, y1, z0]], [0, 0, -1]);
+    quad([[x1, y0, z1], [x1, y0, z0], [x1, y1, z0], [x1, y1, z1]], [1, 0, 0]);
+    quad([[x0, y0, z0], [x0, y0, z1], [x0, y1, z1], [x0, y1, z0]], [-1, 0, 0]);
+    quad([[x0, y1, z1], [x1, y1, z1], [x1, y1, z0], [x0, y1, z0]], [0, 1, 0]);
+    const count = positions.length / 3;
+    const bin = Buffer.alloc(positions.length * 4 * 2);
+    positions.forEach((v, i) => bin.writeFloatLE(v, i * 4));
+    normals.forEach((v, i) => bin.writeFloatLE(v, positions.length * 4 + i * 4));
+    const gltf = {
+        asset: { version: '2.0', generator: 'gi e2e' },
+        scene: 0,
+        scenes: [{ nodes: [0] }],
+        nodes: [{ mesh: 0 }],
+        meshes: [{ primitives: [{ attributes: { POSITION: 0, NORMAL: 1 }, material: 0 }] }],
+        materials: [{ pbrMetallicRoughness: { baseColorFactor: [0.8, 0.6, 0.4, 1], metallicFactor: 0 } }],
+        buffers: [{ byteLength: bin.length }],
+        bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: bin.length / 2 },
+            { buffer: 0, byteOffset: bin.length / 2, byteLength: bin.length / 2 }],
+        accessors: [
+            { bufferView: 0, componentType: 5126, count, type: 'VEC3', min: [-2, 0, -2], max: [2, 1, 2] },
+            { bufferView: 1, componentType: 5126, count, type: 'VEC3' },
+        ],
+    };
+    let json = Buffer.from(JSON.stringify(gltf));
+    json = Buffer.concat([json, Buffer.alloc((4 - (json.length % 4)) % 4, 0x20)]);
+    const chunk = (type, data) => {
+        const head = Buffer.alloc(8);
+        head.writeUInt32LE(data.length, 0);
+        head.write(type, 4, 'latin1');
+        return Buffer.concat([head, data]);
+    };
+    const body = Buffer.concat([chunk('JSON', json), chunk('BIN\0', bin)]);
+    const header = Buffer.alloc(12);
+    header.write('glTF', 0, 'latin1');
+    header.writeUInt32LE(2, 4);
+    header.writeUInt32LE(12 + body.length, 8);
+    return Buffer.concat([header, body]);
 }

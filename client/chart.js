@@ -1,0 +1,92 @@
+// The live per-pass timing chart of the stats overlay: uPlot, stacked areas over the last few
+// seconds, one band per render pass, with a legend of the newest frame's times. The data comes
+// from stats.js PassHistory.
+
+import uPlot from 'uplot';
+
+const PALETTE = ['#5aa9ff', '#ffc857', '#4cd17b', '#ff6b6b', '#c792ea', '#2ec4b6', '#ff9f1c', '#e4e6ea',
+    '#8d99ae', '#f72585', '#b5e48c', '#4361ee'];
+
+export class PassChart {
+    /** `container` holds the chart, `legend` (a list element) the pass names with their times. */
+    constructor(container, legend, { windowS = 10, height = 110 } = {}) {
+        this.container = container;
+        this.legend = legend;
+        this.windowS = windowS;
+        this.height = height;
+        this.now = 0;
+        this.colors = new Map(); // pass name -> colour, kept while the page lives
+        this.names = [];
+        this.plot = null;
+    }
+
+    colorOf(name) {
+        if (!this.colors.has(name)) this.colors.set(name, PALETTE[this.colors.size % PALETTE.length]);
+        return this.colors.get(name);
+    }
+
+    width() {
+        return Math.max(120, Math.floor(this.container.clientWidth || 260));
+    }
+
+    build(names) {
+        this.plot?.destroy();
+        this.names = names;
+        // uPlot draws series in order and fills each down to 0: the top band (the sum of every
+        // pass) first, each lower sum over it, so band k shows pass k's colour.
+        const series = [{}];
+        for (let k = names.length - 1; k >= 0; --k) {
+            const color = this.colorOf(names[k]);
+            series.push({ label: names[k], stroke: color, fill: `${color}cc`, width: 1, points: { show: false } });
+        }
+        const axis = { stroke: '#9aa0aa', font: '10px system-ui, sans-serif', grid: { stroke: '#30343b', width: 1 },
+            ticks: { stroke: '#30343b', width: 1, size: 3 } };
+        this.plot = new uPlot({
+            width: this.width(),
+            height: this.height,
+            legend: { show: false },
+            cursor: { show: false },
+            select: { show: false },
+            scales: {
+                x: { time: false, range: () => [this.now - this.windowS, this.now] },
+                y: { range: (u, min, max) => [0, Math.max(1, max * 1.1)] },
+            },
+            axes: [
+                { ...axis, size: 18, values: (u, ticks) => ticks.map((t) => `${Math.round(t - this.now)}s`) },
+                { ...axis, size: 34, values: (u, ticks) => ticks.map((t) => `${t}`) },
+            ],
+            series,
+        }, [[], ...names.map(() => [])], this.container);
+        this.plot.root.setAttribute('aria-label', 'per-pass render time, stacked, milliseconds over the last seconds');
+    }
+
+    /** Draws PassHistory.series() as of `nowS` seconds. */
+    update({ names, times, values, stacked }, nowS) {
+        this.now = nowS;
+        if (!this.plot || names.length !== this.names.length || names.some((n, i) => n !== this.names[i])) {
+            this.build(names);
+        }
+        const data = [times];
+        for (let k = names.length - 1; k >= 0; --k) data.push(stacked[k]);
+        this.plot.setData(data);
+        this.showLegend(names, values);
+    }
+
+    showLegend(names, values) {
+        if (!this.legend) return;
+        this.legend.replaceChildren(...names.map((name, k) => {
+            const li = document.createElement('li');
+            li.dataset.pass = name;
+            const swatch = Object.assign(document.createElement('span'), { className: 'swatch' });
+            swatch.style.background = this.colorOf(name);
+            const ms = values[k].at(-1);
+            const span = (className, textContent) => Object.assign(document.createElement('span'), { className, textContent });
+            li.append(swatch, span('pass-name', name), span('pass-ms', Number.isFinite(ms) ? ms.toFixed(1) : '–'));
+            return li;
+        }));
+    }
+
+    resize() {
+        this.plot?.setSize({ width: this.width(), height: this.height });
+    }
+}

@@ -1,0 +1,117 @@
+// The spotlight gizmo: an SVG layer over the frame with the light's position (drag: move it
+// parallel to the image) and an aim handle at the end of its beam (drag: point the beam there).
+// Drawn from the client's own camera, so it follows a drag at once, before the frame does.
+
+import { containRect, dragToWorld, gizmoHandles, moveLight, aimAt } from './light.js';
+
+const SVG = 'http://www.w3.org/2000/svg';
+
+function svgElement(tag, attrs = {}) {
+    const el = document.createElementNS(SVG, tag);
+    for (const [k, v] of Object.entries(attrs)) el.setAttribute(k, String(v));
+    return el;
+}
+
+function cssColor(rgb) {
+    const c = (rgb ?? [1, 1, 1]).map((v) => Math.round(255 * Math.min(1, Math.max(0, v))));
+    return `rgb(${c[0]} ${c[1]} ${c[2]})`;
+}
+
+/**
+ * `svg` covers the viewport. Options: getCamera() (protocol camera), getLight() (protocol light),
+ * getFrameSize() ([w, h] of the frame shown), onMove(position), onAim(direction), onDragEnd().
+ */
+export class LightGizmo {
+    constructor(svg, options) {
+        this.svg = svg;
+        this.options = options;
+        this.visible = true;
+        this.enabled = true;
+        this.line = svgElement('line', { class: 'gizmo-beam' });
+        this.origin = svgElement('circle', { class: 'gizmo-handle gizmo-origin', r: 9 });
+        this.tip = svgElement('circle', { class: 'gizmo-handle gizmo-tip', r: 6 });
+        this.origin.append(svgElement('title'));
+        this.origin.firstChild.textContent = 'spotlight: drag to move it';
+        this.tip.append(svgElement('title'));
+        this.tip.firstChild.textContent = 'spotlight aim: drag to point the beam';
+        svg.append(this.line, this.origin, this.tip);
+        this.bindDrag(this.origin, 'move');
+        this.bindDrag(this.tip, 'aim');
+    }
+
+    rect() {
+        const box = this.svg.getBoundingClientRect();
+        const [w, h] = this.options.getFrameSize();
+        return containRect(box.width, box.height, w, h);
+    }
+
+    /** Screen position (CSS pixels in the svg) of a projected point. */
+    static toScreen(p, rect) {
+        return [rect.left + ((p.x + 1) / 2) * rect.width, rect.top + ((1 - p.y) / 2) * rect.height];
+    }
+
+    render() {
+        const camera = this.options.getCamera();
+        const light = this.options.getLight();
+        const show = this.visible && this.enabled && camera && light?.position && light?.direction;
+        this.svg.classList.toggle('hidden', !show);
+        if (!show) return;
+        const rect = this.rect();
+        const { origin, tip } = gizmoHandles(camera, rect.width / Math.max(1, rect.height), light);
+        const place = (el, p) => {
+            el.style.display = p ? '' : 'none';
+            if (!p) return null;
+            const [x, y] = LightGizmo.toScreen(p, rect);
+            el.setAttribute('cx', x);
+            el.setAttribute('cy', y);
+            return [x, y];
+        };
+        const a = place(this.origin, origin);
+        const b = place(this.tip, tip);
+        this.line.style.display = a && b ? '' : 'none';
+        if (a && b) {
+            this.line.setAttribute('x1', a[0]);
+            this.line.setAttribute('y1', a[1]);
+            this.line.setAttribute('x2', b[0]);
+            this.line.setAttribute('y2', b[1]);
+        }
+        const color = cssColor(light.color);
+        this.origin.style.fill = light.enabled === false ? 'transparent' : color;
+        this.line.style.stroke = color;
+    }
+
+    bindDrag(handle, kind) {
+        let start = null;
+        handle.addEventListener('pointerdown', (e) => {
+            e.stopPropagation();
+            e.preventDefault();
+            handle.setPointerCapture?.(e.pointerId);
+            const camera = this.options.getCamera();
+            const light = this.options.getLight();
+            const rect = this.rect();
+            const handles = gizmoHandles(camera, rect.width / Math.max(1, rect.height), light);
+            start = { x: e.clientX, y: e.clientY, camera, rect, position: [...light.position], handles };
+            handle.classList.add('dragging');
+        });
+        handle.addEventListener('pointermove', (e) => {
+            if (!start) return;
+            const dx = e.clientX - start.x;
+            const dy = e.clientY - start.y;
+            if (kind === 'move') {
+                this.options.onMove(moveLight(start.position, start.camera, dx, dy, start.rect.height));
+            } else if (start.handles.tip) {
+                const delta = dragToWorld(start.camera, start.handles.tip.depth, dx, dy, start.rect.height);
+                const tip = start.handles.tipWorld.map((v, i) => v + delta[i]);
+                this.options.onAim(aimAt(start.position, tip));
+            }
+        });
+        const end = () => {
+            if (!start) return;
+            start = null;
+            handle.classList.remove('dragging');
+            this.options.onDragEnd?.();
+        };
+        handle.addEventListener('pointerup', end);
+        handle.addEventListener('pointercancel', end);
+    }
+}

@@ -1,0 +1,157 @@
+// Client-side frame statistics: frame rate, input-to-frame latency, network time and the rolling
+// per-pass history behind the stacked timing chart. Pure (times are passed in, in milliseconds
+// of one clock such as performance.now()), so node's test runner checks it.
+
+/** Frames drawn within the last `windowMs`. */
+export class RateCounter {
+    constructor(windowMs = 1000) {
+        this.windowMs = windowMs;
+        this.times = [];
+    }
+
+    tick(now) {
+        this.times.push(now);
+        this.rate(now);
+    }
+
+    rate(now) {
+        while (this.times.length && this.times[0] <= now - this.windowMs) this.times.shift();
+        return (this.times.length * 1000) / this.windowMs;
+    }
+}
+
+function median(values) {
+    if (!values.length) return null;
+    const s = [...values].sort((a, b) => a - b);
+    const m = s.length >> 1;
+    return s.length % 2 ? s[m] : (s[m - 1] + s[m]) / 2;
+}
+
+/**
+ * Input-to-frame latency: the time from a steering input (camera, light, parameters...) to the
+ * first drawn frame that can contain it. The server does not say which input a frame reflects, so
+ * the tracker estimates when the frame's render started on the client's clock: its arrival minus
+ * the round trip and the server's render and encode times. Inputs sent before that are in the
+ * frame; the latency is measured from the oldest of them (what a user feels when a drag starts).
+ */
+export class LatencyTracker {
+    constructor(keep = 15) {
+        this.keep = keep;
+        this.inputs = [];
+        this.samples = [];
+        this.last = null;
+    }
+
+    input(now) {
+        this.inputs.push(now);
+        if (this.inputs.length > 1000) this.inputs.shift();
+    }
+
+    /** A frame that arrived at `arrivedAt` was drawn at `drawnAt`; returns its latency or null. */
+    frameDrawn(arrivedAt, drawnAt, stats, rttMs = 0) {
+        const serverMs = (stats?.frame_ms ?? 0) + (stats?.encode_ms ?? 0);
+        const renderStart = arrivedAt - (rttMs ?? 0) - serverMs;
+        let oldest = null;
+        while (this.inputs.length && this.inputs[0] <= renderStart) {
+            oldest ??= this.inputs[0];
+            this.inputs.shift();
+        }
+        if (oldest === null) return null;
+        this.last = drawnAt - oldest;
+        this.samples.push(this.last);
+        if (this.samples.length > this.keep) this.samples.shift();
+        return this.last;
+    }
+
+    /** The median of the recent samples (null before the first). */
+    get typical() {
+        return median(this.samples);
+    }
+
+    reset() {
+        this.inputs.length = 0;
+        this.samples.length = 0;
+        this.last = null;
+    }
+}
+
+/**
+ * Network time of a frame: half the ping round trip (the way there) plus the time between its
+ * stats and its binary arriving (the transfer of the image, the stats being sent just before it).
+ */
+export function networkMs(rttMs, statsArrivedAt, binaryArrivedAt) {
+    const transfer = Number.isFinite(statsArrivedAt) && Number.isFinite(binaryArrivedAt)
+        ? Math.max(0, binaryArrivedAt - statsArrivedAt) : 0;
+    return (Number.isFinite(rttMs) ? rttMs / 2 : 0) + transfer;
+}
+
+/** A pass's time: its GPU time where measured, else its CPU time. */
+export function passMs(pass) {
+    if (Number.isFinite(pass?.gpu_ms)) return pass.gpu_ms;
+    if (Number.isFinite(pass?.cpu_ms)) return pass.cpu_ms;
+    return 0;
+}
+
+/**
+ * The per-pass times of the last `windowS` seconds: push(tSeconds, stats.passes) per frame,
+ * series(now) for the chart.
+ */
+export class PassHistory {
+    constructor(windowS = 10) {
+        this.windowS = windowS;
+        this.samples = []; // {t, values: Map name -> ms}
+    }
+
+    push(t, passes) {
+        this.samples.push({ t, values: new Map((passes ?? []).map((p) => [p.name, passMs(p)])) });
+        this.prune(t);
+    }
+
+    prune(now) {
+        while (this.samples.length && this.samples[0].t < now - this.windowS) this.samples.shift();
+    }
+
+    clear() {
+        this.samples.length = 0;
+    }
+
+    /** Pass names in pipeline order: the newest frame's order, then names only older frames had. */
+    names() {
+        const names = [];
+        for (let i = this.samples.length - 1; i >= 0; --i) {
+            for (const name of this.samples[i].values.keys()) if (!names.includes(name)) names.push(name);
+        }
+        return names;
+    }
+
+    /**
+     * {names, times, values, stacked}: values[k][i] is pass k's time in frame i (0 where the frame
+     * had no such pass); stacked[k][i] the sum of passes 0..k, the top of pass k's band.
+     */
+    series() {
+        const names = this.names();
+        const times = this.samples.map((s) => s.t);
+        const values = names.map((n) => this.samples.map((s) => s.values.get(n) ?? 0));
+        return { names, times, values, stacked: stackSeries(values) };
+    }
+}
+
+/** Running sums over the series: out[k][i] = values[0][i] + ... + values[k][i]. */
+export function stackSeries(values) {
+    const out = [];
+    values.forEach((row, k) => {
+        out.push(row.map((v, i) => (k === 0 ? 0 : out[k - 1][i]) + (Number.isFinite(v) ? v : 0)));
+    });
+    return out;
+}
+
+export function formatMs(v, digits = 1) {
+    return Number.isFinite(v) ? `${v.toFixed(digits)} ms` : '–';
+}
+
+export function formatBytes(n) {
+    if (!Number.isFinite(n)) return '–';
+    if (n < 1024) return `${n} B`;
+    if (n < 1024 * 1024) return `${(n / 1024).toFixed(1)} KB`;
+    return `${(n / 1024 / 1024).toFixed(2)} MB`;
+}

@@ -1,0 +1,317 @@
+// Unit tests of the client's pure modules: camera modes and keys, the light gizmo's math, the
+// parameter controls, stats and latency, the accuracy request, error texts, upload names, and
+// that the vendored libraries the import map names are in place. Run: node --test client/test/
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { existsSync, readFileSync } from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+import { DRAG_TOOLS, OrbitCamera, gestureFor, keyMotion } from '../camera.js';
+import {
+    aimAt, aimLight, containRect, dragToWorld, gizmoHandles, moveLight, projectPoint, safeDirection, viewBasis,
+} from '../light.js';
+import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
+import { LatencyTracker, PassHistory, RateCounter, formatBytes, networkMs, passMs, stackSeries } from '../stats.js';
+import {
+    buildCompareRequest, canCompare, compareSize, diffImage, formatCompare, validateCompareRequest, viewKey,
+} from '../accuracy.js';
+import { describeError, describeHttpError } from '../messages.js';
+import { uploadName } from '../upload.js';
+import { cameraMsg, lightMsg, validateClientMessage, validateParamValues } from '../protocol.js';
+import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from '../schemas.js';
+import { dot, length, normalize } from '../vec.js';
+import { VENDOR_FILES, checkVendor } from '../tools/vendor.mjs';
+
+const CLIENT_DIR = fileURLToPath(new URL('../', import.meta.url));
+const HOME = { position: [0, 1, 3.9], target: [0, 1, 0], up: [0, 1, 0], fov_deg: 40 };
+
+function assertClose(actual, expected, eps, what) {
+    assert.equal(actual.length, expected.length, `${what}: length`);
+    actual.forEach((v, i) => assert.ok(Math.abs(v - expected[i]) <= eps, `${what}[${i}]: ${v} vs ${expected[i]}`));
+}
+
+// ---- camera -------------------------------------------------------------------------------------
+
+test('fly look keeps the eye and turns the view the way the drag goes', () => {
+    const cam = new OrbitCamera(HOME);
+    const eye = cam.position;
+    cam.look(100, 0);
+    assertClose(cam.position, eye, 1e-9, 'eye stays');
+    assert.ok(cam.forward[0] > 0.1, 'dragging right looks right (+X from the home view)');
+    cam.look(0, -100);
+    assert.ok(cam.forward[1] > 0.1, 'dragging up looks up');
+    assertClose(cam.position, eye, 1e-9, 'eye still stays');
+    assert.ok(Math.abs(length(cam.forward) - 1) < 1e-12);
+});
+
+test('fly move goes along the view, sideways and up, and zoom-drag changes the distance', () => {
+    const cam = new OrbitCamera(HOME);
+    cam.move(1, 0, 0);
+    assertClose(cam.position, [0, 1, 2.9], 1e-9, 'forward one metre');
+    cam.move(0, 2, 0);
+    assertClose(cam.position, [2, 1, 2.9], 1e-9, 'right two metres');
+    cam.move(0, 0, -0.5);
+    assertClose(cam.position, [2, 0.5, 2.9], 1e-9, 'down half a metre');
+    assertClose(cam.forward, [0, 0, -1], 1e-9, 'moving does not turn');
+    const before = cam.distance;
+    cam.zoomDrag(50);
+    assert.ok(cam.distance > before, 'dragging down moves away');
+    cam.setFov(500);
+    assert.equal(cam.fovDeg, 170, 'the field of view stays within the camera schema');
+    assert.equal(validateClientMessage(cameraMsg(cam.toCamera()), CLIENT_SCHEMAS), null);
+    assert.ok(Math.abs(cam.sceneScale - 3.9) < 1e-9, 'scene scale is the home distance');
+});
+
+test('drag gestures: modifiers first, then the tool', () => {
+    assert.equal(gestureFor({}, 'orbit'), 'orbit');
+    assert.equal(gestureFor({}, 'fly'), 'look');
+    assert.equal(gestureFor({}, 'zoom'), 'zoom');
+    assert.equal(gestureFor({ shiftKey: true }, 'fly'), 'pan');
+    assert.equal(gestureFor({ button: 2 }, 'orbit'), 'pan');
+    assert.equal(gestureFor({ ctrlKey: true }, 'orbit'), 'light-aim');
+    assert.equal(gestureFor({ metaKey: true, shiftKey: true }, 'orbit'), 'light-move');
+    assert.equal(gestureFor({}, 'light-move'), 'light-move');
+    assert.equal(gestureFor({}, 'nonsense'), 'orbit');
+    assert.deepEqual([...DRAG_TOOLS], ['orbit', 'pan', 'zoom', 'fly', 'light-aim', 'light-move']);
+});
+
+test('keys: WASD/EQ move, arrows orbit or look, +/- zoom, Shift is faster', () => {
+    const keys = (...codes) => new Set(codes);
+    assert.deepEqual(keyMotion(keys('KeyW'), 'orbit', 0.5, 2).move, [1, 0, 0]);
+    assert.deepEqual(keyMotion(keys('KeyA', 'KeyQ'), 'fly', 1, 1).move, [0, -1, -1]);
+    assert.deepEqual(keyMotion(keys('KeyW'), 'fly', 1, 1, true).move, [3, 0, 0]);
+    assert.deepEqual(keyMotion(keys('KeyW', 'KeyS'), 'fly', 1, 1).move, [0, 0, 0], 'opposite keys cancel');
+    const orbitLeft = keyMotion(keys('ArrowLeft'), 'orbit', 0.1, 1).turn;
+    assert.ok(orbitLeft[0] > 0, 'orbit: ArrowLeft moves the eye left (like dragging right)');
+    const lookLeft = keyMotion(keys('ArrowLeft'), 'fly', 0.1, 1).turn;
+    assert.ok(lookLeft[0] < 0, 'fly: ArrowLeft looks left');
+    assert.ok(keyMotion(keys('ArrowUp'), 'fly', 0.1, 1).turn[1] < 0, 'fly: ArrowUp looks up');
+    assert.ok(keyMotion(keys('Equal'), 'orbit', 0.1, 1).zoom < 0, '+ zooms in');
+    assert.ok(keyMotion(keys('Minus'), 'orbit', 0.1, 1).zoom > 0, '- zooms out');
+    // Through the camera: a held ArrowLeft in orbit mode moves the eye to -X.
+    const cam = new OrbitCamera(HOME);
+    cam.orbit(...keyMotion(keys('ArrowLeft'), 'orbit', 0.2, 1).turn);
+    assert.ok(cam.position[0] < 0);
+});
+
+// ---- light --------------------------------------------------------------------------------------
+
+test('projection: the target is in the middle, points left/right/up land where expected', () => {
+    const p = projectPoint(HOME, 1, [0, 1, 0]);
+    assertClose([p.x, p.y, p.depth], [0, 0, 3.9], 1e-12, 'target');
+    const t = Math.tan(20 * Math.PI / 180);
+    const edge = projectPoint(HOME, 1, [0, 1 + 3.9 * t, 0]);
+    assert.ok(Math.abs(edge.y - 1) < 1e-9, 'a point at the top of the vertical fov is at y = 1');
+    assert.ok(projectPoint(HOME, 2, [1, 1, 0]).x > 0, '+X is right of the centre');
+    assert.equal(projectPoint(HOME, 1, [0, 1, 5]), null, 'behind the eye');
+    const { forward, right, up } = viewBasis(HOME);
+    assertClose([dot(forward, right), dot(forward, up), dot(right, up)], [0, 0, 0], 1e-12, 'orthogonal basis');
+});
+
+test('a dragged light stays under the cursor', () => {
+    const light = { position: [0.3, 1.5, 0.5], direction: [0, -1, 0] };
+    const before = projectPoint(HOME, 1, light.position);
+    const moved = moveLight(light.position, HOME, 40, -20, 400);
+    const after = projectPoint(HOME, 1, moved);
+    // NDC spans 2 over 400 pixels: 40 px right is +0.2, 20 px up is +0.1.
+    assert.ok(Math.abs(after.x - before.x - 0.2) < 1e-4, `x moved ${after.x - before.x}`);
+    assert.ok(Math.abs(after.y - before.y - 0.1) < 1e-4, `y moved ${after.y - before.y}`);
+    assert.ok(Math.abs(after.depth - before.depth) < 1e-4, 'the depth is kept');
+    const delta = dragToWorld(HOME, 3.9, 0, 100, 400);
+    assert.ok(delta[1] < 0 && Math.abs(delta[0]) < 1e-12, 'dragging down moves down');
+});
+
+test('aiming turns the beam with the drag and keeps it a valid light direction', () => {
+    const light = { position: [0, 1.95, 0], direction: [0, -1, 0] };
+    const right = aimLight(light, HOME, 50, 0, 400);
+    assert.ok(right[0] > 0.1, 'dragging right turns a beam pointing down towards the camera\'s right');
+    const tilted = aimLight({ position: [0, 1, 0], direction: [0, 0, -1] }, HOME, 0, 50, 400);
+    assert.ok(tilted[1] < -0.1, 'dragging down tilts a beam pointing away from the camera down');
+    const toward = aimLight({ position: [0, 1, 0], direction: [0, 0, 1] }, HOME, -50, 0, 400);
+    assert.ok(toward[0] < -0.1, 'a beam pointing at the camera turns too');
+    for (const d of [right, tilted, toward, aimLight(light, HOME, 3000, -7000, 400)]) {
+        assert.ok(Math.abs(length(d) - 1) < 1e-4, `unit length ${d}`);
+        assert.equal(validateClientMessage(lightMsg({ direction: d }), CLIENT_SCHEMAS), null, `valid ${d}`);
+    }
+    assert.deepEqual(safeDirection([0, 0, 0]), [0, -1, 0], 'a zero vector falls back to straight down');
+    assertClose(aimAt([0, 2, 0], [1, 1, 0]), normalize([1, -1, 0]).map((v) => Math.round(v * 1e5) / 1e5), 1e-12, 'aim at');
+});
+
+test('gizmo handles and the contained frame rectangle', () => {
+    const handles = gizmoHandles(HOME, 1, { position: [0, 1.95, 0], direction: [0, -1, 0] });
+    assert.ok(handles.origin.y > handles.tip.y, 'a light pointing down has its aim handle below it');
+    assert.ok(Math.abs(handles.origin.x) < 1e-12 && Math.abs(handles.tip.x) < 1e-12);
+    assert.deepEqual(containRect(800, 400, 100, 100), { left: 200, top: 0, width: 400, height: 400 });
+    assert.deepEqual(containRect(400, 800, 200, 100), { left: 0, top: 300, width: 400, height: 200 });
+    assert.deepEqual(containRect(300, 200, 0, 0), { left: 0, top: 0, width: 300, height: 200 });
+});
+
+// ---- parameters ---------------------------------------------------------------------------------
+
+const VPL_GRID = { type: 'integer', minimum: 1, maximum: 256, default: 16, description: 'VPLs on a grid',
+    'x-unit': 'VPLs per side', 'x-source': '000 §3.1', 'x-log-scale': true };
+
+test('controls follow the schema: kind, range, step, label with unit and help', () => {
+    const grid = controlSpec('vpl_grid', VPL_GRID, 8);
+    assert.deepEqual({ ...grid, help: undefined }, { name: 'vpl_grid', kind: 'integer', label: 'vpl_grid (VPLs per side)',
+        help: undefined, min: 1, max: 256, step: 1, initial: 8 });
+    assert.match(grid.help, /VPLs on a grid · range 1 to 256 VPLs per side · default 16 · source: 000 §3.1/);
+    const exposure = controlSpec('exposure', { type: 'number', minimum: -10, maximum: 10, default: 0, 'x-unit': 'EV' });
+    assert.equal(exposure.step, 0.1);
+    assert.equal(exposure.initial, 0, 'the default when the session has no value');
+    const tonemap = controlSpec('tonemap', { type: 'string', enum: ['filmic', 'linear'], default: 'filmic' }, 'bogus');
+    assert.deepEqual([tonemap.kind, tonemap.options, tonemap.initial], ['enum', ['filmic', 'linear'], 'filmic']);
+    assert.equal(controlSpec('vpl_shadows', { type: 'boolean', default: false }, true).initial, true);
+    const open = controlSpec('scale', { type: 'number', minimum: 0 });
+    assert.equal(open.step, undefined, 'no slider step without a maximum');
+    assert.equal(paramLabel('kernel', { enum: ['point'] }), 'kernel');
+    assert.match(paramHelp({ type: 'number', minimum: 0 }), /at least 0/);
+    // Every value a control can produce is one the server accepts.
+    const schema = { type: 'object', properties: { vpl_grid: VPL_GRID } };
+    for (const v of [grid.min, grid.max, grid.initial]) assert.equal(validateParamValues({ vpl_grid: v }, schema), null);
+});
+
+test('defaults and the preset changes of a frame', () => {
+    const schema = { properties: { a: { default: 1 }, b: { default: 'x' }, c: {} } };
+    assert.deepEqual(schemaDefaults(schema), { a: 1, b: 'x' });
+    assert.deepEqual(schemaDefaults(undefined), {});
+    assert.deepEqual(presetChanges({ vpl_grid: 256, exposure: 0, extra: 1 }, { vpl_grid: 16, exposure: 0 }),
+        [['vpl_grid', 256, 16]]);
+    assert.deepEqual(presetChanges(null, {}), []);
+});
+
+// ---- stats --------------------------------------------------------------------------------------
+
+test('frame rate counts the frames of the last second', () => {
+    const r = new RateCounter(1000);
+    for (const t of [0, 100, 200, 900]) r.tick(t);
+    assert.equal(r.rate(950), 4);
+    assert.equal(r.rate(1150), 2);
+    assert.equal(r.rate(5000), 0);
+});
+
+test('input-to-frame latency counts from the oldest input a frame can contain', () => {
+    const l = new LatencyTracker();
+    l.input(1000);
+    l.input(1010);
+    // Arrived at 1100 after 40 ms of render and encode with a 20 ms round trip: render started by
+    // 1040, so both inputs are in it.
+    assert.equal(l.frameDrawn(1100, 1105, { frame_ms: 30, encode_ms: 10 }, 20), 105);
+    l.input(1200);
+    // This frame started rendering (1250 - 40 - 20 = 1190) before the input: it cannot show it.
+    assert.equal(l.frameDrawn(1250, 1252, { frame_ms: 30, encode_ms: 10 }, 20), null);
+    assert.equal(l.frameDrawn(1400, 1402, { frame_ms: 30, encode_ms: 10 }, 20), 202);
+    assert.equal(l.typical, (105 + 202) / 2);
+    assert.equal(l.frameDrawn(1500, 1501, {}, 0), null, 'no input, no sample');
+    l.reset();
+    assert.equal(l.typical, null);
+});
+
+test('network time, pass times and byte formatting', () => {
+    assert.equal(networkMs(20, 100, 103), 13);
+    assert.equal(networkMs(null, 100, 101), 1);
+    assert.equal(networkMs(10, undefined, 5), 5);
+    assert.equal(passMs({ gpu_ms: 2, cpu_ms: 3 }), 2);
+    assert.equal(passMs({ cpu_ms: 3 }), 3);
+    assert.equal(passMs({}), 0);
+    assert.equal(formatBytes(512), '512 B');
+    assert.equal(formatBytes(41234), '40.3 KB');
+    assert.equal(formatBytes(3 * 1024 * 1024), '3.00 MB');
+});
+
+test('pass history keeps the window, orders passes and stacks them', () => {
+    const h = new PassHistory(10);
+    h.push(0, [{ name: 'shadow_map', gpu_ms: 2 }, { name: 'gather', gpu_ms: 10 }]);
+    h.push(5, [{ name: 'shadow_map', gpu_ms: 3 }, { name: 'blur', cpu_ms: 1 }, { name: 'gather', gpu_ms: 12 }]);
+    h.push(12, [{ name: 'shadow_map', gpu_ms: 4 }, { name: 'blur', gpu_ms: 2 }, { name: 'gather', gpu_ms: 8 }]);
+    const s = h.series();
+    assert.deepEqual(s.times, [5, 12], 'the frame older than 10 s is gone');
+    assert.deepEqual(s.names, ['shadow_map', 'blur', 'gather'], 'pipeline order of the newest frame');
+    assert.deepEqual(s.values, [[3, 4], [1, 2], [12, 8]]);
+    assert.deepEqual(s.stacked, [[3, 4], [4, 6], [16, 14]]);
+    assert.deepEqual(stackSeries([[1, NaN], [2, 2]]), [[1, 0], [3, 2]]);
+    h.clear();
+    assert.deepEqual(h.series().names, []);
+});
+
+// ---- accuracy -----------------------------------------------------------------------------------
+
+test('the accuracy request is the view on screen, small, and valid for POST /api/render', () => {
+    assert.deepEqual(compareSize([480, 400], 128), [128, 107]);
+    assert.deepEqual(compareSize([100, 60], 256), [100, 60], 'never larger than the frame');
+    assert.deepEqual(compareSize([2000, 20], 128), [128, 16], 'each side at least 16');
+    const request = buildCompareRequest({
+        scene: 'builtin:cornell', technique: 'rsm_gather', params: { vpl_grid: 4, exposure: 0 }, camera: HOME,
+        light: { position: [0, 1.95, 0], direction: [0, -1, 0], intensity: 6, color: [1, 1, 1], cone_deg: 60, enabled: true },
+        frameSize: [480, 400], maxSide: 128, mode: 'one-bounce-unoccluded', spp: 8,
+    });
+    assert.equal(request.response, 'json');
+    assert.deepEqual(request.compare, { mode: 'one-bounce-unoccluded', spp: 8 });
+    assert.deepEqual(request.size, [128, 107]);
+    assert.equal(validateCompareRequest(request, RENDER_REQUEST_SCHEMA), null);
+    assert.equal(validateCompareRequest({ ...request, compare: { mode: 'nope' } }, RENDER_REQUEST_SCHEMA).where, '/compare/mode');
+    assert.equal(validateCompareRequest({ ...request, response: 'xml' }, RENDER_REQUEST_SCHEMA).where, '/response');
+    assert.equal(viewKey({ ...request, size: [64, 64], compare: { mode: 'path', spp: 1 } }), viewKey(request),
+        'the view key ignores size and reference settings');
+    assert.notEqual(viewKey({ ...request, params: { vpl_grid: 5 } }), viewKey(request));
+    assert.ok(canCompare('builtin:cornell'));
+    assert.ok(!canCompare('upload:x.glb'), 'uploads are not reachable through the HTTP API');
+});
+
+test('comparison metrics and the difference image', () => {
+    const f = formatCompare({ relative_rmse: 0.0431, psnr_db: 31.25, ssim: 0.95, flip: 0.0812,
+        reference: { mode: 'one-bounce-unoccluded', spp: 8, seconds: 1.234, cache_hit: false } });
+    assert.equal(f.relRmse, '4.31 %');
+    assert.equal(f.psnr, '31.3 dB');
+    assert.equal(f.reference, 'one-bounce-unoccluded, 8 spp, 1.23 s');
+    assert.equal(formatCompare({ relative_rmse: Number.MAX_VALUE }).relRmse, '–', 'undefined relative RMSE');
+    assert.equal(formatCompare(null), null);
+    const a = new Uint8ClampedArray([10, 20, 30, 255, 0, 0, 0, 255]);
+    const b = new Uint8ClampedArray([12, 20, 10, 0, 0, 0, 100, 255]);
+    const d = diffImage(a, b, 4);
+    assert.deepEqual([...d.data], [8, 0, 80, 255, 0, 0, 255, 255]);
+    assert.ok(Math.abs(d.meanAbs - (2 + 20 + 100) / 6) < 1e-12);
+    assert.throws(() => diffImage(a, new Uint8ClampedArray(4)), /differ in size/);
+});
+
+// ---- messages and uploads -----------------------------------------------------------------------
+
+test('server errors read as sentences with the server\'s details', () => {
+    assert.equal(describeError({ code: 'invalid_param', message: 'must be <= 256, got 1000', where: '/values/vpl_grid' }),
+        'The server refused a parameter value. (at /values/vpl_grid: must be <= 256, got 1000)');
+    assert.match(describeError({ code: 'unauthorized', message: 'x' }), /#token=/);
+    assert.match(describeError({ code: 'busy' }), /session limit/);
+    assert.match(describeError({ code: 'something_new', message: 'm' }), /something_new.*\(m\)/);
+    assert.match(describeHttpError(400, { error: 'invalid_request', message: 'too big', where: '/size/0' }),
+        /at \/size\/0: too big/);
+    assert.match(describeHttpError(503, {}), /busy/);
+});
+
+test('upload names follow the server\'s rules', () => {
+    assert.equal(uploadName('My Scene (2).glb'), 'My_Scene_2_.glb');
+    assert.equal(uploadName('C:\\models\\room.GLB'), 'room.glb');
+    assert.equal(uploadName('.hidden.glb'), 'hidden.glb');
+    assert.equal(uploadName('.glb'), 'scene.glb');
+    assert.equal(uploadName(`${'x'.repeat(300)}.glb`).length, 100);
+    assert.equal(uploadName('scene.gltf'), null);
+    assert.equal(uploadName(undefined), null);
+    for (const name of ['My Scene (2).glb', 'ü.glb', `${'y'.repeat(150)}.glb`]) {
+        assert.match(uploadName(name), /^[A-Za-z0-9_-][A-Za-z0-9._-]{0,95}\.glb$/, name);
+    }
+});
+
+// ---- vendored libraries -------------------------------------------------------------------------
+
+test('the import map points at vendored files that npm ci put in place', () => {
+    const html = readFileSync(path.join(CLIENT_DIR, 'index.html'), 'utf8');
+    const map = JSON.parse(html.match(/<script type="importmap">([\s\S]*?)<\/script>/)[1]);
+    const vendored = new Set(VENDOR_FILES.map(([, , name]) => `./vendor/${name}`));
+    for (const [specifier, url] of Object.entries(map.imports)) {
+        assert.ok(vendored.has(url), `${specifier} -> ${url} is one of the files client/tools/vendor.mjs copies`);
+    }
+    assert.ok(html.includes('href="vendor/uPlot.min.css"'), 'uPlot\'s stylesheet is linked');
+    const problems = checkVendor();
+    assert.deepEqual(problems, [], `client/vendor/ is not ready: ${problems.join('; ')}`);
+    for (const [, , name] of VENDOR_FILES) assert.ok(existsSync(path.join(CLIENT_DIR, 'vendor', name)));
+});
