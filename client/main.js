@@ -289,6 +289,13 @@ function handleText(text) {
         break;
     case 'state': applyState(msg.state ?? {}, { fromServer: true }); break;
     case 'error': handleError(msg); break;
+    case 'shutdown':
+        // The server drains before it stops: this session will not survive it, so the reconnect
+        // after the close starts a new session (on this server's replacement).
+        sessionStorage.removeItem(RESUME_KEY);
+        showMessage(`The server is shutting down; this session ends within ${msg.grace_s ?? '?'} s and the `
+            + 'client will reconnect to a new one.', 'info');
+        break;
     case 'pong':
         if (Number.isFinite(msg.t)) state.rttMs = performance.now() - msg.t;
         break;
@@ -298,7 +305,7 @@ function handleText(text) {
 
 function handleError(msg) {
     showMessage(describeError(msg));
-    if (msg.code === 'resume_failed') {
+    if (msg.code === 'resume_failed' || msg.code === 'shutting_down') {
         // The session is gone (grace period over, server restarted): the reconnect that follows
         // the close starts a new one.
         sessionStorage.removeItem(RESUME_KEY);

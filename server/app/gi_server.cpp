@@ -1,7 +1,9 @@
 // gi-server: the interactive rendering service. Serves the web client, streams frames with per-pass
 // stats over WebSockets (one render worker with its own GL context per session), answers one-shot
 // HTTP render requests and exposes health and Prometheus metrics. Settings: net/ServerOptions.h.
-// Exit codes: 0 clean shutdown, 1 runtime failure, 2 bad usage.
+// Exit codes: 0 clean shutdown (also after SIGTERM/SIGINT: docs/operations.md, graceful drain),
+// 1 runtime failure, 2 bad usage.
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -22,10 +24,16 @@
 
 namespace {
 
-gis::WsServer* gServer = nullptr;
+// Read by the signal handler: an atomic pointer, so that clearing it after the loop is not a data race.
+std::atomic<gis::WsServer*> gServer{nullptr};
+static_assert(std::atomic<gis::WsServer*>::is_always_lock_free);
 
+// Async-signal-safe: requestStop() only bumps an atomic counter and wakes the loop. The first signal
+// starts the drain (--drain-seconds), the second ends it at once; the loop does the rest. Linux hands
+// a process-directed signal to the main thread when it does not block it, so the handler runs on
+// the loop's own thread and never beside the server's destruction.
 void onSignal(int) {
-    if (gServer) gServer->requestStop();
+    if (gis::WsServer* server = gServer.load()) server->requestStop();
 }
 
 int run(int argc, char** argv) {
@@ -35,26 +43,46 @@ int run(int argc, char** argv) {
         std::cout << gis::serverUsage();
         return 0;
     }
+    if (parsed.configReference) {
+        std::cout << gis::serverConfigReference();
+        return 0;
+    }
     gis::ServerConfig& config = parsed.config;
     if (config.clientDir.empty()) config.clientDir = GIS_DEFAULT_CLIENT_DIR;
     if (config.glName.empty()) config.session.backend = gis::gl::defaultBackend();
     // Fail at start, not at the first connection.
     gis::findTechnique(config.session.technique, "--technique");
     (void)gis::loadScene(config.session.scene);
+    // A machine whose GL does not work fails here, once and visibly (a pod crash-loops instead of
+    // turning ready and failing every session); the line names the device that renders, which is how
+    // an operator tells a GPU node from a fallback to llvmpipe (docs/operations.md, "GPU nodes").
+    {
+        const auto probe = gis::gl::createContext(config.session.backend);
+        const gis::gl::ContextInfo& gl = probe->info();
+        gis::logInfo("gi-server: GL " + gl.backend + ": " + gl.renderer + ", " + gl.version + " (" +
+                     gl.vendor + ")");
+    }
 
     gis::WsServer server(config);
     server.listen();
     gServer = &server;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
+    struct sigaction action {};
+    action.sa_handler = onSignal;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
     std::signal(SIGPIPE, SIG_IGN);
     gis::logInfo("gi-server: settings\n" + gis::describeServerConfig(config, parsed.sources));
     gis::logInfo("gi-server: listening on http://" + config.host + ":" + std::to_string(server.port()) +
                  "/ (scene " + config.session.scene + ", technique " + config.session.technique + ", GL " +
                  gis::gl::backendName(config.session.backend) + ")");
     server.run();
-    gis::logInfo("gi-server: shutting down");
     gServer = nullptr;
+    // Teardown joins the render threads (a frame in progress finishes first); a further signal while
+    // that runs takes the default action rather than being ignored.
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    gis::logInfo("gi-server: shutting down");
     return 0;
 }
 

@@ -96,7 +96,6 @@ ServerOption listOption(std::string flag, std::string env, std::string valueName
 }
 
 std::vector<ServerOption> buildOptions() {
-    const int cores = std::max(1u, std::thread::hardware_concurrency());
     std::vector<ServerOption> t;
     t.push_back(stringOption("--host", "GI_HOST", "ADDR", "address to listen on (default 127.0.0.1)",
                              &ServerConfig::host));
@@ -190,15 +189,12 @@ std::vector<ServerOption> buildOptions() {
     t.push_back(intOption("--max-sessions", "GI_MAX_SESSIONS",
                           "concurrent sessions, 1..256 (default 8); more are refused as busy", 1, 256,
                           &ServerConfig::maxSessions));
-    {
-        ServerOption o =
-            intOption("--render-slots", "GI_RENDER_SLOTS",
-                      "renders at once across all sessions and the HTTP API, 1..256 (default: the core "
-                      "count, " +
-                          std::to_string(cores) + ")",
-                      1, 256, &ServerConfig::renderSlots);
-        t.push_back(o);
-    }
+    // The default is the machine's core count, not printed here: docs/operations.md embeds this text
+    // and must not depend on the machine that generated it (the startup summary shows the value).
+    t.push_back(intOption("--render-slots", "GI_RENDER_SLOTS",
+                          "renders at once across all sessions and the HTTP API, 1..256 (default: the number "
+                          "of cores)",
+                          1, 256, &ServerConfig::renderSlots));
     t.push_back(intOption("--http-queue", "GI_HTTP_QUEUE",
                           "POST /api/render jobs waiting before 503, 0..1024 (default 8)", 0, 1024,
                           &ServerConfig::httpRenderQueue));
@@ -248,6 +244,11 @@ std::vector<ServerOption> buildOptions() {
         intOption("--hello-timeout", "GI_HELLO_TIMEOUT",
                   "close connections that send no hello within this many seconds, 1..300 (default 10)", 1,
                   300, &ServerConfig::helloTimeoutS));
+    t.push_back(intOption("--drain-seconds", "GI_DRAIN_SECONDS",
+                          "on SIGTERM or SIGINT refuse new sessions, tell clients and let running sessions "
+                          "finish for up to this many seconds, then close them and exit 0; a second signal "
+                          "stops at once; 0 = no wait, 0..3600 (default 20)",
+                          0, 3600, &ServerConfig::drainSeconds));
     t.push_back(listOption("--scene-dir", "GI_SCENE_DIR", "DIR",
                            "offer the .gltf/.glb files below DIR as file:NAME scenes (repeatable)",
                            &ServerConfig::sceneDirs));
@@ -306,7 +307,35 @@ std::string serverUsage() {
     out << "  --config FILE           read settings from a JSON file: {\"max-sessions\": 4, \"scene-dir\": "
            "[\"scenes\"]}\n"
            "                          [$GI_CONFIG]; precedence: defaults < file < environment < flags\n"
+           "  --config-reference      print the settings as a Markdown table (docs/operations.md)\n"
            "  --help                  this text\n";
+    return out.str();
+}
+
+std::string serverConfigReference() {
+    // Markdown table cells: a '|' inside a value name or help text would end the cell (GitHub's tables
+    // take '\|' as a literal bar, inside code spans too).
+    auto cell = [](std::ostream& out, const std::string& text) -> std::ostream& {
+        for (char ch : text) {
+            if (ch == '|') out << '\\';
+            out << ch;
+        }
+        return out;
+    };
+    std::ostringstream out;
+    out << "| flag | environment | config-file key | description |\n|---|---|---|---|\n";
+    for (const auto& o : serverOptions()) {
+        out << "| `" << o.flag;
+        if (!o.valueName.empty()) cell(out << ' ', o.valueName);
+        out << "` | `" << o.env << "` | `" << o.flag.substr(2) << "` | ";
+        cell(out, o.help);
+        if (o.repeatable) out << " (environment: comma-separated; file: a JSON array)";
+        if (o.secret) out << " (masked in the startup log)";
+        out << " |\n";
+    }
+    out << "| `--config FILE` | `GI_CONFIG` | | read settings from a JSON object whose keys are the flag "
+           "names "
+           "without dashes; precedence: defaults < file < environment < flags |\n";
     return out.str();
 }
 
@@ -320,12 +349,13 @@ ParsedServerArgs parseServerArgs(const std::vector<std::string>& args,
     if (const char* f = getenv("GI_CONFIG"); f && *f) configFile = f;
     for (std::size_t i = 0; i < args.size(); ++i) {
         if (args[i] == "--help" || args[i] == "-h") result.help = true;
+        if (args[i] == "--config-reference") result.configReference = true;
         if (args[i] == "--config") {
             if (i + 1 >= args.size()) throw InputError("--config", "needs a value");
             configFile = args[i + 1];
         }
     }
-    if (result.help) return result;
+    if (result.help || result.configReference) return result;
 
     if (!configFile.empty()) {
         std::ifstream in(configFile);

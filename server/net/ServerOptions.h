@@ -29,6 +29,7 @@ struct ServerConfig {
     int resumeGraceS = 30;                 ///< a dropped controller's session waits this long
     int idleTimeoutS = 900;                ///< sessions without steering input end
     int helloTimeoutS = 10;                ///< connections that never say hello are closed
+    int drainSeconds = 20;                 ///< on SIGTERM: running sessions may finish this long
     std::vector<std::string> sceneDirs;    ///< file: scenes
     std::string uploadDir;                 ///< per-session upload sandboxes live below it
     int maxUploadMb = 32;
@@ -51,10 +52,16 @@ const std::vector<ServerOption>& serverOptions();
 /// --help text, generated from the table.
 std::string serverUsage();
 
+/// The configuration reference as a Markdown table (flag, environment variable, config-file key,
+/// description), generated from the same table; docs/operations.md embeds it verbatim and a test
+/// checks that it is current (`gi-server --config-reference`).
+std::string serverConfigReference();
+
 /// Result of parsing: the config, or a request to print help.
 struct ParsedServerArgs {
     ServerConfig config;
     bool help = false;
+    bool configReference = false; ///< --config-reference: print serverConfigReference() and exit
     std::map<std::string, std::string> sources; ///< flag -> "flag", "env GI_X", "config FILE"
 };
 /// Applies defaults, then the config file (--config FILE or $GI_CONFIG: a JSON object whose keys are

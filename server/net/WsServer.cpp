@@ -251,12 +251,21 @@ struct Housekeeping {
 } // namespace
 
 struct WsServer::Impl {
+    /// Running, then (after the first stop request) Draining: no new sessions, running ones go on;
+    /// then Closing: everything is closed with 1001 and the loop ends once the close frames are out.
+    enum class Phase { Running, Draining, Closing };
+
     ServerConfig config;
     std::string clientRoot;
     std::string uploadRoot;
     bool ownsUploadRoot = false;
     lws_context* context = nullptr;
     std::atomic<bool> stop{false};
+    std::atomic<int> stopRequests{0}; // bumped by signal handlers: lock-free, nothing else
+    static_assert(std::atomic<int>::is_always_lock_free);
+    int handledStopRequests = 0;
+    Phase phase = Phase::Running;
+    Clock::time_point drainDeadline{}, closeDeadline{};
     Clock::time_point started = Clock::now();
     std::shared_ptr<SceneCache> scenes = std::make_shared<SceneCache>();
     std::shared_ptr<const Scene> defaultScene; // keeps the default scene cached between sessions
@@ -333,6 +342,8 @@ struct WsServer::Impl {
             .set(static_cast<double>(reaper->pending()));
         metrics.gauge("gis_uptime_seconds", "seconds since the server started")
             .set(std::chrono::duration<double>(Clock::now() - started).count());
+        metrics.gauge("gis_draining", "1 while the server drains after SIGTERM (no new sessions)")
+            .set(phase == Phase::Running ? 0.0 : 1.0);
     }
 
     // --- access control -----------------------------------------------------------------------
@@ -425,14 +436,19 @@ struct WsServer::Impl {
         pss->http->endpoint =
             uri.rfind("/api/", 0) == 0 || uri == "/metrics" || uri == "/healthz" ? uri : "static";
         if (uri == "/healthz") {
-            respond(wsi, pss,
-                    jsonResponse(
-                        200, {{"status", "ok"},
-                              {"sessions", sessions.size()},
-                              {"renders_active", gate->active()},
-                              {"renders_waiting", gate->waiting()},
-                              {"teardowns_pending", reaper->pending()},
-                              {"uptime_s", std::chrono::duration<double>(Clock::now() - started).count()}}));
+            // 503 while draining: readiness probes and load balancers stop sending new clients here.
+            const bool draining = phase != Phase::Running;
+            nlohmann::json body = {
+                {"status", draining ? "draining" : "ok"},
+                {"sessions", sessions.size()},
+                {"renders_active", gate->active()},
+                {"renders_waiting", gate->waiting()},
+                {"teardowns_pending", reaper->pending()},
+                {"uptime_s", std::chrono::duration<double>(Clock::now() - started).count()}};
+            if (draining)
+                body["drain_remaining_s"] =
+                    std::max(0.0, std::chrono::duration<double>(drainDeadline - Clock::now()).count());
+            respond(wsi, pss, jsonResponse(draining ? 503 : 200, body));
             return 0;
         }
         const bool api = uri.rfind("/api/", 0) == 0 || uri == "/metrics";
@@ -447,6 +463,14 @@ struct WsServer::Impl {
             return 0;
         }
         if (post) {
+            if (uri == "/api/render" && phase != Phase::Running) {
+                HttpResponse r =
+                    errorResponse(503, "shutting_down",
+                                  "the server is shutting down; send the request to another instance");
+                r.headers.emplace_back("retry-after:", "1");
+                respond(wsi, pss, std::move(r));
+                return 0;
+            }
             if (uri == "/api/render") {
                 pss->http->bodyLimit = kMaxRenderRequestBytes;
             } else if (uri == "/api/upload") {
@@ -769,6 +793,14 @@ struct WsServer::Impl {
     }
 
     void onHello(Connection& c, const nlohmann::json& hello) {
+        if (phase != Phase::Running) {
+            // Resumes and viewers too: a session on a draining server cannot outlive the drain.
+            closeWith(c,
+                      shuttingDown("hello", "the server is shutting down; connect again (without resume) to "
+                                            "reach another instance"),
+                      1001);
+            return;
+        }
         if (hello["protocol"].get<int>() != kProtocolVersion) {
             closeWith(c,
                       {"protocol_mismatch",
@@ -935,6 +967,7 @@ struct WsServer::Impl {
     int onStream(lws* wsi, lws_callback_reasons reason, PerSession* pss, void* in, size_t len) {
         switch (reason) {
         case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+            if (phase == Phase::Closing) return 1; // the loop ends in a moment
             if (!originAllowed(wsi)) {
                 logWarn("net: refused a WebSocket from origin '" + header(wsi, WSI_TOKEN_ORIGIN) + "'");
                 countHttp("/ws", 403);
@@ -1048,8 +1081,14 @@ struct WsServer::Impl {
                 } else if (entry->controller == &c) {
                     entry->session->detach(link);
                     entry->controller = nullptr;
-                    if (stop) {
+                    if (stop || phase == Phase::Closing) {
                         endSession(entry, "", ""); // the server is going down: no messages
+                    } else if (phase == Phase::Draining) {
+                        // No resume during a drain (hello is refused), so waiting would only delay the exit.
+                        endSession(entry, "session_ended",
+                                   c.peerCloseCode == 1000
+                                       ? "the controller closed the session"
+                                       : "the controller left while the server shuts down; no resume");
                     } else if (c.peerCloseCode == 1000 || config.resumeGraceS == 0) {
                         endSession(entry, "session_ended", "the controller closed the session");
                     } else {
@@ -1070,6 +1109,76 @@ struct WsServer::Impl {
             break;
         }
         return 0;
+    }
+
+    // --- shutdown -------------------------------------------------------------------------------
+    static ProtocolError shuttingDown(const std::string& request, const std::string& message) {
+        return {"shutting_down", message, "", request};
+    }
+
+    /// On the service thread after every lws_service() return: signals interrupt the wait and
+    /// requestStop() wakes it, and the 0.5 s housekeeping timer bounds it, so deadlines are checked
+    /// at least twice a second.
+    void pollShutdown() {
+        for (const int requests = stopRequests.load(); handledStopRequests < requests;) {
+            ++handledStopRequests;
+            if (phase == Phase::Running) {
+                beginDrain();
+            } else if (phase == Phase::Draining) {
+                logInfo("net: second stop request: ending the drain now");
+                beginClosing(std::chrono::milliseconds(500));
+            } else {
+                stop = true;
+                return;
+            }
+        }
+        if (phase == Phase::Running) return;
+        const auto now = Clock::now();
+        if (phase == Phase::Draining && ((sessions.empty() && awaiting.empty()) || now >= drainDeadline))
+            beginClosing(std::chrono::seconds(2));
+        if (phase == Phase::Closing && (connections.empty() || now >= closeDeadline)) stop = true;
+    }
+
+    void beginDrain() {
+        phase = Phase::Draining;
+        drainDeadline = Clock::now() + std::chrono::seconds(config.drainSeconds);
+        logInfo("net: draining: new sessions are refused; " + std::to_string(sessions.size()) +
+                " session(s) and " + std::to_string(awaiting.size()) + " HTTP render(s) have up to " +
+                std::to_string(config.drainSeconds) + " s to finish (a second signal stops at once)");
+        // A detached session waits for a resume that can no longer come (hello is refused).
+        std::vector<std::shared_ptr<SessionEntry>> detached;
+        for (const auto& [id, e] : sessions)
+            if (!e->controller) detached.push_back(e);
+        for (const auto& e : detached)
+            endSession(e, "shutting_down",
+                       "the server is shutting down and the session's controller is gone");
+        const nlohmann::json notice = {
+            {"type", "shutdown"},
+            {"grace_s", config.drainSeconds},
+            {"message", "the server is shutting down: this session may continue for up to " +
+                            std::to_string(config.drainSeconds) +
+                            " s; connect again (without resume) to reach another instance"}};
+        for (auto& [wsi, c] : connections) {
+            if (c->closing) continue;
+            if (!c->helloDone)
+                closeWith(*c, shuttingDown("", "the server is shutting down"), 1001);
+            else if (c->entry)
+                sendDirect(*c, notice);
+        }
+        updateGauges();
+    }
+
+    /// Ends every session (clients get `shutting_down` and close 1001) and gives the close frames
+    /// `flush` to go out before the loop ends.
+    void beginClosing(Clock::duration flush) {
+        phase = Phase::Closing;
+        closeDeadline = Clock::now() + flush;
+        if (!sessions.empty())
+            logInfo("net: drain over: closing " + std::to_string(sessions.size()) + " session(s)");
+        for (auto& [id, e] : std::map(sessions))
+            endSession(e, "shutting_down", "the server's drain period is over");
+        for (auto& [wsi, c] : connections)
+            if (!c->closing) closeWith(*c, shuttingDown("", "the server is shutting down"), 1001);
     }
 
     void onWake() {
@@ -1199,11 +1308,14 @@ void WsServer::listen() {
 void WsServer::run() {
     while (!mImpl->stop.load()) {
         if (lws_service(mImpl->context, 0) < 0) break;
+        mImpl->pollShutdown();
     }
 }
 
 void WsServer::requestStop() {
-    mImpl->stop = true;
+    // Signal handlers call this: an atomic increment and lws_cancel_service (a write to the loop's
+    // wake-up pipe) only; the loop does the work in pollShutdown().
+    mImpl->stopRequests.fetch_add(1);
     if (mImpl->context) lws_cancel_service(mImpl->context);
 }
 

@@ -7,6 +7,12 @@
 // (LWS_CALLBACK_EVENT_WAIT_CANCELLED) to ask for writable callbacks. One lws_write per writable
 // callback. The loop never renders or blocks: session teardown (joining a render thread) happens on a
 // reaper thread, and a housekeeping timer ends sessions whose resume grace or idle time ran out.
+//
+// Shutdown is a drain, driven by the loop itself: requestStop() (from a signal handler) only counts
+// the request and wakes the loop. On the first request the loop stops taking sessions (hello gets
+// `shutting_down`, /healthz answers 503 "draining"), tells every client `shutdown` with the grace
+// period, and keeps serving running sessions until they end or `--drain-seconds` pass; then it closes
+// the rest with 1001 and run() returns. A second request ends the drain at once.
 #pragma once
 
 #include <memory>
@@ -24,8 +30,10 @@ public:
     /// Creates the listening socket; throws gis::Error when it cannot (port in use, bad address).
     void listen();
     int port() const { return mPort; }
-    /// Runs the event loop until requestStop() (safe from signal handlers and other threads).
+    /// Runs the event loop until the drain after requestStop() is over.
     void run();
+    /// Starts the drain, or ends it when one is running. Async-signal-safe (an atomic increment and
+    /// lws_cancel_service) and safe from any thread.
     void requestStop();
 
     struct Impl;

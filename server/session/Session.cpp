@@ -59,6 +59,20 @@ std::string effectPlanKey(const Scene& scene, const FrameState& s) {
 } // namespace
 #endif
 
+double Session::predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const {
+    const std::string prefix = sceneName + "/" + state.technique + "/";
+    const double pixels = static_cast<double>(state.width) * state.height;
+    if (auto own = mRefineCost.find(prefix + std::to_string(step)); own != mRefineCost.end())
+        return own->second.msPerPixel * pixels;
+    // Not rendered yet: scale the nearest measured step by pixels and VPLs (gather cost grows with
+    // their product), so a final preset with 256 times the VPLs is predicted before it runs.
+    for (int other = step - 1; other >= 0; --other)
+        if (auto c = mRefineCost.find(prefix + std::to_string(other)); c != mRefineCost.end())
+            return c->second.msPerPixel * pixels * static_cast<double>(std::max(1L, maxVplEstimate(state))) /
+                   static_cast<double>(c->second.vpls);
+    return 0.0;
+}
+
 long maxVplEstimate(const FrameState& s) {
     auto get = [](const ParamSet& p, const char* name) -> long { return p.has(name) ? p.getInt(name) : 0; };
     long n = 0;
@@ -422,14 +436,17 @@ void Session::workerMain() {
                 }
             }
             if (step == static_cast<int>(Step::Final) && state.frameParams.has("effects") &&
-                !explicitParams.contains("effects"))
+                !explicitParams.contains("effects")) {
+                // The plan's bias compensation (and direct/bounce decisions), but not indirect
+                // occlusion unless asked for: one cube shadow map per VPL costs minutes per frame on
+                // CPU rendering at the final preset's VPL counts.
                 state.frameParams.set("effects", "auto");
-            const std::string costKey = scene->name + "/" + state.technique + "/" + std::to_string(step);
+                if (state.frameParams.has("effect_occlusion") && !explicitParams.contains("effect_occlusion"))
+                    state.frameParams.set("effect_occlusion", "off");
+            }
             if (step != static_cast<int>(Step::Interactive) && !snapshotFor &&
                 mConfig.limits.refineBudgetMs > 0) {
-                auto cost = mRefineMsPerPixel.find(costKey);
-                const double predictedMs =
-                    cost == mRefineMsPerPixel.end() ? 0.0 : cost->second * state.width * state.height;
+                const double predictedMs = predictRefineMs(scene->name, state, step);
                 if (predictedMs > mConfig.limits.refineBudgetMs) continue; // too slow to refine to
             }
             if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
@@ -459,6 +476,7 @@ void Session::workerMain() {
         }
         const double queueMs = queueClock.elapsedMs();
         FrameOutput frame;
+        Stopwatch renderClock;
         try {
             frame = renderer->render(state);
         } catch (const std::exception& e) {
@@ -467,9 +485,10 @@ void Session::workerMain() {
             continue;
         }
         permit.reset();
-        if (step > static_cast<int>(Step::Interactive) && frame.width > 0 && frame.height > 0)
-            mRefineMsPerPixel[scene->name + "/" + state.technique + "/" + std::to_string(step)] =
-                frame.stats.value("frame_ms", 0.0) / (static_cast<double>(frame.width) * frame.height);
+        if (step >= 0 && frame.width > 0 && frame.height > 0)
+            mRefineCost[scene->name + "/" + state.technique + "/" + std::to_string(step)] = {
+                renderClock.elapsedMs() / (static_cast<double>(frame.width) * frame.height),
+                std::max(1L, maxVplEstimate(state))};
         const ImageCodec codec = snapshotFor ? snapshotCodec : stream.codec;
         Stopwatch encodeClock;
         std::vector<std::uint8_t> encoded;

@@ -41,8 +41,9 @@ struct SessionLimits {
     long maxVpls = 65536;                  ///< upper bound on VPLs a parameter set may ask for
     double interactiveScale = 0.5;         ///< (0, 1]: size factor of interactive frames
     int settleMs = 250;                    ///< ms without input before refinement starts
-    /// ms; a refinement step whose predicted time (from the last one of its kind, scaled by the
-    /// pixel count) exceeds this is skipped, so input never waits long behind it. 0 = no limit.
+    /// ms; a refinement step whose predicted time exceeds this is skipped, so input never waits long
+    /// behind it: from the last one of its kind scaled by the pixel count, or before the first one,
+    /// from the previous step scaled by pixels and VPLs. 0 = no limit.
     int refineBudgetMs = 5000;
 };
 
@@ -159,7 +160,13 @@ private:
     } mLastFrame; ///< replayed to a viewer that joins a still view
     std::shared_ptr<ClientLink> mController;
     std::vector<std::shared_ptr<ClientLink>> mViewers;
-    std::map<std::string, double> mRefineMsPerPixel; ///< worker only: technique + step -> measured cost
+    struct StepCost {
+        double msPerPixel = 0;
+        long vpls = 1;
+    };
+    /// Worker only: scene/technique/step -> the last measured cost of that adaptive step.
+    std::map<std::string, StepCost> mRefineCost;
+    double predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const;
     std::atomic<bool> mStop{false};
     std::atomic<std::uint64_t> mFramesRendered{0};
     std::thread mWorker;

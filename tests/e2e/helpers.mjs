@@ -156,6 +156,8 @@ export class ServerProcess {
                 resolve();
             });
             this.proc.kill('SIGTERM');
+            // A second signal ends the drain at once: tests do not wait for sessions to finish.
+            setTimeout(() => { if (!this.exited) this.proc.kill('SIGTERM'); }, 300);
         });
     }
 }
