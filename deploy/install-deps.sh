@@ -23,6 +23,8 @@ PACKAGES=(
     libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
     # end-to-end and browser tests
     nodejs npm chromium
+    # libFuzzer targets (deploy/test.sh's fuzz stage)
+    clang libclang-rt-14-dev
 )
 
 missing=()

@@ -4,8 +4,14 @@ layout(binding = 8) uniform sampler2D gPosition; // RGBA32F world position, w = 
 layout(binding = 9) uniform sampler2D gNormal;   // RGBA16F unit normal
 layout(binding = 10) uniform sampler2D gAlbedo;  // RGBA8 linear albedo
 
+// A pixel with a non-finite position or normal counts as background: the G-buffer pass never writes
+// one, but a single NaN entering the mean and min-max mips would poison every coarser level and,
+// through coarse receivers, whole screen regions (digest S.4 case 5).
 bool eyePixelCovered(ivec2 p) {
-    return all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, gEye.info.yz)) && texelFetch(gPosition, p, 0).w > 0.5;
+    if (!all(greaterThanEqual(p, ivec2(0))) || !all(lessThan(p, gEye.info.yz))) return false;
+    vec4 pos = texelFetch(gPosition, p, 0);
+    vec3 n = texelFetch(gNormal, p, 0).xyz;
+    return pos.w > 0.5 && !any(isnan(pos.xyz)) && !any(isinf(pos.xyz)) && !any(isnan(n)) && !any(isinf(n));
 }
 float eyePixelDistance(ivec2 p) { return length(texelFetch(gPosition, p, 0).xyz - gFrame.cameraPos.xyz); }
 

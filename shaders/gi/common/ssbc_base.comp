@@ -26,7 +26,8 @@ void main() {
     vec4 geo = vec4(0.0), nrm = vec4(0.0), illum = vec4(0.0);
     vec4 stats = vec4(0.0);
     vec4 pos = all(lessThan(p, size)) ? texelFetch(gPosition, p, 0) : vec4(0.0);
-    if (pos.w > 0.5) {
+    // A non-finite position is a hole, not a sample: it would sit in the level-0 chain (digest S.4 case 5).
+    if (pos.w > 0.5 && !any(isnan(pos.xyz)) && !any(isinf(pos.xyz))) {
         vec3 n = texelFetch(gNormal, p, 0).xyz;
         float nl = length(n);
         n = nl > 1e-6 ? n / nl : vec3(0.0, 0.0, 1.0);

@@ -35,8 +35,10 @@ void main() {
         for (int x = lo.x; x < hi.x; ++x) {
             ivec2 t = ivec2(x, y);
             vec4 p = texelFetch(gRsmPosition, t, 0);
-            if (p.w < 0.5) continue; // empty texel: no surface
-            flux += texelFetch(gRsmFlux, t, 0).rgb;
+            // Empty texel (no surface), or one that is not finite: a NaN in the summed flux or the
+            // VPL position would turn every receiver's whole sum into NaN (digest S.4 case 5).
+            if (p.w < 0.5 || any(isnan(p.xyz)) || any(isinf(p.xyz))) continue;
+            flux += max(sanitize(texelFetch(gRsmFlux, t, 0).rgb), vec3(0.0));
             texels += 1.0;
             vec3 v = p.xyz - gFrame.lightPos.xyz;
             area += rsmTexelSolidAngle(vec2(t) + 0.5) * dot(v, v);
@@ -55,7 +57,9 @@ void main() {
         v.flux = vec4(0.0);
     } else {
         v.position = vec4(texelFetch(gRsmPosition, best, 0).xyz, 1.0);
-        v.normal = vec4(texelFetch(gRsmNormal, best, 0).xyz, area);
+        vec3 n = texelFetch(gRsmNormal, best, 0).xyz;
+        if (any(isnan(n)) || any(isinf(n))) n = normalize(gFrame.lightPos.xyz - v.position.xyz); // faces the light
+        v.normal = vec4(n, area);
         v.flux = vec4(flux, texels);
     }
     gVplsOut[index] = v;

@@ -69,12 +69,15 @@ void main() {
             ivec2 t = clamp(ivec2(floor(s.xy * float(size))), ivec2(0), ivec2(size - 1));
             vec4 p = texelFetch(gRsmPosition, t, 0);
             float omega = rsmTexelSolidAngle(vec2(t) + 0.5);
-            if (p.w >= 0.5 && omega > 0.0) {
+            // A non-finite texel is skipped like an empty one (digest S.4 case 5).
+            if (p.w >= 0.5 && omega > 0.0 && !any(isnan(p.xyz)) && !any(isinf(p.xyz))) {
                 vec3 intensity = max(sanitize(texelFetch(gRsmFlux, t, 0).rgb / omega), 0.0);
                 vec3 toSurface = p.xyz - gFrame.lightPos.xyz;
                 v.position = vec4(p.xyz, 1.0);
                 float area = uSampleSolidAngle * dot(toSurface, toSurface);
-                v.normal = vec4(texelFetch(gRsmNormal, t, 0).xyz, area);
+                vec3 n = texelFetch(gRsmNormal, t, 0).xyz;
+                if (any(isnan(n)) || any(isinf(n))) n = -normalize(toSurface); // faces the light
+                v.normal = vec4(n, area);
                 v.flux = vec4(intensity, uSampleSolidAngle / omega); // w: texels this light stands for
                 intensitySum += intensity;
                 valid += 1.0;
