@@ -56,6 +56,22 @@ std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
     return buf;
 }
 
+/// Traces the eye ray through normalised device coordinates (nx, ny) of the pipeline's own projection
+/// (as the reference renderer does), so samples see exactly the GL frustum. False on a miss or a
+/// degenerate ray; `dir` is the unit ray direction.
+bool traceEyeRay(const RayScene& rays, const glm::dmat4& invViewProj, double nx, double ny, SurfaceHit& hit,
+                 glm::vec3& dir, long long& rayCount) {
+    const glm::dvec4 nearP = invViewProj * glm::dvec4(nx, ny, -1.0, 1.0);
+    const glm::dvec4 farP = invViewProj * glm::dvec4(nx, ny, 1.0, 1.0);
+    if (!(std::abs(nearP.w) > 1e-300) || !(std::abs(farP.w) > 1e-300)) return false;
+    const glm::vec3 o(glm::dvec3(nearP) / nearP.w), f(glm::dvec3(farP) / farP.w);
+    const float len = glm::length(f - o);
+    if (!(len > 0.0f)) return false;
+    dir = (f - o) / len;
+    ++rayCount;
+    return rays.intersect(o, dir, 0.0f, len, hit);
+}
+
 /// The forced state of one effect from its frame parameter; "auto" when the table lacks it.
 std::string forcedMode(const FrameState& state, const std::string& effect) {
     const std::string name = "effect_" + effect;
@@ -79,7 +95,8 @@ EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, 
     const int w = std::max(state.width, 1), h = std::max(state.height, 1);
     const int gx = w >= h ? kLevelGrid : std::max(2, kLevelGrid * w / h);
     const int gy = w >= h ? std::max(2, kLevelGrid * h / w) : kLevelGrid;
-    const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
+    const glm::dmat4 invViewProj =
+        glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
     struct Sample {
         bool hit = false;
         float distance = 0.0f;
@@ -88,26 +105,22 @@ EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, 
     std::vector<Sample> grid(static_cast<size_t>(gx) * gy);
     for (int j = 0; j < gy; ++j)
         for (int i = 0; i < gx; ++i) {
-            const double nx = 2.0 * (i + 0.5) / gx - 1.0, ny = 1.0 - 2.0 * (j + 0.5) / gy;
-            const glm::dvec4 nearP = invViewProj * glm::dvec4(nx, ny, -1.0, 1.0);
-            const glm::dvec4 farP = invViewProj * glm::dvec4(nx, ny, 1.0, 1.0);
-            if (!(std::abs(nearP.w) > 1e-300) || !(std::abs(farP.w) > 1e-300)) continue;
-            const glm::vec3 o(glm::dvec3(nearP) / nearP.w), f(glm::dvec3(farP) / farP.w);
-            const float len = glm::length(f - o);
-            if (!(len > 0.0f)) continue;
-            const glm::vec3 dir = (f - o) / len;
             SurfaceHit hit;
-            ++rayCount;
-            if (!rays.intersect(o, dir, 0.0f, len, hit)) continue;
+            glm::vec3 dir;
+            if (!traceEyeRay(rays, invViewProj, 2.0 * (i + 0.5) / gx - 1.0, 1.0 - 2.0 * (j + 0.5) / gy, hit,
+                             dir, rayCount))
+                continue;
             Sample& s = grid[static_cast<size_t>(j) * gx + i];
             s.hit = true;
             s.distance = glm::length(hit.position - state.camera.position);
             s.normal = facing(hit.shadingNormal, -dir);
         }
-    const double depthThreshold =
-        state.techniqueParams.has("depth_threshold") ? state.techniqueParams.getFloat("depth_threshold") : 0.1;
-    const double normalThreshold =
-        state.techniqueParams.has("normal_threshold") ? state.techniqueParams.getFloat("normal_threshold") : 0.25;
+    const double depthThreshold = state.techniqueParams.has("depth_threshold")
+                                      ? state.techniqueParams.getFloat("depth_threshold")
+                                      : 0.1;
+    const double normalThreshold = state.techniqueParams.has("normal_threshold")
+                                       ? state.techniqueParams.getFloat("normal_threshold")
+                                       : 0.25;
     const bool diagonal =
         !state.techniqueParams.has("diagonal_refine") || state.techniqueParams.getBool("diagonal_refine");
     // Whole fraction per candidate level, among the patches with geometry (empty ones are never lit).
@@ -154,7 +167,8 @@ EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, 
                 for (int dy = -1; dy <= 1 && diagonal && !refine; dy += 2)
                     for (int dx = -1; dx <= 1; dx += 2) {
                         const int x = cx + dx, y = cy + dy;
-                        if (x >= 0 && y >= 0 && x < px && y < py && disc[static_cast<size_t>(y) * px + x]) refine = true;
+                        if (x >= 0 && y >= 0 && x < px && y < py && disc[static_cast<size_t>(y) * px + x])
+                            refine = true;
                     }
                 ++patches;
                 if (!refine) ++whole;
@@ -174,8 +188,9 @@ EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, 
         d.reason = "patches left whole: " + densities + "; none reaches 10%, keeping coarsest_size " +
                    std::to_string(current);
     } else {
-        d.reason = "patches left whole: " + densities + "; coarser levels would split nearly all, so start at " +
-                   std::to_string(chosen) + " (configured " + std::to_string(current) + ")";
+        d.reason = "patches left whole: " + densities +
+                   "; coarser levels would split nearly all, so start at " + std::to_string(chosen) +
+                   " (configured " + std::to_string(current) + ")";
     }
     return d;
 }
@@ -236,16 +251,9 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
             Rng rng(options.seed, static_cast<std::uint64_t>(j * gx + i), 0);
             const double nx = 2.0 * (i + rng.uniform()) / gx - 1.0;
             const double ny = 1.0 - 2.0 * (j + rng.uniform()) / gy;
-            glm::dvec4 nearP = invViewProj * glm::dvec4(nx, ny, -1.0, 1.0);
-            glm::dvec4 farP = invViewProj * glm::dvec4(nx, ny, 1.0, 1.0);
-            if (!(std::abs(nearP.w) > 1e-300) || !(std::abs(farP.w) > 1e-300)) continue;
-            const glm::vec3 o(glm::dvec3(nearP) / nearP.w), f(glm::dvec3(farP) / farP.w);
-            const float len = glm::length(f - o);
-            if (!(len > 0.0f)) continue;
-            const glm::vec3 dir = (f - o) / len;
             SurfaceHit hit;
-            ++plan.rays;
-            if (!rays.intersect(o, dir, 0.0f, len, hit)) continue;
+            glm::vec3 dir;
+            if (!traceEyeRay(rays, invViewProj, nx, ny, hit, dir, plan.rays)) continue;
             receivers.push_back({hit.position, facing(hit.shadingNormal, -dir),
                                  facing(hit.geometricNormal, -dir), hit.albedo});
             emission.push_back(hit.emission);
