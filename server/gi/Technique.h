@@ -29,11 +29,18 @@ struct FrameInputs {
     int width = 0, height = 0;
     const gl::Texture* gPosition = nullptr; ///< RGBA32F world position, w = 1 where covered
     const gl::Texture* gNormal = nullptr;   ///< RGBA16F unit normal facing the camera
-    const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 linear albedo
+    const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 linear diffuse albedo rho_d (scene/Brdf.h)
+    const gl::Texture* gSpecular = nullptr; ///< RGBA8: rgb F0, a perceptual roughness (F0 = 0: no lobe)
     int rsmSize = 0;
     const gl::Texture* rsmPosition = nullptr; ///< RGBA32F, w = 1 where a surface was hit
     const gl::Texture* rsmNormal = nullptr;   ///< RGBA16F, facing the light
-    const gl::Texture* rsmFlux = nullptr;     ///< RGBA32F reflected flux per texel
+    const gl::Texture* rsmFlux = nullptr;     ///< RGBA32F diffusely reflected flux per texel
+    const gl::Texture* rsmSpecular = nullptr; ///< RGBA8: rgb F0, a roughness of the texel's surface
+    /// Glossy VPL transport (effect_glossy): when true, a technique whose glossyTransport() is true
+    /// adds the specular lobe (lobe: frame shadingInfo.x) at receivers whose roughness is at least
+    /// glossyMinRoughness; smoother receivers get theirs from the reflection passes.
+    bool glossy = false;
+    float glossyMinRoughness = 0.35f;
     bool lightEnabled = true;
     const gl::Texture* direct = nullptr;          ///< RGBA32F shadowed direct radiance plus emission
     const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
@@ -62,6 +69,8 @@ public:
                          Counters& counters) = 0;
     /// Linear RGB radiance to add to the direct light, or nullptr when the technique adds none.
     virtual const gl::Texture* indirect() const = 0;
+    /// True when execute() honours FrameInputs::glossy (docs/nondiffuse.md).
+    virtual bool glossyTransport() const { return false; }
 };
 
 struct TechniqueEntry {

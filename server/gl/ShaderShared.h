@@ -16,7 +16,7 @@ using uvec4 = glm::uvec4;
 #include "shaders/shared/Subsplat.h"
 
 static_assert(sizeof(FrameUniforms) % 16 == 0, "std140 blocks must be whole vec4s");
-static_assert(sizeof(FrameUniforms) == 2 * 64 + 7 * 16, "FrameUniforms layout drifted from the GLSL side");
+static_assert(sizeof(FrameUniforms) == 2 * 64 + 8 * 16, "FrameUniforms layout drifted from the GLSL side");
 static_assert(offsetof(FrameUniforms, lightViewProj) == 64);
 static_assert(offsetof(FrameUniforms, toneInfo) == 128 + 6 * 16);
 static_assert(sizeof(Vpl) == 48, "Vpl must be three vec4s in std140 and std430");

@@ -125,13 +125,15 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadow
         mRsmPosition = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
         mRsmNormal = gl::Texture::create2D(GL_RGBA16F, rsmSize, rsmSize);
         mRsmFlux = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
+        mRsmSpecular = gl::Texture::create2D(GL_RGBA8, rsmSize, rsmSize);
         mRsmDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, rsmSize, rsmSize);
         mRsmFbo = gl::Framebuffer::create();
         mRsmFbo.attachColor(0, mRsmPosition);
         mRsmFbo.attachColor(1, mRsmNormal);
         mRsmFbo.attachColor(2, mRsmFlux);
+        mRsmFbo.attachColor(3, mRsmSpecular);
         mRsmFbo.attachDepth(mRsmDepth);
-        mRsmFbo.finish(3, "reflective shadow map");
+        mRsmFbo.finish(4, "reflective shadow map");
         mRsmSize = rsmSize;
     }
     if (width != mWidth || height != mHeight) {
@@ -139,14 +141,16 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadow
         mGNormal = gl::Texture::create2D(GL_RGBA16F, width, height);
         mGAlbedo = gl::Texture::create2D(GL_RGBA8, width, height);
         mGEmissive = gl::Texture::create2D(GL_RGBA16F, width, height);
+        mGSpecular = gl::Texture::create2D(GL_RGBA8, width, height);
         mGDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, width, height);
         mGBufferFbo = gl::Framebuffer::create();
         mGBufferFbo.attachColor(0, mGPosition);
         mGBufferFbo.attachColor(1, mGNormal);
         mGBufferFbo.attachColor(2, mGAlbedo);
         mGBufferFbo.attachColor(3, mGEmissive);
+        mGBufferFbo.attachColor(4, mGSpecular);
         mGBufferFbo.attachDepth(mGDepth);
-        mGBufferFbo.finish(4, "G-buffer");
+        mGBufferFbo.finish(5, "G-buffer");
         mDirect = gl::Texture::create2D(GL_RGBA32F, width, height);
         mDirectFbo = gl::Framebuffer::create();
         mDirectFbo.attachColor(0, mDirect);
@@ -183,6 +187,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     const int rsmSize = fp.getInt("rsm_size");
     ensureTargets(state.width, state.height, rsmSize, fp.getInt("shadow_map_size"));
     ensureTechnique(state.technique, state.width, state.height);
+    const Reflections::Decision nonDiffuse =
+        mReflections.decide(*mScene, *mSceneGpu, fp, mTechnique->glossyTransport());
 
     // Frame uniforms.
     shader::FrameUniforms u{};
@@ -202,6 +208,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     u.toneInfo =
         glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
                   lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
+    u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f, fp.getFloat("glossy_split"),
+                              nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 
@@ -230,7 +238,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     mTimer.begin("rsm");
     glBindFramebuffer(GL_FRAMEBUFFER, mRsmFbo.id());
     glViewport(0, 0, rsmSize, rsmSize);
-    for (int i = 0; i < 3; ++i) glClearNamedFramebufferfv(mRsmFbo.id(), GL_COLOR, i, zero);
+    for (int i = 0; i < 4; ++i) glClearNamedFramebufferfv(mRsmFbo.id(), GL_COLOR, i, zero);
     glClearNamedFramebufferfv(mRsmFbo.id(), GL_DEPTH, 0, &one);
     glUseProgram(mRsmProgram.id());
     glUniform1i(mRsmProgram.uniform("uView"), 1);
@@ -241,7 +249,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     mTimer.begin("gbuffer");
     glBindFramebuffer(GL_FRAMEBUFFER, mGBufferFbo.id());
     glViewport(0, 0, state.width, state.height);
-    for (int i = 0; i < 4; ++i) glClearNamedFramebufferfv(mGBufferFbo.id(), GL_COLOR, i, zero);
+    for (int i = 0; i < 5; ++i) glClearNamedFramebufferfv(mGBufferFbo.id(), GL_COLOR, i, zero);
     glClearNamedFramebufferfv(mGBufferFbo.id(), GL_DEPTH, 0, &one);
     glUseProgram(mGBufferProgram.id());
     glUniform1i(mGBufferProgram.uniform("uView"), 0);
@@ -258,6 +266,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     glBindTextureUnit(2, mGAlbedo.id());
     glBindTextureUnit(3, mGEmissive.id());
     glBindTextureUnit(4, mShadowDepth.id());
+    glBindTextureUnit(5, mGSpecular.id());
     glBindVertexArray(mEmptyVao.id());
     glDrawArrays(GL_TRIANGLES, 0, 3);
     mTimer.end();
@@ -270,10 +279,14 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.gPosition = &mGPosition;
     in.gNormal = &mGNormal;
     in.gAlbedo = &mGAlbedo;
+    in.gSpecular = &mGSpecular;
     in.rsmSize = rsmSize;
     in.rsmPosition = &mRsmPosition;
     in.rsmNormal = &mRsmNormal;
     in.rsmFlux = &mRsmFlux;
+    in.rsmSpecular = &mRsmSpecular;
+    in.glossy = nonDiffuse.glossy;
+    in.glossyMinRoughness = fp.getFloat("glossy_split");
     in.lightEnabled = lightOn;
     in.direct = &mDirect;
     in.frame = &u;
@@ -284,15 +297,38 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 
-    // 6. Composite and tone map.
+    // 6. Reflections: environment probe and planar mirrors (docs/nondiffuse.md).
+    ReflectionInputs rin;
+    rin.width = state.width;
+    rin.height = state.height;
+    rin.gPosition = &mGPosition;
+    rin.gNormal = &mGNormal;
+    rin.gAlbedo = &mGAlbedo;
+    rin.gSpecular = &mGSpecular;
+    rin.direct = &mDirect;
+    rin.indirect = mTechnique->indirect();
+    rin.shadowMap = &mShadowDepth;
+    rin.frame = &u;
+    rin.scene = mScene.get();
+    rin.sceneGpu = mSceneGpu.get();
+    rin.envMaxRoughness = nonDiffuse.glossy ? fp.getFloat("glossy_split") : 1.01f;
+    const gl::Texture* reflection = mReflections.execute(nonDiffuse, rin, fp, mTimer, counters);
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+    glDisable(GL_BLEND);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_DEPTH_TEST);
+
+    // 7. Composite and tone map.
     mTimer.begin("composite");
     glBindFramebuffer(GL_FRAMEBUFFER, mCompositeFbo.id());
     glViewport(0, 0, state.width, state.height);
     glUseProgram(mCompositeProgram.id());
     const gl::Texture* indirect = mTechnique->indirect();
     glUniform1i(mCompositeProgram.uniform("uHasIndirect"), indirect ? 1 : 0);
+    glUniform1i(mCompositeProgram.uniform("uHasReflection"), reflection ? 1 : 0);
     glBindTextureUnit(0, mDirect.id());
     glBindTextureUnit(1, indirect ? indirect->id() : mDirect.id());
+    glBindTextureUnit(2, reflection ? reflection->id() : mDirect.id());
     glBindVertexArray(mEmptyVao.id());
     glDrawArrays(GL_TRIANGLES, 0, 3);
     mTimer.end();
@@ -324,6 +360,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
                  {"counts", std::move(countJson)},
                  {"params", std::move(params)}};
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
+    out.stats["nondiffuse"] = nonDiffuse.reasons;
     return out;
 }
 

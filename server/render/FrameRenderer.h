@@ -18,6 +18,7 @@
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 #include "render/FrameState.h"
+#include "render/Reflections.h"
 #include "render/SceneGpu.h"
 
 namespace gis {
@@ -43,6 +44,8 @@ public:
 
     /// The technique of the last frame (tests inspect its intermediate buffers); may be null.
     Technique* technique() { return mTechnique.get(); }
+    /// The planar mirrors of the current scene (after the first frame).
+    const std::vector<MirrorPlane>& mirrors() const { return mReflections.mirrors(); }
 
     /// Camera and spotlight matrices exactly as the pipeline builds them (also used by tests and
     /// the reference renderer so both see the same view).
@@ -65,14 +68,16 @@ private:
     int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0;
     gl::Texture mShadowDepth;
     gl::Framebuffer mShadowFbo;
-    gl::Texture mRsmPosition, mRsmNormal, mRsmFlux, mRsmDepth;
+    gl::Texture mRsmPosition, mRsmNormal, mRsmFlux, mRsmSpecular, mRsmDepth;
     gl::Framebuffer mRsmFbo;
-    gl::Texture mGPosition, mGNormal, mGAlbedo, mGEmissive, mGDepth;
+    gl::Texture mGPosition, mGNormal, mGAlbedo, mGEmissive, mGSpecular, mGDepth;
     gl::Framebuffer mGBufferFbo;
     gl::Texture mDirect;
     gl::Framebuffer mDirectFbo;
     gl::Texture mDisplay, mLinear;
     gl::Framebuffer mCompositeFbo;
+
+    Reflections mReflections;
 
     std::string mTechniqueName;
     std::unique_ptr<Technique> mTechnique;

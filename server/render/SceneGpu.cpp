@@ -25,6 +25,7 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         d.indexCount = static_cast<GLsizei>(mesh.indices.size());
         d.baseVertex = static_cast<GLint>(vertices.size());
         d.material = mesh.material;
+        d.mesh = static_cast<int>(&mesh - scene.meshes.data());
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
             v.position[0] = mesh.positions[i].x;
@@ -79,15 +80,26 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     gl::checkErrors("scene upload");
 }
 
+void SceneGpu::setMirrorIndices(const std::vector<int>& mirrorOfMesh) {
+    for (Draw& d : mDraws) {
+        const auto m = static_cast<size_t>(d.mesh);
+        d.mirror = m < mirrorOfMesh.size() ? mirrorOfMesh[m] : -1;
+    }
+}
+
 void SceneGpu::draw(const gl::Program& program, bool withMaterials, int instances) const {
     glBindVertexArray(mVao.id());
     const GLint baseColor = program.uniform("uBaseColor");
     const GLint emissive = program.uniform("uEmissive");
     const GLint hasTexture = program.uniform("uHasTexture");
+    const GLint metalRoughSpec = program.uniform("uMetalRoughSpec");
+    const GLint mirrorId = program.uniform("uMirrorId");
     for (const Draw& d : mDraws) {
         if (withMaterials) {
             const Material& m = mMaterials[static_cast<size_t>(d.material)];
             glUniform4f(baseColor, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
+            glUniform3f(metalRoughSpec, m.metallic, m.roughness, m.specular);
+            glUniform1i(mirrorId, d.mirror + 1);
             glUniform3f(emissive, m.emissive.r, m.emissive.g, m.emissive.b);
             const bool textured =
                 m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());

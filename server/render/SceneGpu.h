@@ -18,6 +18,9 @@ public:
     /// when `withMaterials`.
     void draw(const gl::Program& program, bool withMaterials, int instances = 1) const;
     std::size_t triangleCount() const { return mTriangles; }
+    /// Marks meshes as planar mirrors: `mirrorOfMesh[i]` is mesh i's mirror index, -1 for none. The
+    /// G-buffer writes index + 1 into the normal's w (shaders/render/gbuffer.frag).
+    void setMirrorIndices(const std::vector<int>& mirrorOfMesh);
 
 private:
     struct Draw {
@@ -25,6 +28,8 @@ private:
         GLsizei indexCount = 0;
         GLint baseVertex = 0;
         int material = 0;
+        int mesh = 0;    ///< index into Scene::meshes
+        int mirror = -1; ///< planar-mirror index, -1 for none
     };
     gl::Buffer mVertices;
     gl::Buffer mIndices;

@@ -112,11 +112,11 @@ double bumpyRadiusFactor(double theta, double phi) {
 /// (x, z) position base. Normals are left empty: finalizeScene generates area-weighted vertex
 /// normals from the displaced surface, smooth everywhere because every vertex is shared.
 Mesh makeBumpySphere(const std::string& name, int material, const glm::vec3& base, float radius, int rings,
-                     int segments) {
+                     int segments, bool bumpy = true) {
     Mesh mesh{.name = name, .material = material};
     const double pi = glm::pi<double>();
     auto addVertex = [&](double theta, double phi) {
-        const double r = radius * bumpyRadiusFactor(theta, phi);
+        const double r = radius * (bumpy ? bumpyRadiusFactor(theta, phi) : 1.0);
         mesh.positions.emplace_back(static_cast<float>(r * std::sin(theta) * std::cos(phi)),
                                     static_cast<float>(r * std::cos(theta)),
                                     static_cast<float>(r * std::sin(theta) * std::sin(phi)));
@@ -180,6 +180,44 @@ Scene makeCornell(CornellContents contents) {
     return scene;
 }
 
+/// The non-diffuse gallery (docs/nondiffuse.md): the Cornell room with a glossy floor (metal 0.5,
+/// roughness 0.2: environment probe), a planar mirror on the back wall, a smooth gold sphere
+/// (roughness 0.15: environment probe), a rough copper block (roughness 0.55: glossy VPL transport)
+/// and a cyan marker cube whose reflection the mirror shows at a pixel predictable from geometry.
+Scene makeGallery() {
+    Scene scene;
+    const int white = addMaterial(scene, "white", kWhite);
+    const int red = addMaterial(scene, "red", kRed);
+    const int green = addMaterial(scene, "green", kGreen);
+    auto addPbr = [&](const std::string& name, const glm::vec3& base, float metallic, float roughness) {
+        scene.materials.push_back(Material{.name = name,
+                                           .baseColor = glm::vec4(base, 1.0f),
+                                           .metallic = metallic,
+                                           .roughness = roughness,
+                                           .specular = 1.0f});
+        return static_cast<int>(scene.materials.size()) - 1;
+    };
+    const int floorMat = addPbr("glossy_floor", {0.5f, 0.45f, 0.4f}, 0.5f, 0.2f);
+    const int mirror = addPbr("mirror", {0.95f, 0.95f, 0.95f}, 1.0f, 0.0f);
+    const int gold = addPbr("gold", {1.0f, 0.78f, 0.34f}, 1.0f, 0.15f);
+    const int copper = addPbr("rough_copper", {0.95f, 0.64f, 0.54f}, 1.0f, 0.55f);
+    const int cyan = addMaterial(scene, "marker_cyan", {0.05f, 0.8f, 0.8f});
+    const glm::vec3 x(2, 0, 0), y(0, 2, 0), z(0, 0, 2);
+    scene.meshes.push_back(makeGrid("floor", floorMat, {-1, 0, -1}, z, x));
+    scene.meshes.push_back(makeGrid("ceiling", white, {-1, 2, -1}, x, z));
+    scene.meshes.push_back(makeGrid("back_wall", white, {-1, 0, -1}, x, y));
+    scene.meshes.push_back(makeGrid("left_wall", red, {-1, 0, -1}, y, z));
+    scene.meshes.push_back(makeGrid("right_wall", green, {1, 0, -1}, z, y));
+    // 2 cm in front of the back wall, facing +z (towards the camera).
+    scene.meshes.push_back(makeGrid("mirror", mirror, {-0.6f, 0.35f, -0.98f}, {1.2f, 0, 0}, {0, 1.2f, 0}));
+    scene.meshes.push_back(makeBumpySphere("gold_sphere", gold, {-0.3f, 0.0f, 0.2f}, 0.3f, 32, 64, false));
+    scene.meshes.push_back(makeBox("copper_block", copper, {-0.55f, 0.35f, -0.5f}, {0.4f, 0.7f, 0.4f}, 0.3f));
+    scene.meshes.push_back(makeBox("marker", cyan, {0.5f, 0.1f, 0.55f}, glm::vec3(0.2f), 0.0f));
+    scene.lights.push_back(makeSpot("ceiling_spot", {0.0f, 1.95f, 0.0f}, {0.0f, -1.0f, 0.0f}, 50.0f, 60.0f));
+    scene.cameras.push_back(makeCamera({0.0f, 1.0f, 3.9f}, {0.0f, 1.0f, 0.0f}));
+    return scene;
+}
+
 Scene makeCrease() {
     Scene scene;
     const int grey = addMaterial(scene, "grey", kGrey);
@@ -193,7 +231,7 @@ Scene makeCrease() {
 } // namespace
 
 std::vector<std::string> builtinSceneNames() {
-    return {"cornell", "cornell-empty", "cornell-dense", "crease", "cornell-black"};
+    return {"cornell", "cornell-empty", "cornell-dense", "crease", "cornell-black", "gallery"};
 }
 
 Scene makeBuiltinScene(const std::string& name) {
@@ -208,6 +246,8 @@ Scene makeBuiltinScene(const std::string& name) {
         scene = makeCornell(CornellContents::Black);
     else if (name == "crease")
         scene = makeCrease();
+    else if (name == "gallery")
+        scene = makeGallery();
     else {
         std::string known;
         for (const auto& n : builtinSceneNames()) known += (known.empty() ? "" : ", ") + n;

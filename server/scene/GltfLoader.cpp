@@ -25,6 +25,7 @@ namespace {
 
 constexpr const char* kLightsExtension = "KHR_lights_punctual";
 constexpr const char* kEmissiveStrengthExtension = "KHR_materials_emissive_strength";
+constexpr const char* kSpecularExtension = "KHR_materials_specular";
 // Quantized attributes are just non-float component types, which the accessor reader handles.
 constexpr const char* kQuantizationExtension = "KHR_mesh_quantization";
 constexpr int kNotConverted = -2;
@@ -175,7 +176,8 @@ private:
 
     void checkRequiredExtensions() const {
         for (const auto& ext : mModel.extensionsRequired)
-            if (ext != kLightsExtension && ext != kEmissiveStrengthExtension && ext != kQuantizationExtension)
+            if (ext != kLightsExtension && ext != kEmissiveStrengthExtension && ext != kQuantizationExtension &&
+                ext != kSpecularExtension)
                 fail("unsupported required extension '" + ext + "'");
     }
 
@@ -310,6 +312,14 @@ private:
                 strength->second.Get("emissiveStrength").IsNumber())
                 m.emissive *=
                     static_cast<float>(strength->second.Get("emissiveStrength").GetNumberAsDouble());
+            // glTF's default dielectric reflects F0 = 0.04; KHR_materials_specular scales it.
+            m.specular = 1.0f;
+            const auto spec = src.extensions.find(kSpecularExtension);
+            if (spec != src.extensions.end() && spec->second.IsObject() && spec->second.Has("specularFactor") &&
+                spec->second.Get("specularFactor").IsNumber()) {
+                const double f = spec->second.Get("specularFactor").GetNumberAsDouble();
+                m.specular = std::isfinite(f) ? std::clamp(static_cast<float>(f), 0.0f, 1.0f) : 1.0f;
+            }
             if (pbr.baseColorTexture.index >= 0)
                 m.baseColorTexture = convertTexture(pbr.baseColorTexture.index, "material '" + m.name + "'");
             mScene.materials.push_back(std::move(m));

@@ -30,6 +30,10 @@ struct Material {
     int baseColorTexture = -1; ///< index into Scene::textures, -1 for none
     float metallic = 0.0f;     ///< [0, 1]
     float roughness = 1.0f;    ///< [0, 1], perceptual
+    /// [0, 1], KHR_materials_specular's specularFactor: scales the dielectric F0 (0.04). 0 here, so
+    /// materials built in code are Lambertian unless they ask for a specular lobe; glTF files get the
+    /// glTF default 1 from the loader. The reflection model is scene/Brdf.h.
+    float specular = 0.0f;
     glm::vec3 emissive{0.0f};  ///< linear RGB radiance scale (glTF emissiveFactor)
 };
 

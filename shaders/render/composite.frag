@@ -1,11 +1,13 @@
 #version 450 core
-// Composite: direct + indirect, sanitised (no NaN/Inf/negative leaves this pass), then exposure,
+// Composite: direct + indirect + reflections, sanitised (no NaN/Inf/negative leaves this pass), then exposure,
 // tone mapping and sRGB encoding for display. The linear sum is kept for EXR output and metrics.
 #include "common.glsl"
 
 layout(binding = 0) uniform sampler2D gDirect;
 layout(binding = 1) uniform sampler2D gIndirect;
+layout(binding = 2) uniform sampler2D gReflection; // env probe + planar mirrors (render/Reflections)
 uniform int uHasIndirect;
+uniform int uHasReflection;
 
 layout(location = 0) out vec4 outDisplay; // RGBA8: tone-mapped sRGB
 layout(location = 1) out vec4 outLinear;  // RGBA32F: linear radiance
@@ -25,6 +27,7 @@ void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec3 c = sanitize(texelFetch(gDirect, px, 0).rgb);
     if (uHasIndirect == 1) c += sanitize(texelFetch(gIndirect, px, 0).rgb);
+    if (uHasReflection == 1) c += max(sanitize(texelFetch(gReflection, px, 0).rgb), vec3(0.0));
     c = max(c, vec3(0.0));
     outLinear = vec4(c, 1.0);
     vec3 exposed = c * gFrame.toneInfo.x;

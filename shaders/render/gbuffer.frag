@@ -1,5 +1,5 @@
 #version 450 core
-// Eye G-buffer (000 §3 step 2): world position, normal, albedo, emission.
+// Eye G-buffer (000 §3 step 2): world position, normal, diffuse albedo, emission, specular.
 #include "common.glsl"
 #include "render/material.glsl"
 
@@ -11,12 +11,14 @@ layout(location = 0) out vec4 outPosition; // xyz world (m), w = 1 covered
 layout(location = 1) out vec4 outNormal;   // xyz unit normal facing the camera
 layout(location = 2) out vec4 outAlbedo;   // rgb linear albedo
 layout(location = 3) out vec4 outEmissive; // rgb emitted radiance
+layout(location = 4) out vec4 outSpecular; // rgb F0, a perceptual roughness (render/brdf.glsl)
 
 void main() {
     vec3 toEye = gFrame.cameraPos.xyz - vWorldPos;
     vec3 n = safeNormal(vNormal, vWorldPos, toEye);
     outPosition = vec4(vWorldPos, 1.0);
-    outNormal = vec4(n, 0.0);
+    outNormal = vec4(n, float(uMirrorId)); // w: planar-mirror index + 1, 0 for none
     outAlbedo = vec4(materialAlbedo(vTexcoord), 1.0);
+    outSpecular = vec4(materialF0(materialBaseColor(vTexcoord)), clamp(uMetalRoughSpec.y, 0.0, 1.0));
     outEmissive = vec4(max(sanitize(uEmissive), vec3(0.0)), 1.0);
 }

@@ -2,12 +2,29 @@
 uniform vec4 uBaseColor;      // linear RGBA factor
 uniform vec3 uEmissive;       // linear radiance
 uniform int uHasTexture;      // 1 when uBaseColorTex holds the base colour texture
+uniform vec3 uMetalRoughSpec; // x metallic, y perceptual roughness, z specular factor; all [0, 1]
+uniform int uMirrorId;        // planar-mirror index + 1 (SceneGpu); 0: not a mirror
 layout(binding = 0) uniform sampler2D uBaseColorTex; // sRGB texture, decoded by the sampler
 
-vec3 materialAlbedo(vec2 uv) {
+vec3 materialBaseColor(vec2 uv) {
     vec4 c = uBaseColor;
     if (uHasTexture == 1) c *= texture(uBaseColorTex, uv);
     return clamp(c.rgb, 0.0, 1.0);
+}
+
+// scene/Brdf.h's surfaceFrom(): F0 = mix(0.04 s, base, metal).
+vec3 materialF0(vec3 base) {
+    float metal = clamp(uMetalRoughSpec.x, 0.0, 1.0);
+    return mix(vec3(0.04 * clamp(uMetalRoughSpec.z, 0.0, 1.0)), base, metal);
+}
+
+// The diffuse albedo rho_d = base (1 - metal) (1 - Favg): what every technique multiplies by.
+vec3 materialAlbedo(vec2 uv) {
+    vec3 base = materialBaseColor(uv);
+    vec3 f0 = materialF0(base);
+    float f90 = clamp(50.0 * 0.33 * (f0.r + f0.g + f0.b), 0.0, 1.0);
+    vec3 favg = f0 + (vec3(f90) - f0) * (1.0 / 21.0);
+    return base * (1.0 - clamp(uMetalRoughSpec.x, 0.0, 1.0)) * (vec3(1.0) - favg);
 }
 
 // A unit normal facing the viewer; falls back to the geometric normal when the interpolated one

@@ -9,7 +9,8 @@ in vec2 vTexcoord;
 
 layout(location = 0) out vec4 outPosition; // xyz world (m), w = 1 valid
 layout(location = 1) out vec4 outNormal;   // xyz unit normal facing the light
-layout(location = 2) out vec4 outFlux;     // rgb reflected flux of this texel
+layout(location = 2) out vec4 outFlux;     // rgb diffusely reflected flux of this texel
+layout(location = 3) out vec4 outSpecular; // rgb F0, a perceptual roughness (glossy VPLs)
 
 void main() {
     vec3 toLight = gFrame.lightPos.xyz - vWorldPos;
@@ -23,8 +24,10 @@ void main() {
     float intensity = gFrame.lightPos.w * spotFactor(-l);
     vec3 albedo = materialAlbedo(vTexcoord);
     // Flux arriving on the texel's surface patch is I * solid angle (the patch's cosine is already
-    // in its projected area); a Lambertian surface reflects albedo times that.
+    // in its projected area); the diffuse lobe reflects rho_d times that. A glossy VPL's specular
+    // lobe is evaluated where it is received, from outSpecular and the light position.
     outFlux = vec4(sanitize(gFrame.lightColor.rgb * intensity * solidAngle * albedo), 1.0);
     outPosition = vec4(vWorldPos, 1.0);
     outNormal = vec4(n, 0.0);
+    outSpecular = vec4(materialF0(materialBaseColor(vTexcoord)), clamp(uMetalRoughSpec.y, 0.0, 1.0));
 }

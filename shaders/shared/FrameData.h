@@ -18,6 +18,7 @@ struct FrameUniforms {
     vec4 viewport;       // x: width, y: height (px); z: 1/width; w: 1/height
     vec4 rsmInfo;        // x: RSM size (texels); y: tan(half fov) of the light frustum; z: shadow map size; w: PCF radius (texels)
     vec4 toneInfo;       // x: exposure scale 2^EV; y: operator (0 linear, 1 filmic); z: light enabled (0/1); w: RSM texel solid angle (0 exact, 1 equal)
+    vec4 shadingInfo;    // x: specular lobe (GIS_LOBE_GGX 0, GIS_LOBE_PHONG 1); y: glossy_split roughness; z: direct specular (0/1); w: unused
 };
 
 // One virtual point light: a diffuse emitter of reflected flux at an RSM sample.

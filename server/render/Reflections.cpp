@@ -1,0 +1,191 @@
+#include "render/Reflections.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/Error.h"
+#include "render/EnvProbe.h"
+#include "render/PlanarMirrors.h"
+#include "scene/Brdf.h"
+
+namespace gis {
+namespace {
+
+// A material is a mirror candidate when it is this metallic (dimensionless, [0, 1]).
+constexpr float kMirrorMinMetallic = 0.9f;
+// Vertices farther than this fraction of the mesh's extent from its plane make it curved.
+constexpr float kPlanarTolerance = 1e-4f;
+
+brdf::Surface materialSurface(const Material& m) {
+    return brdf::surfaceFrom(m, glm::vec3(m.baseColor));
+}
+
+std::string count(int n, const char* what) { return std::to_string(n) + " " + what; }
+
+} // namespace
+
+std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness) {
+    struct Candidate {
+        MirrorPlane plane;
+        float area = 0.0f;
+    };
+    std::vector<Candidate> found;
+    for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+        const Mesh& mesh = scene.meshes[mi];
+        if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
+        const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
+        if (mat.metallic < kMirrorMinMetallic || mat.roughness > maxRoughness) continue;
+        if (mesh.positions.empty() || mesh.indices.size() < 3) continue;
+        // Area-weighted normal and centroid from the triangles.
+        glm::dvec3 nsum(0.0), csum(0.0);
+        double area = 0.0;
+        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+            const glm::dvec3 a(mesh.positions[mesh.indices[t]]), b(mesh.positions[mesh.indices[t + 1]]),
+                c(mesh.positions[mesh.indices[t + 2]]);
+            const glm::dvec3 cr = glm::cross(b - a, c - a);
+            const double twice = glm::length(cr);
+            if (!(twice > 0.0) || !std::isfinite(twice)) continue;
+            // Orient each triangle's normal like its vertex normals, so mixed windings add up.
+            glm::dvec3 tn = cr / twice;
+            if (!mesh.normals.empty() && glm::dot(glm::dvec3(mesh.normals[mesh.indices[t]]), tn) < 0.0) tn = -tn;
+            nsum += tn * (0.5 * twice);
+            csum += (a + b + c) / 3.0 * (0.5 * twice);
+            area += 0.5 * twice;
+        }
+        const double nlen = glm::length(nsum);
+        if (!(area > 0.0) || !(nlen > 0.5 * area)) continue; // degenerate, or folded onto itself
+        const glm::dvec3 n = nsum / nlen, centre = csum / area;
+        glm::dvec3 lo(mesh.positions[0]), hi(mesh.positions[0]);
+        for (const glm::vec3& p : mesh.positions) {
+            lo = glm::min(lo, glm::dvec3(p));
+            hi = glm::max(hi, glm::dvec3(p));
+        }
+        const double extent = std::max(glm::length(hi - lo), 1e-12);
+        bool flat = true;
+        for (const glm::vec3& p : mesh.positions)
+            if (std::abs(glm::dot(glm::dvec3(p) - centre, n)) > kPlanarTolerance * extent) {
+                flat = false;
+                break;
+            }
+        if (!flat) continue;
+        Candidate c;
+        c.plane.mesh = static_cast<int>(mi);
+        c.plane.point = glm::vec3(centre);
+        c.plane.normal = glm::vec3(n);
+        c.plane.f0 = materialSurface(mat).f0;
+        c.plane.roughness = mat.roughness;
+        c.area = static_cast<float>(area);
+        found.push_back(c);
+    }
+    std::stable_sort(found.begin(), found.end(), [](const Candidate& a, const Candidate& b) { return a.area > b.area; });
+    std::vector<MirrorPlane> out;
+    for (size_t i = 0; i < found.size() && i < static_cast<size_t>(kMaxMirrors); ++i) out.push_back(found[i].plane);
+    return out;
+}
+
+Reflections::Reflections() = default;
+Reflections::~Reflections() = default;
+
+Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu, const ParamSet& fp,
+                                          bool techniqueHasGlossy) {
+    const float mirrorRoughness = fp.getFloat("mirror_roughness");
+    if (&scene != mMirrorScene || mirrorRoughness != mMirrorRoughness) {
+        mMirrors = findPlanarMirrors(scene, mirrorRoughness);
+        std::vector<int> mirrorOfMesh(scene.meshes.size(), -1);
+        for (size_t i = 0; i < mMirrors.size(); ++i)
+            mirrorOfMesh[static_cast<size_t>(mMirrors[i].mesh)] = static_cast<int>(i);
+        sceneGpu.setMirrorIndices(mirrorOfMesh);
+        mMirrorScene = &scene;
+        mMirrorRoughness = mirrorRoughness;
+    }
+    const float split = fp.getFloat("glossy_split");
+    const int mirrorDepth = fp.getInt("mirror_depth");
+    std::vector<bool> isMirrorMaterialOnly(scene.materials.size(), false);
+    int specularMaterials = 0, smooth = 0, rough = 0;
+    {
+        // A material counts for env/glossy only where a non-mirror mesh uses it.
+        std::vector<bool> usedByOther(scene.materials.size(), false);
+        std::vector<bool> mirrorMesh(scene.meshes.size(), false);
+        if (mirrorDepth > 0)
+            for (const MirrorPlane& m : mMirrors) mirrorMesh[static_cast<size_t>(m.mesh)] = true;
+        for (size_t i = 0; i < scene.meshes.size(); ++i) {
+            const int mat = scene.meshes[i].material;
+            if (mat >= 0 && mat < static_cast<int>(scene.materials.size()) && !mirrorMesh[i])
+                usedByOther[static_cast<size_t>(mat)] = true;
+        }
+        for (size_t i = 0; i < scene.materials.size(); ++i) {
+            if (!materialSurface(scene.materials[i]).hasSpecular()) continue;
+            ++specularMaterials;
+            if (!usedByOther[i]) continue;
+            if (scene.materials[i].roughness < split || !techniqueHasGlossy) ++smooth;
+            else ++rough;
+        }
+    }
+    Decision d;
+    auto resolve = [&](const char* param, bool wanted, const std::string& why, bool& out, const char* key) {
+        const std::string mode = fp.getEnum(param);
+        if (mode == "on") {
+            out = true;
+            d.reasons[key] = std::string("on: ") + param + "=on";
+        } else if (mode == "off") {
+            out = false;
+            d.reasons[key] = std::string("off: ") + param + "=off";
+        } else {
+            out = wanted;
+            d.reasons[key] = std::string(wanted ? "on: " : "off: ") + why;
+        }
+    };
+    resolve("effect_specular", specularMaterials > 0,
+            specularMaterials > 0 ? count(specularMaterials, "materials with a specular lobe")
+                                  : "every material is Lambertian",
+            d.specular, "specular");
+    resolve("effect_glossy", rough > 0 && techniqueHasGlossy,
+            !techniqueHasGlossy ? "the technique has no glossy VPL transport"
+            : rough > 0         ? count(rough, "materials at least glossy_split rough")
+                                : "no specular material is at least glossy_split rough",
+            d.glossy, "glossy");
+    resolve("effect_env", smooth > 0,
+            smooth > 0 ? count(smooth, "smooth specular materials outside planar mirrors")
+                       : "no smooth specular material outside planar mirrors",
+            d.env, "env");
+    const bool mirrorsWanted = !mMirrors.empty() && mirrorDepth > 0;
+    resolve("effect_mirrors", mirrorsWanted,
+            mMirrors.empty() ? "no flat, smooth metallic mesh"
+            : mirrorDepth == 0 ? "mirror_depth=0 (the environment probe shades them)"
+                               : count(static_cast<int>(mMirrors.size()), "planar mirrors"),
+            d.mirrors, "mirrors");
+    if (d.mirrors && mMirrors.empty()) {
+        d.mirrors = false;
+        d.reasons["mirrors"] = "off: the scene has no planar mirror";
+    }
+    return d;
+}
+
+const gl::Texture* Reflections::execute(const Decision& d, ReflectionInputs in, const ParamSet& fp,
+                                        gl::PassTimer& timer, Counters& counters) {
+    counters["env_probe"] = d.env ? 1 : 0;
+    counters["mirrors"] = d.mirrors ? static_cast<double>(mMirrors.size()) : 0.0;
+    if (!d.env && !d.mirrors) return nullptr;
+    if (in.width != mWidth || in.height != mHeight) {
+        mOutput = gl::Texture::create2D(GL_RGBA32F, in.width, in.height);
+        mOutputFbo = gl::Framebuffer::create();
+        mOutputFbo.attachColor(0, mOutput);
+        mOutputFbo.finish(1, "reflections");
+        mWidth = in.width;
+        mHeight = in.height;
+    }
+    const float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(mOutputFbo.id(), GL_COLOR, 0, zero);
+    in.mirrors = &mMirrors;
+    if (d.env) {
+        if (!mEnv) mEnv = std::make_unique<EnvProbe>();
+        mEnv->execute(in, fp, mOutputFbo, timer, counters);
+    }
+    if (d.mirrors) {
+        if (!mMirrorPass) mMirrorPass = std::make_unique<PlanarMirrors>();
+        mMirrorPass->execute(in, fp, mOutputFbo, timer, counters);
+    }
+    return &mOutput;
+}
+
+} // namespace gis

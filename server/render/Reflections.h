@@ -1,0 +1,105 @@
+// Non-diffuse effects of the frame pipeline (docs/nondiffuse.md): which of them a scene calls for,
+// and the reflection passes that add specular indirect light on top of the technique's diffuse
+// bounce:
+//   - EnvProbe (004 §2.1-2.2): a dynamic cube map from a probe, prefiltered per roughness, for
+//     smooth specular surfaces (roughness below glossy_split, or every specular surface when the
+//     technique has no glossy VPL transport);
+//   - PlanarMirrors (004 §5.1): flat, smooth metallic meshes re-rendered from the mirrored camera.
+// Rough specular surfaces take their glossy indirect light from the technique's VPLs instead
+// (FrameInputs::glossy), so no light path is counted twice.
+//
+// Each effect_* frame parameter may force an effect on or off; `auto` decides from the materials
+// (this class) and, with effects=auto, from what the view shows (analysis/EffectPlan). The decision
+// and its reason are in the frame stats ("nondiffuse").
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/Param.h"
+#include "gi/Technique.h"
+#include "gl/Objects.h"
+#include "gl/PassTimer.h"
+#include "render/SceneGpu.h"
+
+namespace gis {
+
+namespace shader {
+struct FrameUniforms;
+}
+
+/// A planar mirror: a flat mesh with a smooth metallic material.
+struct MirrorPlane {
+    int mesh = -1;                        ///< index into Scene::meshes
+    glm::vec3 point{0.0f};                ///< a point of the plane (m): the mesh's centroid
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};   ///< unit; the side the mesh's vertex normals face
+    glm::vec3 f0{1.0f};                   ///< reflectance at normal incidence
+    float roughness = 0.0f;               ///< the material's, for the optional glossy blur
+};
+
+/// Which meshes of `scene` are planar mirrors: material metallic >= 0.9 and roughness <=
+/// maxRoughness, every vertex within 1e-4 of the mesh's extent from its best-fit plane, and a
+/// non-degenerate area. At most kMaxMirrors, the largest first.
+std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness);
+inline constexpr int kMaxMirrors = 4;
+
+/// What the reflection passes read. Textures are the renderer's; the frame block is bound at
+/// GIS_UBO_FRAME and `frame` is its CPU copy.
+struct ReflectionInputs {
+    int width = 0, height = 0;
+    const gl::Texture* gPosition = nullptr; ///< RGBA32F, w = 1 covered
+    const gl::Texture* gNormal = nullptr;   ///< RGBA16F, w = mirror index + 1 (0: not a mirror)
+    const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 diffuse albedo
+    const gl::Texture* gSpecular = nullptr; ///< RGBA8 rgb F0, a roughness
+    const gl::Texture* direct = nullptr;    ///< RGBA32F direct radiance + emission (eye view)
+    const gl::Texture* indirect = nullptr;  ///< the technique's indirect radiance (eye view), may be null
+    const gl::Texture* shadowMap = nullptr; ///< bind at unit 4 for shaders/render/lighting.glsl
+    const shader::FrameUniforms* frame = nullptr;
+    const Scene* scene = nullptr;
+    const SceneGpu* sceneGpu = nullptr;
+    const std::vector<MirrorPlane>* mirrors = nullptr;
+    /// Env reflections apply to covered, non-mirror pixels with a specular lobe and roughness below
+    /// this (1.01 when the technique has no glossy transport, so every glossy pixel gets one).
+    float envMaxRoughness = 0.35f;
+};
+
+class EnvProbe;
+class PlanarMirrors;
+
+class Reflections {
+public:
+    Reflections();
+    ~Reflections();
+
+    struct Decision {
+        bool specular = false, glossy = false, env = false, mirrors = false;
+        nlohmann::json reasons; ///< {"specular": "...", "glossy": ..., "env": ..., "mirrors": ...}
+    };
+    /// Resolves the effect_* parameters against the scene's materials (and the technique's ability
+    /// to carry glossy transport); recomputes the mirror list when the scene or mirror_roughness
+    /// changed and marks the mirrors in `sceneGpu`.
+    Decision decide(const Scene& scene, SceneGpu& sceneGpu, const ParamSet& frameParams,
+                    bool techniqueHasGlossy);
+
+    /// Runs the enabled passes and returns the radiance to add (RGBA32F, width x height), or null
+    /// when neither env nor mirrors is on. Never throws after the first frame at a size.
+    const gl::Texture* execute(const Decision& decision, ReflectionInputs in, const ParamSet& frameParams,
+                               gl::PassTimer& timer, Counters& counters);
+
+    const std::vector<MirrorPlane>& mirrors() const { return mMirrors; }
+
+private:
+    std::unique_ptr<EnvProbe> mEnv;
+    std::unique_ptr<PlanarMirrors> mMirrorPass;
+    std::vector<MirrorPlane> mMirrors;
+    const Scene* mMirrorScene = nullptr;
+    float mMirrorRoughness = -1.0f;
+    int mWidth = 0, mHeight = 0;
+    gl::Texture mOutput;
+    gl::Framebuffer mOutputFbo;
+};
+
+} // namespace gis

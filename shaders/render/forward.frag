@@ -1,0 +1,29 @@
+#version 450 core
+// Forward shading for views other than the eye camera: emission plus the shadowed spotlight (diffuse
+// and specular lobes of render/brdf.glsl) as seen from uEye. No indirect light: a reflection shows
+// the directly lit scene (docs/nondiffuse.md, limits). Output is linear radiance, sanitised.
+#include "common.glsl"
+#include "render/material.glsl"
+#include "render/lighting.glsl"
+
+in vec3 vWorldPos;
+in vec3 vNormal;
+in vec2 vTexcoord;
+
+uniform vec3 uEye; // the viewpoint (m): probe centre or mirrored camera
+
+layout(location = 0) out vec4 outRadiance; // rgb linear radiance, a = 1 covered
+layout(location = 1) out vec4 outPosition; // xyz world position (m), w = 1 covered
+
+void main() {
+    vec3 toEye = uEye - vWorldPos;
+    float e2 = dot(toEye, toEye);
+    vec3 v = e2 > 1e-20 ? toEye * inversesqrt(e2) : vec3(0.0, 1.0, 0.0);
+    vec3 n = safeNormal(vNormal, vWorldPos, v);
+    vec3 base = materialBaseColor(vTexcoord);
+    vec4 spec = vec4(materialF0(base), clamp(uMetalRoughSpec.y, 0.0, 1.0));
+    vec3 radiance = max(sanitize(uEmissive), vec3(0.0)) +
+                    spotReflected(vWorldPos, n, materialAlbedo(vTexcoord), spec, v, gFrame.shadingInfo.z > 0.5);
+    outRadiance = vec4(max(sanitize(radiance), vec3(0.0)), 1.0);
+    outPosition = vec4(vWorldPos, 1.0);
+}

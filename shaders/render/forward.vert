@@ -1,0 +1,23 @@
+#version 450 core
+// Forward render of the scene from a viewpoint other than the eye camera (environment-probe faces,
+// mirrored views): world position through uViewProj, with one user clip plane.
+#include "common.glsl"
+
+layout(location = 0) in vec3 inPosition;
+layout(location = 1) in vec3 inNormal;
+layout(location = 2) in vec2 inTexcoord;
+
+uniform mat4 uViewProj;  // world -> clip space of this view
+uniform vec4 uClipPlane; // keeps dot(xyz, p) + w >= 0 (a mirror's front side); (0, 0, 0, 1) keeps all
+
+out vec3 vWorldPos;
+out vec3 vNormal;
+out vec2 vTexcoord;
+
+void main() {
+    vWorldPos = inPosition;
+    vNormal = inNormal;
+    vTexcoord = inTexcoord;
+    gl_ClipDistance[0] = dot(uClipPlane.xyz, inPosition) + uClipPlane.w;
+    gl_Position = uViewProj * vec4(inPosition, 1.0);
+}
