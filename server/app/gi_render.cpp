@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "encode/Encoder.h"
 #include "analysis/EffectPlan.h"
@@ -201,8 +202,10 @@ nlohmann::json readRequest(const std::string& path) {
         if (!f) throw gis::InputError(path, "cannot read the request file");
         text.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
     }
-    nlohmann::json request = nlohmann::json::parse(text, nullptr, false);
-    if (request.is_discarded()) throw gis::InputError(requestName(path), "the request is not valid JSON");
+    std::string parseError;
+    nlohmann::json request = gis::parseJsonExplained(text, parseError);
+    if (request.is_discarded())
+        throw gis::InputError(requestName(path), "the request is not valid JSON: " + parseError);
     return request;
 }
 

@@ -123,4 +123,19 @@ std::optional<SchemaViolation> validateJson(const nlohmann::json& instance, cons
     return check(instance, schema, "");
 }
 
+nlohmann::json parseJsonExplained(std::string_view text, std::string& error) {
+    error.clear();
+    try {
+        return nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+        std::string what = e.what();
+        if (what.rfind("[json.exception.", 0) == 0) {
+            const size_t close = what.find("] ");
+            if (close != std::string::npos) what = what.substr(close + 2);
+        }
+        error = what.empty() ? "not valid JSON" : what;
+        return nlohmann::json(nlohmann::json::value_t::discarded);
+    }
+}
+
 } // namespace gis

@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -19,5 +20,10 @@ struct SchemaViolation {
 
 /// Returns the first violation found, or nullopt when `instance` conforms to `schema`.
 std::optional<SchemaViolation> validateJson(const nlohmann::json& instance, const nlohmann::json& schema);
+
+/// Parses `text`; on failure returns a discarded value and sets `error` to why and where, e.g.
+/// "number overflow parsing '1e400'" or "syntax error at line 1, column 12: ..." (nlohmann's text
+/// without its "[json.exception...]" prefix), so that error replies can say what to fix.
+nlohmann::json parseJsonExplained(std::string_view text, std::string& error);
 
 } // namespace gis

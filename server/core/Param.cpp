@@ -21,10 +21,20 @@ std::string paramTypeName(ParamType type) {
 
 namespace {
 
+// Exact, so that a range or a rejected value reads as it was written: 16777216, not 1.67772e+07.
 std::string formatNumber(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
+    if (std::isnan(v)) return "NaN";
+    if (std::isinf(v)) return v > 0 ? "Infinity" : "-Infinity";
+    if (v == std::floor(v) && std::abs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+    char buf[32];
+    auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v); // shortest text that reads back as v
+    return ec == std::errc() ? std::string(buf, end) : std::to_string(v);
+}
+
+/// A rejected value as the error shows it: numbers exactly (NaN and infinities by name, where JSON
+/// would print null), anything else as JSON.
+std::string valueText(const nlohmann::json& v) {
+    return v.is_number() ? formatNumber(v.get<double>()) : v.dump();
 }
 
 std::string rangeText(const ParamSpec& s) {
@@ -157,24 +167,24 @@ nlohmann::json ParamSet::validated(const ParamSpec& s, const nlohmann::json& val
     };
     switch (s.type) {
     case ParamType::Bool:
-        if (!value.is_boolean()) return fail(value.dump());
+        if (!value.is_boolean()) return fail(valueText(value));
         return value;
     case ParamType::Enum: {
-        if (!value.is_string()) return fail(value.dump());
+        if (!value.is_string()) return fail(valueText(value));
         const auto& str = value.get_ref<const std::string&>();
         if (std::find(s.options.begin(), s.options.end(), str) == s.options.end()) return fail("'" + str + "'");
         return value;
     }
     case ParamType::Int: {
-        if (!value.is_number()) return fail(value.dump());
+        if (!value.is_number()) return fail(valueText(value));
         double d = value.get<double>();
-        if (!std::isfinite(d) || d != std::floor(d) || d < s.min || d > s.max) return fail(value.dump());
+        if (!std::isfinite(d) || d != std::floor(d) || d < s.min || d > s.max) return fail(valueText(value));
         return static_cast<long long>(d);
     }
     case ParamType::Float: {
-        if (!value.is_number()) return fail(value.dump());
+        if (!value.is_number()) return fail(valueText(value));
         double d = value.get<double>();
-        if (!std::isfinite(d) || d < s.min || d > s.max) return fail(value.dump());
+        if (!std::isfinite(d) || d < s.min || d > s.max) return fail(valueText(value));
         return d;
     }
     }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/Error.h"
+#include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "gi/Technique.h"
 #include "net/Metrics.h"
@@ -532,10 +533,16 @@ struct WsServer::Impl {
 
     void startRender(lws* wsi, PerSession* pss) {
         HttpExchange* x = pss->http;
-        nlohmann::json request = nlohmann::json::parse(x->body, nullptr, false);
+        std::string parseError;
+        nlohmann::json request = parseJsonExplained(x->body, parseError);
         if (request.is_discarded() || !request.is_object()) {
-            respond(wsi, pss,
-                    errorResponse(400, "invalid_json", "the body must be a JSON object (see PROTOCOL.md)"));
+            respond(
+                wsi, pss,
+                errorResponse(400, "invalid_json",
+                              request.is_discarded()
+                                  ? "the body is not valid JSON: " + parseError
+                                  : "the body must be a JSON object such as {\"scene\": \"builtin:cornell\"} "
+                                    "(see PROTOCOL.md)"));
             return;
         }
         bool jsonReply = false;

@@ -107,8 +107,18 @@ RenderJob parseRenderRequest(const nlohmann::json& request, const RenderLimits& 
     if (!request.is_object())
         throw InputError("", "a render request is a JSON object such as {\"scene\": \"builtin:cornell\"}");
     if (auto v = validateJson(request, renderRequestSchema())) {
-        const std::string hint = hintFor(v->pointer, v->message, limits);
-        throw InputError(v->pointer, v->message + (hint.empty() ? "" : " (" + hint + ")"));
+        // A parameter value of the wrong type (null, an array) is left to the parameter tables below,
+        // whose error names the parameter's type and range, when nothing else is wrong.
+        bool tablesJudge = false;
+        if (v->pointer.rfind("/params/", 0) == 0) {
+            nlohmann::json rest = request;
+            rest["params"] = nlohmann::json::object();
+            tablesJudge = !validateJson(rest, renderRequestSchema()).has_value();
+        }
+        if (!tablesJudge) {
+            const std::string hint = hintFor(v->pointer, v->message, limits);
+            throw InputError(v->pointer, v->message + (hint.empty() ? "" : " (" + hint + ")"));
+        }
     }
 
     RenderJob job;

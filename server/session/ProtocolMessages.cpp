@@ -37,8 +37,10 @@ const std::vector<std::string>& clientMessageTypes() {
 }
 
 nlohmann::json parseClientMessage(std::string_view text) {
-    nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
-    if (msg.is_discarded()) throw ProtocolError{"invalid_json", "the message is not valid JSON", "", ""};
+    std::string parseError;
+    nlohmann::json msg = parseJsonExplained(text, parseError);
+    if (msg.is_discarded())
+        throw ProtocolError{"invalid_json", "the message is not valid JSON: " + parseError, "", ""};
     if (!msg.is_object())
         throw ProtocolError{"invalid_message", "a message must be a JSON object with a 'type' field", "", ""};
     auto type = msg.find("type");
@@ -54,9 +56,19 @@ nlohmann::json parseClientMessage(std::string_view text) {
         throw ProtocolError{"unknown_type", "unknown message type '" + t + "' (known: " + known + ")",
                             "/type", t};
     }
-    if (auto v = validateJson(msg, *schema))
-        throw ProtocolError{"invalid_message", (v->pointer.empty() ? "" : v->pointer + ": ") + v->message,
-                            v->pointer, t};
+    if (auto v = validateJson(msg, *schema)) {
+        // A params value of the wrong type (null, an array) is left to the parameter tables, whose
+        // invalid_param error names the parameter's type and range, when nothing else is wrong.
+        bool tablesJudge = false;
+        if (t == "params" && v->pointer.rfind("/values/", 0) == 0) {
+            nlohmann::json rest = msg;
+            rest["values"] = nlohmann::json::object();
+            tablesJudge = !validateJson(rest, *schema).has_value();
+        }
+        if (!tablesJudge)
+            throw ProtocolError{"invalid_message", (v->pointer.empty() ? "" : v->pointer + ": ") + v->message,
+                                v->pointer, t};
+    }
     return msg;
 }
 

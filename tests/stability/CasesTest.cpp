@@ -479,13 +479,9 @@ TEST_P(S4, C10_MipBoundaryEdges) {
         note(diagonal ? "rel. RMSE edge/all (diagonal)" : "rel. RMSE edge/all (adjacent)",
              std::to_string(edgeErr).substr(0, 6) + "/" + std::to_string(allErr).substr(0, 6));
         EXPECT_LT(allErr, 0.2);
-        if (edgeErr > 2 * allErr + 0.02)
-            knownFailure("light leaks across the depth edge on the cell boundary (rel. RMSE " +
-                             std::to_string(edgeErr).substr(0, 6) + " in the two edge columns vs " +
-                             std::to_string(allErr).substr(0, 6) + " overall)",
-                         "no patch straddles the edge, so both sides stay coarse receivers, and "
-                         "eyeInterpolateCoarse's bilinear weights ignore depth: the upsampling mixes them; "
-                         "there is no adjacent-cell refinement option");
+        // No patch straddles the edge, so both sides stay coarse receivers: eyeInterpolateCoarse's
+        // geometric weights keep the upsampling from mixing them.
+        EXPECT_LE(edgeErr, 2 * allErr + 0.02) << "light leaks across the depth edge on the cell boundary";
         EXPECT_LE(f.counter("receivers_total", 0), 4.0 / 3.0 * 64 * 64);
     }
 }
@@ -583,13 +579,7 @@ TEST_P(S4, C12_ThresholdExtremes) {
         const double err = relativeRmse(cf, ch);
         note("ssbc thresholds 0: hierarchical vs flat compensation", err);
         note("compensation sum hierarchical/flat", sumRgb(ch) / sumRgb(cf));
-        if (err >= 1e-3)
-            knownFailure(
-                "hierarchical != flat at thresholds 0 (rel. RMSE " + std::to_string(err) + ")",
-                "ssbc_integrate.comp refines only when omega > threshold: a coarse sample whose mean "
-                "normal faces away (omega = 0) is never refined although children face the receiver "
-                "(refining at omega >= 0 brings it to 0.7%)");
-        EXPECT_LT(err, 0.1) << "regression beyond the diagnosed deviation";
+        EXPECT_LT(err, 1e-3) << "hierarchical != flat at thresholds 0";
     } else {
         GTEST_SKIP();
     }
@@ -616,13 +606,7 @@ TEST_P(S4, C13_ScatterGather) {
         const double e2 = relativeRmse(perFrame.out.linear, perVpl.out.linear);
         note("per-VPL (T=1e-7) vs per-frame", e2);
         note("indirect sum per-VPL/per-frame", indirectSum(perVpl) / indirectSum(perFrame));
-        if (e2 >= 1e-3)
-            knownFailure(
-                "per-VPL refinement at T=1e-7 differs from per-frame full refinement (rel. RMSE " +
-                    std::to_string(e2) + ")",
-                "per-VPL lists replicate the unrefined parent patch (eyeCombine, interpolate=false): "
-                "patches whose children agree within T keep the parent's mean-point value");
-        EXPECT_LT(e2, 0.05) << "regression beyond the diagnosed deviation";
+        EXPECT_LT(e2, 1e-3) << "per-VPL refinement at T=1e-7 differs from per-frame full refinement";
     }
 }
 
@@ -649,12 +633,7 @@ TEST_P(S4, C14_ScaleAndLinearity) {
         // Unexpressible clamps (second_order's min_distance at 1e4, ssbc's clamp_b at 1e-3) are
         // range limits documented in docs/stability.md, measured but not held to the tolerance.
         const bool rangeLimited = (t == "second_order" && s > 1) || (t == "ssbc" && s < 1);
-        if (s < 1 && err >= 2e-2) {
-            knownFailure("scale 1e-3: rel. RMSE " + std::to_string(err) + " (direct light included)",
-                         "FrameRenderer::lightViewProj: light frustum reach has +1 m and znear a 1 mm floor, "
-                         "so geometry within 1 mm of the light (the tall box top at s=1e-3) leaves the "
-                         "shadow map; 3e-3 and above match to 1e-6");
-        } else if (!rangeLimited) {
+        if (!rangeLimited) {
             EXPECT_LT(err, 2e-2);
         }
     }
@@ -733,14 +712,7 @@ TEST_P(S4, C17_FarFromOrigin) {
     note("total radiance ratio", level);
     note("pixels changed > 10% (%)", 100.0 * moved / std::max(covered, 1));
     EXPECT_NEAR(level, 1.0, 0.02);
-    if (t == "second_order" && moved > 0.03 * covered) {
-        knownFailure(
-            std::to_string(100.0 * moved / covered).substr(0, 4) + "% of pixels change by > 10% at +1e4 m",
-            "second_order's negative lights land elsewhere at +1e4 m: with negative_count 0 it changes "
-            "0.9% like every technique; place_negative.comp's fp32 position differences");
-    } else {
-        EXPECT_LE(moved, 0.03 * covered);
-    }
+    EXPECT_LE(moved, 0.03 * covered);
     if (t_hasIndirect(f)) {
         const double ind = indirectSum(f) / indirectSum(ref);
         note("indirect ratio", ind);
@@ -834,13 +806,10 @@ TEST_P(S4, C20_WorstCaseRefinement) {
                         {"negative_count", 1024},
                         {"discontinuity_threshold", 0.0}};
     if (t == "multires_splat") p.update({{"refinement", "illumination"}, {"illum_threshold", 1e-7}});
-    FrameBounds bounds;
-    if (t == "multires_splat")
-        bounds.knownGlError = "MultiresSplat::execute seeds per-VPL lists with one 1-D dispatch of "
-                              "coarsest texels x VPLs / 64 groups: 256 x 16384 / 64 = 65536 > "
-                              "GL_MAX_COMPUTE_WORK_GROUP_COUNT (65535), so the frame has no indirect light "
-                              "and subsplat_capped stays 0";
-    Frame f = render(spec(bumpy, p), bounds);
+    // multires_splat seeds 256 coarsest texels x 16384 VPLs = 4M items, 65536 work groups of 64: a
+    // 2D dispatch (65535 is GL's guaranteed limit per dimension; one dimension failed with
+    // GL_INVALID_VALUE and no light before).
+    Frame f = render(spec(bumpy, p));
     note("frame ms", f.wallMs);
     if (usesEyeHierarchy(t)) {
         const double cap = 4.0 / 3.0 * 64 * 64;
@@ -851,11 +820,12 @@ TEST_P(S4, C20_WorstCaseRefinement) {
     }
     if (t == "multires_splat") {
         note("subsplats", f.counter("subsplats_total"));
-        if (f.glErrors == 0) {
-            EXPECT_GT(f.indirectMax, 0.0);
-        }
-        // A list buffer too small for the frame: capped with a flag, never a silent overrun (at a
-        // VPL count the seed dispatch can express: 64^2 VPLs).
+        EXPECT_GT(f.indirectMax, 0.0);
+        // The seed alone fills the default 4M-item list, so refinement is cut short: reported.
+        EXPECT_GT(f.counter("subsplat_capped"), 0.0) << "truncation at 128^2 VPLs must be reported";
+        EXPECT_LE(f.counter("subsplats_total"), 4.0 * (1 << 20));
+        note("items capped at 128^2 VPLs", f.counter("subsplat_capped"));
+        // A list buffer too small for the frame: capped with a flag, never a silent overrun.
         nlohmann::json small = merge(p, {{"rsm_size", 64}, {"vpl_grid", 64}, {"max_subsplats", 1024}});
         Frame capped = render(spec(bumpy, small), {.energy = -1});
         EXPECT_GT(capped.counter("subsplat_capped"), 0.0) << "truncation must be reported";

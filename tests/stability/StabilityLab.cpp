@@ -224,13 +224,13 @@ FrameTextures locateFrameTextures(int w, int h, int rsm, GLuint indirect) {
     FrameTextures t;
     const std::vector<FboInfo> fbos = listFramebuffers();
     GLuint gFbo = 0;
-    if (const FboInfo* g = findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F}, w, h, true)) {
+    if (const FboInfo* g = findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F, GL_RGBA8}, w, h, true)) {
         gFbo = g->id;
         t.gPosition = g->colours[0].id;
         t.gNormal = g->colours[1].id;
         t.gAlbedo = g->colours[2].id;
     }
-    if (const FboInfo* s = findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA32F}, rsm, rsm, true)) {
+    if (const FboInfo* s = findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA32F, GL_RGBA8}, rsm, rsm, true)) {
         t.rsmPosition = s->colours[0].id;
         t.rsmNormal = s->colours[1].id;
         t.rsmFlux = s->colours[2].id;

@@ -282,6 +282,8 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     glUniform1i(mUpsample.uniform("uInterpolate"), irradiance ? 1 : 0);
     glBindTextureUnit(0, mIllumination.id());
     glBindTextureUnit(1, mReconstructed.id());
+    glBindTextureUnit(11, mGeoPosition.id()); // receiver geometry for the upsampling's edge weights
+    glBindTextureUnit(12, mGeoNormal.id());
     for (int l = static_cast<int>(mLevels.size()) - 1; l >= 1; --l) {
         glTextureBarrier(); // level l + 1 is complete before level l reads it
         glUniform1i(mUpsample.uniform("uLevel"), l);

@@ -28,15 +28,6 @@ constexpr float kMinCosView = 0.1f;
 // Stats block of second_order.glsl: active VPL slots, clamped pixels, negatives placed, valid positives.
 constexpr int kStatsWords = 4;
 
-glm::vec3 unproject(const glm::mat4& inverseViewProj, glm::vec3 ndc, bool* ok) {
-    const glm::vec4 p = inverseViewProj * glm::vec4(ndc, 1.0f);
-    if (!(std::abs(p.w) > 1e-20f)) {
-        *ok = false;
-        return glm::vec3(0.0f);
-    }
-    return glm::vec3(p) / p.w;
-}
-
 bool finite(glm::vec3 v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -204,16 +195,24 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
     counters["negative_candidates"] = 0;
     if (target <= 0 || positiveCount <= 0) return 0;
 
-    // The camera's frustum from its inverse view-projection: the axis, the four corner directions
-    // (their spherical quadrilateral is the frustum's solid angle) and the cone that encloses them.
-    const glm::mat4 inverse = glm::inverse(f.viewProj);
-    const glm::vec3 eye(f.cameraPos);
+    // The camera's frustum: the axis, the four corner directions (their spherical quadrilateral is
+    // the frustum's solid angle) and the cone that encloses them. Directions only (digest S.4 case
+    // 17): the eye projects to x = y = w = 0, so viewProj's rows x, y and w map a direction d to the
+    // clip coordinates of eye + d, and their inverse maps an image point back to its direction.
+    // Unprojecting near-plane points or projecting eye + d instead lost the directions to fp32
+    // rounding far from the origin (a 1 mm ulp at 1e4 m against a 5 cm near plane): the candidates,
+    // and with them the negative lights, moved.
+    glm::dmat3 rows; // rows[c]: column c of viewProj's rows x, y, w
+    for (int c = 0; c < 3; ++c) rows[c] = glm::dvec3(f.viewProj[c][0], f.viewProj[c][1], f.viewProj[c][3]);
+    const double det = glm::determinant(rows);
+    if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return 0;
+    const glm::dmat3 inverseRows = glm::inverse(rows);
     bool ok = true;
-    const glm::vec3 centre = unproject(inverse, {0, 0, 0}, &ok) - eye;
+    const glm::vec3 centre(inverseRows * glm::dvec3(0.0, 0.0, 1.0));
     const glm::vec2 cornerNdc[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
     glm::dvec3 corners[4];
     for (int i = 0; i < 4; ++i) {
-        const glm::vec3 c = unproject(inverse, glm::vec3(cornerNdc[i], 0.0f), &ok) - eye;
+        const glm::vec3 c(inverseRows * glm::dvec3(cornerNdc[i], 1.0));
         const float len = glm::length(c);
         ok = ok && finite(c) && len > 1e-20f;
         corners[i] = ok ? glm::dvec3(c / len) : glm::dvec3(0, 0, 1);
@@ -234,9 +233,9 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
     pixels.reserve(static_cast<size_t>(target));
     for (const glm::vec3& local : samples.directions) {
         if (static_cast<int>(pixels.size()) >= target) break;
-        const glm::vec4 clip = f.viewProj * glm::vec4(eye + frame.toWorld(local), 1.0f);
-        if (!(clip.w > 1e-6f)) continue;
-        const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+        const glm::dvec3 xyw = rows * glm::dvec3(frame.toWorld(local));
+        if (!(xyw.z > 1e-6)) continue;
+        const glm::vec2 ndc(xyw.x / xyw.z, xyw.y / xyw.z);
         if (!(std::abs(ndc.x) <= 1.0f && std::abs(ndc.y) <= 1.0f)) continue;
         const int x = std::clamp(static_cast<int>((ndc.x * 0.5f + 0.5f) * static_cast<float>(in.width)), 0,
                                  in.width - 1);

@@ -1,4 +1,6 @@
 // Eye-space hierarchy access shared by every multiresolution pass (layout: shared/EyeHierarchy.h).
+// common.glsl (included once per program) provides gFrame for pixel footprints and isBad.
+#include "common.glsl"
 #include "shared/EyeHierarchy.h"
 
 layout(std140, binding = GIS_UBO_EYE) uniform EyeBlock {
@@ -65,14 +67,49 @@ bool eyeIsReceiver(usampler2D flags, int level, ivec2 t, bool pixelCovered) {
     return true;
 }
 
+// Receiver geometry the reconstruction compares (digest S.4 case 10): the texel's mean position
+// (w > 0: it has geometry) and unit normal. The coarse levels' come from the atlas geometry
+// (EyeHierarchy binds it at units 11 and 12 for the reconstruction), level 0's from the G-buffer.
+struct EyeGeometry {
+    vec4 position;
+    vec3 normal;
+};
+
+// World size (m) of one pixel at p, perpendicular to the view: 2 w / (H f), with the clip w and the
+// focal length f = 1 / tan(fov_y / 2) = |row 1 of viewProj| (the view's rotation rows are unit).
+float eyePixelFootprint(vec3 p) {
+    mat4 m = gFrame.viewProj;
+    float focal = length(vec3(m[0][1], m[1][1], m[2][1]));
+    float w = m[0][3] * p.x + m[1][3] * p.y + m[2][3] * p.z + m[3][3];
+    return 2.0 * abs(w) / max(focal * gFrame.viewport.y, 1e-30);
+}
+
+// How far a coarse neighbour's surface agrees with the fine texel's (1 same surface, 0 another):
+// its plane distance (either tangent plane) against the coarse texel's footprint, 1 up to 1/4 of it
+// and 0 from 1/2 (a continuous surface's neighbours lie in its tangent plane up to its curvature),
+// times the normals' agreement, 1 up to 26 degrees and 0 from 60 degrees apart.
+float eyeGeometricWeight(EyeGeometry fine, vec3 coarsePos, vec3 coarseNormal, int coarse) {
+    vec3 v = coarsePos - fine.position.xyz;
+    float plane = max(abs(dot(fine.normal, v)), abs(dot(coarseNormal, v)));
+    float footprint = float(1 << coarse) * eyePixelFootprint(fine.position.xyz);
+    float wd = clamp(2.0 - 4.0 * plane / max(footprint, 1e-30), 0.0, 1.0);
+    float wn = clamp((dot(fine.normal, coarseNormal) - 0.5) * 2.5, 0.0, 1.0);
+    return isBad(wd * wn) ? 0.0 : wd * wn;
+}
+
 // Coarse-to-fine reconstruction step (000 §3.5, digest S.3 U1) for texel t of level `coarse - 1`:
 // when the texel lies under a coarser receiver (its parent holds data), interpolate the finished
 // coarse level bilinearly using only the coarse texels that hold data (alpha > 0), weights
 // renormalised, so energy is never pulled from empty or refined areas nor spread into them.
 // Otherwise the texel stays empty (alpha 0). 000 leaves the weights open: bilinear (tent) weights
-// of the 2x upsample.
+// of the 2x upsample, times a geometric similarity weight (eyeGeometricWeight) when the texel has
+// geometry: a coarse receiver on another surface (across a depth or normal edge that no patch
+// straddles, so nothing was refined) lends it no light. When every weight vanishes the parent, the
+// nearest sample, is replicated. On a continuous surface every geometric weight is exactly 1 and the
+// result is the plain bilinear one.
 // `interpolate` false replicates the parent instead (per-VPL lists, see eyeCombine).
-vec4 eyeInterpolateCoarse(sampler2D reconstructed, int coarse, ivec2 t, bool interpolate) {
+vec4 eyeInterpolateCoarse(sampler2D reconstructed, sampler2D atlasPosition, sampler2D atlasNormal, int coarse,
+                          ivec2 t, bool interpolate, EyeGeometry fine) {
     if (coarse >= gEye.info.x) return vec4(0.0);
     vec4 parent = texelFetch(reconstructed, eyeAtlas(coarse, t >> 1), 0);
     if (parent.a <= 0.0 || !interpolate) return parent.a > 0.0 ? parent : vec4(0.0);
@@ -88,11 +125,16 @@ vec4 eyeInterpolateCoarse(sampler2D reconstructed, int coarse, ivec2 t, bool int
             vec4 v = texelFetch(reconstructed, eyeAtlas(coarse, q), 0);
             if (v.a <= 0.0) continue;
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
+            if (fine.position.w > 0.0) {
+                ivec2 a = eyeAtlas(coarse, q);
+                w *= eyeGeometricWeight(fine, texelFetch(atlasPosition, a, 0).xyz, texelFetch(atlasNormal, a, 0).xyz,
+                                        coarse);
+            }
             sum += w * v.rgb;
             weight += w;
         }
-    // The parent holds data with weight >= 1/16, so weight > 0; guarded anyway.
-    return weight > 0.0 ? vec4(sum / weight, 1.0) : vec4(0.0);
+    // Every neighbour on another surface: the parent (it holds data, and covers the texel).
+    return weight > 1e-6 ? vec4(sum / weight, 1.0) : vec4(parent.rgb, 1.0);
 }
 
 // One texel of the reconstruction: what was splatted or gathered on its own level plus the
@@ -104,8 +146,9 @@ vec4 eyeInterpolateCoarse(sampler2D reconstructed, int coarse, ivec2 t, bool int
 // another's patch (measured: 3.9% relative RMSE where refining everything should be exact); those
 // buffers replicate the parent instead (`interpolate` false), leaving the patch constant as 000
 // describes subsplats.
-vec4 eyeCombine(vec4 rendered, sampler2D reconstructed, int level, ivec2 t, bool interpolate) {
-    vec4 coarse = eyeInterpolateCoarse(reconstructed, level + 1, t, interpolate);
+vec4 eyeCombine(vec4 rendered, sampler2D reconstructed, sampler2D atlasPosition, sampler2D atlasNormal, int level,
+                ivec2 t, bool interpolate, EyeGeometry fine) {
+    vec4 coarse = eyeInterpolateCoarse(reconstructed, atlasPosition, atlasNormal, level + 1, t, interpolate, fine);
     vec3 own = rendered.a > 0.0 ? rendered.rgb : vec3(0.0);
     return (rendered.a > 0.0 || coarse.a > 0.0) ? vec4(own + coarse.rgb, 1.0) : vec4(0.0);
 }

@@ -13,6 +13,8 @@ layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gAlbedo;
 layout(binding = 3) uniform sampler2D uReconstructed; // levels >= 1 finished
 layout(binding = 4) uniform sampler2D uRendered;      // level 0 receivers (alpha 1)
+layout(binding = 11) uniform sampler2D uAtlasPosition; // levels >= 1: xyz mean position; w covered pixels
+layout(binding = 12) uniform sampler2D uAtlasNormal;   // levels >= 1: xyz mean unit normal
 uniform int uInterpolate; // 0: replicate the parent (per-VPL lists)
 layout(location = 0) out vec4 outIndirect;
 
@@ -24,7 +26,12 @@ void main() {
     vec4 pos = texelFetch(gPosition, p, 0);
     vec3 c = vec3(0.0);
     if (pos.w > 0.5) {
-        c = eyeCombine(texelFetch(uRendered, p, 0), uReconstructed, 0, p, uInterpolate != 0).rgb; // level 0 at the atlas origin
+        EyeGeometry fine;
+        fine.position = pos;
+        fine.normal = texelFetch(gNormal, p, 0).xyz;
+        // Level 0 at the atlas origin.
+        c = eyeCombine(texelFetch(uRendered, p, 0), uReconstructed, uAtlasPosition, uAtlasNormal, 0, p,
+                       uInterpolate != 0, fine).rgb;
         if (uIrradiance != 0) c *= texelFetch(gAlbedo, p, 0).rgb * kInvPi;
         if (uDetailAlpha > 0.0) {
             vec3 toEye = gFrame.cameraPos.xyz - pos.xyz;

@@ -85,7 +85,9 @@ LightNode combine(LightNode c[4]) {
     vec3 pos = weighted ? posW / weight : posC / texels;
     vec3 nSum = weighted ? normalW : normalC;
     float len = length(nSum);
-    vec3 n = len > 1e-6 ? nSum / len : fallbackNormal;
+    // Relative to the weights' sum (the mean normal's length): flux scales with the scene (I x s^2 in
+    // digest S.4 case 14), and an absolute floor sent dim millimetre-scale nodes to the fallback.
+    vec3 n = len > 1e-6 * (weighted ? weight : texels) ? nSum / len : fallbackNormal;
     if (!finite3(pos)) pos = posC / texels;
     if (!finite3(n)) n = fallbackNormal;
     LightNode node;

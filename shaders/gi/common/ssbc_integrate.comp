@@ -26,7 +26,7 @@ uniform float uB;             // clamp bound b (1/m^2), > 0
 uniform float uR;             // 1/sqrt(b) (m)
 uniform float uTanHalfFov;
 uniform int uLevels;          // mip levels (>= 1)
-uniform float uSolidAngle;    // refine above this (sr)
+uniform float uSolidAngle;    // refine above this (sr); <= 0 refines everything
 uniform float uDiscAngle;     // refine discontinuous samples above this (sr)
 uniform int uMaxVisited;      // per-pixel cap on samples visited (bounded frame time)
 uniform int uSlot;            // counter slot of this step
@@ -84,7 +84,10 @@ void main() {
                     vec3 v = g.xyz - y;
                     float d2 = dot(v, v);
                     // Every point of the sample is farther than r: G <= 1/d^2 < b, nothing to add.
-                    if (!containsSelf && sqrt(d2) - sqrt(area) >= uR) continue;
+                    // sqrt(area) bounds no coarse sample's extent (grazing, or across a depth edge),
+                    // so with thresholds 0 (refine everything) only level 0, where it is exact, prunes.
+                    bool prune = level == 0 || uSolidAngle > 0.0;
+                    if (!containsSelf && prune && sqrt(d2) - sqrt(area) >= uR) continue;
                     vec4 nz = texelFetch(uNormal, t, level);
                     vec3 w = d2 > 1e-20 ? v * inversesqrt(d2) : vec3(0.0);
                     float cosZ = max(-dot(nz.xyz, w), 0.0);
@@ -97,7 +100,9 @@ void main() {
                     float dNear = max(sqrt(d2) - ext, 0.0);
                     float cosYc = max(dot(ny, w), 0.0);
                     bool straddles = ext > 0.25 * uR && cosYc * max(cosZ, 0.1) > uB * dNear * dNear;
-                    bool refine = level > 0 && (containsSelf || omega > uSolidAngle ||
+                    // A threshold of 0 refines every sample (the flat sum, digest S.4 case 12): a coarse
+                    // sample whose mean normal faces away (omega = 0) may hold children that face y.
+                    bool refine = level > 0 && (containsSelf || uSolidAngle <= 0.0 || omega > uSolidAngle ||
                                                 (nz.w > 0.5 && omega > uDiscAngle) || straddles);
                     if (refine && sp + 4 <= kStack) {
                         for (int k = 3; k >= 0; --k) stack[sp++] = packNode(level - 1, 2 * t + ivec2(k & 1, k >> 1));

@@ -1,15 +1,17 @@
 // VPL transport kernels shared by every VPL technique (digest S.3 P6). Both return the irradiance
 // (W/m^2 in the renderer's units) a diffuse VPL of reflected flux Phi gives a receiver; the caller
 // multiplies by the receiver's BRDF. Guards (digest S.4): a VPL coincident with the receiver
-// (d^2 below 1e-20 m^2) has no defined direction and contributes 0 (case 1); back-facing pairs
-// contribute exactly 0 (case 2, the max(.,0) 001 Eq. 1 leaves implicit).
+// (d^2 below 1e-20 m^2) has no defined direction and contributes 0 (case 1), except under K2, whose
+// limit is bounded (case 8); back-facing pairs contribute exactly 0 (case 2, the max(.,0) 001 Eq. 1
+// leaves implicit).
 //
 // K1, point kernel with a distance clamp (000 Eq. 2):  E = Phi/pi * cos_l cos_r / max(d^2, dmin^2).
 // The clamp bounds the r -> 0 singularity (000 Fig. 13 names it, gives no value): dmin in metres.
 //
 // K2, disk-to-point form factor (001 Eq. 1, Wallace et al.): the VPL is a disk of area A (001 Eq. 3)
 // with radiosity Phi/A, so  E = Phi cos_l cos_r / (pi d^2 + A). Bounded by Phi/A as d -> 0, so it
-// needs no clamp; A = 0 degrades to the unclamped point kernel, still finite by the d^2 guard.
+// needs no clamp; A = 0 degrades to the unclamped point kernel, still finite by the d^2 guard. A
+// coincident pair gets that bound, Phi/A <n_r, -n_l>+ (the limit along the disk's axis), not 0.
 //
 // K3, bounded geometry term (002 G_b; digest S.1): with clamp_b = b > 0 both kernels above become
 // E = Phi/pi * min(G, b), G = cos_l cos_r / d^2 unclamped (no dmin, no disk area), so the energy the
@@ -52,8 +54,14 @@ vec3 vplIrradiance(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplN
 vec3 vplIrradianceDisk(vec3 receiverPos, vec3 receiverNormal, vec3 vplPos, vec3 vplNormal, vec3 vplFlux,
                        float area) {
     float d2, cosR, cosL;
-    if (!vplPair(receiverPos, receiverNormal, vplPos, vplNormal, d2, cosR, cosL)) return vec3(0.0);
     float a = uVplInvClampB > 0.0 ? 0.0 : max(area, 0.0);
+    if (!vplPair(receiverPos, receiverNormal, vplPos, vplNormal, d2, cosR, cosL)) {
+        // Coincident pair: K2's bounded limit along the disk's axis, Phi/A cos_r with cos_l = 1 and
+        // cos_r = <n_r, -n_l> (the on-axis value B of digest S.4 case 8 for facing normals, 0 for a
+        // receiver on the disk's own side). No disk (A = 0, or K3) keeps the fallback 0.
+        if (!(d2 <= 1e-20) || !(a > 0.0)) return vec3(0.0);
+        return vplFlux * (max(-dot(receiverNormal, vplNormal), 0.0) / a);
+    }
     return vplFlux * (cosR * cosL / (kPi * d2 + a) * vplClampFactor(cosR, cosL, d2));
 }
 

@@ -14,7 +14,11 @@ void main() {
     if (uMode == 0) {
         gCounters.counts.x = min(gCounters.counts.y, uCapacity);
         gCounters.counts.y = 0u;
-        gCounters.dispatch = uvec4((gCounters.counts.x + GIS_SUBSPLAT_GROUP - 1u) / GIS_SUBSPLAT_GROUP, 1u, 1u, 0u);
+        // 2D when one dimension cannot hold the groups (per-VPL lists reach millions of items).
+        uint groups = (gCounters.counts.x + GIS_SUBSPLAT_GROUP - 1u) / GIS_SUBSPLAT_GROUP;
+        uint x = min(groups, GIS_SUBSPLAT_MAX_GROUPS_X);
+        uint y = x > 0u ? (groups + x - 1u) / x : 1u;
+        gCounters.dispatch = uvec4(x, y, 1u, 0u);
     } else {
         gCounters.draw = uvec4(min(gCounters.counts.z, uCapacity), uInstances, 0u, 0u);
     }

@@ -18,8 +18,10 @@ uniform uint uCapacity; // list capacity (items)
 uint packPatch(int level, ivec2 t) { return (uint(level) << 28) | (uint(t.y) << 14) | uint(t.x); }
 
 void main() {
-    int index = int(gl_GlobalInvocationID.x);
-    if (index >= uItems) return;
+    // 2D dispatch when the items need more than GIS_SUBSPLAT_MAX_GROUPS_X groups (128^2 VPLs).
+    uint linearIndex = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * GIS_SUBSPLAT_GROUP + gl_LocalInvocationID.x;
+    if (linearIndex >= uint(uItems)) return;
+    int index = int(linearIndex);
     int coarsest = eyeLevelCount() - 1;
     ivec2 size = eyeLevelSize(coarsest);
     int texels = size.x * size.y;

@@ -47,9 +47,14 @@ vec3 backIrradiance(vec3 x, vec3 n, Vpl v, out vec3 toLight) {
     if (!(d2 > 1e-20)) return vec3(0.0); // coincident: no defined direction (digest S.4 case 1)
     toLight = d * inversesqrt(d2);
     // Light in (or numerically at) p's tangent plane does not cross the surface: a light on the
-    // same plane reads cos ~ 1e-7 from rounded positions, and would take a slot for nothing.
+    // same plane reads cos ~ 1e-7 from rounded positions, and would take a slot for nothing. The
+    // positions are fp32 world coordinates: far from the origin (digest S.4 case 17, 1e4 m: a 1 mm
+    // ulp) a light on p's own wall sits a few ulps off its plane, so the light must also be farther
+    // from the plane than 8 ulps of the larger coordinate (a micrometre near the origin).
+    vec3 m = max(abs(x), abs(v.position.xyz));
+    float planeTolerance = 8.0 * 1.1920929e-7 * max(m.x, max(m.y, m.z));
     float cosBack = -dot(n, toLight);
-    if (!(cosBack > 1e-3)) return vec3(0.0);
+    if (!(cosBack > max(1e-3, planeTolerance * inversesqrt(d2)))) return vec3(0.0);
     float cosLight = max(dot(v.normal.xyz, -toLight), 0.0);
     return v.flux.rgb * (kInvPi * cosBack * cosLight / max(d2, uMinDistance * uMinDistance));
 }
