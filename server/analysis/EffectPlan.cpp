@@ -12,6 +12,8 @@
 #include "reference/RayScene.h"
 #include "reference/Sampling.h"
 #include "render/FrameRenderer.h"
+#include "render/Reflections.h"
+#include "scene/Brdf.h"
 
 namespace gis {
 namespace {
@@ -73,6 +75,17 @@ bool traceEyeRay(const RayScene& rays, const glm::dmat4& invViewProj, double nx,
 }
 
 /// The forced state of one effect from its frame parameter; "auto" when the table lacks it.
+Material materialOf(const Scene& scene, int mesh) {
+    if (mesh < 0 || mesh >= static_cast<int>(scene.meshes.size())) return Material{};
+    const int m = scene.meshes[static_cast<size_t>(mesh)].material;
+    return m >= 0 && m < static_cast<int>(scene.materials.size()) ? scene.materials[static_cast<size_t>(m)]
+                                                                  : Material{};
+}
+
+bool hasLobe(const Material& m) {
+    return brdf::surfaceFrom(m, glm::vec3(m.baseColor)).hasSpecular();
+}
+
 std::string forcedMode(const FrameState& state, const std::string& effect) {
     const std::string name = "effect_" + effect;
     return state.frameParams.has(name) ? state.frameParams.getEnum(name) : "auto";
@@ -86,6 +99,9 @@ std::string forcedMode(const FrameState& state, const std::string& effect) {
 // no refinement. Candidates are powers of two from 4 to 64 patches along the longer side (the
 // parameter's unit), each patch at least 2x2 samples.
 constexpr double kMinWholeFraction = 0.10;
+// A non-diffuse effect runs when more than this fraction of the samples (0.2%: two of 1024 view
+// samples) reach it.
+constexpr double kNonDiffuseMinFraction = 0.002;
 constexpr int kLevelGrid = 128; // samples along the longer side
 
 EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, long long& rayCount) {
@@ -246,6 +262,8 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     std::vector<Point> receivers;
     receivers.reserve(static_cast<size_t>(gx) * gy);
     std::vector<glm::vec3> emission;
+    std::vector<Material> receiverMaterial; // what the non-diffuse decisions read
+    std::vector<int> receiverMesh;
     for (int j = 0; j < gy; ++j)
         for (int i = 0; i < gx; ++i) {
             Rng rng(options.seed, static_cast<std::uint64_t>(j * gx + i), 0);
@@ -257,6 +275,8 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
             receivers.push_back({hit.position, facing(hit.shadingNormal, -dir),
                                  facing(hit.geometricNormal, -dir), hit.albedo});
             emission.push_back(hit.emission);
+            receiverMesh.push_back(hit.mesh);
+            receiverMaterial.push_back(materialOf(scene, hit.mesh));
         }
     plan.receivers = static_cast<int>(receivers.size());
 
@@ -268,6 +288,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         glm::vec3 flux{0.0f};
     };
     std::vector<Vpl> vpls;
+    std::vector<Material> vplMaterial;
     if (lightOn) {
         const int n = std::max(options.vplSamples, 1);
         const int side = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(n))));
@@ -292,6 +313,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
                        hit.albedo},
                       flux};
                 vpls.push_back(v);
+                vplMaterial.push_back(materialOf(scene, hit.mesh));
             }
     }
     plan.vpls = static_cast<int>(vpls.size());
@@ -453,6 +475,79 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         decide(std::move(d), on);
     }
 
+    // Non-diffuse effects (docs/nondiffuse.md): which specular paths the view and the light reach.
+    // Each value is a fraction of samples (view samples on geometry, or light samples); an effect
+    // runs when that fraction exceeds kNonDiffuseMinFraction.
+    {
+        const float split =
+            state.frameParams.has("glossy_split") ? state.frameParams.getFloat("glossy_split") : 0.35f;
+        const int mirrorDepth =
+            state.frameParams.has("mirror_depth") ? state.frameParams.getInt("mirror_depth") : 1;
+        const float mirrorRoughness =
+            state.frameParams.has("mirror_roughness") ? state.frameParams.getFloat("mirror_roughness") : 0.1f;
+        const TechniqueInfo& info = findTechnique(state.technique).info;
+        const bool glossyAvailable = info.glossyTransport && info.glossyTransport(state.techniqueParams);
+        std::vector<bool> mirrorMesh(scene.meshes.size(), false);
+        if (mirrorDepth > 0)
+            for (const MirrorPlane& m : findPlanarMirrors(scene, mirrorRoughness))
+                mirrorMesh[static_cast<size_t>(m.mesh)] = true;
+        int specularView = 0, roughView = 0, smoothView = 0, mirrorView = 0, roughLight = 0;
+        for (size_t i = 0; i < receiverMaterial.size(); ++i) {
+            const Material& m = receiverMaterial[i];
+            if (!hasLobe(m)) continue;
+            ++specularView;
+            const int mesh = receiverMesh[i];
+            if (mesh >= 0 && mirrorMesh[static_cast<size_t>(mesh)])
+                ++mirrorView;
+            else if (m.roughness >= split && glossyAvailable)
+                ++roughView;
+            else
+                ++smoothView;
+        }
+        for (const Material& m : vplMaterial)
+            if (hasLobe(m) && m.roughness >= split) ++roughLight;
+        const double view = std::max<double>(receivers.size(), 1.0);
+        const double lightSamples = std::max<double>(vpls.size(), 1.0);
+        auto fraction = [&](EffectDecision& d, double v, const char* what) {
+            d.value = v;
+            d.threshold = kNonDiffuseMinFraction;
+            d.reason = fmt("%.1f%% of the ", 100.0 * v) + what;
+        };
+        {
+            EffectDecision d{.effect = "specular"};
+            d.measurement = "fraction of view samples on surfaces with a specular lobe";
+            fraction(d, specularView / view, "view has a specular lobe");
+            d.costMs = pixels * kDirectNsPerPixel * 1e-6 * 0.3;
+            if (!directOn) d.reason = "the light is off";
+            decide(std::move(d), directOn && specularView / view > kNonDiffuseMinFraction);
+        }
+        {
+            EffectDecision d{.effect = "glossy"};
+            d.measurement = "larger of the view and light fractions on lobes at least glossy_split rough";
+            const double v = std::max(roughView / view, glossyAvailable ? roughLight / lightSamples : 0.0);
+            fraction(d, v, "view or light samples are on rough specular surfaces");
+            d.available = glossyAvailable;
+            d.costMs = d.available ? 2.0 * gatherMs * std::min(1.0, v * 4.0) : 0.0;
+            if (!indirectOn) d.reason = "the bounce is off";
+            if (!glossyAvailable) d.reason += "; the technique has no glossy VPL transport";
+            decide(std::move(d), indirectOn && glossyAvailable && v > kNonDiffuseMinFraction);
+        }
+        {
+            EffectDecision d{.effect = "env"};
+            d.measurement = "fraction of view samples on smooth specular surfaces outside planar mirrors";
+            fraction(d, smoothView / view, "view is smooth specular (environment probe)");
+            if (!directOn) d.reason = "the light is off";
+            decide(std::move(d), directOn && smoothView / view > kNonDiffuseMinFraction);
+        }
+        {
+            EffectDecision d{.effect = "mirrors"};
+            d.measurement = "fraction of view samples on planar mirrors";
+            fraction(d, mirrorView / view, "view is a planar mirror");
+            if (mirrorDepth == 0) d.reason = "mirror_depth is 0";
+            decide(std::move(d), mirrorDepth > 0 && mirrorView / view > kNonDiffuseMinFraction);
+        }
+    }
+
     // Multiresolution level limit: where the eye-space hierarchy should start refining.
     if (state.techniqueParams.has("coarsest_size")) decide(planCoarsestLevel(rays, state, plan.rays), true);
 
@@ -472,6 +567,12 @@ void applyEffectPlan(FrameState& state, const EffectPlan& plan) {
         } else if (d.effect == "occlusion") {
             if (state.techniqueParams.has("vpl_shadows"))
                 state.techniqueParams.set("vpl_shadows", d.enabled, "effect_occlusion");
+        } else if (d.effect == "specular" || d.effect == "glossy" || d.effect == "env" ||
+                   d.effect == "mirrors") {
+            // The renderer resolves these itself (render/Reflections); the plan narrows `auto` to
+            // what the view shows.
+            const std::string name = "effect_" + d.effect;
+            if (state.frameParams.has(name)) state.frameParams.set(name, d.enabled ? "on" : "off", "effects");
         } else if (d.effect == "levels") {
             if (state.techniqueParams.has("coarsest_size") && d.value >= 1.0)
                 state.techniqueParams.set("coarsest_size", static_cast<int>(d.value), "effects");

@@ -57,6 +57,9 @@ struct TechniqueInfo {
     std::string description; ///< one line
     std::string paper;       ///< seed paper and section
     ParamTable params;
+    /// Whether the technique carries glossy VPL transport with these parameters (FrameInputs::glossy;
+    /// docs/nondiffuse.md); empty for none. The planner reads it without creating the technique.
+    std::function<bool(const ParamSet&)> glossyTransport;
 };
 
 class Technique {
@@ -69,8 +72,9 @@ public:
                          Counters& counters) = 0;
     /// Linear RGB radiance to add to the direct light, or nullptr when the technique adds none.
     virtual const gl::Texture* indirect() const = 0;
-    /// True when execute() honours FrameInputs::glossy (docs/nondiffuse.md).
-    virtual bool glossyTransport() const { return false; }
+    /// True when execute() with these parameters honours FrameInputs::glossy (docs/nondiffuse.md);
+    /// overrides return what their TechniqueInfo::glossyTransport says.
+    virtual bool glossyTransport(const ParamSet& /*params*/) const { return false; }
 };
 
 struct TechniqueEntry {

@@ -20,6 +20,7 @@ static_assert(sizeof(FrameUniforms) == 2 * 64 + 8 * 16, "FrameUniforms layout dr
 static_assert(offsetof(FrameUniforms, lightViewProj) == 64);
 static_assert(offsetof(FrameUniforms, toneInfo) == 128 + 6 * 16);
 static_assert(sizeof(Vpl) == 48, "Vpl must be three vec4s in std140 and std430");
+static_assert(sizeof(VplGlossy) == 32, "VplGlossy must be two vec4s in std430");
 static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) <= 65536, "a VPL batch must fit the 64 KiB UBO limit");
 static_assert(sizeof(EyeHierarchyUniforms) == GIS_MAX_EYE_LEVELS * 16 + 2 * 16, "EyeHierarchyUniforms drifted");
 static_assert(offsetof(EyeHierarchyUniforms, info) == GIS_MAX_EYE_LEVELS * 16);

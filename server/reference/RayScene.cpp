@@ -230,6 +230,7 @@ SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const g
         return h;
     }
     const Mesh& mesh = m.source.meshes[static_cast<size_t>(meshIndex)];
+    h.mesh = meshIndex;
     const size_t base = static_cast<size_t>(raw.primId) * 3;
     const std::uint32_t last = static_cast<std::uint32_t>(mesh.positions.size() - 1);
     const std::uint32_t i0 = std::min(mesh.indices[base], last), i1 = std::min(mesh.indices[base + 1], last),
@@ -259,7 +260,12 @@ SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const g
         glm::vec3 c(mat.baseColor);
         if (mat.baseColorTexture >= 0 && static_cast<size_t>(mat.baseColorTexture) < m.textures.size())
             c *= sampleBilinear(m.textures[static_cast<size_t>(mat.baseColorTexture)], uv);
-        h.albedo = glm::clamp(sanitizePositive(c), 0.0f, 1.0f);
+        // materialBaseColor() / materialAlbedo() / materialF0() of material.glsl, via scene/Brdf.h.
+        const glm::vec3 baseColour = glm::clamp(sanitizePositive(c), 0.0f, 1.0f);
+        const auto finiteOr = [](float v, float fallback) { return std::isfinite(v) ? v : fallback; };
+        h.surface = brdf::surfaceFrom(baseColour, finiteOr(mat.metallic, 0.0f), finiteOr(mat.roughness, 1.0f),
+                                      finiteOr(mat.specular, 0.0f));
+        h.albedo = h.surface.diffuse; // == base when F0 = 0 (metallic 0, specular 0)
         h.emission = sanitizePositive(mat.emissive);
     }
     return h;

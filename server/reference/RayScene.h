@@ -1,6 +1,7 @@
 // Ray queries and surface shading data for the reference renderer: the scene's triangles in an Embree 3
 // BVH, plus the same material and normal rules as the GL pipeline (shaders/render/material.glsl), so a
-// hit here and a G-buffer / RSM texel there describe the same surface.
+// hit here and a G-buffer / RSM texel there describe the same surface: the same brdf::Surface
+// (scene/Brdf.h surfaceFrom() of the material and its textured base colour).
 #pragma once
 
 #include <cstdint>
@@ -9,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/Brdf.h"
 #include "scene/Scene.h"
 
 namespace gis::reference {
@@ -19,8 +21,15 @@ struct SurfaceHit {
     glm::vec3 position{0.0f};
     glm::vec3 geometricNormal{0.0f, 1.0f, 0.0f}; ///< unit, unoriented (triangle winding)
     glm::vec3 shadingNormal{0.0f, 1.0f, 0.0f};   ///< unit, unoriented (interpolated vertex normals)
-    glm::vec3 albedo{0.0f};                      ///< clamp(baseColor * texture, 0, 1)
-    glm::vec3 emission{0.0f};                    ///< >= 0, finite
+    /// Diffuse albedo rho_d = surface.diffuse (the G-buffer's gAlbedo): base (1 - metal) (1 - Favg) with
+    /// base = clamp(baseColor * texture, 0, 1); exactly the base colour for a Lambertian material
+    /// (metallic 0, specular 0, so F0 = 0).
+    glm::vec3 albedo{0.0f};
+    glm::vec3 emission{0.0f}; ///< >= 0, finite
+    /// The whole reflection model at this point (rho_d, F0, F90, alpha); Lambertian black without a
+    /// material.
+    brdf::Surface surface{};
+    int mesh = -1; ///< index into Scene::meshes, -1 when unresolved
 };
 
 /// Minimal ray record for the all-hits query: the surface is resolved only when needed.

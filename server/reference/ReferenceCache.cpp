@@ -18,7 +18,9 @@ namespace reference {
 
 // Bump when the renderer's output for the same request changes (estimators, epsilon, sampling), so old
 // cache files stop matching.
-constexpr const char* kKeyVersion = "gis-reference-1";
+// 2: non-diffuse materials (scene/Brdf.h: metallic, roughness, specular) and the frame parameters
+// specular_lobe and effect_specular.
+constexpr const char* kKeyVersion = "gis-reference-2";
 
 std::string sceneDigest(const Scene& scene) {
     Hasher h;
@@ -40,6 +42,7 @@ std::string sceneDigest(const Scene& scene) {
         h.value(m.baseColorTexture);
         h.value(m.metallic);
         h.value(m.roughness);
+        h.value(m.specular);
         h.value(m.emissive);
     }
     h.value(scene.textures.size());
@@ -77,12 +80,19 @@ std::string requestKey(const std::string& digest, const FrameState& state, const
     h.value(state.lightEnabled);
     h.value(state.width);
     h.value(state.height);
+    // The frame parameters the reflection model reads (ReferenceRenderer.cpp ShadingModel); a state
+    // without the frame table renders with the defaults, hashed as such.
+    const ParamSet& fp = state.frameParams;
+    h.text(fp.has("specular_lobe") ? fp.getEnum("specular_lobe") : std::string("ggx"));
+    // auto and on shade alike (ShadingModel), so only off changes the key.
+    h.value(fp.has("effect_specular") && fp.getEnum("effect_specular") == "off");
     h.text(options.mode);
     h.value(options.spp);
     h.value(options.timeBudgetSeconds);
     h.value(options.maxDepth);
     h.value(options.seed);
     h.value(options.jitter);
+    h.value(options.causticMinRoughness);
     return h.hex();
 }
 

@@ -1,9 +1,14 @@
 // Reference light transport: the estimators behind the modes documented in ReferenceRenderer.h.
 //
 // All modes share one receiver and one direct-light evaluation, so a difference between two modes is
-// exactly the indirect term. Indirect estimators cosine-sample the hemisphere at the receiver
-// (pdf = cos(theta_x) / pi), which cancels the cosine and the 1/pi of the Lambertian BRDF: a sample's
-// value is rho_x times the radiance arriving along the sampled direction.
+// exactly the indirect term. Surfaces reflect with scene/Brdf.h (the GL pipeline's model): direct light
+// is f(l, wo) E_d with the whole f (diffuse + the specular lobe, GGX or Phong by the frame parameter
+// specular_lobe). Indirect estimators at a Lambertian vertex cosine-sample the hemisphere
+// (pdf = cos(theta_x) / pi), which cancels the cosine and the 1/pi: a sample's value is rho_x times the
+// radiance arriving along the sampled direction (bit for bit the estimator of the Lambertian-only
+// renderer). At a vertex with a specular lobe they sample the BRDF (Sampling.h sampleBrdf(): diffuse or
+// specular lobe picked by their estimated albedos, weighed by the combined density), so a sample's value
+// is f cos / pdf times that radiance.
 #include "reference/ReferenceRenderer.h"
 
 #include <algorithm>
@@ -98,20 +103,44 @@ struct Vertex {
     SurfaceHit hit;
     glm::vec3 n{0.0f};  ///< shading normal on the shaded side
     glm::vec3 ng{0.0f}; ///< geometric normal on the same side (ray offsets, leaving-the-surface test)
+    glm::vec3 wo{0.0f}; ///< unit direction towards the previous vertex (the camera for a receiver)
 };
 
-Vertex orient(const SurfaceHit& hit, const glm::vec3& towards) {
+/// `wo` is the unit direction from the hit back along the ray that found it.
+Vertex orient(const SurfaceHit& hit, const glm::vec3& wo) {
     Vertex v;
     v.hit = hit;
-    v.n = facing(hit.shadingNormal, towards);
-    v.ng = facing(hit.geometricNormal, towards);
+    v.n = facing(hit.shadingNormal, wo);
+    v.ng = facing(hit.geometricNormal, wo);
+    v.wo = wo;
     return v;
 }
 
+/// How the frame parameters shape the reflection model (FrameState built without the frame table, as
+/// the unit tests do, gets the defaults: GGX, specular on).
+struct ShadingModel {
+    brdf::Lobe lobe = brdf::Lobe::Ggx;
+    /// effect_specular: the GL direct pass adds the specular lobe unless it is off (auto turns it on
+    /// exactly when some material has a specular lobe, and brdf::specular() is 0 for the others, so
+    /// auto and on shade alike). Off drops the specular lobe at every vertex here: the reference then
+    /// renders the scene with each surface's diffuse lobe rho_d only.
+    bool specular = true;
+
+    explicit ShadingModel(const FrameState& state) {
+        const ParamSet& fp = state.frameParams;
+        if (fp.has("specular_lobe") && fp.getEnum("specular_lobe") == "phong") lobe = brdf::Lobe::Phong;
+        if (fp.has("effect_specular") && fp.getEnum("effect_specular") == "off") specular = false;
+    }
+};
+
 class Integrator {
 public:
-    Integrator(const RayScene& rays, const LightModel& light, Mode mode, int maxDepth)
-        : mRays(rays), mLight(light), mMode(mode), mMaxDepth(maxDepth), mEps(rays.epsilon()) {}
+    Integrator(const RayScene& rays, const LightModel& light, const ShadingModel& shading, Mode mode,
+               int maxDepth, float causticMinRoughness)
+        : mRays(rays), mLight(light), mShading(shading), mMode(mode), mMaxDepth(maxDepth),
+          mEps(rays.epsilon()),
+          // alpha of that roughness; 0 keeps every caustic (alpha >= kMinAlpha > 0 is never below it)
+          mCausticMinAlpha(causticMinRoughness > 0.0f ? brdf::alphaFrom(causticMinRoughness) : 0.0f) {}
 
     /// Unit direction from p towards the light and the distance (infinite for directional); false when
     /// the direction is undefined (p at the light's position: digest S.4 case 1, contributes 0).
@@ -129,12 +158,15 @@ public:
         return true;
     }
 
-    /// E_d at p for the side of unit normal n: I c f max(0, n.l) / d^2 times a hard shadow ray.
-    glm::vec3 directIrradiance(const glm::vec3& p, const glm::vec3& n, const glm::vec3& ngRaw) const {
+    /// E_d at p for the side of unit normal n: I c f max(0, n.l) / d^2 times a hard shadow ray. `lOut`
+    /// receives the unit direction to the light when given.
+    glm::vec3 directIrradiance(const glm::vec3& p, const glm::vec3& n, const glm::vec3& ngRaw,
+                               glm::vec3* lOut = nullptr) const {
         if (!mLight.on) return glm::vec3(0.0f);
         glm::vec3 l;
         float dist = 0.0f;
         if (!toLight(p, l, dist)) return glm::vec3(0.0f);
+        if (lOut) *lOut = l;
         const float cosTheta = glm::dot(n, l);
         if (!(cosTheta > 0.0f)) return glm::vec3(0.0f);
         const float falloff = mLight.type == LightType::Directional ? 1.0f : 1.0f / (dist * dist);
@@ -148,9 +180,25 @@ public:
         return mLight.power * scale;
     }
 
-    /// Outgoing radiance of vertex v due to direct light: rho / pi * E_d.
-    glm::vec3 reflectedDirect(const Vertex& v) const {
-        return v.hit.albedo * kInvPi * directIrradiance(v.hit.position, v.n, v.hit.geometricNormal);
+    /// True when vertex v reflects through a specular lobe (its material has one and effect_specular is
+    /// not off).
+    bool specularAt(const Vertex& v) const { return mShading.specular && v.hit.surface.hasSpecular(); }
+
+    /// Outgoing radiance of vertex v towards v.wo due to direct light: f(l, wo) E_d, i.e. rho_d / pi E_d
+    /// (the Lambertian term, evaluated as before) plus the specular lobe's f_s(l, wo) E_d, as
+    /// spotReflected() in shaders/render/lighting.glsl.
+    /// `reachedAlpha`: the widest lobe (GGX alpha; 1 for a diffuse lobe) sampled on the path before v, 0
+    /// at the receiver. With causticMinRoughness > 0, v's specular lobe is left out when it is smoother
+    /// than that roughness AND narrower than reachedAlpha: a sharp lobe found by sampling a wider one
+    /// (a caustic, or a glossy-to-sharper-glossy path) is what a path tracer finds only by chance.
+    glm::vec3 reflectedDirect(const Vertex& v, float reachedAlpha = 0.0f) const {
+        glm::vec3 l(0.0f);
+        const glm::vec3 e = directIrradiance(v.hit.position, v.n, v.hit.geometricNormal, &l);
+        glm::vec3 radiance = v.hit.albedo * kInvPi * e;
+        const bool caustic = v.hit.surface.alpha < std::min(mCausticMinAlpha, reachedAlpha);
+        if (specularAt(v) && !caustic && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f))
+            radiance += brdf::specular(v.hit.surface, mShading.lobe, v.n, l, v.wo) * e;
+        return radiance;
     }
 
     /// One sample of the pixel's radiance for the camera ray (origin, dir, tfar).
@@ -177,30 +225,54 @@ public:
     }
 
 private:
-    /// Cosine-distributed direction around the shading normal, leaving x on its shaded side. Where
-    /// shading and geometric normals differ (smooth-shaded meshes) the lobe can dip below the geometric
-    /// surface by the angle a between them; such a direction is mirrored back above it rather than
-    /// dropped, so no energy is lost (the directional bias covers a probability of about a^2 / 4).
-    /// False only for a direction in the surface plane.
-    bool sampleBounce(const Vertex& x, Rng& rng, glm::vec3& w) const {
+    /// A bounce direction w leaving x on its shaded side and the sample's weight f cos / pdf (for a
+    /// Lambertian vertex exactly rho_d). False when the path ends here (nothing sampled, or zero weight).
+    ///
+    /// Lambertian vertex: cosine-distributed direction around the shading normal. Where shading and
+    /// geometric normals differ (smooth-shaded meshes) the lobe can dip below the geometric surface by
+    /// the angle a between them; such a direction is mirrored back above it rather than dropped, so no
+    /// energy is lost (the directional bias covers a probability of about a^2 / 4). False only for a
+    /// direction in the surface plane.
+    ///
+    /// Vertex with a specular lobe: Sampling.h sampleBrdf() (the density must stay exact there, so a
+    /// direction below the geometric surface is dropped instead: it loses a probability of about a^2 / 4
+    /// of the diffuse lobe and, for the specular lobe, the part of it past the geometric horizon).
+    bool sampleBounce(const Vertex& x, Rng& rng, glm::vec3& w, glm::vec3& weight,
+                      float* lobeAlpha = nullptr) const {
+        if (lobeAlpha) *lobeAlpha = 1.0f; // the diffuse lobe
+        if (specularAt(x)) {
+            const float uPick = rng.uniform();
+            const float u1 = rng.uniform();
+            const float u2 = rng.uniform();
+            reference::BrdfSample bs;
+            if (!reference::sampleBrdf(x.hit.surface, mShading.lobe, x.n, x.wo, uPick, u1, u2, bs))
+                return false;
+            w = bs.wi;
+            weight = bs.weight;
+            if (lobeAlpha && bs.specular) *lobeAlpha = x.hit.surface.alpha;
+            return glm::dot(w, x.ng) > 0.0f && (weight.x > 0.0f || weight.y > 0.0f || weight.z > 0.0f);
+        }
         const float u1 = rng.uniform();
         const float u2 = rng.uniform();
         w = unitOr(reference::sampleCosine(x.n, u1, u2), x.n);
         const float below = glm::dot(w, x.ng);
         if (below < 0.0f) w = unitOr(w - 2.0f * below * x.ng, x.ng);
+        weight = x.hit.albedo;
         return glm::dot(w, x.ng) > 0.0f;
     }
 
     // L_1 with visibility: the first surface y along w, seen from its x-facing side, reflects its direct
-    // light. Estimate: rho_x * L_r(y).
+    // light through its whole BRDF towards x. Estimate: (f_x cos / pdf) * L_r(y) (rho_x * L_r(y) for a
+    // Lambertian x).
     glm::vec3 oneBounce(const Vertex& x, Rng& rng) const {
-        glm::vec3 w;
-        if (!sampleBounce(x, rng, w)) return glm::vec3(0.0f);
+        glm::vec3 w, weight;
+        float lobeAlpha = 1.0f;
+        if (!sampleBounce(x, rng, w, weight, &lobeAlpha)) return glm::vec3(0.0f);
         SurfaceHit hit;
         if (!mRays.intersect(x.hit.position + x.ng * mEps, w, 0.0f, std::numeric_limits<float>::infinity(),
                              hit))
             return glm::vec3(0.0f);
-        return x.hit.albedo * reflectedDirect(orient(hit, -w));
+        return weight * reflectedDirect(orient(hit, -w), lobeAlpha);
     }
 
     // L_1 without visibility between x and y. Changing the area integral to directions at x turns
@@ -209,9 +281,13 @@ private:
     // ratio of y's shading to geometric cosine is taken as 1 (exact for flat-shaded meshes). Each y
     // still needs its own shadow ray to the light (it must be in the RSM). No 1/d^2 appears, so there
     // is no singularity where y approaches x.
+    // Specular surfaces: y reflects diffusely only (rho_y / pi E_d: the RSM's flux is the diffusely
+    // reflected flux, the VPL a diffuse emitter), while x gathers through its whole BRDF (a sample
+    // weighs f_x cos / pdf instead of rho_x), i.e. what the VPL gather converges to with the receiver's
+    // specular lobe and without the VPLs' own glossy lobes.
     glm::vec3 oneBounceUnoccluded(const Vertex& x, Rng& rng, std::vector<RawHit>& hits) const {
-        glm::vec3 w;
-        if (!sampleBounce(x, rng, w) || !mLight.on) return glm::vec3(0.0f);
+        glm::vec3 w, weight;
+        if (!sampleBounce(x, rng, w, weight) || !mLight.on) return glm::vec3(0.0f);
         const glm::vec3 origin = x.hit.position + x.ng * mEps;
         mRays.intersectAll(origin, w, 0.0f, std::numeric_limits<float>::infinity(), hits);
         glm::vec3 sum(0.0f);
@@ -224,24 +300,28 @@ private:
             if (!(glm::dot(nLight, -w) > 0.0f)) continue;        // x behind y's lit side
             sum += y.albedo * kInvPi * directIrradiance(y.position, nLight, y.geometricNormal);
         }
-        return x.hit.albedo * sum;
+        return weight * sum;
     }
 
     // Multi-bounce path: next-event estimation to the delta light at every vertex (the only way to reach
-    // it), emission where a bounce ray hits an emissive surface, Russian roulette from vertex
-    // kRouletteDepth on with survival probability min(max albedo, 0.95).
+    // it), emission where a bounce ray hits an emissive surface (reached by BRDF sampling only, so no
+    // MIS weight is needed), Russian roulette from vertex kRouletteDepth on with survival probability
+    // min(max weight, 0.95), the weight being this vertex's f cos / pdf (rho for a Lambertian vertex).
     glm::vec3 pathIndirect(const Vertex& first, Rng& rng) const {
         glm::vec3 radiance(0.0f);
         glm::vec3 throughput(1.0f);
         Vertex v = first;
+        float reachedAlpha = 0.0f; // widest lobe sampled so far
         for (int depth = 1; depth < mMaxDepth; ++depth) {
-            glm::vec3 w;
-            if (!sampleBounce(v, rng, w)) break;
-            throughput *= v.hit.albedo;
+            glm::vec3 w, weight;
+            float lobeAlpha = 1.0f;
+            if (!sampleBounce(v, rng, w, weight, &lobeAlpha)) break;
+            reachedAlpha = std::max(reachedAlpha, lobeAlpha);
+            throughput *= weight;
             if (depth >= kRouletteDepth) {
-                // Survival follows this vertex's albedo (not the accumulated throughput), so on grey
-                // surfaces the weight of a surviving path stays constant instead of jumping by 1/q.
-                const glm::vec3& a = v.hit.albedo;
+                // Survival follows this vertex's sample weight (not the accumulated throughput), so on
+                // grey surfaces the weight of a surviving path stays constant instead of jumping by 1/q.
+                const glm::vec3& a = weight;
                 const float survive = std::min(std::max({a.x, a.y, a.z}), 0.95f);
                 if (!(survive > 0.0f) || rng.uniform() >= survive) break;
                 throughput /= survive;
@@ -251,16 +331,18 @@ private:
                                  std::numeric_limits<float>::infinity(), hit))
                 break;
             v = orient(hit, -w);
-            radiance += throughput * (v.hit.emission + reflectedDirect(v));
+            radiance += throughput * (v.hit.emission + reflectedDirect(v, reachedAlpha));
         }
         return radiance;
     }
 
     const RayScene& mRays;
     const LightModel& mLight;
+    const ShadingModel& mShading;
     Mode mMode;
     int mMaxDepth;
     float mEps;
+    float mCausticMinAlpha;
 };
 
 void addSanitized(double* acc, const glm::vec3& c) {
@@ -282,6 +364,8 @@ void validateReferenceOptions(const ReferenceOptions& options) {
     if (options.maxDepth < 1 || options.maxDepth > 1024)
         throw InputError("max_depth", "must be in [1, 1024], got " + std::to_string(options.maxDepth));
     if (options.threads < 0) throw InputError("threads", "must be >= 0 (0 = all hardware threads)");
+    if (!(options.causticMinRoughness >= 0.0f && options.causticMinRoughness <= 1.0f))
+        throw InputError("caustic_min_roughness", "must be in [0, 1] (0 = every caustic)");
 }
 
 ReferenceRenderer::ReferenceRenderer(const Scene& scene)
@@ -310,7 +394,8 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
     const glm::dmat4 invViewProj =
         glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
     const LightModel light(state);
-    const Integrator integrator(*mRays, light, mode, options.maxDepth);
+    const ShadingModel shading(state);
+    const Integrator integrator(*mRays, light, shading, mode, options.maxDepth, options.causticMinRoughness);
 
     // A pixel-centre direct render has no random decision: one sample is the exact answer.
     const int target = (mode == Mode::Direct && !options.jitter) ? 1 : options.spp;

@@ -3,9 +3,9 @@
 // and a reference image differ only by the light transport.
 //
 // Notation: x a receiver (first hit of the camera ray through a pixel centre), n_x its shading normal
-// turned towards the camera, rho the Lambertian albedo, L_e emission, and for the light (position p_l,
-// intensity I in cd, colour c, spot factor f = t^2 with t = clamp((cos - cosOuter) / max(cosInner -
-// cosOuter, 1e-4), 0, 1), f = 1 for point lights) the direct irradiance
+// turned towards the camera, rho the diffuse albedo rho_d of scene/Brdf.h, L_e emission, and for the light
+// (position p_l, intensity I in cd, colour c, spot factor f = t^2 with t = clamp((cos - cosOuter) /
+// max(cosInner - cosOuter, 1e-4), 0, 1), f = 1 for point lights) the direct irradiance
 //     E_d(x) = I c f(x) max(0, n_x . l) / |p_l - x|^2 * V(x, p_l)       (0 when |p_l - x|^2 == 0).
 // Modes (the integral each estimates per pixel; L is outgoing radiance towards the camera):
 //  - "direct":                L = L_e(x) + rho_x / pi * E_d(x)
@@ -17,11 +17,15 @@
 //        converges to (rsm_gather with one VPL per RSM texel and min_distance 0).
 //  - "one-bounce":            direct + L_1 with the visibility V(x, y) inside the integral (the rendering
 //        equation truncated after one diffuse bounce of the light's direct illumination).
-//  - "path":                  the rendering equation for Lambertian surfaces, paths of up to maxDepth
+//  - "path":                  the rendering equation, paths of up to maxDepth
 //        surface vertices (1 = direct only), Russian roulette after vertex 3, next-event estimation
 //        to the (delta) light at every vertex, emission added where a path hits an emissive surface.
 // The one-bounce modes bounce the light source only: emissive surfaces are seen directly but do not
 // light other surfaces (as in the GL pipeline, whose VPLs come from the spotlight's RSM).
+//
+// Non-diffuse surfaces: every rho / pi above stands for the whole BRDF f(l, wo) of scene/Brdf.h (lobe
+// and specular switch from the frame parameters specular_lobe and effect_specular), and bounces sample
+// that BRDF (ReferenceRenderer.cpp, README.md); for Lambertian materials everything is as written.
 //
 // Sampling: one camera ray through each pixel centre per sample (GL's single raster sample), or a
 // uniformly jittered point in the pixel with `jitter` (box filter). Estimators are in README.md.
@@ -58,6 +62,15 @@ struct ReferenceOptions {
     std::uint64_t seed = 1;
     bool jitter = false; ///< box-filtered jitter inside each pixel instead of the pixel centre
     int threads = 0;     ///< 0 = all hardware threads
+    /// Caustic regularisation (perceptual roughness, [0, 1]; 0 = none, the unbiased default): at a bounce
+    /// vertex, the spotlight's reflection through a specular lobe smoother than this is left out when the
+    /// path found the vertex by sampling a wider lobe (diffuse, or a rougher specular one): paths
+    /// light -> sharp lobe -> wider lobe ... -> camera, e.g. caustics. A path tracer finds those for a
+    /// point light only by chance and they dominate its noise (README.md "Non-diffuse surfaces"); the
+    /// GL pipeline renders them only from lobes at least glossy_split rough (glossy VPLs), so glossy_split
+    /// is the matching value. Lobes seen from the camera, or through sharper ones (a mirror), keep their
+    /// highlights.
+    float causticMinRoughness = 0.0f;
 };
 
 struct ReferenceImage {
@@ -78,7 +91,8 @@ public:
     ReferenceRenderer(const ReferenceRenderer&) = delete;
     ReferenceRenderer& operator=(const ReferenceRenderer&) = delete;
 
-    /// Renders `state` (camera, light, lightEnabled, width, height; the parameter tables are ignored).
+    /// Renders `state` (camera, light, lightEnabled, width, height, and the frame parameters specular_lobe
+    /// and effect_specular; the rest of the parameter tables is ignored).
     /// `progress` is called after each pass with the samples per pixel and seconds so far.
     /// Throws InputError naming the option for bad options or sizes.
     /// "direct" without jitter is deterministic, so it stops after one sample (reported spp = 1).
@@ -97,7 +111,8 @@ std::vector<std::string> referenceModes();
 void validateReferenceOptions(const ReferenceOptions& options);
 
 /// Content hash (hex, 32 digits) of everything the image depends on: geometry, materials, textures,
-/// camera, light, size, mode, spp, time budget, seed, depth, jitter (not the thread count).
+/// camera, light, size, specular_lobe, effect_specular (off or not), mode, spp, time budget, seed, depth,
+/// jitter, causticMinRoughness (not the thread count).
 std::string referenceCacheKey(const Scene& scene, const FrameState& state, const ReferenceOptions& options);
 
 /// Writes an RGB float EXR with metadata gis:mode, gis:spp, gis:seconds, gis:key (atomic: temp + rename).

@@ -50,7 +50,7 @@ const ParamTable& frameParamTable() {
         {.name = "mirror_blur", .type = ParamType::Enum, .defaultValue = 0,
          .help = "on: blur each planar reflection by its material's roughness and the reflected distance "
                  "(004 §5.1.1); off: sharp",
-         .source = "004 §5.1.1", .options = {"on", "off"}},
+         .source = "004 §5.1.1", .options = {"off", "on"}},
         // Effect planning (analysis/EffectPlan.h, docs/effects.md). `manual` is the default so every
         // technique's parameters, and so the default images, stay as they were; `auto` lets the planner
         // switch off effects the scene and view do not call for. The renderer ignores these knobs: the

@@ -84,8 +84,23 @@ glm::mat4 FrameRenderer::lightViewProj(const Light& light, const Bounds& bounds,
     glm::mat4 view = glm::lookAt(light.position, light.position + dir, upFor(dir, {0, 1, 0}));
     float half = std::clamp(light.outerConeAngle, 0.01f, kMaxLightHalfFov);
     if (tanHalfFov) *tanHalfFov = std::tan(half);
-    float reach = glm::length(bounds.center() - light.position) + bounds.radius() * 1.5f + 1.0f;
-    float znear = std::max(reach * 1e-3f, 1e-3f);
+    // Scale-relative frustum (digest S.4 case 14): every term is a distance to the scene's bounds, so a
+    // scene scaled by s gets the same frustum scaled by s (absolute terms, a 1 m margin and a 1 mm near
+    // plane, clipped the geometry next to the light of a millimetre-scale scene).
+    const glm::vec3 lo = glm::min(bounds.min, bounds.max), hi = glm::max(bounds.min, bounds.max);
+    const float extent = glm::length(hi - lo);
+    float farthest = 0.0f;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 corner((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+        farthest = std::max(farthest, glm::length(corner - light.position));
+    }
+    const float nearest = glm::length(glm::clamp(light.position, lo, hi) - light.position);
+    // Far plane: past the farthest bounds corner by 5% of the extent (room for the shadow lookup's
+    // normal offset). Near plane: half the way to the bounds for a light outside them, else 1e-3 of the
+    // far plane (geometry closer to a light inside the bounds than that is clipped).
+    float reach = farthest * 1.001f + 0.05f * extent;
+    if (!(reach > 0.0f) || !std::isfinite(reach)) reach = 1.0f; // no bounds, or a light on a point scene
+    const float znear = std::max(0.5f * nearest, reach * 1e-3f);
     return glm::perspective(2.0f * half, 1.0f, znear, reach) * view;
 }
 
@@ -188,7 +203,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     ensureTargets(state.width, state.height, rsmSize, fp.getInt("shadow_map_size"));
     ensureTechnique(state.technique, state.width, state.height);
     const Reflections::Decision nonDiffuse =
-        mReflections.decide(*mScene, *mSceneGpu, fp, mTechnique->glossyTransport());
+        mReflections.decide(*mScene, *mSceneGpu, fp, mTechnique->glossyTransport(state.techniqueParams));
 
     // Frame uniforms.
     shader::FrameUniforms u{};

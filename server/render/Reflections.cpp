@@ -20,7 +20,9 @@ brdf::Surface materialSurface(const Material& m) {
     return brdf::surfaceFrom(m, glm::vec3(m.baseColor));
 }
 
-std::string count(int n, const char* what) { return std::to_string(n) + " " + what; }
+std::string count(int n, const char* what) {
+    return std::to_string(n) + " " + what;
+}
 
 } // namespace
 
@@ -47,7 +49,8 @@ std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughnes
             if (!(twice > 0.0) || !std::isfinite(twice)) continue;
             // Orient each triangle's normal like its vertex normals, so mixed windings add up.
             glm::dvec3 tn = cr / twice;
-            if (!mesh.normals.empty() && glm::dot(glm::dvec3(mesh.normals[mesh.indices[t]]), tn) < 0.0) tn = -tn;
+            if (!mesh.normals.empty() && glm::dot(glm::dvec3(mesh.normals[mesh.indices[t]]), tn) < 0.0)
+                tn = -tn;
             nsum += tn * (0.5 * twice);
             csum += (a + b + c) / 3.0 * (0.5 * twice);
             area += 0.5 * twice;
@@ -77,9 +80,11 @@ std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughnes
         c.area = static_cast<float>(area);
         found.push_back(c);
     }
-    std::stable_sort(found.begin(), found.end(), [](const Candidate& a, const Candidate& b) { return a.area > b.area; });
+    std::stable_sort(found.begin(), found.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.area > b.area; });
     std::vector<MirrorPlane> out;
-    for (size_t i = 0; i < found.size() && i < static_cast<size_t>(kMaxMirrors); ++i) out.push_back(found[i].plane);
+    for (size_t i = 0; i < found.size() && i < static_cast<size_t>(kMaxMirrors); ++i)
+        out.push_back(found[i].plane);
     return out;
 }
 
@@ -117,8 +122,10 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
             if (!materialSurface(scene.materials[i]).hasSpecular()) continue;
             ++specularMaterials;
             if (!usedByOther[i]) continue;
-            if (scene.materials[i].roughness < split || !techniqueHasGlossy) ++smooth;
-            else ++rough;
+            if (scene.materials[i].roughness < split || !techniqueHasGlossy)
+                ++smooth;
+            else
+                ++rough;
         }
     }
     Decision d;
@@ -150,7 +157,7 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
             d.env, "env");
     const bool mirrorsWanted = !mMirrors.empty() && mirrorDepth > 0;
     resolve("effect_mirrors", mirrorsWanted,
-            mMirrors.empty() ? "no flat, smooth metallic mesh"
+            mMirrors.empty()   ? "no flat, smooth metallic mesh"
             : mirrorDepth == 0 ? "mirror_depth=0 (the environment probe shades them)"
                                : count(static_cast<int>(mMirrors.size()), "planar mirrors"),
             d.mirrors, "mirrors");
@@ -177,6 +184,7 @@ const gl::Texture* Reflections::execute(const Decision& d, ReflectionInputs in, 
     const float zero[4] = {0, 0, 0, 0};
     glClearNamedFramebufferfv(mOutputFbo.id(), GL_COLOR, 0, zero);
     in.mirrors = &mMirrors;
+    in.mirrorPass = d.mirrors;
     if (d.env) {
         if (!mEnv) mEnv = std::make_unique<EnvProbe>();
         mEnv->execute(in, fp, mOutputFbo, timer, counters);

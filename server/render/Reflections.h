@@ -33,11 +33,11 @@ struct FrameUniforms;
 
 /// A planar mirror: a flat mesh with a smooth metallic material.
 struct MirrorPlane {
-    int mesh = -1;                        ///< index into Scene::meshes
-    glm::vec3 point{0.0f};                ///< a point of the plane (m): the mesh's centroid
-    glm::vec3 normal{0.0f, 1.0f, 0.0f};   ///< unit; the side the mesh's vertex normals face
-    glm::vec3 f0{1.0f};                   ///< reflectance at normal incidence
-    float roughness = 0.0f;               ///< the material's, for the optional glossy blur
+    int mesh = -1;                      ///< index into Scene::meshes
+    glm::vec3 point{0.0f};              ///< a point of the plane (m): the mesh's centroid
+    glm::vec3 normal{0.0f, 1.0f, 0.0f}; ///< unit; the side the mesh's vertex normals face
+    glm::vec3 f0{1.0f};                 ///< reflectance at normal incidence
+    float roughness = 0.0f;             ///< the material's, for the optional glossy blur
 };
 
 /// Which meshes of `scene` are planar mirrors: material metallic >= 0.9 and roughness <=
@@ -64,6 +64,9 @@ struct ReflectionInputs {
     /// Env reflections apply to covered, non-mirror pixels with a specular lobe and roughness below
     /// this (1.01 when the technique has no glossy transport, so every glossy pixel gets one).
     float envMaxRoughness = 0.35f;
+    /// True when the planar-mirror pass shades the mirror pixels (gNormal.w > 0); otherwise the
+    /// environment probe shades them too (mirror_depth=0, effect_mirrors=off).
+    bool mirrorPass = false;
 };
 
 class EnvProbe;

@@ -14,6 +14,7 @@ uniform vec3 uEye; // the viewpoint (m): probe centre or mirrored camera
 
 layout(location = 0) out vec4 outRadiance; // rgb linear radiance, a = 1 covered
 layout(location = 1) out vec4 outPosition; // xyz world position (m), w = 1 covered
+layout(location = 2) out vec4 outMirror;   // x planar-mirror index + 1 (0 none); only mirrored views attach it
 
 void main() {
     vec3 toEye = uEye - vWorldPos;
@@ -26,4 +27,5 @@ void main() {
                     spotReflected(vWorldPos, n, materialAlbedo(vTexcoord), spec, v, gFrame.shadingInfo.z > 0.5);
     outRadiance = vec4(max(sanitize(radiance), vec3(0.0)), 1.0);
     outPosition = vec4(vWorldPos, 1.0);
+    outMirror = vec4(float(uMirrorId), 0.0, 0.0, 1.0);
 }

@@ -28,4 +28,10 @@ struct Vpl {
     vec4 flux;      // rgb: reflected flux (W, in the renderer's intensity units); w: texels merged
 };
 
+// Glossy data of a grid VPL (glossy VPL transport, docs/nondiffuse.md), indexed like the Vpl buffer.
+struct VplGlossy {
+    vec4 specular;  // rgb: F0 of the VPL's centre texel; a: its perceptual roughness
+    vec4 incident;  // rgb: flux arriving on the cell's valid texels (W, before any albedo); a: 1 when the VPL has a specular lobe
+};
+
 #endif

@@ -62,6 +62,8 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
     counters["vpl_count"] = mCount;
     const GLsizeiptr bytes = static_cast<GLsizeiptr>(std::max(mCount, 1)) * sizeof(shader::Vpl);
     if (mVpls.size() < bytes) mVpls = gl::Buffer::create(bytes);
+    const GLsizeiptr glossyBytes = static_cast<GLsizeiptr>(std::max(mCount, 1)) * sizeof(shader::VplGlossy);
+    if (mGlossy.size() < glossyBytes) mGlossy = gl::Buffer::create(glossyBytes);
     if (mCount == 0) return 0;
 
     timer.begin("vpl_extract");
@@ -71,7 +73,9 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
     glBindTextureUnit(0, in.rsmPosition->id());
     glBindTextureUnit(1, in.rsmNormal->id());
     glBindTextureUnit(2, in.rsmFlux->id());
+    glBindTextureUnit(3, in.rsmSpecular ? in.rsmSpecular->id() : 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mGlossy.id());
     glDispatchCompute(static_cast<GLuint>((mCount + 63) / 64), 1, 1);
     glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     timer.end();

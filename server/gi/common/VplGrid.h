@@ -44,6 +44,8 @@ public:
     /// the pass "vpl_extract" and the counter "vpl_count". Returns the VPL count.
     int extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Counters& counters);
     const gl::Buffer& buffer() const { return mVpls; }
+    /// The VPLs' glossy data (shader::VplGlossy), indexed like buffer().
+    const gl::Buffer& glossyBuffer() const { return mGlossy; }
     int count() const { return mCount; }
     /// Binds the VPLs batch by batch (GIS_MAX_VPLS_PER_BATCH each) at GIS_UBO_VPLS and calls
     /// `draw(batchCount)` for each batch. Returns the number of batches.
@@ -52,6 +54,7 @@ public:
 private:
     gl::Program mExtract;
     gl::Buffer mVpls;
+    gl::Buffer mGlossy;
     int mCount = 0;
 };
 

@@ -62,8 +62,11 @@ TechniqueInfo MultiresSplat::info() {
                              "unrefined and counted",
                      .source = "000 Table 1 (N/A entries: excessive memory)",
                      .logScale = true});
+    // Glossy transport needs per-VPL (illumination) refinement: the geometry list splats irradiance,
+    // correct for diffuse receivers only.
     return {"multires_splat", "iteratively refined subsplats splatted from grid VPLs, upsampled", "000 §3",
-            ParamTable(std::move(specs))};
+            ParamTable(std::move(specs)),
+            [](const ParamSet& params) { return params.getEnum("refinement") == "illumination"; }};
 }
 
 MultiresSplat::MultiresSplat() {
@@ -179,6 +182,19 @@ void MultiresSplat::ensureCapacity(GLuint items) {
     mCapacity = items;
 }
 
+bool MultiresSplat::glossyTransport(const ParamSet& params) const {
+    return info().glossyTransport(params);
+}
+
+void MultiresSplat::bindGlossy(const gl::Program& program, const FrameInputs& in, bool perVpl) const {
+    const bool glossy = perVpl && in.glossy && in.gSpecular != nullptr;
+    glUniform1i(program.uniform("uGlossy"), glossy ? 1 : 0);
+    glUniform1f(program.uniform("uGlossyMinRoughness"), in.glossyMinRoughness);
+    if (!glossy) return;
+    glBindTextureUnit(14, in.gSpecular->id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mVpls.glossyBuffer().id());
+}
+
 void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                             Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
@@ -195,7 +211,15 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     const EyeLevel& coarsest = mEye.levels().back();
 
     timer.begin("subsplat_refine");
-    const shader::SubsplatCounters zero{};
+    shader::SubsplatCounters zero{};
+    long long seedWanted = 0;
+    if (vplCount > 0 && !feedback) {
+        seedWanted = static_cast<long long>(coarsest.width) * coarsest.height * (perVpl ? vplCount : 1);
+        // Seed items beyond the int range the seed pass indexes are dropped and reported like the
+        // list cap's (counts.w), never silently.
+        zero.counts.w =
+            static_cast<GLuint>(std::min<long long>(std::max(seedWanted - (1LL << 30), 0LL), ~0u));
+    }
     mCounters.upload(0, sizeof zero, &zero);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, mCounters.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.buffer().id());
@@ -208,8 +232,6 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     if (vplCount > 0 && feedback) {
         refineWithFeedback(in, counters);
     } else if (vplCount > 0) {
-        const long long seedWanted =
-            static_cast<long long>(coarsest.width) * coarsest.height * (perVpl ? vplCount : 1);
         const int seedItems = static_cast<int>(std::min<long long>(seedWanted, 1 << 30));
         // The seed fills the "next" list; each level then advances (next -> input, indirect
         // dispatch size) and refines.
@@ -219,8 +241,11 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
         glUniform1i(mSeed.uniform("uItems"), seedItems);
         glUniform1ui(mSeed.uniform("uCapacity"), mCapacity);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, next->id());
-        glDispatchCompute(static_cast<GLuint>((seedItems + GIS_SUBSPLAT_GROUP - 1) / GIS_SUBSPLAT_GROUP), 1,
-                          1);
+        // 2D: coarsest texels x VPLs / 64 exceeds GL_MAX_COMPUTE_WORK_GROUP_COUNT's guaranteed 65535 in
+        // one dimension at 128^2 VPLs (GL_INVALID_VALUE and no light before this was split).
+        const GLuint groups = static_cast<GLuint>((seedItems + GIS_SUBSPLAT_GROUP - 1) / GIS_SUBSPLAT_GROUP);
+        const GLuint groupsX = std::min<GLuint>(groups, GIS_SUBSPLAT_MAX_GROUPS_X);
+        glDispatchCompute(groupsX, groupsX > 0 ? (groups + groupsX - 1) / groupsX : 1, 1);
 
         glUseProgram(mRefine.id());
         glUniform1ui(mRefine.uniform("uCapacity"), mCapacity);
@@ -231,6 +256,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
         setVplClamp(mRefine, params);
         glUniform1f(mRefine.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
         glUniform1f(mRefine.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
+        bindGlossy(mRefine, in, perVpl);
         glUseProgram(mAdvance.id());
         glUniform1i(mAdvance.uniform("uMode"), 0);
         glUniform1ui(mAdvance.uniform("uCapacity"), mCapacity);
@@ -267,6 +293,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
         setVplClamp(splat, params);
         glUniform1f(splat.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
         glUniform1f(splat.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
+        bindGlossy(splat, in, perVpl);
         mEye.beginIlluminationPass(in, false); // every list item is a receiver: no stencil
         if (feedback) {
             glBindVertexArray(mItemVao.id());

@@ -27,6 +27,9 @@
 // same lists, one pass per level. Measured on llvmpipe, feedback refinement took 2.9 ms against
 // 5.2 ms at 512^2 (1.5 vs 2.3 at 256^2), though it waits on a query for the splat counts.
 //
+// Glossy transport (FrameInputs::glossy, refinement=illumination only): the materials' lobes replace
+// the phong_* knobs, so illumination-driven refinement follows real glossy highlights (000 Fig. 6).
+//
 // Limits: no indirect visibility; the geometry list is correct for diffuse receivers only (000
 // §3.3); per-VPL refinement point-samples the children, so sharp highlights between the samples are
 // missed (000 §3.3.1); the receiver set must equal multires_gather's (tested).
@@ -51,12 +54,16 @@ public:
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
     const gl::Texture* indirect() const override { return &mIndirect.texture; }
+    /// Glossy transport needs per-VPL (illumination) refinement: the geometry list splats
+    /// irradiance, correct for diffuse receivers only.
+    bool glossyTransport(const ParamSet& params) const override;
 
     EyeHierarchy& hierarchy() { return mEye; }
     /// Test hook: the last frame's splat list as sorted (level, x, y) triples (geometry refinement).
     std::vector<std::array<int, 3>> readSplatPatches() const;
 
 private:
+    void bindGlossy(const gl::Program& program, const FrameInputs& in, bool perVpl) const;
     void ensureCapacity(GLuint items);
     void ensureFeedbackLists();
     void refineWithFeedback(const FrameInputs& in, Counters& counters);

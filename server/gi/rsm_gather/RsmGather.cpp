@@ -15,7 +15,7 @@ std::vector<ParamSpec> withShadows(std::vector<ParamSpec> specs) {
 
 TechniqueInfo RsmGather::info() {
     return {"rsm_gather", "full-resolution gather from VPLs on a regular RSM grid", "000 §3, Eq. 2",
-            ParamTable(withShadows(vplParamSpecs(VplKernel::Point)))};
+            ParamTable(withShadows(vplParamSpecs(VplKernel::Point))), [](const ParamSet&) { return true; }};
 }
 
 TechniqueInfo RsmGather::ssbcInfo() {
@@ -28,7 +28,7 @@ TechniqueInfo RsmGather::ssbcInfo() {
         if (s.name == "ssbc_iterations") s.defaultValue = 1;
     }
     return {"ssbc", "clamped grid-VPL gather (K3) with screen-space bias compensation", "002 §3-4",
-            ParamTable(std::move(specs))};
+            ParamTable(std::move(specs)), [](const ParamSet&) { return true; }};
 }
 
 RsmGather::RsmGather() {
@@ -60,6 +60,13 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         glBindTextureUnit(0, in.gPosition->id());
         glBindTextureUnit(1, in.gNormal->id());
         glBindTextureUnit(2, in.gAlbedo->id());
+        const bool glossy = in.glossy && in.gSpecular != nullptr;
+        glUniform1i(gather.uniform("uGlossy"), glossy ? 1 : 0);
+        glUniform1f(gather.uniform("uGlossyMinRoughness"), in.glossyMinRoughness);
+        if (glossy) {
+            glBindTextureUnit(3, in.gSpecular->id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mVpls.glossyBuffer().id());
+        }
         glBindVertexArray(mEmptyVao.id());
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);

@@ -20,7 +20,10 @@
 //   clamp_b, ssbc_*  K3 clamp and bias compensation (BiasCompensation.h), off by default; the
 //                 `ssbc` preset (002) is this pipeline with clamp_b 10 and ssbc_iterations 1
 //
-// Limits: no indirect visibility (light leaks behind occluders, as in 000/001); VPLs are diffuse;
+// Glossy transport (FrameInputs::glossy, docs/nondiffuse.md): VPLs and receivers on specular surfaces
+// at least glossy_split rough add their specular lobes (gi/common/vpl_glossy.glsl).
+//
+// Limits: no indirect visibility (light leaks behind occluders, as in 000/001); smooth VPLs are diffuse;
 // grid sampling ignores flux (000 suggests importance sampling as future work).
 #pragma once
 
@@ -44,6 +47,7 @@ public:
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                  Counters& counters) override;
     const gl::Texture* indirect() const override { return &mIndirect.texture; }
+    bool glossyTransport(const ParamSet&) const override { return true; }
 
 private:
     VplGrid mVpls;

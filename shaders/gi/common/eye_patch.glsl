@@ -7,6 +7,7 @@ layout(binding = 13) uniform sampler2D uAtlasAlbedo;   // rgb mean albedo
 struct EyePatch {
     vec3 position, normal, albedo;
     float covered; // pixels of the patch that see geometry
+    ivec2 pixel;   // the full-resolution pixel at the patch's centre (its material sample)
 };
 
 EyePatch eyePatch(int level, ivec2 t) {
@@ -17,6 +18,7 @@ EyePatch eyePatch(int level, ivec2 t) {
         p.normal = texelFetch(gNormal, t, 0).xyz;
         p.albedo = texelFetch(gAlbedo, t, 0).rgb;
         p.covered = pos.w > 0.5 ? 1.0 : 0.0;
+        p.pixel = t;
     } else {
         ivec2 a = eyeAtlas(level, t);
         vec4 pos = texelFetch(uAtlasPosition, a, 0);
@@ -24,6 +26,7 @@ EyePatch eyePatch(int level, ivec2 t) {
         p.normal = texelFetch(uAtlasNormal, a, 0).xyz;
         p.albedo = texelFetch(uAtlasAlbedo, a, 0).rgb;
         p.covered = pos.w;
+        p.pixel = min((t << level) + ivec2((1 << level) / 2), ivec2(gFrame.viewport.xy) - 1);
     }
     return p;
 }

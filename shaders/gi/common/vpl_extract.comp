@@ -10,9 +10,13 @@ layout(local_size_x = 64) in;
 layout(binding = 0) uniform sampler2D gRsmPosition;
 layout(binding = 1) uniform sampler2D gRsmNormal;
 layout(binding = 2) uniform sampler2D gRsmFlux;
+layout(binding = 3) uniform sampler2D gRsmSpecular; // rgb F0, a roughness (0 when unbound)
 
 layout(std430, binding = 0) writeonly buffer VplOut {
     Vpl gVplsOut[];
+};
+layout(std430, binding = 1) writeonly buffer VplGlossyOut {
+    VplGlossy gVplGlossyOut[];
 };
 
 uniform int uGrid;     // VPLs per side
@@ -27,6 +31,7 @@ void main() {
     ivec2 centre = (lo + hi) / 2;
 
     vec3 flux = vec3(0.0);
+    vec3 incident = vec3(0.0); // rsm.frag's flux before the albedo: colour x I x spot x solid angle
     float texels = 0.0;
     float area = 0.0;
     ivec2 best = ivec2(-1);
@@ -41,7 +46,11 @@ void main() {
             flux += max(sanitize(texelFetch(gRsmFlux, t, 0).rgb), vec3(0.0));
             texels += 1.0;
             vec3 v = p.xyz - gFrame.lightPos.xyz;
-            area += rsmTexelSolidAngle(vec2(t) + 0.5) * dot(v, v);
+            float omega = rsmTexelSolidAngle(vec2(t) + 0.5);
+            area += omega * dot(v, v);
+            float v2 = dot(v, v);
+            vec3 fromLight = v2 > 1e-20 ? v * inversesqrt(v2) : gFrame.lightDir.xyz;
+            incident += max(sanitize(gFrame.lightColor.rgb * (gFrame.lightPos.w * spotFactor(fromLight) * omega)), vec3(0.0));
             ivec2 d = t - centre;
             int dist = d.x * d.x + d.y * d.y;
             if (dist < bestDist) {
@@ -50,6 +59,9 @@ void main() {
             }
         }
 
+    VplGlossy g;
+    g.specular = vec4(0.0);
+    g.incident = vec4(0.0);
     Vpl v;
     if (best.x < 0) {
         v.position = vec4(0.0);
@@ -61,6 +73,11 @@ void main() {
         if (any(isnan(n)) || any(isinf(n))) n = normalize(gFrame.lightPos.xyz - v.position.xyz); // faces the light
         v.normal = vec4(n, area);
         v.flux = vec4(flux, texels);
+        vec4 spec = texelFetch(gRsmSpecular, best, 0);
+        bool specular = clamp(50.0 * 0.33 * (spec.r + spec.g + spec.b), 0.0, 1.0) > 0.0;
+        g.specular = spec;
+        g.incident = vec4(incident, specular ? 1.0 : 0.0);
     }
     gVplsOut[index] = v;
+    gVplGlossyOut[index] = g;
 }

@@ -37,8 +37,7 @@ bool childCovered(int level, ivec2 c) {
 // splatted when the test passes) joins the comparison, so a patch whose children happen to agree
 // (e.g. all unlit) but whose mean geometry straddles an edge is still refined.
 bool illuminationDiffers(uint vpl, ivec2 t) {
-    Vpl v = gVpls[vpl];
-    vec3 own = splatContribution(v, eyePatch(uLevel, t));
+    vec3 own = splatContribution(vpl, eyePatch(uLevel, t));
     vec3 lo = own, hi = own;
     int children = 0;
     float footprint = 0.0, covered = 0.0;
@@ -50,12 +49,27 @@ bool illuminationDiffers(uint vpl, ivec2 t) {
             EyePatch p = eyePatch(uLevel - 1, c);
             covered += p.covered;
             if (p.covered <= 0.0) continue;
-            vec3 l = splatContribution(v, p);
+            vec3 l = splatContribution(vpl, p);
             lo = min(lo, l);
             hi = max(hi, l);
             ++children;
         }
     if (covered < footprint) return true; // object / background edge: never light the background
+    if (children > 0 && all(equal(hi, vec3(0.0)))) {
+        // Every sample receives exactly 0. That is a cutoff (the VPL's tangent plane, or the
+        // receiver's facing), conclusive for the whole patch only when the patch is one continuous
+        // surface (the eye hierarchy's geometric refine flag is clear: mean normals of a patch across
+        // a crease may face away while one side is lit) and its mean lies farther behind either plane
+        // than the patch's extent (generously 4 x its width, for slanted views). Otherwise refine:
+        // zero-sampled patches held 1.4% of the light at T -> 0 (digest S.4 case 13).
+        if ((texelFetch(uFlags, eyeAtlas(uLevel, t), 0).r & GIS_EYE_FLAG_REFINE) != 0u) return true;
+        EyePatch self = eyePatch(uLevel, t);
+        Vpl v = gVpls[vpl];
+        float extent = 4.0 * float(1 << uLevel) * eyePixelFootprint(self.position);
+        float behindVpl = -dot(v.normal.xyz, self.position - v.position.xyz);
+        float behindReceiver = -dot(self.normal, v.position.xyz - self.position);
+        return !(behindVpl > extent || behindReceiver > extent);
+    }
     return children > 0 && any(greaterThan(hi - lo, vec3(uIllumThreshold)));
 }
 
@@ -70,11 +84,20 @@ void splat(uvec2 item) {
 }
 
 void main() {
-    uint index = gl_GlobalInvocationID.x;
+    uint index = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * GIS_SUBSPLAT_GROUP +
+                 gl_LocalInvocationID.x; // 2D dispatches of long lists (see advance.comp)
     if (index >= min(gCounters.counts.x, uCapacity)) return;
     uvec2 item = gIn[index];
     ivec2 t = patchTexel(item.y);
     bool refine = false;
+    // The next list is already full (a subsplat explosion, e.g. 128^2 VPLs with per-VPL lists): no
+    // child would fit, so skip the refinement test and splat the item as capped. A racy read of a
+    // counter that only shrinks by the hand-back below: at worst an item is tested needlessly.
+    if (uLevel > 0 && gCounters.counts.y + 4u > uCapacity) {
+        splat(item);
+        atomicAdd(gCounters.counts.w, 1u);
+        return;
+    }
     if (uLevel > 0) {
         if (uPerVpl != 0) refine = illuminationDiffers(item.x, t);
         else refine = (texelFetch(uFlags, eyeAtlas(uLevel, t), 0).r & GIS_EYE_FLAG_REFINE) != 0u;

@@ -13,5 +13,5 @@ layout(location = 0) out vec4 outLight; // rgb added by blending; alpha 1 marks 
 
 void main() {
     EyePatch p = eyePatch(patchLevel(vPatch), patchTexel(vPatch));
-    outLight = vec4(max(sanitize(splatContribution(gVpls[vVpl], p)), vec3(0.0)), 1.0);
+    outLight = vec4(max(sanitize(splatContribution(vVpl, p)), vec3(0.0)), 1.0);
 }

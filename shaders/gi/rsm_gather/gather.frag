@@ -1,14 +1,19 @@
 #version 450 core
 // Full-resolution gather (digest S.3 preset rsm_naive, receivers R0): every covered pixel sums the
 // irradiance of every VPL in the current batch. Batches are accumulated with additive blending.
+// With glossy transport on (uGlossy), each VPL's specular lobe and the pixel's are added
+// (gi/common/vpl_glossy.glsl).
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
 #define GIS_VPL_SHADOW_LOOKUP 1
 #include "gi/common/vpl_shadow.glsl"
+#include "render/brdf.glsl"
+#include "gi/common/vpl_glossy.glsl"
 
 layout(binding = 0) uniform sampler2D gPosition;
 layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gAlbedo;
+layout(binding = 3) uniform sampler2D gSpecular; // rgb F0, a roughness
 
 layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
     Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
@@ -29,10 +34,28 @@ void main() {
     }
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     vec3 e = vec3(0.0);
+    vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
+    if (uGlossy == 0) {
+        for (int i = 0; i < uVplCount; ++i) {
+            Vpl v = gVpls[i];
+            e += vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vplVisibility(uVplFirst + i, v.position.xyz, pos.xyz, n);
+        }
+        outRadiance = vec4(max(sanitize(albedo * kInvPi * e), vec3(0.0)), 1.0);
+        return;
+    }
+    vec4 spec = texelFetch(gSpecular, px, 0);
+    bool glossyReceiver = glossyLobe(spec);
+    vec3 toEye = gFrame.cameraPos.xyz - pos.xyz;
+    float e2 = dot(toEye, toEye);
+    vec3 wo = e2 > 1e-20 ? toEye * inversesqrt(e2) : n;
+    vec3 eExtra = vec3(0.0), lGlossy = vec3(0.0);
     for (int i = 0; i < uVplCount; ++i) {
         Vpl v = gVpls[i];
-        e += vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vplVisibility(uVplFirst + i, v.position.xyz, pos.xyz, n);
+        float vis = vplVisibility(uVplFirst + i, v.position.xyz, pos.xyz, n);
+        vec3 ei = vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vis;
+        e += ei;
+        vplGlossyAccumulate(v, gVplGlossy[uVplFirst + i], ei, vis, uMinDistance, pos.xyz, n, wo, spec, glossyReceiver,
+                            eExtra, lGlossy);
     }
-    vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
-    outRadiance = vec4(max(sanitize(albedo * kInvPi * e), vec3(0.0)), 1.0);
+    outRadiance = vec4(max(sanitize(albedo * kInvPi * (e + eExtra) + lGlossy), vec3(0.0)), 1.0);
 }

@@ -24,7 +24,23 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
 
 TEST(BuiltinScenes, NamesList) {
     EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{"cornell", "cornell-empty", "cornell-dense",
-                                                             "crease", "cornell-black"}));
+                                                             "crease", "cornell-black", "gallery"}));
+}
+
+TEST(BuiltinScenes, GalleryHasEachNonDiffuseMaterial) {
+    const Scene g = makeBuiltinScene("gallery");
+    auto material = [&](const std::string& mesh) -> const Material& {
+        for (const Mesh& m : g.meshes)
+            if (m.name == mesh) return g.materials[static_cast<size_t>(m.material)];
+        ADD_FAILURE() << "no mesh " << mesh;
+        return g.materials.front();
+    };
+    EXPECT_EQ(material("mirror").metallic, 1.0f);
+    EXPECT_EQ(material("mirror").roughness, 0.0f);
+    EXPECT_LT(material("gold_sphere").roughness, 0.35f);  // environment probe
+    EXPECT_GE(material("copper_block").roughness, 0.35f); // glossy VPL transport
+    EXPECT_GT(material("floor").specular, 0.0f);
+    EXPECT_EQ(material("back_wall").specular, 0.0f); // Lambertian
 }
 
 TEST(BuiltinScenes, CornellBlackIsTheEmptyBoxWithDarkWalls) {
