@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <map>
 #include <set>
@@ -643,11 +644,21 @@ int report(const std::vector<std::string>& args) {
           "- Plots and their gnuplot scripts: `"
        << rel(o.images, o.out) << "/accuracy_*.{png,gp}`.\n";
 
+    // The non-diffuse section comes from another benchmark (bench/nondiffuse/run.sh): kept as it is.
+    std::string kept;
+    {
+        std::ifstream previous(o.out);
+        const std::string text((std::istreambuf_iterator<char>(previous)), std::istreambuf_iterator<char>());
+        const std::string begin = "<!-- nondiffuse:begin -->", end = "<!-- nondiffuse:end -->";
+        const size_t b = text.find(begin), e = text.find(end);
+        if (b != std::string::npos && e != std::string::npos && e > b)
+            kept = "\n" + text.substr(b, e + end.size() - b) + "\n";
+    }
     fs::path op(o.out);
     if (op.has_parent_path()) fs::create_directories(op.parent_path());
     std::ofstream out(o.out);
     if (!out) throw InputError(o.out, "cannot open for writing");
-    out << md.str();
+    out << md.str() << kept;
     std::fprintf(stderr, "gi-bench: wrote %s, %s%s\n", o.out.c_str(), o.presets.c_str(),
                  plotter ? "" : " (plots skipped: gnuplot is not installed)");
     return 0;

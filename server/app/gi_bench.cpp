@@ -52,6 +52,10 @@ table    renders each technique configuration with GL (median frame time over --
   --config SPEC           technique[:name=value,...], repeatable (default: none, rsm_gather)
   --reference MODE        reference mode, repeatable (default: one-bounce-unoccluded, one-bounce)
   --spp N                 reference samples per pixel (default 1024)
+  --caustic-min-roughness R  leave out of the reference the spotlight's reflection off specular
+                          lobes smoother than R reaching a rougher surface (caustics the GL
+                          pipeline does not render; biased; default 0 = unbiased; see
+                          docs/nondiffuse.md)
   --frames N              timed GL frames per configuration (default 5)
   --cache-dir DIR         reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)
   --json FILE             also write the rows as JSON
@@ -261,6 +265,8 @@ int table(const std::vector<std::string>& args) {
             modes.push_back(value());
         else if (a == "--spp")
             ro.spp = parseInt("--spp", value(), 1, 1000000);
+        else if (a == "--caustic-min-roughness")
+            ro.causticMinRoughness = static_cast<float>(parseDouble("--caustic-min-roughness", value(), 0.0, 1.0));
         else if (a == "--frames")
             frames = parseInt("--frames", value(), 1, 1000);
         else if (a == "--cache-dir")

@@ -65,6 +65,9 @@ Ground truth and error (CPU reference renderer, Embree):
   --time-budget S       stop the reference after S seconds (reports the spp reached)
   --seed N              reference random seed (default 1)
   --max-depth N         path mode: vertices per path, 1..64 (default 8)
+  --caustic-min-roughness R  leave out the spotlight's reflection off specular lobes smoother than R
+                        that reaches a rougher surface (caustics the GL pipeline does not render;
+                        biased, default 0 = unbiased; docs/nondiffuse.md)
   --cache-dir DIR       reuse references rendered before ($GI_CACHE_DIR, default ~/.cache/gi-render)
   --no-cache            always render the reference
   --compare REF.exr     compare the rendered frame's linear radiance with a reference EXR of the same
@@ -327,6 +330,17 @@ int run(int argc, char** argv) {
             }
         } else if (a == "--seed") o.reference.seed = static_cast<std::uint64_t>(parseInt("--seed", value(i), 0, 2147483647));
         else if (a == "--max-depth") o.reference.maxDepth = parseInt("--max-depth", value(i), 1, 64);
+        else if (a == "--caustic-min-roughness") {
+            const std::string& t = value(i);
+            try {
+                size_t used = 0;
+                const double r = std::stod(t, &used);
+                if (used != t.size() || !(r >= 0.0 && r <= 1.0)) throw std::invalid_argument(t);
+                o.reference.causticMinRoughness = static_cast<float>(r);
+            } catch (const std::exception&) {
+                throw UsageError{"--caustic-min-roughness must be a roughness in [0, 1], got '" + t + "'"};
+            }
+        }
         else if (a == "--cache-dir") o.cacheDir = value(i);
         else if (a == "--no-cache") o.useCache = false;
         else if (a == "--compare") o.compare = value(i);

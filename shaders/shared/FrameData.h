@@ -30,8 +30,8 @@ struct Vpl {
 
 // Glossy data of a grid VPL (glossy VPL transport, docs/nondiffuse.md), indexed like the Vpl buffer.
 struct VplGlossy {
-    vec4 specular;  // rgb: F0 of the VPL's centre texel; a: its perceptual roughness
-    vec4 incident;  // rgb: flux arriving on the cell's valid texels (W, before any albedo); a: 1 when the VPL has a specular lobe
+    vec4 specular;  // rgb: F0, a: perceptual roughness; means over the cell's specular texels weighted by their incident flux
+    vec4 incident;  // rgb: flux arriving on the cell's specular texels (W, before any reflectance); a: 1 when there are any
 };
 
 #endif

@@ -31,7 +31,9 @@ void main() {
     ivec2 centre = (lo + hi) / 2;
 
     vec3 flux = vec3(0.0);
-    vec3 incident = vec3(0.0); // rsm.frag's flux before the albedo: colour x I x spot x solid angle
+    vec3 incident = vec3(0.0); // rsm.frag's flux before the albedo (colour x I x spot x solid angle), specular texels
+    vec4 specSum = vec4(0.0);
+    float specWeight = 0.0;
     float texels = 0.0;
     float area = 0.0;
     ivec2 best = ivec2(-1);
@@ -48,9 +50,20 @@ void main() {
             vec3 v = p.xyz - gFrame.lightPos.xyz;
             float omega = rsmTexelSolidAngle(vec2(t) + 0.5);
             area += omega * dot(v, v);
-            float v2 = dot(v, v);
-            vec3 fromLight = v2 > 1e-20 ? v * inversesqrt(v2) : gFrame.lightDir.xyz;
-            incident += max(sanitize(gFrame.lightColor.rgb * (gFrame.lightPos.w * spotFactor(fromLight) * omega)), vec3(0.0));
+            // The glossy lobe sums only texels that have one (a cell mixing copper and a diffuse floor
+            // must not send the floor's light through the copper's lobe): F0 and roughness are the
+            // means over those texels weighted by their incident flux.
+            vec4 spec = texelFetch(gRsmSpecular, t, 0);
+            if (clamp(50.0 * 0.33 * (spec.r + spec.g + spec.b), 0.0, 1.0) > 0.0) {
+                float v2 = dot(v, v);
+                vec3 fromLight = v2 > 1e-20 ? v * inversesqrt(v2) : gFrame.lightDir.xyz;
+                vec3 phi = max(sanitize(gFrame.lightColor.rgb * (gFrame.lightPos.w * spotFactor(fromLight) * omega)),
+                               vec3(0.0));
+                float w = phi.r + phi.g + phi.b;
+                incident += phi;
+                specSum += vec4(spec.rgb, spec.a) * w;
+                specWeight += w;
+            }
             ivec2 d = t - centre;
             int dist = d.x * d.x + d.y * d.y;
             if (dist < bestDist) {
@@ -73,9 +86,8 @@ void main() {
         if (any(isnan(n)) || any(isinf(n))) n = normalize(gFrame.lightPos.xyz - v.position.xyz); // faces the light
         v.normal = vec4(n, area);
         v.flux = vec4(flux, texels);
-        vec4 spec = texelFetch(gRsmSpecular, best, 0);
-        bool specular = clamp(50.0 * 0.33 * (spec.r + spec.g + spec.b), 0.0, 1.0) > 0.0;
-        g.specular = spec;
+        bool specular = specWeight > 0.0;
+        g.specular = specular ? specSum / specWeight : vec4(0.0);
         g.incident = vec4(incident, specular ? 1.0 : 0.0);
     }
     gVplsOut[index] = v;
