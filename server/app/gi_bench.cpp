@@ -266,7 +266,8 @@ int table(const std::vector<std::string>& args) {
         else if (a == "--spp")
             ro.spp = parseInt("--spp", value(), 1, 1000000);
         else if (a == "--caustic-min-roughness")
-            ro.causticMinRoughness = static_cast<float>(parseDouble("--caustic-min-roughness", value(), 0.0, 1.0));
+            ro.causticMinRoughness =
+                static_cast<float>(parseDouble("--caustic-min-roughness", value(), 0.0, 1.0));
         else if (a == "--frames")
             frames = parseInt("--frames", value(), 1, 1000);
         else if (a == "--cache-dir")
