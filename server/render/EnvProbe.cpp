@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -55,7 +56,8 @@ struct EnvProbe::Impl {
     gl::Texture lut; ///< kBrdfTableSize^2 RGBA32F: rg GGX (A, B), ba Phong (A, B)
     gl::VertexArray emptyVao;
     CubeTexture source;      ///< rendered radiance, full mip chain
-    CubeTexture prefiltered; ///< level k = roughness k / (levels - 1)
+    /// Per probe (0: the room probe, 1..: local probes), level k = roughness k / (levels - 1).
+    CubeTexture prefiltered[1 + kMaxLocalProbes];
     gl::Texture depth;       ///< env_size^2, shared by the six faces
     gl::Framebuffer faceFbo[6];
     bool fboOk = false;
@@ -121,7 +123,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     if (size != m.size) {
         const int sourceLevels = log2Floor(size) + 1;
         m.source.create(size, sourceLevels);
-        m.prefiltered.create(size, levels);
+        for (CubeTexture& c : m.prefiltered) c.create(size, levels);
         m.depth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, size, size);
         m.fboOk = true;
         for (int f = 0; f < 6; ++f) {
@@ -139,63 +141,78 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     if (!m.fboOk) return;
 
     const Bounds& bounds = in.scene->bounds;
-    const glm::vec3 probe = probePosition(bounds);
-    // Depth range (m): everything in the bounds is within their diagonal of the probe; the near
-    // plane at 1e-3 of it (at least 0.1 mm) keeps 32-bit float depth well resolved.
+    // Probe 0 sees the whole scene from the centre of the bounds; probe k >= 1 sits at the centre
+    // of local object k - 1 and does not draw it (ReflectionInputs::envObjects).
+    struct ProbeSpec {
+        glm::vec3 position;
+        int skipMesh;
+    };
+    std::vector<ProbeSpec> probes{{probePosition(bounds), -1}};
+    if (in.envObjects)
+        for (const EnvObject& o : *in.envObjects)
+            if (static_cast<int>(probes.size()) < 1 + kMaxLocalProbes) probes.push_back({o.centre, o.mesh});
+    counters["env_probes"] = static_cast<double>(probes.size());
+    // Depth range (m): everything in the bounds is within their diagonal of a probe inside them; the
+    // near plane at 1e-3 of it (at least 0.1 mm) keeps 32-bit float depth well resolved.
     const float extent = std::max(glm::length(bounds.max - bounds.min), 1e-3f);
     const float zNear = std::max(1e-3f * extent, 1e-4f), zFar = 1.01f * extent + zNear;
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
-
-    // 1. Six faces, then the source mip chain.
-    timer.begin("env_render");
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glViewport(0, 0, size, size);
-    glUseProgram(m.forward.id());
-    glUniform4f(m.forward.uniform("uClipPlane"), 0.0f, 0.0f, 0.0f, 1.0f);
-    glUniform3fv(m.forward.uniform("uEye"), 1, &probe.x);
-    if (in.shadowMap) glBindTextureUnit(4, in.shadowMap->id());
     const float zero[4] = {0, 0, 0, 0};
     const float one = 1.0f;
-    for (int f = 0; f < 6; ++f) {
-        glBindFramebuffer(GL_FRAMEBUFFER, m.faceFbo[f].id());
-        glClearNamedFramebufferfv(m.faceFbo[f].id(), GL_COLOR, 0, zero);
-        glClearNamedFramebufferfv(m.faceFbo[f].id(), GL_DEPTH, 0, &one);
-        const glm::mat4 vp = faceViewProj(f, probe, zNear, zFar);
-        glUniformMatrix4fv(m.forward.uniform("uViewProj"), 1, GL_FALSE, &vp[0][0]);
-        in.sceneGpu->draw(m.forward, true);
-    }
-    glDisable(GL_DEPTH_TEST);
-    glGenerateTextureMipmap(m.source.id);
-    timer.end();
 
-    // 2. Prefilter: level 0 is the source itself, levels >= 1 one dispatch each.
-    timer.begin("env_prefilter");
-    glCopyImageSubData(m.source.id, GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, m.prefiltered.id, GL_TEXTURE_CUBE_MAP, 0,
-                       0, 0, 0, size, size, 6);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    glUseProgram(m.prefilter.id());
-    glBindTextureUnit(0, m.source.id);
-    glUniform1i(m.prefilter.uniform("uSamples"), samples);
-    glUniform1i(m.prefilter.uniform("uLobe"), phong ? 1 : 0);
-    glUniform1f(m.prefilter.uniform("uTexelSolidAngle"),
-                4.0f * 3.14159265f / (6.0f * static_cast<float>(size) * static_cast<float>(size)));
-    glUniform1f(m.prefilter.uniform("uMaxSourceLod"), static_cast<float>(m.source.levels - 1));
-    for (int k = 1; k < levels; ++k) {
-        const int levelSize = std::max(size >> k, 1);
-        glUniform1i(m.prefilter.uniform("uSize"), levelSize);
-        glUniform1f(m.prefilter.uniform("uRoughness"),
-                    static_cast<float>(k) / static_cast<float>(levels - 1));
-        glBindImageTexture(0, m.prefiltered.id, k, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-        const GLuint groups = static_cast<GLuint>((levelSize + 7) / 8);
-        glDispatchCompute(groups, groups, 6);
+    for (size_t p = 0; p < probes.size(); ++p) {
+        const glm::vec3 probe = probes[p].position;
+        CubeTexture& prefiltered = m.prefiltered[p];
+
+        // 1. Six faces, then the source mip chain.
+        timer.begin(p == 0 ? "env_render" : "env_render_local");
+        glDisable(GL_BLEND);
+        glDisable(GL_CULL_FACE);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glViewport(0, 0, size, size);
+        glUseProgram(m.forward.id());
+        glUniform4f(m.forward.uniform("uClipPlane"), 0.0f, 0.0f, 0.0f, 1.0f);
+        glUniform3fv(m.forward.uniform("uEye"), 1, &probe.x);
+        if (in.shadowMap) glBindTextureUnit(4, in.shadowMap->id());
+        for (int f = 0; f < 6; ++f) {
+            glBindFramebuffer(GL_FRAMEBUFFER, m.faceFbo[f].id());
+            glClearNamedFramebufferfv(m.faceFbo[f].id(), GL_COLOR, 0, zero);
+            glClearNamedFramebufferfv(m.faceFbo[f].id(), GL_DEPTH, 0, &one);
+            const glm::mat4 vp = faceViewProj(f, probe, zNear, zFar);
+            glUniformMatrix4fv(m.forward.uniform("uViewProj"), 1, GL_FALSE, &vp[0][0]);
+            in.sceneGpu->draw(m.forward, true, 1, probes[p].skipMesh);
+        }
+        glDisable(GL_DEPTH_TEST);
+        glGenerateTextureMipmap(m.source.id);
+        timer.end();
+
+        // 2. Prefilter: level 0 is the source itself, levels >= 1 one dispatch each.
+        timer.begin(p == 0 ? "env_prefilter" : "env_prefilter_local");
+        glCopyImageSubData(m.source.id, GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, prefiltered.id, GL_TEXTURE_CUBE_MAP, 0,
+                           0, 0, 0, size, size, 6);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        glUseProgram(m.prefilter.id());
+        glBindTextureUnit(0, m.source.id);
+        glUniform1i(m.prefilter.uniform("uSamples"), samples);
+        glUniform1i(m.prefilter.uniform("uLobe"), phong ? 1 : 0);
+        glUniform1f(m.prefilter.uniform("uTexelSolidAngle"),
+                    4.0f * 3.14159265f / (6.0f * static_cast<float>(size) * static_cast<float>(size)));
+        glUniform1f(m.prefilter.uniform("uMaxSourceLod"), static_cast<float>(m.source.levels - 1));
+        for (int k = 1; k < levels; ++k) {
+            const int levelSize = std::max(size >> k, 1);
+            glUniform1i(m.prefilter.uniform("uSize"), levelSize);
+            glUniform1f(m.prefilter.uniform("uRoughness"),
+                        static_cast<float>(k) / static_cast<float>(levels - 1));
+            glBindImageTexture(0, prefiltered.id, k, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+            const GLuint groups = static_cast<GLuint>((levelSize + 7) / 8);
+            glDispatchCompute(groups, groups, 6);
+        }
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        timer.end();
     }
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-    timer.end();
 
     // 3. Apply over the eye view, added into the target.
     timer.begin("env_apply");
@@ -208,9 +225,18 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     glBindTextureUnit(0, in.gPosition->id());
     glBindTextureUnit(1, in.gNormal->id());
     glBindTextureUnit(2, in.gSpecular->id());
-    glBindTextureUnit(3, m.prefiltered.id);
+    glBindTextureUnit(3, m.prefiltered[0].id);
     glBindTextureUnit(5, m.lut.id());
-    glUniform3fv(m.apply.uniform("uProbe"), 1, &probe.x);
+    glUniform3fv(m.apply.uniform("uProbe"), 1, &probes[0].position.x);
+    glm::vec3 local[kMaxLocalProbes]{};
+    for (int k = 0; k < kMaxLocalProbes; ++k) {
+        // Unused units get the room probe: a sampler must never read an incomplete texture.
+        const bool used = k + 1 < static_cast<int>(probes.size());
+        glBindTextureUnit(6 + k, m.prefiltered[used ? k + 1 : 0].id);
+        local[k] = used ? probes[static_cast<size_t>(k) + 1].position : probes[0].position;
+    }
+    glUniform3fv(m.apply.uniform("uLocalProbe"), kMaxLocalProbes, &local[0].x);
+    glUniform1i(m.apply.uniform("uLocalCount"), static_cast<int>(probes.size()) - 1);
     glUniform3fv(m.apply.uniform("uBoxMin"), 1, &bounds.min.x);
     glUniform3fv(m.apply.uniform("uBoxMax"), 1, &bounds.max.x);
     glUniform1i(m.apply.uniform("uParallax"), parallax ? 1 : 0);

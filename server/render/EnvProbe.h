@@ -23,7 +23,10 @@
 // Parameters (frame table): env_size (8-512 texels per face), env_samples (1-256), env_parallax,
 // specular_lobe. Timer passes env_render, env_prefilter, env_apply; counters env_size, env_samples,
 // env_levels.
-// Limits: one probe at the centre of the scene bounds; reflections show direct light and emission
+// Probes: the room probe at the centre of the scene bounds, and one local probe per
+// ReflectionInputs::envObjects entry (at most kMaxLocalProbes curved objects), at the object's
+// centre and blind to it, read by the pixels whose G-buffer id is -(k + 1).
+// Limits: other curved objects reflect from the room probe; reflections show direct light and emission
 // only (no indirect light in the probe); direct specular highlights in the probe are seen from the
 // probe, not from the reflecting point; between two levels the roughness is interpolated linearly.
 #pragma once

@@ -24,6 +24,52 @@ std::string count(int n, const char* what) {
     return std::to_string(n) + " " + what;
 }
 
+struct Flatness {
+    bool flat = false;
+    glm::dvec3 normal{0.0, 1.0, 0.0}, centre{0.0};
+    double area = 0.0;
+};
+
+/// Whether every vertex of `mesh` lies within kPlanarTolerance of its extent from the area-weighted
+/// plane of its triangles (oriented like its vertex normals).
+Flatness flatness(const Mesh& mesh) {
+    Flatness out;
+    if (mesh.positions.empty() || mesh.indices.size() < 3) return out;
+    glm::dvec3 nsum(0.0), csum(0.0);
+    double area = 0.0;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        const glm::dvec3 a(mesh.positions[mesh.indices[t]]), b(mesh.positions[mesh.indices[t + 1]]),
+            c(mesh.positions[mesh.indices[t + 2]]);
+        const glm::dvec3 cr = glm::cross(b - a, c - a);
+        const double twice = glm::length(cr);
+        if (!(twice > 0.0) || !std::isfinite(twice)) continue;
+        // Orient each triangle's normal like its vertex normals, so mixed windings add up.
+        glm::dvec3 tn = cr / twice;
+        if (!mesh.normals.empty() && glm::dot(glm::dvec3(mesh.normals[mesh.indices[t]]), tn) < 0.0) tn = -tn;
+        nsum += tn * (0.5 * twice);
+        csum += (a + b + c) / 3.0 * (0.5 * twice);
+        area += 0.5 * twice;
+    }
+    out.area = area;
+    const double nlen = glm::length(nsum);
+    if (!(area > 0.0) || !(nlen > 0.5 * area)) return out; // degenerate, or folded onto itself
+    out.normal = nsum / nlen;
+    out.centre = csum / area;
+    glm::dvec3 lo(mesh.positions[0]), hi(mesh.positions[0]);
+    for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, glm::dvec3(p));
+        hi = glm::max(hi, glm::dvec3(p));
+    }
+    const double extent = std::max(glm::length(hi - lo), 1e-12);
+    out.flat = true;
+    for (const glm::vec3& p : mesh.positions)
+        if (std::abs(glm::dot(glm::dvec3(p) - out.centre, out.normal)) > kPlanarTolerance * extent) {
+            out.flat = false;
+            break;
+        }
+    return out;
+}
+
 } // namespace
 
 std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness) {
@@ -37,40 +83,10 @@ std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughnes
         if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
         const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
         if (mat.metallic < kMirrorMinMetallic || mat.roughness > maxRoughness) continue;
-        if (mesh.positions.empty() || mesh.indices.size() < 3) continue;
-        // Area-weighted normal and centroid from the triangles.
-        glm::dvec3 nsum(0.0), csum(0.0);
-        double area = 0.0;
-        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-            const glm::dvec3 a(mesh.positions[mesh.indices[t]]), b(mesh.positions[mesh.indices[t + 1]]),
-                c(mesh.positions[mesh.indices[t + 2]]);
-            const glm::dvec3 cr = glm::cross(b - a, c - a);
-            const double twice = glm::length(cr);
-            if (!(twice > 0.0) || !std::isfinite(twice)) continue;
-            // Orient each triangle's normal like its vertex normals, so mixed windings add up.
-            glm::dvec3 tn = cr / twice;
-            if (!mesh.normals.empty() && glm::dot(glm::dvec3(mesh.normals[mesh.indices[t]]), tn) < 0.0)
-                tn = -tn;
-            nsum += tn * (0.5 * twice);
-            csum += (a + b + c) / 3.0 * (0.5 * twice);
-            area += 0.5 * twice;
-        }
-        const double nlen = glm::length(nsum);
-        if (!(area > 0.0) || !(nlen > 0.5 * area)) continue; // degenerate, or folded onto itself
-        const glm::dvec3 n = nsum / nlen, centre = csum / area;
-        glm::dvec3 lo(mesh.positions[0]), hi(mesh.positions[0]);
-        for (const glm::vec3& p : mesh.positions) {
-            lo = glm::min(lo, glm::dvec3(p));
-            hi = glm::max(hi, glm::dvec3(p));
-        }
-        const double extent = std::max(glm::length(hi - lo), 1e-12);
-        bool flat = true;
-        for (const glm::vec3& p : mesh.positions)
-            if (std::abs(glm::dot(glm::dvec3(p) - centre, n)) > kPlanarTolerance * extent) {
-                flat = false;
-                break;
-            }
-        if (!flat) continue;
+        const Flatness f = flatness(mesh);
+        if (!f.flat) continue;
+        const glm::dvec3 n = f.normal, centre = f.centre;
+        const double area = f.area;
         Candidate c;
         c.plane.mesh = static_cast<int>(mi);
         c.plane.point = glm::vec3(centre);
@@ -94,17 +110,51 @@ Reflections::~Reflections() = default;
 Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu, const ParamSet& fp,
                                           bool techniqueHasGlossy) {
     const float mirrorRoughness = fp.getFloat("mirror_roughness");
-    if (&scene != mMirrorScene || mirrorRoughness != mMirrorRoughness) {
-        mMirrors = findPlanarMirrors(scene, mirrorRoughness);
-        std::vector<int> mirrorOfMesh(scene.meshes.size(), -1);
-        for (size_t i = 0; i < mMirrors.size(); ++i)
-            mirrorOfMesh[static_cast<size_t>(mMirrors[i].mesh)] = static_cast<int>(i);
-        sceneGpu.setMirrorIndices(mirrorOfMesh);
-        mMirrorScene = &scene;
-        mMirrorRoughness = mirrorRoughness;
-    }
     const float split = fp.getFloat("glossy_split");
     const int mirrorDepth = fp.getInt("mirror_depth");
+    const bool changed = &scene != mMirrorScene || &sceneGpu != mSceneGpu || mirrorRoughness != mMirrorRoughness || split != mSplit ||
+                         techniqueHasGlossy != mTechniqueGlossy;
+    if (changed) {
+        mMirrors = findPlanarMirrors(scene, mirrorRoughness);
+        mMirrorScene = &scene;
+        mSceneGpu = &sceneGpu;
+        mMirrorRoughness = mirrorRoughness;
+        mSplit = split;
+        mTechniqueGlossy = techniqueHasGlossy;
+        // Reflector ids for the G-buffer: mirror k -> k + 1, local probe k -> -(k + 1). Local probes
+        // go to the largest curved objects that the probe shades (smooth, or any specular one when
+        // the technique has no glossy transport).
+        std::vector<int> idOfMesh(scene.meshes.size(), 0);
+        for (size_t i = 0; i < mMirrors.size(); ++i)
+            idOfMesh[static_cast<size_t>(mMirrors[i].mesh)] = static_cast<int>(i) + 1;
+        struct Candidate {
+            EnvObject object;
+            float size = 0.0f;
+        };
+        std::vector<Candidate> candidates;
+        for (size_t i = 0; i < scene.meshes.size(); ++i) {
+            const Mesh& mesh = scene.meshes[i];
+            if (idOfMesh[i] != 0 || mesh.positions.empty()) continue;
+            if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
+            const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
+            if (!materialSurface(mat).hasSpecular() || !(mat.roughness < split || !techniqueHasGlossy)) continue;
+            if (flatness(mesh).flat) continue; // a plane never reflects itself: the room probe serves it
+            glm::vec3 lo = mesh.positions[0], hi = mesh.positions[0];
+            for (const glm::vec3& p : mesh.positions) {
+                lo = glm::min(lo, p);
+                hi = glm::max(hi, p);
+            }
+            candidates.push_back({EnvObject{static_cast<int>(i), 0.5f * (lo + hi)}, glm::length(hi - lo)});
+        }
+        std::stable_sort(candidates.begin(), candidates.end(),
+                         [](const Candidate& a, const Candidate& b) { return a.size > b.size; });
+        mEnvObjects.clear();
+        for (size_t k = 0; k < candidates.size() && k < static_cast<size_t>(kMaxLocalProbes); ++k) {
+            mEnvObjects.push_back(candidates[k].object);
+            idOfMesh[static_cast<size_t>(candidates[k].object.mesh)] = -(static_cast<int>(k) + 1);
+        }
+        sceneGpu.setSurfaceIds(idOfMesh);
+    }
     std::vector<bool> isMirrorMaterialOnly(scene.materials.size(), false);
     int specularMaterials = 0, smooth = 0, rough = 0;
     {
@@ -184,6 +234,7 @@ const gl::Texture* Reflections::execute(const Decision& d, ReflectionInputs in, 
     const float zero[4] = {0, 0, 0, 0};
     glClearNamedFramebufferfv(mOutputFbo.id(), GL_COLOR, 0, zero);
     in.mirrors = &mMirrors;
+    in.envObjects = &mEnvObjects;
     in.mirrorPass = d.mirrors;
     if (d.env) {
         if (!mEnv) mEnv = std::make_unique<EnvProbe>();

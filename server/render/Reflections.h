@@ -46,6 +46,15 @@ struct MirrorPlane {
 std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness);
 inline constexpr int kMaxMirrors = 4;
 
+/// A curved object shaded by the environment probe that gets a local probe of its own, at its
+/// centre and blind to the object itself: the room probe sees such an object from outside, so it
+/// would reflect its own far side (docs/nondiffuse.md).
+struct EnvObject {
+    int mesh = -1;            ///< index into Scene::meshes
+    glm::vec3 centre{0.0f};   ///< centre of the mesh's bounds (m): the local probe's position
+};
+inline constexpr int kMaxLocalProbes = 3;
+
 /// What the reflection passes read. Textures are the renderer's; the frame block is bound at
 /// GIS_UBO_FRAME and `frame` is its CPU copy.
 struct ReflectionInputs {
@@ -61,6 +70,7 @@ struct ReflectionInputs {
     const Scene* scene = nullptr;
     const SceneGpu* sceneGpu = nullptr;
     const std::vector<MirrorPlane>* mirrors = nullptr;
+    const std::vector<EnvObject>* envObjects = nullptr; ///< local probes (G-buffer id -(k + 1))
     /// Env reflections apply to covered, non-mirror pixels with a specular lobe and roughness below
     /// this (1.01 when the technique has no glossy transport, so every glossy pixel gets one).
     float envMaxRoughness = 0.35f;
@@ -93,13 +103,18 @@ public:
                                gl::PassTimer& timer, Counters& counters);
 
     const std::vector<MirrorPlane>& mirrors() const { return mMirrors; }
+    const std::vector<EnvObject>& envObjects() const { return mEnvObjects; }
 
 private:
     std::unique_ptr<EnvProbe> mEnv;
     std::unique_ptr<PlanarMirrors> mMirrorPass;
     std::vector<MirrorPlane> mMirrors;
+    std::vector<EnvObject> mEnvObjects;
     const Scene* mMirrorScene = nullptr;
+    const SceneGpu* mSceneGpu = nullptr; ///< the upload the surface ids were set on
     float mMirrorRoughness = -1.0f;
+    float mSplit = -1.0f;        ///< glossy_split the surface ids were computed for
+    bool mTechniqueGlossy = false;
     int mWidth = 0, mHeight = 0;
     gl::Texture mOutput;
     gl::Framebuffer mOutputFbo;

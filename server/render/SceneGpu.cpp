@@ -80,14 +80,14 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     gl::checkErrors("scene upload");
 }
 
-void SceneGpu::setMirrorIndices(const std::vector<int>& mirrorOfMesh) {
+void SceneGpu::setSurfaceIds(const std::vector<int>& idOfMesh) {
     for (Draw& d : mDraws) {
         const auto m = static_cast<size_t>(d.mesh);
-        d.mirror = m < mirrorOfMesh.size() ? mirrorOfMesh[m] : -1;
+        d.surfaceId = m < idOfMesh.size() ? idOfMesh[m] : 0;
     }
 }
 
-void SceneGpu::draw(const gl::Program& program, bool withMaterials, int instances) const {
+void SceneGpu::draw(const gl::Program& program, bool withMaterials, int instances, int skipMesh) const {
     glBindVertexArray(mVao.id());
     const GLint baseColor = program.uniform("uBaseColor");
     const GLint emissive = program.uniform("uEmissive");
@@ -95,11 +95,12 @@ void SceneGpu::draw(const gl::Program& program, bool withMaterials, int instance
     const GLint metalRoughSpec = program.uniform("uMetalRoughSpec");
     const GLint mirrorId = program.uniform("uMirrorId");
     for (const Draw& d : mDraws) {
+        if (d.mesh == skipMesh) continue;
         if (withMaterials) {
             const Material& m = mMaterials[static_cast<size_t>(d.material)];
             glUniform4f(baseColor, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
             glUniform3f(metalRoughSpec, m.metallic, m.roughness, m.specular);
-            glUniform1i(mirrorId, d.mirror + 1);
+            glUniform1i(mirrorId, d.surfaceId);
             glUniform3f(emissive, m.emissive.r, m.emissive.g, m.emissive.b);
             const bool textured =
                 m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());

@@ -15,12 +15,14 @@ public:
     /// Uploads everything; throws gis::Error on GL failure (a load boundary).
     explicit SceneGpu(const Scene& scene);
     /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
-    /// when `withMaterials`.
-    void draw(const gl::Program& program, bool withMaterials, int instances = 1) const;
+    /// when `withMaterials`. `skipMesh` (an index into Scene::meshes) is left out: a local
+    /// environment probe does not see the object it belongs to.
+    void draw(const gl::Program& program, bool withMaterials, int instances = 1, int skipMesh = -1) const;
     std::size_t triangleCount() const { return mTriangles; }
-    /// Marks meshes as planar mirrors: `mirrorOfMesh[i]` is mesh i's mirror index, -1 for none. The
-    /// G-buffer writes index + 1 into the normal's w (shaders/render/gbuffer.frag).
-    void setMirrorIndices(const std::vector<int>& mirrorOfMesh);
+    /// The reflector id of each mesh, written by the G-buffer into the normal's w
+    /// (shaders/render/gbuffer.frag): k + 1 for planar mirror k, -(k + 1) for the object of local
+    /// environment probe k, 0 for none (render/Reflections).
+    void setSurfaceIds(const std::vector<int>& idOfMesh);
 
 private:
     struct Draw {
@@ -29,7 +31,7 @@ private:
         GLint baseVertex = 0;
         int material = 0;
         int mesh = 0;    ///< index into Scene::meshes
-        int mirror = -1; ///< planar-mirror index, -1 for none
+        int surfaceId = 0; ///< reflector id (setSurfaceIds)
     };
     gl::Buffer mVertices;
     gl::Buffer mIndices;

@@ -15,6 +15,14 @@ layout(binding = 1) uniform sampler2D gNormal;    // xyz unit normal, w = mirror
 layout(binding = 2) uniform sampler2D gSpecular;  // rgb F0, a roughness
 layout(binding = 3) uniform samplerCube uEnv;     // prefiltered radiance, level k = roughness k / uMaxLod
 layout(binding = 5) uniform sampler2D uEnvBrdf;   // rg: GGX (A, B); ba: Phong (A, B)
+// Local probes (render/Reflections EnvObject): pixels whose G-buffer id is -(k + 1) read probe k,
+// rendered at their object's centre without the object. Three explicit samplers: GLSL 4.5 allows
+// only dynamically uniform indices into sampler arrays.
+layout(binding = 6) uniform samplerCube uLocal0;
+layout(binding = 7) uniform samplerCube uLocal1;
+layout(binding = 8) uniform samplerCube uLocal2;
+uniform vec3 uLocalProbe[3]; // local probe centres (m)
+uniform int uLocalCount;     // local probes in use, 0..3
 
 uniform vec3 uProbe;         // probe centre (m)
 uniform vec3 uBoxMin;        // scene bounds (m)
@@ -28,7 +36,7 @@ layout(location = 0) out vec4 outRadiance;
 
 // The lookup direction for a ray from p along unit r: towards the ray's exit from the box, seen
 // from the probe. Falls back to r when p is outside the box or the hit coincides with the probe.
-vec3 parallaxDirection(vec3 p, vec3 r) {
+vec3 parallaxDirection(vec3 p, vec3 r, vec3 probe) {
     if (any(lessThan(p, uBoxMin - 1e-4)) || any(greaterThan(p, uBoxMax + 1e-4))) return r;
     // Per-axis exit distance (m); an axis the ray does not move along never exits (1e30).
     vec3 tExit;
@@ -39,7 +47,7 @@ vec3 parallaxDirection(vec3 p, vec3 r) {
     }
     float t = max(min(tExit.x, min(tExit.y, tExit.z)), 0.0);
     if (!(t < 1e29)) return r;
-    vec3 dir = p + r * t - uProbe;
+    vec3 dir = p + r * t - probe;
     float len2 = dot(dir, dir);
     return len2 > 1e-12 ? dir * inversesqrt(len2) : r;
 }
@@ -51,6 +59,9 @@ void main() {
     if (pos.w < 0.5) return;
     vec4 nrm = texelFetch(gNormal, px, 0);
     if (uSkipMirrors == 1 && nrm.w > 0.5) return;
+    // -(k + 1): the object of local probe k.
+    int local = nrm.w < -0.5 ? int(-nrm.w + 0.5) - 1 : -1;
+    if (local >= uLocalCount) local = -1;
     vec4 spec = texelFetch(gSpecular, px, 0);
     vec3 f0 = clamp(sanitize(spec.rgb), 0.0, 1.0);
     float roughness = clamp(isBad(spec.a) ? 1.0 : spec.a, 0.0, 1.0);
@@ -65,8 +76,15 @@ void main() {
     float nv = dot(n, v);
     if (!(nv > 0.0)) return; // back-facing or exactly grazing: the BRDF is 0 there
     vec3 r = 2.0 * nv * n - v; // unit: reflection of a unit vector about a unit normal
-    if (uParallax == 1) r = parallaxDirection(pos.xyz, r);
-    vec3 env = max(sanitize(textureLod(uEnv, r, clamp(roughness, 0.0, 1.0) * uMaxLod).rgb), vec3(0.0));
+    vec3 probe = local < 0 ? uProbe : uLocalProbe[local];
+    if (uParallax == 1) r = parallaxDirection(pos.xyz, r, probe);
+    float lod = clamp(roughness, 0.0, 1.0) * uMaxLod;
+    vec3 sampled;
+    if (local == 0) sampled = textureLod(uLocal0, r, lod).rgb;
+    else if (local == 1) sampled = textureLod(uLocal1, r, lod).rgb;
+    else if (local == 2) sampled = textureLod(uLocal2, r, lod).rgb;
+    else sampled = textureLod(uEnv, r, lod).rgb;
+    vec3 env = max(sanitize(sampled), vec3(0.0));
     // Table texel centres cover n.v and roughness in [0.5/N, 1 - 0.5/N]; the sampler clamps beyond.
     vec4 ab = texture(uEnvBrdf, vec2(clamp(nv, 0.0, 1.0), roughness));
     vec2 lobe = int(gFrame.shadingInfo.x) == GIS_LOBE_PHONG ? ab.ba : ab.rg;

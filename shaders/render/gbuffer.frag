@@ -17,7 +17,7 @@ void main() {
     vec3 toEye = gFrame.cameraPos.xyz - vWorldPos;
     vec3 n = safeNormal(vNormal, vWorldPos, toEye);
     outPosition = vec4(vWorldPos, 1.0);
-    outNormal = vec4(n, float(uMirrorId)); // w: planar-mirror index + 1, 0 for none
+    outNormal = vec4(n, float(uMirrorId)); // w: reflector id (mirror k + 1, local probe -(k + 1), 0)
     outAlbedo = vec4(materialAlbedo(vTexcoord), 1.0);
     outSpecular = vec4(materialF0(materialBaseColor(vTexcoord)), clamp(uMetalRoughSpec.y, 0.0, 1.0));
     outEmissive = vec4(max(sanitize(uEmissive), vec3(0.0)), 1.0);

@@ -3,7 +3,7 @@ uniform vec4 uBaseColor;      // linear RGBA factor
 uniform vec3 uEmissive;       // linear radiance
 uniform int uHasTexture;      // 1 when uBaseColorTex holds the base colour texture
 uniform vec3 uMetalRoughSpec; // x metallic, y perceptual roughness, z specular factor; all [0, 1]
-uniform int uMirrorId;        // planar-mirror index + 1 (SceneGpu); 0: not a mirror
+uniform int uMirrorId;        // reflector id (SceneGpu::setSurfaceIds): mirror k + 1, local probe -(k + 1), 0 none
 layout(binding = 0) uniform sampler2D uBaseColorTex; // sRGB texture, decoded by the sampler
 
 vec3 materialBaseColor(vec2 uv) {
