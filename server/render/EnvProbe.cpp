@@ -190,8 +190,8 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
 
         // 2. Prefilter: level 0 is the source itself, levels >= 1 one dispatch each.
         timer.begin(p == 0 ? "env_prefilter" : "env_prefilter_local");
-        glCopyImageSubData(m.source.id, GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, prefiltered.id, GL_TEXTURE_CUBE_MAP, 0,
-                           0, 0, 0, size, size, 6);
+        glCopyImageSubData(m.source.id, GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, prefiltered.id, GL_TEXTURE_CUBE_MAP,
+                           0, 0, 0, 0, size, size, 6);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(m.prefilter.id());
         glBindTextureUnit(0, m.source.id);

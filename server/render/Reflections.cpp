@@ -112,7 +112,8 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
     const float mirrorRoughness = fp.getFloat("mirror_roughness");
     const float split = fp.getFloat("glossy_split");
     const int mirrorDepth = fp.getInt("mirror_depth");
-    const bool changed = &scene != mMirrorScene || &sceneGpu != mSceneGpu || mirrorRoughness != mMirrorRoughness || split != mSplit ||
+    const bool changed = &scene != mMirrorScene || &sceneGpu != mSceneGpu ||
+                         mirrorRoughness != mMirrorRoughness || split != mSplit ||
                          techniqueHasGlossy != mTechniqueGlossy;
     if (changed) {
         mMirrors = findPlanarMirrors(scene, mirrorRoughness);
@@ -137,7 +138,8 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
             if (idOfMesh[i] != 0 || mesh.positions.empty()) continue;
             if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
             const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
-            if (!materialSurface(mat).hasSpecular() || !(mat.roughness < split || !techniqueHasGlossy)) continue;
+            if (!materialSurface(mat).hasSpecular() || !(mat.roughness < split || !techniqueHasGlossy))
+                continue;
             if (flatness(mesh).flat) continue; // a plane never reflects itself: the room probe serves it
             glm::vec3 lo = mesh.positions[0], hi = mesh.positions[0];
             for (const glm::vec3& p : mesh.positions) {

@@ -50,8 +50,8 @@ inline constexpr int kMaxMirrors = 4;
 /// centre and blind to the object itself: the room probe sees such an object from outside, so it
 /// would reflect its own far side (docs/nondiffuse.md).
 struct EnvObject {
-    int mesh = -1;            ///< index into Scene::meshes
-    glm::vec3 centre{0.0f};   ///< centre of the mesh's bounds (m): the local probe's position
+    int mesh = -1;          ///< index into Scene::meshes
+    glm::vec3 centre{0.0f}; ///< centre of the mesh's bounds (m): the local probe's position
 };
 inline constexpr int kMaxLocalProbes = 3;
 
@@ -113,7 +113,7 @@ private:
     const Scene* mMirrorScene = nullptr;
     const SceneGpu* mSceneGpu = nullptr; ///< the upload the surface ids were set on
     float mMirrorRoughness = -1.0f;
-    float mSplit = -1.0f;        ///< glossy_split the surface ids were computed for
+    float mSplit = -1.0f; ///< glossy_split the surface ids were computed for
     bool mTechniqueGlossy = false;
     int mWidth = 0, mHeight = 0;
     gl::Texture mOutput;

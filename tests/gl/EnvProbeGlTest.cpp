@@ -228,7 +228,8 @@ TEST(EnvProbeGl, GlossyReflectionsConvergeWithEnvSize) {
     // spotlight's highlight on it as a few very bright texels, which alias differently at each
     // resolution; this test is about the prefilter's resolution. The physically complete comparison
     // is ReflectionsConvergeToTheReferenceWithEnvSize below.
-    const nlohmann::json base = {{"effect_glossy", "on"}, {"env_parallax", "box"}, {"effect_specular", "off"}};
+    const nlohmann::json base = {
+        {"effect_glossy", "on"}, {"env_parallax", "box"}, {"effect_specular", "off"}};
     nlohmann::json p = base;
     p["effect_env"] = "off";
     const FrameOutput off = render(w, h, p);
@@ -288,7 +289,8 @@ TEST(EnvProbeGl, ReflectionsConvergeToTheReferenceWithEnvSize) {
         for (int i = 0; i <= segments; ++i) {
             const float theta = 3.14159265f * static_cast<float>(j) / rings;
             const float phi = 6.28318531f * static_cast<float>(i) / segments;
-            const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+            const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                              std::sin(theta) * std::sin(phi));
             ball.positions.push_back(centre + radius * n);
             ball.normals.push_back(n);
         }
@@ -332,15 +334,18 @@ TEST(EnvProbeGl, ReflectionsConvergeToTheReferenceWithEnvSize) {
         double num = 0.0, den = 0.0;
         for (int i : pixels)
             for (int ch = 0; ch < 3; ++ch) {
-                const double a = f.linear[static_cast<size_t>(i) * 4 + ch], b = ref.rgb[static_cast<size_t>(i) * 3 + ch];
+                const double a = f.linear[static_cast<size_t>(i) * 4 + ch],
+                             b = ref.rgb[static_cast<size_t>(i) * 3 + ch];
                 num += (a - b) * (a - b);
                 den += b * b;
             }
         errors.push_back(den > 0.0 ? std::sqrt(num / den) : 0.0);
-        std::printf("[env] ball vs one-bounce reference, env_size %3d: relative RMSE %.4f\n", size, errors.back());
+        std::printf("[env] ball vs one-bounce reference, env_size %3d: relative RMSE %.4f\n", size,
+                    errors.back());
     }
     // Measured on llvmpipe: see docs/nondiffuse.md. The reference's own noise at 512 spp and the
     // directions the ball hides from the probe set the floor.
     EXPECT_LT(errors.back(), 0.6 * errors.front());
-    for (size_t i = 1; i < errors.size(); ++i) EXPECT_LT(errors[i], errors[i - 1] * 1.05 + 0.005) << "env_size step " << i;
+    for (size_t i = 1; i < errors.size(); ++i)
+        EXPECT_LT(errors[i], errors[i - 1] * 1.05 + 0.005) << "env_size step " << i;
 }
