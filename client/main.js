@@ -468,7 +468,7 @@ function recordDraw(frame, decodeMs, frameBytes) {
     }
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
-    sceneGui.showPlan(stats?.plan);
+    sceneGui.showPlan(stats?.plan, stats?.nondiffuse);
     statsGui.showDetails(stats);
     accuracyGui.frameDrawn();
     gizmo.render();
@@ -613,15 +613,28 @@ const sceneGui = (() => {
             if (fraction !== null) bar.value = fraction;
             progressText.textContent = text ?? '';
         },
-        /** The effect plan of the frame on screen: each effect on or off, and why. */
-        showPlan(p) {
-            const key = `${state.params.effects}:${JSON.stringify(p ?? null)}`;
+        /**
+         * The effect plan of the frame on screen: each effect on or off, and why. Without a plan the
+         * renderer's own non-diffuse decisions (stats.nondiffuse: "on: reason" / "off: reason") are
+         * listed, since they run whatever the mode.
+         */
+        showPlan(p, nondiffuse) {
+            const key = `${state.params.effects}:${JSON.stringify(p ?? null)}:${JSON.stringify(nondiffuse ?? null)}`;
             if (key === lastPlanKey) return;
             lastPlanKey = key;
             if (!p || p.mode === 'manual' || !Array.isArray(p.decisions)) {
                 planSummary.textContent = 'Manual: the technique\'s parameters decide which effects run. '
                     + 'Turn on "plan effects" to let the server measure what this view needs.';
-                planList.replaceChildren();
+                const entries = Object.entries(nondiffuse ?? {});
+                planList.replaceChildren(...entries.map(([effect, text]) => {
+                    const on = String(text).startsWith('on');
+                    const li = block('li', `decision ${on ? 'on' : 'off'}`);
+                    li.dataset.effect = effect;
+                    const head = li.appendChild(block('div', 'decision-head'));
+                    head.append(block('span', 'decision-name', effect), block('span', 'badge', on ? 'on' : 'off'));
+                    li.append(block('div', 'decision-reason', String(text).replace(/^(on|off): /, '')));
+                    return li;
+                }));
                 return;
             }
             const why = state.params.effects === 'auto' ? 'planned for this view'
