@@ -26,12 +26,14 @@ struct Pair {
     glm::vec4 flux;                                           // rgb flux; w: min_distance (K1)
 };
 struct Result {
-    glm::vec4 k; // x: K1 (point + distance clamp, or K3 when b is set), y: K2 (disk, or K3)
+    glm::vec4 k; // x: K1 (point + distance clamp, or K3 when b is set), y: K2 (disk, or K3),
+                 // z: K4 (second_order's back-side kernel, gi/second_order/k4.glsl)
 };
 
 const char* kProbe = R"(#version 450 core
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
+#include "gi/second_order/k4.glsl"
 layout(local_size_x = 1) in;
 struct Pair { vec4 receiverPos, receiverNormal, vplPos, vplNormal, flux; };
 layout(std430, binding = 0) readonly buffer Pairs { Pair gPairs[]; };
@@ -40,7 +42,13 @@ void main() {
     Pair p = gPairs[gl_WorkGroupID.x];
     vec3 k1 = vplIrradiance(p.receiverPos.xyz, p.receiverNormal.xyz, p.vplPos.xyz, p.vplNormal.xyz, p.flux.rgb, p.flux.w);
     vec3 k2 = vplIrradianceDisk(p.receiverPos.xyz, p.receiverNormal.xyz, p.vplPos.xyz, p.vplNormal.xyz, p.flux.rgb, p.vplNormal.w);
-    gResults[gl_WorkGroupID.x] = vec4(k1.r, k2.r, 0.0, 0.0);
+    Vpl v;
+    v.position = vec4(p.vplPos.xyz, 1.0);
+    v.normal = p.vplNormal;
+    v.flux = vec4(p.flux.rgb, 1.0);
+    vec3 toLight;
+    vec3 k4 = backIrradiance(p.receiverPos.xyz, p.receiverNormal.xyz, v, p.flux.w, toLight);
+    gResults[gl_WorkGroupID.x] = vec4(k1.r, k2.r, k4.r, 0.0);
 }
 )";
 
@@ -118,13 +126,19 @@ TEST_F(KernelCell, C01_CoincidentVpl) {
             EXPECT_LE(plain[i].k.x, phi / (pi * dminI * dminI) * (1 + 1e-5)) << "K1 above Phi/(pi dmin^2)";
         }
         EXPECT_LE(plain[i].k.y, phi / area * (1 + 1e-5)) << "K2 above Phi/A";
+        EXPECT_TRUE(std::isfinite(plain[i].k.z));
+        EXPECT_GE(plain[i].k.z, 0.0f);
+        if (dminI > 0) {
+            EXPECT_LE(plain[i].k.z, phi / (pi * dminI * dminI) * (1 + 1e-5)) << "K4 above Phi/(pi dmin^2)";
+        }
         EXPECT_LE(k3[i].k.x, phi * b / pi * (1 + 1e-5)) << "K3 (point form) above Phi b/pi";
         EXPECT_LE(k3[i].k.y, phi * b / pi * (1 + 1e-5)) << "K3 (disk form) above Phi b/pi";
     }
     EXPECT_EQ(plain[0].k.x, 0.0f);
     EXPECT_EQ(plain[0].k.y, 0.0f);
     EXPECT_EQ(k3[0].k.x, 0.0f);
-    note("coincident pair", "0 for K1, K2, K3");
+    EXPECT_EQ(plain[0].k.z, 0.0f);
+    note("coincident pair", "0 for K1, K2, K3, K4");
     note("max K2*A/Phi", [&] {
         double m = 0;
         for (const Result& r : plain) m = std::max(m, double(r.k.y) * area / phi);
@@ -151,9 +165,44 @@ TEST_F(KernelCell, C02_GrazingBackFacing) {
         for (size_t i = 0; i < r.size(); ++i) {
             EXPECT_EQ(r[i].k.x, 0.0f) << "pair " << i << " b " << b;
             EXPECT_EQ(r[i].k.y, 0.0f) << "pair " << i << " b " << b;
+            // K4 reads the back side: 0 here too (front, tangent plane, or a light facing away).
+            EXPECT_EQ(r[i].k.z, 0.0f) << "K4, pair " << i;
         }
     }
-    note("grazing / back-facing contributions", "exactly 0 (K1, K2, K3)");
+    // K4 is non-zero only on the back side (S.4 case 2): a light 1 m behind the receiver, facing it.
+    const std::vector<Pair> back = {pair({0, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, -1, 0}, 1e-3f, 1.0f, 0.1f),
+                                    pair({0, 0, 0}, {0, 1, 0}, {0, 1, 0}, {0, -1, 0}, 1e-3f, 1.0f, 0.1f)};
+    const std::vector<Result> rb = evaluate(back, 0.0f);
+    EXPECT_EQ(rb[0].k.x, 0.0f) << "K1 on the back side";
+    EXPECT_EQ(rb[0].k.y, 0.0f) << "K2 on the back side";
+    EXPECT_NEAR(rb[0].k.z, 1.0 / glm::pi<double>(), 1e-6) << "K4 = Phi/pi cos cos / d^2 on the back side";
+    EXPECT_EQ(rb[1].k.z, 0.0f) << "K4 on the front side";
+    EXPECT_GT(rb[1].k.x, 0.0f) << "K1 on the front side";
+    note("grazing / back-facing contributions", "exactly 0 (K1, K2, K3); K4 only on the back side (Phi/pi at 1 m)");
+}
+
+// Case 14 (linearity): splitting every VPL into two at the same position with half the flux leaves
+// the result unchanged, for every kernel (halving is exact in floating point, so 2 K(Phi/2) must equal
+// K(Phi) bit for bit).
+TEST_F(KernelCell, C14_ScaleAndLinearity) {
+    open("C14_ScaleAndLinearity");
+    std::vector<Pair> whole, half;
+    const float phi = 3.0f;
+    for (float d : {1e-4f, 0.05f, 0.3f, 2.0f, 40.0f})
+        for (const glm::vec3& dir : {glm::vec3(0, 1, 0), glm::normalize(glm::vec3(1, 1, 0.5f)), glm::vec3(0, -1, 0)}) {
+            whole.push_back(pair({0, 0, 0}, {0, 1, 0}, d * dir, -dir, 1e-2f, phi, 0.1f));
+            half.push_back(pair({0, 0, 0}, {0, 1, 0}, d * dir, -dir, 1e-2f, 0.5f * phi, 0.1f));
+        }
+    int compared = 0;
+    for (float b : {0.0f, 10.0f}) {
+        const std::vector<Result> a = evaluate(whole, b), h = evaluate(half, b);
+        for (size_t i = 0; i < a.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_EQ(a[i].k[k], 2.0f * h[i].k[k]) << "pair " << i << " kernel " << k << " b " << b;
+                ++compared;
+            }
+    }
+    note("split VPL: 2 K(Phi/2) == K(Phi)", std::to_string(compared) + " kernel values, bit for bit (K1-K4)");
 }
 
 // Case 8: K2 with A = pi R^2, both cosines 1, gives E = B R^2 / (h^2 + R^2) exactly.

@@ -15,6 +15,7 @@
 //    -D, i.e. onward along the blocked light; its flux is stored negated so the gathers subtract it.
 #include "common.glsl"
 #include "gi/second_order/second_order.glsl"
+#include "gi/second_order/k4.glsl"
 
 layout(local_size_x = 256) in;
 
@@ -38,26 +39,6 @@ uniform float uMinCosView;        // clamp of cos(view angle) in the area estima
 shared uint sScan[256];
 shared uint sPlaced;
 shared uint sExamined;
-
-// K4: irradiance on the back side of a receiver (normal n) from a diffuse point light.
-vec3 backIrradiance(vec3 x, vec3 n, Vpl v, out vec3 toLight) {
-    toLight = vec3(0.0);
-    vec3 d = v.position.xyz - x;
-    float d2 = dot(d, d);
-    if (!(d2 > 1e-20)) return vec3(0.0); // coincident: no defined direction (digest S.4 case 1)
-    toLight = d * inversesqrt(d2);
-    // Light in (or numerically at) p's tangent plane does not cross the surface: a light on the
-    // same plane reads cos ~ 1e-7 from rounded positions, and would take a slot for nothing. The
-    // positions are fp32 world coordinates: far from the origin (digest S.4 case 17, 1e4 m: a 1 mm
-    // ulp) a light on p's own wall sits a few ulps off its plane, so the light must also be farther
-    // from the plane than 8 ulps of the larger coordinate (a micrometre near the origin).
-    vec3 m = max(abs(x), abs(v.position.xyz));
-    float planeTolerance = 8.0 * 1.1920929e-7 * max(m.x, max(m.y, m.z));
-    float cosBack = -dot(n, toLight);
-    if (!(cosBack > max(1e-3, planeTolerance * inversesqrt(d2)))) return vec3(0.0);
-    float cosLight = max(dot(v.normal.xyz, -toLight), 0.0);
-    return v.flux.rgb * (kInvPi * cosBack * cosLight / max(d2, uMinDistance * uMinDistance));
-}
 
 void main() {
     uint tid = gl_LocalInvocationID.x;
@@ -84,7 +65,7 @@ void main() {
                     Vpl v = gVpls[j];
                     if (v.position.w < 0.5) continue;
                     vec3 toLight;
-                    vec3 ej = backIrradiance(p.xyz, n, v, toLight);
+                    vec3 ej = backIrradiance(p.xyz, n, v, uMinDistance, toLight);
                     e += ej;
                     weighted += dot(ej, kLuma) * toLight;
                 }
