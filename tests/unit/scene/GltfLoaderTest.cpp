@@ -259,6 +259,25 @@ TEST(GltfLoader, MaterialFactorsEmissiveStrengthAndBaseColorTexture) {
     EXPECT_EQ(t.rgba, (std::vector<std::uint8_t>{255, 0, 0, 255, 0, 255, 0, 255}));
 }
 
+TEST(GltfLoader, SpecularFactorDefaultsToGltfsDielectricAndReadsTheExtension) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["materials"] = {
+        {{"name", "plain"}},
+        {{"name", "matte"}, {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}},
+        {{"name", "half"}, {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.5}}}}}}};
+    b.doc["extensionsUsed"] = {"KHR_materials_specular"};
+    b.doc["extensionsRequired"] = {"KHR_materials_specular"}; // supported, so accepted
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGltf(dir, "specular.gltf"));
+    ASSERT_GE(s.materials.size(), 3u);
+    EXPECT_FLOAT_EQ(s.materials[0].specular, 1.0f); // glTF: every dielectric reflects F0 = 0.04
+    EXPECT_FLOAT_EQ(s.materials[1].specular, 0.0f); // exactly Lambertian (scene/Brdf.h)
+    EXPECT_FLOAT_EQ(s.materials[2].specular, 0.5f);
+}
+
 TEST(GltfLoader, InterleavedStrideAndNormalizedTexcoords) {
     TempDir dir;
     GltfBuilder b;
