@@ -499,13 +499,15 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
             const int mesh = receiverMesh[i];
             if (mesh >= 0 && mirrorMesh[static_cast<size_t>(mesh)])
                 ++mirrorView;
+            else if (!specularWorthAPass(m, split))
+                continue; // a rough dielectric: direct highlights only
             else if (m.roughness >= split && glossyAvailable)
                 ++roughView;
             else
                 ++smoothView;
         }
         for (const Material& m : vplMaterial)
-            if (hasLobe(m) && m.roughness >= split) ++roughLight;
+            if (specularWorthAPass(m, split) && m.roughness >= split) ++roughLight;
         const double view = std::max<double>(receivers.size(), 1.0);
         const double lightSamples = std::max<double>(vpls.size(), 1.0);
         auto fraction = [&](EffectDecision& d, double v, const char* what) {

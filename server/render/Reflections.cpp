@@ -104,6 +104,10 @@ std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughnes
     return out;
 }
 
+bool specularWorthAPass(const Material& m, float split) {
+    return materialSurface(m).hasSpecular() && (m.metallic > 0.0f || m.roughness < split);
+}
+
 Reflections::Reflections() = default;
 Reflections::~Reflections() = default;
 
@@ -138,7 +142,7 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
             if (idOfMesh[i] != 0 || mesh.positions.empty()) continue;
             if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
             const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
-            if (!materialSurface(mat).hasSpecular() || !(mat.roughness < split || !techniqueHasGlossy))
+            if (!specularWorthAPass(mat, split) || !(mat.roughness < split || !techniqueHasGlossy))
                 continue;
             if (flatness(mesh).flat) continue; // a plane never reflects itself: the room probe serves it
             glm::vec3 lo = mesh.positions[0], hi = mesh.positions[0];
@@ -173,7 +177,7 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
         for (size_t i = 0; i < scene.materials.size(); ++i) {
             if (!materialSurface(scene.materials[i]).hasSpecular()) continue;
             ++specularMaterials;
-            if (!usedByOther[i]) continue;
+            if (!usedByOther[i] || !specularWorthAPass(scene.materials[i], split)) continue;
             if (scene.materials[i].roughness < split || !techniqueHasGlossy)
                 ++smooth;
             else

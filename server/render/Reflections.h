@@ -46,6 +46,13 @@ struct MirrorPlane {
 std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness);
 inline constexpr int kMaxMirrors = 4;
 
+/// Whether a material's specular lobe is worth an indirect specular pass (environment probe or glossy
+/// VPL transport): metals always, dielectrics only below `split` roughness. A rough dielectric
+/// reflects a few percent (F0 = 0.04) of a blurred environment, close to what its diffuse lobe
+/// already gets; it keeps its direct highlights. So a glTF file of plain materials (roughness 1)
+/// runs no reflection pass.
+bool specularWorthAPass(const Material& m, float split);
+
 /// A curved object shaded by the environment probe that gets a local probe of its own, at its
 /// centre and blind to the object itself: the room probe sees such an object from outside, so it
 /// would reflect its own far side (docs/nondiffuse.md).
