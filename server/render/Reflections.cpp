@@ -28,6 +28,7 @@ struct Flatness {
     bool flat = false;
     glm::dvec3 normal{0.0, 1.0, 0.0}, centre{0.0};
     double area = 0.0;
+    glm::dvec3 lo{0.0}, hi{0.0}; ///< the mesh's bounds (m)
 };
 
 /// Whether every vertex of `mesh` lies within kPlanarTolerance of its extent from the area-weighted
@@ -35,6 +36,11 @@ struct Flatness {
 Flatness flatness(const Mesh& mesh) {
     Flatness out;
     if (mesh.positions.empty() || mesh.indices.size() < 3) return out;
+    out.lo = out.hi = glm::dvec3(mesh.positions[0]);
+    for (const glm::vec3& p : mesh.positions) {
+        out.lo = glm::min(out.lo, glm::dvec3(p));
+        out.hi = glm::max(out.hi, glm::dvec3(p));
+    }
     glm::dvec3 nsum(0.0), csum(0.0);
     double area = 0.0;
     for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
@@ -55,12 +61,7 @@ Flatness flatness(const Mesh& mesh) {
     if (!(area > 0.0) || !(nlen > 0.5 * area)) return out; // degenerate, or folded onto itself
     out.normal = nsum / nlen;
     out.centre = csum / area;
-    glm::dvec3 lo(mesh.positions[0]), hi(mesh.positions[0]);
-    for (const glm::vec3& p : mesh.positions) {
-        lo = glm::min(lo, glm::dvec3(p));
-        hi = glm::max(hi, glm::dvec3(p));
-    }
-    const double extent = std::max(glm::length(hi - lo), 1e-12);
+    const double extent = std::max(glm::length(out.hi - out.lo), 1e-12);
     out.flat = true;
     for (const glm::vec3& p : mesh.positions)
         if (std::abs(glm::dot(glm::dvec3(p) - out.centre, out.normal)) > kPlanarTolerance * extent) {
@@ -144,13 +145,10 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
             const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
             if (!specularWorthAPass(mat, split) || !(mat.roughness < split || !techniqueHasGlossy))
                 continue;
-            if (flatness(mesh).flat) continue; // a plane never reflects itself: the room probe serves it
-            glm::vec3 lo = mesh.positions[0], hi = mesh.positions[0];
-            for (const glm::vec3& p : mesh.positions) {
-                lo = glm::min(lo, p);
-                hi = glm::max(hi, p);
-            }
-            candidates.push_back({EnvObject{static_cast<int>(i), 0.5f * (lo + hi)}, glm::length(hi - lo)});
+            const Flatness f = flatness(mesh);
+            if (f.flat || !(f.area > 0.0)) continue; // a plane never reflects itself: the room probe serves it
+            candidates.push_back({EnvObject{static_cast<int>(i), glm::vec3(0.5 * (f.lo + f.hi))},
+                                  static_cast<float>(glm::length(f.hi - f.lo))});
         }
         std::stable_sort(candidates.begin(), candidates.end(),
                          [](const Candidate& a, const Candidate& b) { return a.size > b.size; });

@@ -18,6 +18,33 @@ export const REPLY_TIMEOUT_MS = 5000;
 
 export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
+/**
+ * Tests whose connections are closed (code 1000) when each test ends, and which remember whether any
+ * failed so the file can print the server log once at the end. (Not an afterEach hook: those run
+ * after every subtest too.) `test` is node:test's.
+ */
+export function testGroup(test) {
+    const clients = new Set();
+    let failed = false;
+    return {
+        clients,
+        failed: () => failed,
+        check(name, fn) {
+            test(name, async (t) => {
+                try {
+                    await fn(t);
+                } catch (e) {
+                    failed = true;
+                    throw e;
+                } finally {
+                    await Promise.all([...clients].map((c) => c.close()));
+                    clients.clear();
+                }
+            });
+        },
+    };
+}
+
 export function freePort() {
     return new Promise((resolve, reject) => {
         const probe = net.createServer();

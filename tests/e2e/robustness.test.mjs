@@ -17,13 +17,13 @@ import assert from 'node:assert/strict';
 import path from 'node:path';
 import zlib from 'node:zlib';
 
-import { Client, REPO, ServerProcess } from './helpers.mjs';
+import { Client, REPO, ServerProcess, testGroup } from './helpers.mjs';
 
 const SIZE = [16, 16]; // the smallest size every entry point accepts
 let server = null;
 let api = null; // GET /api/techniques
-const clients = new Set();
-let anyFailed = false;
+const group = testGroup(test); // closes each test's clients; remembers failures for the log
+const { clients, check } = group;
 
 before(async () => {
     server = await ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'none', '--size',
@@ -35,24 +35,11 @@ before(async () => {
 });
 
 after(async () => {
-    if (anyFailed && server) console.error(`--- gi-server log ---\n${server.log.slice(-4000)}`);
+    if (group.failed() && server) console.error(`--- gi-server log ---\n${server.log.slice(-4000)}`);
     await Promise.all([...clients].map((c) => c.close()));
     if (server) await server.stop();
 });
 
-function check(name, fn) {
-    test(name, async (t) => {
-        try {
-            await fn(t);
-        } catch (e) {
-            anyFailed = true;
-            throw e;
-        } finally {
-            await Promise.all([...clients].map((c) => c.close()));
-            clients.clear();
-        }
-    });
-}
 
 // ---- cases derived from the published tables ---------------------------------------------------------
 

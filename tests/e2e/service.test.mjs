@@ -12,7 +12,7 @@ import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 
-import { Client, isPng, REPO, SERVER, ServerProcess, sleep } from './helpers.mjs';
+import { Client, isPng, REPO, SERVER, ServerProcess, sleep, testGroup } from './helpers.mjs';
 
 const TOKEN = 's3cret';
 const SIZE = [64, 64];
@@ -21,8 +21,8 @@ const COMMON = ['--scene', 'builtin:cornell', '--technique', 'none', '--size', `
     '--client-dir', path.join(REPO, 'client')];
 
 const servers = {};
-const clients = new Set(); // closed when their test ends, so no session outlives its test
-let anyFailed = false;
+const group = testGroup(test); // closes each test's clients; remembers failures for the log
+const { clients, check } = group;
 let uploadDir = null;
 
 before(async () => {
@@ -37,30 +37,13 @@ before(async () => {
 });
 
 after(async () => {
-    if (anyFailed) {
+    if (group.failed()) {
         for (const [name, server] of Object.entries(servers)) console.error(`--- gi-server (${name}) log ---\n${server.log.slice(-4000)}`);
     }
     await Promise.all(Object.values(servers).map((s) => s.stop()));
     if (uploadDir) rmSync(uploadDir, { recursive: true, force: true });
 });
 
-/**
- * A test whose failure prints the server logs at the end; the connections it opened are closed
- * with 1000 when it ends. (Not an afterEach hook: those run after every subtest too.)
- */
-function check(name, fn) {
-    test(name, async (t) => {
-        try {
-            await fn(t);
-        } catch (e) {
-            anyFailed = true;
-            throw e;
-        } finally {
-            await Promise.all([...clients].map((c) => c.close()));
-            clients.clear();
-        }
-    });
-}
 
 /**
  * A connection past welcome. Controllers default to SIZE and adaptive false (each frame exactly
