@@ -123,6 +123,48 @@ std::optional<SchemaViolation> validateJson(const nlohmann::json& instance, cons
     return check(instance, schema, "");
 }
 
+std::string validUtf8(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    size_t i = 0;
+    while (i < text.size()) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        // Length of the sequence this lead byte starts (0: not a lead byte), and the smallest code
+        // point it may encode (overlong forms are invalid).
+        size_t len = 0;
+        unsigned long cp = 0, min = 0;
+        if (c < 0x80) {
+            out += static_cast<char>(c);
+            ++i;
+            continue;
+        } else if ((c & 0xE0) == 0xC0) {
+            len = 2, cp = c & 0x1Fu, min = 0x80;
+        } else if ((c & 0xF0) == 0xE0) {
+            len = 3, cp = c & 0x0Fu, min = 0x800;
+        } else if ((c & 0xF8) == 0xF0) {
+            len = 4, cp = c & 0x07u, min = 0x10000;
+        }
+        bool ok = len > 0 && i + len <= text.size();
+        for (size_t k = 1; ok && k < len; ++k) {
+            const auto b = static_cast<unsigned char>(text[i + k]);
+            if ((b & 0xC0) != 0x80) ok = false;
+            cp = (cp << 6) | (b & 0x3Fu);
+        }
+        if (ok && (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))) ok = false;
+        if (ok) {
+            out.append(text.substr(i, len));
+            i += len;
+        } else {
+            static const char* kHex = "0123456789ABCDEF";
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 0xF];
+            ++i;
+        }
+    }
+    return out;
+}
+
 nlohmann::json parseJsonExplained(std::string_view text, std::string& error) {
     error.clear();
     try {
@@ -133,7 +175,8 @@ nlohmann::json parseJsonExplained(std::string_view text, std::string& error) {
             const size_t close = what.find("] ");
             if (close != std::string::npos) what = what.substr(close + 2);
         }
-        error = what.empty() ? "not valid JSON" : what;
+        // The parser quotes the bytes it stopped at, which may not be UTF-8.
+        error = what.empty() ? "not valid JSON" : validUtf8(what);
         return nlohmann::json(nlohmann::json::value_t::discarded);
     }
 }

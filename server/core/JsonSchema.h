@@ -21,6 +21,10 @@ struct SchemaViolation {
 /// Returns the first violation found, or nullopt when `instance` conforms to `schema`.
 std::optional<SchemaViolation> validateJson(const nlohmann::json& instance, const nlohmann::json& schema);
 
+/// `text` with every byte that is not part of valid UTF-8 written as \xNN: safe to put into JSON
+/// (nlohmann::json::dump throws on invalid UTF-8) when a message quotes the client's input.
+std::string validUtf8(std::string_view text);
+
 /// Parses `text`; on failure returns a discarded value and sets `error` to why and where, e.g.
 /// "number overflow parsing '1e400'" or "syntax error at line 1, column 12: ..." (nlohmann's text
 /// without its "[json.exception...]" prefix), so that error replies can say what to fix.

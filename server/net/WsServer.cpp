@@ -190,8 +190,9 @@ HttpResponse jsonResponse(unsigned status, const nlohmann::json& body) {
 
 HttpResponse errorResponse(unsigned status, const std::string& code, const std::string& message,
                            const std::string& where = {}) {
-    nlohmann::json body = {{"error", code}, {"message", message}};
-    if (!where.empty()) body["where"] = where;
+    // Messages may quote the request's bytes (a path, a query value): only valid UTF-8 may reach dump().
+    nlohmann::json body = {{"error", code}, {"message", validUtf8(message)}};
+    if (!where.empty()) body["where"] = validUtf8(where);
     return jsonResponse(status, body);
 }
 

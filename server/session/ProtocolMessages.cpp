@@ -73,9 +73,10 @@ nlohmann::json parseClientMessage(std::string_view text) {
 }
 
 nlohmann::json errorMessage(const ProtocolError& e) {
-    nlohmann::json m = {{"type", "error"}, {"code", e.code}, {"message", e.message}};
-    if (!e.where.empty()) m["where"] = e.where;
-    if (!e.request.empty()) m["request"] = e.request;
+    // Messages may quote the client's bytes: only valid UTF-8 may reach dump().
+    nlohmann::json m = {{"type", "error"}, {"code", e.code}, {"message", validUtf8(e.message)}};
+    if (!e.where.empty()) m["where"] = validUtf8(e.where);
+    if (!e.request.empty()) m["request"] = validUtf8(e.request);
     return m;
 }
 

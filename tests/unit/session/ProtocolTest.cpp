@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/JsonSchema.h"
 #include "session/ProtocolMessages.h"
 
 namespace fs = std::filesystem;
@@ -106,4 +107,23 @@ TEST(Protocol, FrameHeaderCarriesTheWebpCode) {
     auto m = gis::makeFrameMessage(7, 16, 16, gis::ImageCodec::Webp, {1, 2, 3});
     EXPECT_EQ(m[12], 3);
     EXPECT_EQ(m.size(), gis::kFrameHeaderSize + 3);
+}
+
+// Found by the protocol fuzzer: the JSON parser's message quotes the byte it stopped at, and an
+// invalid UTF-8 byte there made errorMessage(...).dump() throw (a terminate in the server's callback).
+TEST(Protocol, ErrorsQuotingInvalidUtf8StaySerialisable) {
+    const std::string text = "{\"type\":\"technique\",\"name\":\"rsm_gather\"\xfd\n";
+    try {
+        (void)gis::parseClientMessage(text);
+        FAIL() << "accepted malformed JSON";
+    } catch (const gis::ProtocolError& e) {
+        EXPECT_EQ(e.code, "invalid_json");
+        std::string dumped;
+        EXPECT_NO_THROW(dumped = gis::errorMessage(e).dump());
+        EXPECT_NE(dumped.find("\\\\xFD"), std::string::npos) << dumped;
+    }
+    EXPECT_EQ(gis::validUtf8("caf\xc3\xa9 \xe2\x82\xac"), "caf\xc3\xa9 \xe2\x82\xac"); // valid UTF-8 kept
+    EXPECT_EQ(gis::validUtf8("a\xc3"), "a\\xC3");                                       // truncated
+    EXPECT_EQ(gis::validUtf8("\xc0\xaf"), "\\xC0\\xAF");                                // overlong
+    EXPECT_EQ(gis::validUtf8("\xed\xa0\x80"), "\\xED\\xA0\\x80");                       // surrogate
 }
