@@ -71,6 +71,12 @@ Flatness flatness(const Mesh& mesh) {
     return out;
 }
 
+/// The material of `mesh`, or null when its index is out of range.
+const Material* meshMaterial(const Scene& scene, const Mesh& mesh) {
+    if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) return nullptr;
+    return &scene.materials[static_cast<size_t>(mesh.material)];
+}
+
 } // namespace
 
 std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness) {
@@ -80,9 +86,10 @@ std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughnes
     };
     std::vector<Candidate> found;
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+        const Material* material = meshMaterial(scene, scene.meshes[mi]);
+        if (!material) continue;
+        const Material& mat = *material;
         const Mesh& mesh = scene.meshes[mi];
-        if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
-        const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
         if (mat.metallic < kMirrorMinMetallic || mat.roughness > maxRoughness) continue;
         const Flatness f = flatness(mesh);
         if (!f.flat) continue;
@@ -140,9 +147,9 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
         std::vector<Candidate> candidates;
         for (size_t i = 0; i < scene.meshes.size(); ++i) {
             const Mesh& mesh = scene.meshes[i];
-            if (idOfMesh[i] != 0 || mesh.positions.empty()) continue;
-            if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size())) continue;
-            const Material& mat = scene.materials[static_cast<size_t>(mesh.material)];
+            const Material* material = meshMaterial(scene, mesh);
+            if (idOfMesh[i] != 0 || mesh.positions.empty() || !material) continue;
+            const Material& mat = *material;
             if (!specularWorthAPass(mat, split) || !(mat.roughness < split || !techniqueHasGlossy))
                 continue;
             const Flatness f = flatness(mesh);

@@ -183,7 +183,9 @@ void MultiresSplat::ensureCapacity(GLuint items) {
 }
 
 bool MultiresSplat::glossyTransport(const ParamSet& params) const {
-    return info().glossyTransport(params);
+    // Built once: info() assembles the whole parameter table, and this runs every frame.
+    static const TechniqueInfo kInfo = info();
+    return kInfo.glossyTransport(params);
 }
 
 void MultiresSplat::bindGlossy(const gl::Program& program, const FrameInputs& in, bool perVpl) const {
