@@ -10,6 +10,7 @@ find_path(GIS_GLCOREARB_H GL/glcorearb.h REQUIRED)     # libgl-dev
 find_package(glm CONFIG REQUIRED)
 find_package(nlohmann_json 3 CONFIG REQUIRED)
 find_package(TinyGLTF CONFIG REQUIRED)                 # shared lib: never define TINYGLTF_IMPLEMENTATION
+pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)    # libstb-dev: image headers read before decoding
 find_package(libjpeg-turbo CONFIG REQUIRED)
 find_package(PNG REQUIRED)
 find_package(libwebsockets CONFIG REQUIRED)

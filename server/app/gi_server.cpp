@@ -4,11 +4,13 @@
 // Exit codes: 0 clean shutdown (also after SIGTERM/SIGINT: docs/operations.md, graceful drain),
 // 1 runtime failure, 2 bad usage.
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
+#include <thread>
 
 #include "core/Error.h"
 #include "core/Log.h"
@@ -78,6 +80,17 @@ int run(int argc, char** argv) {
                  gis::gl::backendName(config.session.backend) + ")");
     server.run();
     gServer = nullptr;
+    if (server.stoppedAtOnce()) {
+        // The second signal means now: frames still rendering are not waited for. The watchdog ends
+        // the process if the teardown (which joins render threads) is not over within half a second.
+        gis::logInfo("gi-server: stopping at once (second signal)");
+        std::thread([] {
+            std::this_thread::sleep_for(std::chrono::milliseconds(500));
+            std::fflush(stdout);
+            std::fflush(stderr);
+            std::_Exit(0);
+        }).detach();
+    }
     // Teardown joins the render threads (a frame in progress finishes first); a further signal while
     // that runs takes the default action rather than being ignored.
     std::signal(SIGINT, SIG_DFL);

@@ -22,22 +22,58 @@ bool matchesType(const nlohmann::json& v, const std::string& type) {
 }
 
 std::string describe(const nlohmann::json& v) {
-    std::string s = v.dump();
-    if (s.size() > 60) s = s.substr(0, 57) + "...";
-    return s;
+    return jsonExcerpt(v, 60);
+}
+
+/// Appends a rendering of `v` to `out`, stopping once `out` holds more than `budget` bytes.
+void appendExcerpt(const nlohmann::json& v, std::string& out, std::size_t budget, int depth) {
+    if (out.size() > budget) return;
+    if (v.is_object() || v.is_array()) {
+        const bool object = v.is_object();
+        out += object ? '{' : '[';
+        if (depth >= 3 && !v.empty()) {
+            out += "...";
+        } else {
+            bool first = true;
+            for (auto it = v.begin(); it != v.end() && out.size() <= budget; ++it) {
+                if (!first) out += ',';
+                first = false;
+                if (object) {
+                    // Keys can be long too: bounded like string values.
+                    appendExcerpt(nlohmann::json(it.key().substr(0, budget)), out, budget, depth + 1);
+                    out += ':';
+                }
+                appendExcerpt(*it, out, budget, depth + 1);
+            }
+        }
+        out += object ? '}' : ']';
+        return;
+    }
+    if (v.is_string()) {
+        // Only the part that can be shown is serialised: a 1 MB string costs what its excerpt costs.
+        const auto& s = v.get_ref<const std::string&>();
+        out += nlohmann::json(s.substr(0, budget + 1))
+                   .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+        return;
+    }
+    out += v.dump();
 }
 
 std::string escapePointerToken(const std::string& key) {
     std::string out;
     for (char c : key) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
+        if (c == '~')
+            out += "~0";
+        else if (c == '/')
+            out += "~1";
+        else
+            out += c;
     }
     return out;
 }
 
-std::optional<SchemaViolation> check(const nlohmann::json& v, const nlohmann::json& schema, const std::string& at) {
+std::optional<SchemaViolation> check(const nlohmann::json& v, const nlohmann::json& schema,
+                                     const std::string& at) {
     if (schema.is_boolean()) {
         if (schema.get<bool>()) return std::nullopt;
         return SchemaViolation{at, "is not allowed here"};
@@ -86,9 +122,11 @@ std::optional<SchemaViolation> check(const nlohmann::json& v, const nlohmann::js
     }
     if (v.is_array()) {
         if (auto m = schema.find("minItems"); m != schema.end() && v.size() < m->get<size_t>())
-            return SchemaViolation{at, "must have at least " + m->dump() + " items, got " + std::to_string(v.size())};
+            return SchemaViolation{at, "must have at least " + m->dump() + " items, got " +
+                                           std::to_string(v.size())};
         if (auto m = schema.find("maxItems"); m != schema.end() && v.size() > m->get<size_t>())
-            return SchemaViolation{at, "must have at most " + m->dump() + " items, got " + std::to_string(v.size())};
+            return SchemaViolation{at, "must have at most " + m->dump() + " items, got " +
+                                           std::to_string(v.size())};
         if (auto items = schema.find("items"); items != schema.end()) {
             for (size_t i = 0; i < v.size(); ++i)
                 if (auto r = check(v[i], *items, at + "/" + std::to_string(i))) return r;
@@ -165,8 +203,49 @@ std::string validUtf8(std::string_view text) {
     return out;
 }
 
-nlohmann::json parseJsonExplained(std::string_view text, std::string& error) {
+std::optional<std::size_t> findExcessNesting(std::string_view text, int maxDepth) {
+    int depth = 0;
+    bool inString = false, escaped = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (escaped)
+                escaped = false;
+            else if (c == '\\')
+                escaped = true;
+            else if (c == '"')
+                inString = false;
+            continue;
+        }
+        if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > maxDepth) return i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return std::nullopt;
+}
+
+std::string jsonExcerpt(const nlohmann::json& value, std::size_t maxChars) {
+    std::string out;
+    appendExcerpt(value, out, maxChars, 0);
+    if (out.size() <= maxChars) return out;
+    std::size_t cut = maxChars >= 3 ? maxChars - 3 : 0;
+    // Never split a UTF-8 sequence: back up over continuation bytes.
+    while (cut > 0 && (static_cast<unsigned char>(out[cut]) & 0xC0) == 0x80) --cut;
+    out.resize(cut);
+    return out + "...";
+}
+
+nlohmann::json parseJsonExplained(std::string_view text, std::string& error, int maxDepth) {
     error.clear();
+    if (auto at = findExcessNesting(text, maxDepth)) {
+        error = "arrays and objects nested deeper than " + std::to_string(maxDepth) + " levels at byte " +
+                std::to_string(*at) + "; flatten the document";
+        return nlohmann::json(nlohmann::json::value_t::discarded);
+    }
     try {
         return nlohmann::json::parse(text);
     } catch (const nlohmann::json::exception& e) {

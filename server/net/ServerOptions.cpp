@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/JsonSchema.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
 
@@ -260,6 +262,26 @@ std::vector<ServerOption> buildOptions() {
                           "largest uploaded .glb in MiB, 0..1024 (0 disables "
                           "uploads; default 32)",
                           0, 1024, &ServerConfig::maxUploadMb));
+    t.push_back(
+        intOption("--max-decoded-mb", "GI_MAX_DECODED_MB",
+                  "most memory one uploaded or file: scene may take once decoded (buffers, images, "
+                  "geometry), checked from image headers before decoding, 16..65536 MiB (default 512)",
+                  16, 65536, &ServerConfig::maxDecodedMb));
+    t.push_back(intOption("--max-session-uploads-mb", "GI_MAX_SESSION_UPLOADS_MB",
+                          "all uploads of one session together, 1..65536 MiB (default 128)", 1, 65536,
+                          &ServerConfig::maxSessionUploadsMb));
+    t.push_back(intOption("--max-connections", "GI_MAX_CONNECTIONS",
+                          "open HTTP and WebSocket connections; more are closed at accept; 0 = the open-file "
+                          "limit less a reserve for sessions and files, 0..1000000 (default 0)",
+                          0, 1000000, &ServerConfig::maxConnections));
+    t.push_back(intOption("--max-pending-per-ip", "GI_MAX_PENDING_PER_IP",
+                          "connections from one address that have not finished their HTTP request or hello, "
+                          "1..100000 (default 32)",
+                          1, 100000, &ServerConfig::maxPendingPerIp));
+    t.push_back(intOption("--request-timeout", "GI_REQUEST_TIMEOUT",
+                          "seconds an HTTP request may take from its first byte to the end of its body, "
+                          "1..3600 (default 30)",
+                          1, 3600, &ServerConfig::requestTimeoutS));
     {
         ServerOption o{"--gl", "GI_GL", "egl|osmesa", "headless GL backend (default egl)"};
         o.set = [](ServerConfig& c, const std::string& v) {
@@ -360,8 +382,11 @@ ParsedServerArgs parseServerArgs(const std::vector<std::string>& args,
     if (!configFile.empty()) {
         std::ifstream in(configFile);
         if (!in) throw InputError(configFile, "cannot read the config file");
-        nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
-        if (doc.is_discarded() || !doc.is_object())
+        const std::string fileText((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::string parseError;
+        nlohmann::json doc = parseJsonExplained(fileText, parseError);
+        if (doc.is_discarded()) throw InputError(configFile, "not valid JSON: " + parseError);
+        if (!doc.is_object())
             throw InputError(configFile, "the config file must be a JSON object of option names, e.g. "
                                          "{\"max-sessions\": 4}");
         for (const auto& [key, value] : doc.items()) {

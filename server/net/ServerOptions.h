@@ -33,7 +33,12 @@ struct ServerConfig {
     std::vector<std::string> sceneDirs;    ///< file: scenes
     std::string uploadDir;                 ///< per-session upload sandboxes live below it
     int maxUploadMb = 32;
-    std::string glName; ///< egl, osmesa or empty (default)
+    int maxDecodedMb = 512;        ///< one client-chosen scene once decoded (buffers, images, geometry)
+    int maxSessionUploadsMb = 128; ///< a session's uploads together, on disk
+    int maxConnections = 0;        ///< HTTP + WebSocket connections; 0: from RLIMIT_NOFILE
+    int maxPendingPerIp = 32;      ///< per address: connections before their request or hello is done
+    int requestTimeoutS = 30;      ///< an HTTP request, first byte to the end of its body
+    std::string glName;            ///< egl, osmesa or empty (default)
 };
 
 struct ServerOption {

@@ -2,6 +2,9 @@
 
 #include <libwebsockets.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +18,7 @@
 #include <map>
 #include <mutex>
 #include <random>
+#include <set>
 #include <thread>
 #include <vector>
 
@@ -132,6 +136,44 @@ std::string customHeader(lws* wsi, const char* name) {
     return out;
 }
 
+std::string addressText(const sockaddr_storage& address) {
+    char text[INET6_ADDRSTRLEN] = {};
+    if (address.ss_family == AF_INET)
+        inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in&>(address).sin_addr, text, sizeof text);
+    else if (address.ss_family == AF_INET6)
+        inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6&>(address).sin6_addr, text, sizeof text);
+    return text[0] ? text : "unknown";
+}
+
+std::string lowerCase(std::string text) {
+    for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return text;
+}
+
+/// The token of an `Authorization: Bearer <token>` header; the scheme is case-insensitive (RFC 9110
+/// 11.1) and surrounding blanks are ignored. Empty for any other header.
+std::string bearerToken(const std::string& header) {
+    const std::size_t space = header.find(' ');
+    if (space == std::string::npos || lowerCase(header.substr(0, space)) != "bearer") return {};
+    const std::size_t start = header.find_first_not_of(' ', space);
+    if (start == std::string::npos) return {};
+    const std::size_t end = header.find_last_not_of(" \t");
+    return header.substr(start, end + 1 - start);
+}
+
+/// Default connection cap: the open-file limit less what sessions (GL contexts, upload files), the
+/// listening socket, logs and libraries need, so that accept() never fails with EMFILE.
+int connectionCapFromFileLimit(int maxSessions) {
+    rlimit limit{};
+    long files = 1024;
+    if (getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+        files = static_cast<long>(limit.rlim_cur);
+    else if (getrlimit(RLIMIT_NOFILE, &limit) == 0)
+        files = 1 << 20;
+    const long reserve = 64 + 16L * maxSessions;
+    return static_cast<int>(std::clamp(files - reserve, 16L, 1L << 20));
+}
+
 std::string urlArg(lws* wsi, const char* name) {
     char buf[512];
     const char* v = lws_get_urlarg_by_name(wsi, name, buf, sizeof buf);
@@ -199,6 +241,9 @@ HttpResponse errorResponse(unsigned status, const std::string& code, const std::
 struct HttpExchange {
     std::string uri;
     bool post = false;
+    bool bodyDone = false;        ///< LWS_CALLBACK_HTTP_BODY_COMPLETION came (or no body is expected)
+    bool closeAfter = false;      ///< answered before its body arrived: close instead of reading it
+    Clock::time_point deadline{}; ///< the whole request (headers and body) must be in by then
     std::string body;
     bool bodyTooLarge = false;
     std::size_t bodyLimit = 0;
@@ -282,6 +327,22 @@ struct WsServer::Impl {
     lws_protocols protocols[3];
     Housekeeping housekeeping{};
 
+    /// Every accepted connection, HTTP or WebSocket, from accept to close; `pending` until its HTTP
+    /// request is in or its hello accepted (what the per-address cap counts).
+    struct Peer {
+        std::string address;
+        Clock::time_point opened = Clock::now();
+        bool pending = true;
+    };
+    std::map<lws*, Peer> peers;
+    std::map<std::string, int> pendingByAddress;
+    int connectionCap = 0;
+    std::set<lws*> bodiesPending; ///< POST requests whose body has not completed
+    /// Refusals are logged, but at most kRefusalLinesPerTick lines per housekeeping tick and reason:
+    /// a flood must not become a flood of log lines. The rest are counted and summed up.
+    static constexpr int kRefusalLinesPerTick = 5;
+    std::map<std::string, int> refusalLines, refusalsSuppressed;
+
     // Finished HTTP render jobs, handed from workers to the loop.
     std::mutex doneMutex;
     std::map<std::uint64_t, HttpResponse> done;
@@ -348,6 +409,68 @@ struct WsServer::Impl {
             .set(phase == Phase::Running ? 0.0 : 1.0);
     }
 
+    // --- connections and refusals ---------------------------------------------------------------
+    void logRefusal(const std::string& reason, const std::string& detail) {
+        metrics
+            .counter("gis_refusals_total", "requests and connections refused, by reason",
+                     {{"reason", reason}})
+            .inc();
+        if (refusalLines[reason]++ < kRefusalLinesPerTick)
+            logWarn("net: refused (" + reason + "): " + validUtf8(detail));
+        else
+            ++refusalsSuppressed[reason];
+    }
+    void flushRefusalLog() {
+        for (const auto& [reason, count] : refusalsSuppressed)
+            if (count > 0)
+                logWarn("net: refused (" + reason + "): " + std::to_string(count) +
+                        " more in the last 0.5 s");
+        refusalsSuppressed.clear();
+        refusalLines.clear();
+    }
+    std::string peerAddress(lws* wsi) const {
+        auto it = peers.find(wsi);
+        return it == peers.end() ? std::string("unknown") : it->second.address;
+    }
+    /// Before lws reads a byte: the overall cap (below the open-file limit) and the per-address cap on
+    /// connections that have not finished their request or hello.
+    bool admitConnection(const lws_filter_network_conn_args& args) {
+        const std::string address = addressText(args.cli_addr);
+        if (static_cast<int>(peers.size()) >= connectionCap) {
+            logRefusal("connection_limit", address + ": " + std::to_string(peers.size()) +
+                                               " connections open (cap " + std::to_string(connectionCap) +
+                                               ", --max-connections)");
+            return false;
+        }
+        if (pendingByAddress[address] >= config.maxPendingPerIp) {
+            logRefusal("pending_per_address", address + " has " + std::to_string(config.maxPendingPerIp) +
+                                                  " connections without a finished request or hello "
+                                                  "(--max-pending-per-ip)");
+            return false;
+        }
+        return true;
+    }
+    void peerCreated(lws* wsi) {
+        char name[INET6_ADDRSTRLEN + 8] = {};
+        const char* address = lws_get_peer_simple(wsi, name, sizeof name);
+        Peer& peer = peers[wsi];
+        if (!peer.address.empty()) return; // counted already
+        peer.address = address && *address ? address : "unknown";
+        peer.pending = true;
+        ++pendingByAddress[peer.address];
+    }
+    void settle(lws* wsi) {
+        auto it = peers.find(wsi);
+        if (it == peers.end() || !it->second.pending || it->second.address.empty()) return;
+        it->second.pending = false;
+        if (--pendingByAddress[it->second.address] <= 0) pendingByAddress.erase(it->second.address);
+    }
+    void peerDestroyed(lws* wsi) {
+        settle(wsi);
+        peers.erase(wsi);
+        bodiesPending.erase(wsi);
+    }
+
     // --- access control -----------------------------------------------------------------------
     bool originAllowed(lws* wsi) {
         const std::string origin = header(wsi, WSI_TOKEN_ORIGIN);
@@ -360,14 +483,25 @@ struct WsServer::Impl {
     }
     bool bearerOk(lws* wsi) {
         if (config.token.empty()) return true;
-        const std::string auth = header(wsi, WSI_TOKEN_HTTP_AUTHORIZATION);
-        return auth.rfind("Bearer ", 0) == 0 && sameSecret(auth.substr(7), config.token);
+        const std::string token = bearerToken(header(wsi, WSI_TOKEN_HTTP_AUTHORIZATION));
+        return !token.empty() && sameSecret(token, config.token);
     }
 
     // --- HTTP -------------------------------------------------------------------------------
     void respond(lws* wsi, PerSession* pss, HttpResponse response) {
         if (!pss->http) pss->http = new HttpExchange;
         countHttp(pss->http->endpoint.empty() ? "static" : pss->http->endpoint, response.status);
+        if (response.status >= 400 && response.status != 404)
+            logRefusal("http_" + std::to_string(response.status), peerAddress(wsi) + " " +
+                                                                      (pss->http->post ? "POST " : "GET ") +
+                                                                      pss->http->uri.substr(0, 200));
+        if (pss->http->post && !pss->http->bodyDone) {
+            // Answered before its body came (auth, origin, limits): the body is not read, the
+            // connection closes once the answer is out.
+            pss->http->closeAfter = true;
+            bodiesPending.erase(wsi);
+            response.headers.emplace_back("connection:", "close");
+        }
         pss->http->response = std::move(response);
         pss->http->ready = true;
         lws_callback_on_writable(wsi);
@@ -399,9 +533,10 @@ struct WsServer::Impl {
         std::vector<unsigned char> body(LWS_PRE + r.body.size());
         std::memcpy(body.data() + LWS_PRE, r.body.data(), r.body.size());
         const int n = lws_write(wsi, body.data() + LWS_PRE, r.body.size(), LWS_WRITE_HTTP_FINAL);
+        const bool closeAfter = pss->http->closeAfter;
         delete pss->http;
         pss->http = nullptr;
-        if (n < 0) return -1;
+        if (n < 0 || closeAfter) return -1;
         return lws_http_transaction_completed(wsi) ? -1 : 0;
     }
 
@@ -437,6 +572,16 @@ struct WsServer::Impl {
         pss->http->post = post;
         pss->http->endpoint =
             uri.rfind("/api/", 0) == 0 || uri == "/metrics" || uri == "/healthz" ? uri : "static";
+        if (!post) {
+            pss->http->bodyDone = true;
+            settle(wsi); // a GET is complete with its headers
+        } else {
+            auto peer = peers.find(wsi);
+            const Clock::time_point start =
+                peer != peers.end() && peer->second.pending ? peer->second.opened : Clock::now();
+            pss->http->deadline = start + std::chrono::seconds(config.requestTimeoutS);
+            bodiesPending.insert(wsi);
+        }
         if (uri == "/healthz") {
             // 503 while draining: readiness probes and load balancers stop sending new clients here.
             const bool draining = phase != Phase::Running;
@@ -465,6 +610,28 @@ struct WsServer::Impl {
             return 0;
         }
         if (post) {
+            // lws reads bodies by Content-Length only: a chunked body would never complete, and a
+            // malformed length would wait forever.
+            if (!header(wsi, WSI_TOKEN_HTTP_TRANSFER_ENCODING).empty()) {
+                respond(wsi, pss,
+                        errorResponse(411, "length_required",
+                                      "send the body with a Content-Length header; chunked transfer "
+                                      "encoding is not accepted"));
+                return 0;
+            }
+            const std::string length = header(wsi, WSI_TOKEN_HTTP_CONTENT_LENGTH);
+            if (length.empty()) {
+                respond(wsi, pss,
+                        errorResponse(411, "length_required", "POST needs a Content-Length header"));
+                return 0;
+            }
+            if (length.size() > 12 || length.find_first_not_of("0123456789") != std::string::npos) {
+                respond(wsi, pss,
+                        errorResponse(400, "bad_content_length",
+                                      "Content-Length must be a non-negative decimal number, got '" +
+                                          length.substr(0, 40) + "'"));
+                return 0;
+            }
             if (uri == "/api/render" && phase != Phase::Running) {
                 HttpResponse r =
                     errorResponse(503, "shutting_down",
@@ -518,6 +685,9 @@ struct WsServer::Impl {
 
     void onHttpBody(lws* wsi, PerSession* pss) {
         HttpExchange* x = pss->http;
+        bodiesPending.erase(wsi);
+        if (x) x->bodyDone = true;
+        settle(wsi);
         if (!x || x->ready) return; // already answered (auth, origin): the body is ignored
         if (x->bodyTooLarge) {
             respond(
@@ -583,7 +753,7 @@ struct WsServer::Impl {
             try {
                 auto resolve = [&](const std::string& name) {
                     try {
-                        return sceneCache->get(catalogRef->resolve(name));
+                        return sceneCache->get(catalogRef->resolve(name), catalogRef->loadOptions(name));
                     } catch (const InputError& e) {
                         throw InputError("/scene", e.reason());
                     }
@@ -595,13 +765,13 @@ struct WsServer::Impl {
                 RenderResult result = executeRenderJob(renderer, *job, resolve);
                 result.stats["queue_ms"] = queueMs;
                 if (jsonReply) {
-                    finish(
-                        jsonResponse(200, result.referenceImage.empty()
-                                              ? nlohmann::json{{"stats", result.stats},
-                                                               {"image_base64", base64(result.image)}}
-                                              : nlohmann::json{{"stats", result.stats},
-                                                               {"image_base64", base64(result.image)},
-                                                               {"reference_base64", base64(result.referenceImage)}}));
+                    finish(jsonResponse(
+                        200,
+                        result.referenceImage.empty()
+                            ? nlohmann::json{{"stats", result.stats}, {"image_base64", base64(result.image)}}
+                            : nlohmann::json{{"stats", result.stats},
+                                             {"image_base64", base64(result.image)},
+                                             {"reference_base64", base64(result.referenceImage)}}));
                 } else {
                     HttpResponse r{200, result.mimeType, {{"x-gi-stats:", result.stats.dump()}}, {}};
                     r.body.assign(result.image.begin(), result.image.end());
@@ -653,12 +823,37 @@ struct WsServer::Impl {
         std::error_code ec;
         const fs::path dir = entry->session->uploadDir();
         fs::create_directories(dir, ec);
-        std::ofstream out(dir / name, std::ios::binary | std::ios::trunc);
-        out.write(x->body.data(), static_cast<std::streamsize>(x->body.size()));
-        if (ec || !out) {
+        // The session's uploads together (a replaced file no longer counts) stay within the budget.
+        std::uintmax_t stored = 0;
+        for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
+             it.increment(ec))
+            if (it->is_regular_file(ec) && it->path().filename() != name) stored += it->file_size(ec);
+        const std::uintmax_t budget = static_cast<std::uintmax_t>(config.maxSessionUploadsMb) << 20;
+        if (stored + x->body.size() > budget) {
+            respond(wsi, pss,
+                    errorResponse(413, "uploads_full",
+                                  "this session's uploads would take " +
+                                      std::to_string((stored + x->body.size()) >> 20) +
+                                      " MiB; a session may store " +
+                                      std::to_string(config.maxSessionUploadsMb) +
+                                      " MiB: upload under an existing name to replace a file"));
+            return;
+        }
+        // Written beside, then renamed: a scene load never sees half a file.
+        const fs::path partial = dir / ("." + name + ".part");
+        {
+            std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+            out.write(x->body.data(), static_cast<std::streamsize>(x->body.size()));
+            if (!out) ec = std::make_error_code(std::errc::io_error);
+        }
+        if (!ec) fs::rename(partial, dir / name, ec);
+        if (ec) {
+            fs::remove(partial, ec);
             respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
             return;
         }
+        logInfo("net: session " + entry->session->id() + " stored upload:" + name + " (" +
+                std::to_string(x->body.size()) + " bytes) from " + peerAddress(wsi));
         respond(wsi, pss, jsonResponse(201, {{"scene", "upload:" + name}, {"bytes", x->body.size()}}));
     }
 
@@ -671,7 +866,7 @@ struct WsServer::Impl {
             return onHttpRequest(wsi, pss, uri);
         }
         case LWS_CALLBACK_HTTP_BODY:
-            if (pss && pss->http && !pss->http->ready) {
+            if (pss && pss->http && !pss->http->ready && !pss->http->closeAfter) {
                 HttpExchange* x = pss->http;
                 if (x->body.size() + len > x->bodyLimit) {
                     x->bodyTooLarge = true;
@@ -688,6 +883,7 @@ struct WsServer::Impl {
             return writeHttp(wsi, pss);
         case LWS_CALLBACK_HTTP_DROP_PROTOCOL:
         case LWS_CALLBACK_CLOSED_HTTP:
+            bodiesPending.erase(wsi);
             if (pss && pss->http) {
                 if (pss->http->jobId) awaiting.erase(pss->http->jobId); // the result is discarded
                 delete pss->http;
@@ -740,7 +936,11 @@ struct WsServer::Impl {
         entry->ended = true;
         for (auto& [wsi, c] : connections) {
             if (c->entry != entry) continue;
-            if (!code.empty()) closeWith(*c, {code, message, "", ""}, code == "idle_timeout" ? 1000 : 1001);
+            if (!code.empty())
+                closeWith(*c, {code, message, "", ""},
+                          code == "idle_timeout"    ? 1000
+                          : code == "render_failed" ? 1011
+                                                    : 1001);
             c->link.reset();
             c->entry.reset();
         }
@@ -847,9 +1047,10 @@ struct WsServer::Impl {
             c.link = makeLink(ClientRole::Viewer, maxInFlight);
             c.entry = entry;
             c.helloDone = true;
+            settle(c.wsi);
             sendDirect(c, welcomeFor(*entry, ClientRole::Viewer, false, maxInFlight));
             entry->session->attach(c.link);
-            logInfo("net: a viewer joined session " + entry->session->id());
+            logInfo("net: a viewer joined session " + entry->session->id() + " from " + peerAddress(c.wsi));
             return;
         }
         std::shared_ptr<SessionEntry> entry;
@@ -896,6 +1097,8 @@ struct WsServer::Impl {
             }
             entry->session->setObservers([this](const FrameReport& r) { onFrame(r); },
                                          [this](const std::string& code) { countError(code); });
+            lws_context* ctx = context;
+            entry->session->setFailureObserver([ctx] { lws_cancel_service(ctx); });
             entry->resumeToken = randomToken("r-");
             entry->viewToken = randomToken("v-");
             sessions[id] = entry;
@@ -911,6 +1114,7 @@ struct WsServer::Impl {
         c.link = makeLink(ClientRole::Controller, maxInFlight);
         c.entry = entry;
         c.helloDone = true;
+        settle(c.wsi);
         entry->controller = &c;
         entry->detachedAt = {};
         // Attach first so that welcome reports the negotiated stream; it still goes out before any
@@ -918,8 +1122,8 @@ struct WsServer::Impl {
         entry->session->attach(c.link, &stream);
         sendDirect(c, welcomeFor(*entry, ClientRole::Controller, resumed, maxInFlight));
         if (!resumed) entry->session->start();
-        logInfo("net: session " + entry->session->id() + (resumed ? " resumed" : " opened") + " (" +
-                std::to_string(sessions.size()) + " open)");
+        logInfo("net: session " + entry->session->id() + (resumed ? " resumed" : " opened") + " by " +
+                peerAddress(c.wsi) + " (" + std::to_string(sessions.size()) + " open)");
     }
 
     void onMessage(Connection& c, const std::string& text) {
@@ -958,7 +1162,11 @@ struct WsServer::Impl {
         }
         if (!c.entry || !c.link) return; // the session ended; the close is on its way
         if (type == "ack") {
-            c.entry->session->ack(c.link, msg["frame"].get<std::uint32_t>());
+            try {
+                c.entry->session->ack(c.link, msg["frame"].get<std::uint32_t>());
+            } catch (const ProtocolError& e) {
+                sendError(c, e);
+            }
             return;
         }
         if (c.link->role() == ClientRole::Viewer && type != "snapshot") {
@@ -976,6 +1184,10 @@ struct WsServer::Impl {
         switch (reason) {
         case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
             if (phase == Phase::Closing) return 1; // the loop ends in a moment
+            if (header(wsi, WSI_TOKEN_GET_URI) != "/ws") {
+                logRefusal("ws_path", peerAddress(wsi) + " asked for a WebSocket on another path than /ws");
+                return 1;
+            }
             if (!originAllowed(wsi)) {
                 logWarn("net: refused a WebSocket from origin '" + header(wsi, WSI_TOKEN_ORIGIN) + "'");
                 countHttp("/ws", 403);
@@ -1022,7 +1234,18 @@ struct WsServer::Impl {
                 }
                 break;
             }
-            if (tooLarge)
+            if (!c->helloDone && (tooLarge || lws_frame_is_binary(wsi))) {
+                // PROTOCOL.md: anything but a hello first is answered hello_required and closed.
+                logRefusal("hello_required", peerAddress(wsi) + " sent a " +
+                                                 (tooLarge ? "too large" : "binary") + " first message");
+                closeWith(*c,
+                          {"hello_required",
+                           tooLarge ? "the first message must be a hello of at most " +
+                                          std::to_string(config.maxMessageBytes) + " bytes"
+                                    : "the first message must be a JSON text hello",
+                           "", ""},
+                          tooLarge ? 1009 : 1003);
+            } else if (tooLarge)
                 sendError(*c, {"message_too_large",
                                "messages are limited to " + std::to_string(config.maxMessageBytes) + " bytes",
                                "", ""});
@@ -1190,13 +1413,37 @@ struct WsServer::Impl {
     }
 
     void onWake() {
+        endFailedSessions();
         for (auto& [w, c] : connections)
             if (!c->direct.empty() || (c->link && c->link->hasOutgoing())) lws_callback_on_writable(w);
         deliverFinishedJobs();
     }
 
+    /// A session whose renderer failed ends alone, with the reason; the process and every other
+    /// session go on.
+    void endFailedSessions() {
+        std::vector<std::shared_ptr<SessionEntry>> failed;
+        for (const auto& [id, e] : sessions)
+            if (e->session->failed()) failed.push_back(e);
+        for (const auto& e : failed) endSession(e, "render_failed", e->session->failure());
+    }
+
     void housekeep() {
         const auto now = Clock::now();
+        flushRefusalLog();
+        endFailedSessions();
+        for (lws* wsi : std::set<lws*>(bodiesPending)) {
+            auto* pss = static_cast<PerSession*>(lws_wsi_user(wsi));
+            if (!pss || !pss->http) {
+                bodiesPending.erase(wsi);
+                continue;
+            }
+            if (now < pss->http->deadline) continue;
+            respond(wsi, pss,
+                    errorResponse(408, "request_timeout",
+                                  "the request did not arrive within " +
+                                      std::to_string(config.requestTimeoutS) + " s (--request-timeout)"));
+        }
         for (auto& [w, c] : connections)
             if (!c->helloDone && !c->closing && now - c->opened > std::chrono::seconds(config.helloTimeoutS))
                 closeWith(*c,
@@ -1229,11 +1476,58 @@ struct WsServer::Impl {
             500 * LWS_US_PER_MS);
     }
 
+    /// protocols[0] sees every connection first: accept filter, creation and destruction, upgrades.
+    int onConnectionEvent(lws* wsi, lws_callback_reasons reason, void* user, bool& handled) {
+        handled = true;
+        switch (reason) {
+        case LWS_CALLBACK_FILTER_NETWORK_CONNECTION:
+            return user && admitConnection(*static_cast<lws_filter_network_conn_args*>(user)) ? 0 : 1;
+        case LWS_CALLBACK_WSI_CREATE:
+            // Before the socket is attached: the connection counts from here, its address comes next.
+            peers[wsi];
+            return 0;
+        case LWS_CALLBACK_SERVER_NEW_CLIENT_INSTANTIATED:
+            peerCreated(wsi);
+            return 0;
+        case LWS_CALLBACK_WSI_DESTROY:
+            peerDestroyed(wsi);
+            return 0;
+        case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+            // An upgrade without Sec-WebSocket-Protocol lands on the HTTP protocol: refuse it.
+            logRefusal("ws_protocol",
+                       peerAddress(wsi) + " asked for a WebSocket without the gi-stream sub-protocol");
+            return 1;
+        case LWS_CALLBACK_HTTP_CONFIRM_UPGRADE: {
+            const std::string uri = header(wsi, WSI_TOKEN_GET_URI);
+            const std::string subprotocols = header(wsi, WSI_TOKEN_PROTOCOL);
+            if (uri != "/ws" || subprotocols.find("gi-stream") == std::string::npos) {
+                logRefusal("ws_upgrade", peerAddress(wsi) + " asked to upgrade " + uri.substr(0, 200) +
+                                             " with sub-protocol '" + subprotocols.substr(0, 100) + "'");
+                const char* why = uri != "/ws"
+                                      ? "WebSocket upgrades are served on /ws only"
+                                      : "send Sec-WebSocket-Protocol: gi-stream (protocol/PROTOCOL.md)";
+                lws_return_http_status(wsi, uri != "/ws" ? HTTP_STATUS_NOT_FOUND : HTTP_STATUS_BAD_REQUEST,
+                                       why);
+                return 1;
+            }
+            return 0;
+        }
+        default:
+            handled = false;
+            return 0;
+        }
+    }
+
     static int httpCallback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len) {
         Impl* self = from(wsi);
         if (self && reason == LWS_CALLBACK_EVENT_WAIT_CANCELLED) {
             self->onWake();
             return 0;
+        }
+        if (self) {
+            bool handled = false;
+            const int r = self->onConnectionEvent(wsi, reason, user, handled);
+            if (handled) return r;
         }
         return self ? self->onHttp(wsi, reason, static_cast<PerSession*>(user), in, len)
                     : lws_callback_http_dummy(wsi, reason, user, in, len);
@@ -1252,7 +1546,10 @@ WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
         throw InputError("--client-dir", "directory '" + m.config.clientDir + "' does not exist");
     m.clientRoot = resolved;
     m.config.clientDir = resolved;
-    m.catalog = std::make_shared<SceneCatalog>(m.config.sceneDirs, m.config.session.scene);
+    m.catalog = std::make_shared<SceneCatalog>(m.config.sceneDirs, m.config.session.scene,
+                                               static_cast<std::uint64_t>(m.config.maxDecodedMb) << 20);
+    m.connectionCap = m.config.maxConnections > 0 ? m.config.maxConnections
+                                                  : connectionCapFromFileLimit(m.config.maxSessions);
     m.defaultScene = m.scenes->get(m.catalog->resolve(m.config.session.scene));
     if (m.config.uploadDir.empty()) {
         m.uploadRoot =
@@ -1310,6 +1607,11 @@ void WsServer::listen() {
         throw Error("net: cannot listen on " + mImpl->config.host + ":" + std::to_string(mImpl->config.port) +
                     " (address in use or not available?)");
     mPort = mImpl->config.port;
+    logInfo("net: at most " + std::to_string(mImpl->connectionCap) + " connections (" +
+            (mImpl->config.maxConnections > 0 ? std::string("--max-connections")
+                                              : std::string("from the open-file limit")) +
+            "), " + std::to_string(mImpl->config.maxPendingPerIp) +
+            " per address before their request or hello is done");
     mImpl->scheduleHousekeeping();
 }
 
@@ -1318,6 +1620,10 @@ void WsServer::run() {
         if (lws_service(mImpl->context, 0) < 0) break;
         mImpl->pollShutdown();
     }
+}
+
+bool WsServer::stoppedAtOnce() const {
+    return mImpl->handledStopRequests >= 2;
 }
 
 void WsServer::requestStop() {

@@ -12,7 +12,13 @@
 // the request and wakes the loop. On the first request the loop stops taking sessions (hello gets
 // `shutting_down`, /healthz answers 503 "draining"), tells every client `shutdown` with the grace
 // period, and keeps serving running sessions until they end or `--drain-seconds` pass; then it closes
-// the rest with 1001 and run() returns. A second request ends the drain at once.
+// the rest with 1001 and run() returns. A second request ends the drain at once: the close frames get
+// half a second, and gi-server exits without waiting for frames still rendering.
+//
+// Hostile input (docs/service.md, "Limits"): every connection passes an overall cap below the
+// open-file limit and a per-address cap on connections that have not finished their request or
+// hello; HTTP requests have a whole-request deadline and bodies are read only for requests that were
+// not already answered; the stream is served on /ws with the gi-stream sub-protocol only.
 #pragma once
 
 #include <memory>
@@ -35,6 +41,9 @@ public:
     /// Starts the drain, or ends it when one is running. Async-signal-safe (an atomic increment and
     /// lws_cancel_service) and safe from any thread.
     void requestStop();
+    /// True when run() returned because of a second stop request: the caller should exit within a
+    /// second instead of waiting for frames still rendering.
+    bool stoppedAtOnce() const;
 
     struct Impl;
 

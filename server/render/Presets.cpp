@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <mutex>
 
 #include "core/Error.h"
+#include "core/JsonSchema.h"
 
 #ifndef GIS_DEFAULT_PRESETS
 #define GIS_DEFAULT_PRESETS "presets/presets.json"
@@ -26,8 +28,10 @@ const std::vector<std::string>& knownPresets() {
 nlohmann::json loadPresets(const std::string& path) {
     std::ifstream f(path);
     if (!f) throw InputError(path, "cannot read the presets file");
-    nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
-    if (j.is_discarded()) throw InputError(path, "not valid JSON");
+    const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    std::string parseError;
+    nlohmann::json j = parseJsonExplained(text, parseError);
+    if (j.is_discarded()) throw InputError(path, "not valid JSON: " + parseError);
     if (!j.is_object() || !j.contains("techniques") || !j["techniques"].is_object())
         throw InputError(path, "expected an object with a \"techniques\" object");
     for (const auto& [tech, presets] : j["techniques"].items()) {

@@ -9,13 +9,16 @@
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <optional>
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <stb_image.h>
 #include <tiny_gltf.h>
 
 #include "core/Error.h"
+#include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "scene/Geometry.h"
 #include "scene/SceneLoader.h"
@@ -44,6 +47,157 @@ std::string oneLine(const std::string& text) {
         start = end + 1;
     }
     return out;
+}
+
+std::string mib(std::uint64_t bytes) {
+    return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
+}
+
+/// What one load may reach and spend, shared by tinygltf's file and image callbacks and the reader.
+/// A refusal is recorded here (the callbacks can only answer false) and turned into the load's error.
+struct LoadContext {
+    std::string name;           ///< the file as errors call it
+    std::string baseDir;        ///< the file's directory as tinygltf joins it ("/abs/dir")
+    std::filesystem::path root; ///< canonical baseDir: external files must resolve below it
+    bool allowExternal = true;
+    std::uint64_t budget = 0; ///< 0: no limit
+    std::uint64_t spent = 0;
+    std::string refusal; ///< the first refusal, for the error message
+
+    /// Counts `bytes` against the budget; false (with the refusal recorded) when it would overflow.
+    bool spend(std::uint64_t bytes, const std::string& what) {
+        if (budget == 0 || (bytes <= budget && spent <= budget - bytes)) {
+            spent += bytes;
+            return true;
+        }
+        if (refusal.empty())
+            refusal = what + " would take " + mib(bytes) + " in memory and the scene already uses " +
+                      mib(spent) + "; this server loads scenes of at most " + mib(budget) +
+                      " once decoded (buffers, images and geometry): use smaller or fewer textures, or "
+                      "fewer instances";
+        return false;
+    }
+    void refuse(const std::string& why) {
+        if (refusal.empty()) refusal = why;
+    }
+};
+
+bool isDotDotSegment(const std::string& rel) {
+    std::size_t start = 0;
+    while (start <= rel.size()) {
+        std::size_t end = rel.find_first_of("/\\", start);
+        if (end == std::string::npos) end = rel.size();
+        if (rel.compare(start, end - start, "..") == 0) return true;
+        start = end + 1;
+    }
+    return false;
+}
+
+/// The URI as the file wrote it (after tinygltf's percent-decoding), when `absPath` is tinygltf's
+/// candidate in the file's own directory; nullopt for its other candidate (the working directory),
+/// which is never searched.
+std::optional<std::string> uriInBaseDir(const LoadContext& c, const std::string& absPath) {
+    const std::string prefix = c.baseDir + "/";
+    if (absPath.compare(0, prefix.size(), prefix) != 0) return std::nullopt;
+    return absPath.substr(prefix.size());
+}
+
+/// Whether the file tinygltf asks for may be read; records why not. Symbolic links are resolved: a
+/// link inside the folder that points out of it is refused like a '..' path.
+bool externalAllowed(LoadContext& c, const std::string& absPath) {
+    const auto uri = uriInBaseDir(c, absPath);
+    if (!uri) return false;
+    if (!c.allowExternal) {
+        c.refuse("refers to the external file '" + validUtf8(*uri) +
+                 "'; uploaded files must be self-contained: export a binary glTF (.glb) with its buffers "
+                 "and textures embedded");
+        logWarn("scene: sandbox: " + c.name + " asked for external file '" + validUtf8(*uri) + "' (refused)");
+        return false;
+    }
+    if (uri->empty() || (*uri)[0] == '/' || (*uri)[0] == '\\' || isDotDotSegment(*uri) ||
+        uri->find(':') != std::string::npos) {
+        c.refuse("refers to '" + validUtf8(*uri) +
+                 "', outside its own folder; external buffers and images must be relative paths below the "
+                 "glTF file, without '..'");
+        logWarn("scene: sandbox: " + c.name + " asked for '" + validUtf8(*uri) +
+                "' (refused: outside its folder)");
+        return false;
+    }
+    std::error_code ec;
+    const std::filesystem::path resolved = std::filesystem::weakly_canonical(absPath, ec);
+    const std::string r = resolved.string(), root = c.root.string() + "/";
+    if (ec || r.compare(0, root.size(), root) != 0) {
+        c.refuse("refers to '" + validUtf8(*uri) + "', which leads outside its own folder");
+        logWarn("scene: sandbox: " + c.name + " asked for '" + validUtf8(*uri) +
+                "' (refused: a link out of its folder)");
+        return false;
+    }
+    return true;
+}
+
+bool sandboxFileExists(const std::string& absPath, void* user) {
+    auto& c = *static_cast<LoadContext*>(user);
+    if (!externalAllowed(c, absPath)) return false;
+    std::error_code ec;
+    return std::filesystem::is_regular_file(absPath, ec);
+}
+
+std::string sandboxExpandPath(const std::string& path, void*) {
+    return path;
+} // no ~ or $VAR expansion
+
+bool sandboxReadFile(std::vector<unsigned char>* out, std::string* err, const std::string& absPath,
+                     void* user) {
+    auto& c = *static_cast<LoadContext*>(user);
+    if (!externalAllowed(c, absPath)) return false;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(absPath, ec);
+    const std::string uri = uriInBaseDir(c, absPath).value_or("?");
+    if (ec) {
+        if (err) *err = "cannot read '" + validUtf8(uri) + "'";
+        return false;
+    }
+    if (!c.spend(size, "the external file '" + validUtf8(uri) + "'")) return false;
+    std::ifstream in(absPath, std::ios::binary);
+    out->resize(size);
+    if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(size))) {
+        if (err) *err = "cannot read '" + validUtf8(uri) + "'";
+        return false;
+    }
+    return true;
+}
+
+bool sandboxWriteFile(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err = "the loader writes no files";
+    return false;
+}
+
+/// tinygltf's image callback: the decoded size is read from the image's header and charged to the
+/// budget before a pixel is decoded, so a small file with a huge texture costs only its header.
+bool budgetedImageLoader(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
+                         int reqWidth, int reqHeight, const unsigned char* bytes, int size, void* user) {
+    auto& c = *static_cast<LoadContext*>(user);
+    int w = 0, h = 0, comp = 0;
+    if (size <= 0 || !stbi_info_from_memory(bytes, size, &w, &h, &comp) || w <= 0 || h <= 0) {
+        if (err)
+            *err +=
+                "image " + std::to_string(index) + " is not a PNG, JPEG or other format the loader decodes\n";
+        return false;
+    }
+    constexpr int kMaxSide = 16384; // GL_MAX_TEXTURE_SIZE on llvmpipe; larger could not be sampled anyway
+    if (w > kMaxSide || h > kMaxSide) {
+        c.refuse("image " + std::to_string(index) + " is " + std::to_string(w) + "x" + std::to_string(h) +
+                 "; textures may be at most " + std::to_string(kMaxSide) + " pixels on a side");
+        return false;
+    }
+    const bool wide = stbi_is_16_bit_from_memory(bytes, size) != 0;
+    // tinygltf decodes to 4 channels; the reader then converts to RGBA8 beside it.
+    const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    const std::uint64_t cost = pixels * 4 * (wide ? 2 : 1) + pixels * 4;
+    if (!c.spend(cost,
+                 "image " + std::to_string(index) + " (" + std::to_string(w) + "x" + std::to_string(h) + ")"))
+        return false;
+    return tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
 }
 
 int componentCount(int type) {
@@ -155,9 +309,9 @@ struct AccessorView {
 
 class GltfReader {
 public:
-    GltfReader(const tinygltf::Model& model, const std::string& path)
-        : mModel(model), mPath(path), mImageTexture(model.images.size(), kNotConverted),
-          mOnPath(model.nodes.size(), false) {}
+    GltfReader(const tinygltf::Model& model, LoadContext& context)
+        : mModel(model), mPath(context.name), mContext(context),
+          mImageTexture(model.images.size(), kNotConverted), mOnPath(model.nodes.size(), false) {}
 
     Scene read() {
         checkRequiredExtensions();
@@ -176,8 +330,8 @@ private:
 
     void checkRequiredExtensions() const {
         for (const auto& ext : mModel.extensionsRequired)
-            if (ext != kLightsExtension && ext != kEmissiveStrengthExtension && ext != kQuantizationExtension &&
-                ext != kSpecularExtension)
+            if (ext != kLightsExtension && ext != kEmissiveStrengthExtension &&
+                ext != kQuantizationExtension && ext != kSpecularExtension)
                 fail("unsupported required extension '" + ext + "'");
     }
 
@@ -315,8 +469,8 @@ private:
             // glTF's default dielectric reflects F0 = 0.04; KHR_materials_specular scales it.
             m.specular = 1.0f;
             const auto spec = src.extensions.find(kSpecularExtension);
-            if (spec != src.extensions.end() && spec->second.IsObject() && spec->second.Has("specularFactor") &&
-                spec->second.Get("specularFactor").IsNumber()) {
+            if (spec != src.extensions.end() && spec->second.IsObject() &&
+                spec->second.Has("specularFactor") && spec->second.Get("specularFactor").IsNumber()) {
                 const double f = spec->second.Get("specularFactor").GetNumberAsDouble();
                 m.specular = std::isfinite(f) ? std::clamp(static_cast<float>(f), 0.0f, 1.0f) : 1.0f;
             }
@@ -472,6 +626,11 @@ private:
         if (prim.material >= static_cast<int>(mModel.materials.size()))
             fail(context + ": material " + std::to_string(prim.material) + " does not exist");
         mesh.material = prim.material >= 0 ? prim.material : defaultMaterial();
+        // Instances are flattened: a small file can name one mesh a million times through its nodes.
+        const std::uint64_t bytes =
+            mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
+            mesh.texcoords.size() * sizeof(glm::vec2) + mesh.indices.size() * sizeof(std::uint32_t);
+        if (!mContext.spend(bytes, context)) fail(mContext.refusal);
         mScene.meshes.push_back(std::move(mesh));
     }
 
@@ -545,65 +704,108 @@ private:
 
     const tinygltf::Model& mModel;
     const std::string& mPath;
+    LoadContext& mContext;
     Scene mScene;
     std::vector<int> mImageTexture; ///< glTF image -> Scene::textures index, kNotConverted, or -1
     std::vector<bool> mOnPath;      ///< nodes on the current root-to-node path, to reject cycles
     int mDefaultMaterial = -1;
 };
 
-/// tinygltf reports a short GLB only as "Invalid glTF binary."; say what is wrong instead.
-void checkGlbLength(const std::string& path) {
-    std::ifstream file(path, std::ios::binary);
-    unsigned char header[12] = {};
-    if (!file.read(reinterpret_cast<char*>(header), sizeof header)) return; // tinygltf reports it
-    if (std::memcmp(header, "glTF", 4) != 0) return;
-    const std::uint64_t declared =
-        header[8] | header[9] << 8 | header[10] << 16 | std::uint64_t(header[11]) << 24;
-    std::error_code ec;
-    const std::uint64_t actual = std::filesystem::file_size(path, ec);
-    if (!ec && declared > actual)
-        throw InputError(path, "truncated GLB: header declares " + std::to_string(declared) +
-                                   " bytes, file has " + std::to_string(actual));
+/// tinygltf reports a short GLB only as "Invalid glTF binary."; say what is wrong instead. Returns the
+/// JSON chunk for the depth check.
+std::string_view glbJsonChunk(const std::string& bytes, const std::string& name) {
+    auto u32 = [&](std::size_t at) {
+        const auto* b = reinterpret_cast<const unsigned char*>(bytes.data()) + at;
+        return std::uint64_t(b[0]) | std::uint64_t(b[1]) << 8 | std::uint64_t(b[2]) << 16 |
+               std::uint64_t(b[3]) << 24;
+    };
+    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) return {}; // tinygltf reports it
+    const std::uint64_t declared = u32(8);
+    if (declared > bytes.size())
+        throw InputError(name, "truncated GLB: header declares " + std::to_string(declared) +
+                                   " bytes, file has " + std::to_string(bytes.size()));
+    const std::uint64_t jsonLength = u32(12);
+    if (jsonLength > bytes.size() - 20) return {}; // tinygltf reports it
+    return std::string_view(bytes).substr(20, jsonLength);
 }
 
-tinygltf::Model parseFile(const std::string& path) {
+tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
+    const std::string& name = context.name;
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
-    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a regular file");
+    if (!std::filesystem::exists(path, ec)) throw InputError(name, "file not found");
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name, "not a regular file");
     const std::string ext = std::filesystem::path(path).extension().string();
     const bool binary = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'g' &&
                         std::tolower(static_cast<unsigned char>(ext[2])) == 'l' &&
                         std::tolower(static_cast<unsigned char>(ext[3])) == 'b';
-    if (binary) checkGlbLength(path);
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) throw InputError(name, "cannot read the file");
+    if (!context.spend(size, "the file")) throw InputError(name, context.refusal);
+    std::string bytes(size, '\0');
+    {
+        std::ifstream in(path, std::ios::binary);
+        if (!in.read(bytes.data(), static_cast<std::streamsize>(size)))
+            throw InputError(name, "cannot read the file");
+    }
+    // tinygltf walks extras and extensions recursively: a deep document must never reach it.
+    const std::string_view json = binary ? glbJsonChunk(bytes, name) : std::string_view(bytes);
+    if (auto at = findExcessNesting(json, kMaxGltfJsonDepth))
+        throw InputError(name, "malformed JSON: arrays and objects nested deeper than " +
+                                   std::to_string(kMaxGltfJsonDepth) + " levels (at byte " +
+                                   std::to_string(*at) + " of the JSON)");
+
     tinygltf::TinyGLTF parser;
+    parser.SetFsCallbacks(
+        {&sandboxFileExists, &sandboxExpandPath, &sandboxReadFile, &sandboxWriteFile, &context});
+    parser.SetImageLoader(&budgetedImageLoader, &context);
     tinygltf::Model model;
     std::string err, warnings;
-    const bool ok = binary ? parser.LoadBinaryFromFile(&model, &err, &warnings, path)
-                           : parser.LoadASCIIFromFile(&model, &err, &warnings, path);
-    if (!warnings.empty()) logWarn("scene: " + path + ": " + oneLine(warnings));
+    const bool ok =
+        binary ? parser.LoadBinaryFromMemory(&model, &err, &warnings,
+                                             reinterpret_cast<const unsigned char*>(bytes.data()),
+                                             static_cast<unsigned int>(bytes.size()), context.baseDir)
+               : parser.LoadASCIIFromString(&model, &err, &warnings, bytes.data(),
+                                            static_cast<unsigned int>(bytes.size()), context.baseDir);
+    // tinygltf's messages name files by the path it joined: show them relative to the file's folder.
+    auto relative = [&](std::string text) {
+        const std::string prefix = context.baseDir + "/";
+        for (std::size_t at; (at = text.find(prefix)) != std::string::npos;) text.erase(at, prefix.size());
+        return validUtf8(oneLine(text));
+    };
+    if (!warnings.empty()) logWarn("scene: " + name + ": " + relative(warnings));
+    if (!context.refusal.empty()) throw InputError(name, context.refusal);
     if (!ok) {
         // nlohmann's messages ("[json.exception.parse_error.101] ...") do not say what was parsed.
-        const std::string reason = oneLine(err);
-        if (reason.starts_with("[json.exception")) throw InputError(path, "malformed JSON: " + reason);
-        throw InputError(path, reason.empty() ? "not a valid glTF file" : reason);
+        const std::string reason = relative(err);
+        if (reason.starts_with("[json.exception")) throw InputError(name, "malformed JSON: " + reason);
+        throw InputError(name, reason.empty() ? "not a valid glTF file" : reason);
     }
     return model;
 }
 
 } // namespace
 
-Scene loadGltf(const std::string& path) {
+Scene loadGltf(const std::string& path, const SceneLoadOptions& options) {
+    LoadContext context;
+    context.name = options.displayName.empty() ? path : options.displayName;
+    context.allowExternal = options.allowExternalFiles;
+    context.budget = options.maxDecodedBytes;
     try {
-        const tinygltf::Model model = parseFile(path);
-        return GltfReader(model, path).read();
+        std::error_code ec;
+        const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+        if (ec) throw InputError(context.name, "file not found");
+        context.baseDir = absolute.parent_path().string();
+        context.root = std::filesystem::weakly_canonical(absolute.parent_path(), ec);
+        const tinygltf::Model model = parseFile(absolute.string(), context);
+        return GltfReader(model, context).read();
     } catch (const InputError&) {
         throw;
     } catch (const std::bad_alloc&) {
-        throw InputError(path, "out of memory while loading");
+        throw InputError(context.name, "out of memory while loading");
     } catch (const std::exception& e) {
-        throw InputError(path, std::string("failed to load: ") + e.what());
+        throw InputError(context.name, std::string("failed to load: ") + validUtf8(e.what()));
     } catch (...) {
-        throw InputError(path, "failed to load: unknown error");
+        throw InputError(context.name, "failed to load: unknown error");
     }
 }
 

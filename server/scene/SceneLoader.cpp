@@ -28,11 +28,12 @@ std::string joinedBuiltinNames() {
 
 } // namespace
 
-Scene loadScene(const std::string& name) {
+Scene loadScene(const std::string& name, const SceneLoadOptions& options) {
     if (name.starts_with(kBuiltinPrefix)) return makeBuiltinScene(name.substr(kBuiltinPrefix.size()));
-    if (endsWithIgnoreCase(name, ".gltf") || endsWithIgnoreCase(name, ".glb")) return loadGltf(name);
-    throw InputError(name, "unsupported scene: expected 'builtin:NAME' (NAME one of " + joinedBuiltinNames() +
-                               ") or a path to a .gltf or .glb file");
+    if (endsWithIgnoreCase(name, ".gltf") || endsWithIgnoreCase(name, ".glb")) return loadGltf(name, options);
+    throw InputError(options.displayName.empty() ? name : options.displayName,
+                     "unsupported scene: expected 'builtin:NAME' (NAME one of " + joinedBuiltinNames() +
+                         ") or a path to a .gltf or .glb file");
 }
 
 } // namespace gis

@@ -3,6 +3,7 @@
 // functions; bad files never crash the process.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -10,15 +11,32 @@
 
 namespace gis {
 
+/// What a scene file may reach and cost, and what its errors call it. The defaults fit files an
+/// operator or a developer chose; the server loads clients' files with a display name, a budget and,
+/// for uploads, no external files.
+///
+/// Whatever the options, a glTF file's external URIs resolve only inside the file's own directory:
+/// absolute paths and '..' segments are refused, and symbolic links that lead out of it too.
+struct SceneLoadOptions {
+    std::string displayName;           ///< how errors, logs and Scene::name call the file ("": the path)
+    bool allowExternalFiles = true;    ///< false: only the GLB's own chunk and data: URIs (uploads)
+    std::uint64_t maxDecodedBytes = 0; ///< file + external files + decoded images + geometry; 0: none
+};
+
+/// Deepest JSON nesting a glTF file may have: far beyond what exporters write (extras included),
+/// and shallow enough for tinygltf's recursive walk of extras and extensions.
+constexpr int kMaxGltfJsonDepth = 128;
+
 /// "builtin:NAME" for a scene generated in code, otherwise a path ending in .gltf or .glb.
-Scene loadScene(const std::string& name);
+Scene loadScene(const std::string& name, const SceneLoadOptions& options = {});
 
 /// Names accepted by makeBuiltinScene (and by loadScene after "builtin:").
 std::vector<std::string> builtinSceneNames();
 Scene makeBuiltinScene(const std::string& name);
 
 /// Loads a .gltf (JSON, external or data-URI buffers) or .glb file, flattened to world space.
-Scene loadGltf(const std::string& path);
+/// Every InputError names `options.displayName` (or the path), never another server path.
+Scene loadGltf(const std::string& path, const SceneLoadOptions& options = {});
 
 /// Brings a freshly built scene to the loaded-scene guarantees, then validates it:
 ///  - missing normals generated as area-weighted vertex normals (cross products summed over the

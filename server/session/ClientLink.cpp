@@ -59,6 +59,7 @@ bool ClientLink::offerFrame(std::uint32_t id, std::string stats, std::shared_ptr
             {false, std::make_shared<const std::string>(std::move(stats)), id, true, !bypassWindow});
         mQueue.push_back({true, std::move(frame), id, false, false});
         if (!bypassWindow) mInFlight.insert(id);
+        mNewestOffered = std::max(mNewestOffered, id);
         ++mOffered;
         wake = mWake;
     }
@@ -66,9 +67,16 @@ bool ClientLink::offerFrame(std::uint32_t id, std::string stats, std::shared_ptr
     return true;
 }
 
-void ClientLink::ack(std::uint32_t id) {
+bool ClientLink::ack(std::uint32_t id) {
     std::lock_guard lock(mMutex);
+    if (id > mNewestOffered) return false;
     mInFlight.erase(mInFlight.begin(), mInFlight.upper_bound(id));
+    return true;
+}
+
+std::uint32_t ClientLink::newestOffered() const {
+    std::lock_guard lock(mMutex);
+    return mNewestOffered;
 }
 
 bool ClientLink::windowFull() const {

@@ -41,7 +41,10 @@ public:
     bool offerFrame(std::uint32_t id, std::string stats, std::shared_ptr<const std::string> frame,
                     bool bypassWindow = false);
     /// Frees `id` and every older frame from the window (clients may acknowledge only the latest).
-    void ack(std::uint32_t id);
+    /// False, changing nothing, when no frame `id` was ever offered to this client.
+    bool ack(std::uint32_t id);
+    /// The newest frame id offered to this client (0: none yet).
+    std::uint32_t newestOffered() const;
     bool windowFull() const;
     std::size_t inFlight() const;
 
@@ -74,6 +77,7 @@ private:
     std::uint64_t mDroppedFrames = 0;
     std::uint64_t mDroppedText = 0;
     std::uint64_t mOffered = 0;
+    std::uint32_t mNewestOffered = 0;
     bool mClosed = false;
 };
 

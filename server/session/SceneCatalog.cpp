@@ -29,8 +29,9 @@ bool inside(const fs::path& path, const std::string& root, std::string& resolved
 
 } // namespace
 
-SceneCatalog::SceneCatalog(std::vector<std::string> sceneDirs, std::string defaultScene)
-    : mDefault(std::move(defaultScene)) {
+SceneCatalog::SceneCatalog(std::vector<std::string> sceneDirs, std::string defaultScene,
+                           std::uint64_t maxDecodedBytes)
+    : mDefault(std::move(defaultScene)), mMaxDecodedBytes(maxDecodedBytes) {
     for (const auto& d : sceneDirs) {
         std::error_code ec;
         fs::path c = fs::canonical(d, ec);
@@ -101,6 +102,15 @@ std::string SceneCatalog::resolve(const std::string& name, const std::string& up
     }
     throw InputError("/name",
                      "unknown scene '" + name + "': pick one from welcome.scenes or GET /api/scenes");
+}
+
+SceneLoadOptions SceneCatalog::loadOptions(const std::string& name) const {
+    SceneLoadOptions options;
+    options.displayName = name;
+    if (name == mDefault) return options; // the operator's own choice: no budget
+    options.allowExternalFiles = name.rfind("upload:", 0) != 0;
+    options.maxDecodedBytes = mMaxDecodedBytes;
+    return options;
 }
 
 void SceneCatalog::checkUploadName(const std::string& name) {

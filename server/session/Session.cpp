@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "core/Error.h"
+#include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "core/Timer.h"
 #include "gi/Technique.h"
@@ -134,7 +135,17 @@ std::vector<std::string> Session::sceneNames() const {
 }
 
 void Session::start() {
-    mWorker = std::thread([this] { workerMain(); });
+    mWorker = std::thread([this] {
+        // Nothing the renderer throws may leave the thread (std::terminate would end every session):
+        // the session fails alone and the network layer ends it with the reason.
+        try {
+            workerMain();
+        } catch (const std::exception& e) {
+            fail(std::string("the renderer stopped: ") + e.what());
+        } catch (...) {
+            fail("the renderer stopped on an unknown error");
+        }
+    });
 }
 
 void Session::stop() {
@@ -210,7 +221,12 @@ void Session::markInput() {
 }
 
 void Session::ack(const std::shared_ptr<ClientLink>& link, std::uint32_t id) {
-    link->ack(id);
+    if (!link->ack(id))
+        throw ProtocolError{"invalid_message",
+                            "frame " + std::to_string(id) +
+                                " was never sent on this connection (the newest is " +
+                                std::to_string(link->newestOffered()) + ")",
+                            "/frame", "ack"};
     // The worker reads the window while holding mMutex; passing through it orders this ack before
     // the worker's next check or after its wait began, so the notify cannot be lost.
     { std::lock_guard lock(mMutex); }
@@ -309,6 +325,22 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
     mCv.notify_all();
 }
 
+void Session::fail(const std::string& reason) {
+    logError("session " + mId + ": " + reason);
+    {
+        std::lock_guard lock(mMutex);
+        if (mFailure.empty()) mFailure = reason;
+    }
+    mFailed = true;
+    if (mOnError) mOnError("render_failed");
+    if (mOnFailure) mOnFailure();
+}
+
+std::string Session::failure() const {
+    std::lock_guard lock(mMutex);
+    return mFailure;
+}
+
 void Session::broadcastText(const nlohmann::json& msg) {
     const std::string text = msg.dump();
     for (const auto& c : clients()) c->pushText(text);
@@ -331,9 +363,7 @@ void Session::workerMain() {
         renderer = std::make_unique<FrameRenderer>();
         renderer->setScene(mScene);
     } catch (const std::exception& e) {
-        logError("session " + mId + ": " + e.what());
-        broadcastText(errorMessage(
-            {"render_failed", std::string("the renderer could not start: ") + e.what(), "", ""}));
+        fail(std::string("the renderer could not start: ") + e.what());
         return;
     }
     nlohmann::json presets;
@@ -368,8 +398,13 @@ void Session::workerMain() {
                     mCv.wait(lock);
             }
             if (mStop) break;
-            snapshotFor = mSnapshotFor.lock();
-            mSnapshotFor.reset();
+            // A viewer's snapshot waits while the controller has input to answer: viewers never delay
+            // the controller by more than the frame already rendering.
+            const bool controllerWaits = mDirty && mController && !mController->windowFull();
+            if (!controllerWaits) {
+                snapshotFor = mSnapshotFor.lock();
+                mSnapshotFor.reset();
+            }
             snapshotCodec = mSnapshotCodec;
             stream = mStream;
             if (snapshotFor) {
@@ -392,7 +427,12 @@ void Session::workerMain() {
             try {
                 const std::string path =
                     mCatalog ? mCatalog->resolve(sceneRequest, mUploadDir) : sceneRequest;
-                auto next = mScenes->get(path);
+                Stopwatch loadClock;
+                auto next =
+                    mScenes->get(path, mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{});
+                logInfo("session " + mId + ": scene " + validUtf8(sceneRequest) + " loaded (" +
+                        std::to_string(next->triangleCount()) + " triangles, " +
+                        std::to_string(static_cast<long>(loadClock.elapsedMs())) + " ms)");
                 renderer->setScene(next);
                 scene = next;
                 nlohmann::json stateMsg;
@@ -408,6 +448,8 @@ void Session::workerMain() {
                 }
                 broadcastText(stateMsg);
             } catch (const std::exception& e) {
+                logWarn("session " + mId + ": scene " + validUtf8(sceneRequest) +
+                        " refused: " + validUtf8(e.what()));
                 broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
                 if (mOnError) mOnError("scene_load_failed");
             }
@@ -421,18 +463,33 @@ void Session::workerMain() {
         double scale = 1.0;
         if (step >= 0) {
             static const char* presetNames[] = {"interactive", "balanced", "final"};
-            if (!presets.is_null()) {
+            const FrameState requested = state;
+            auto presetState = [&](int s) {
+                FrameState out = requested;
+                if (presets.is_null()) return out;
                 try {
-                    FrameState preset = state;
+                    FrameState preset = requested;
                     preset.techniqueParams.resetToDefaults();
-                    applyPreset(preset, presets, presetNames[step]);
+                    applyPreset(preset, presets, presetNames[s]);
                     nlohmann::json techniqueExplicit = nlohmann::json::object();
                     for (const auto& [k, v] : explicitParams.items())
                         if (preset.techniqueParams.has(k)) techniqueExplicit[k] = v;
                     preset.techniqueParams.apply(techniqueExplicit);
-                    if (maxVplEstimate(preset) <= mConfig.limits.maxVpls) state = std::move(preset);
+                    if (maxVplEstimate(preset) <= mConfig.limits.maxVpls) out = std::move(preset);
                 } catch (const InputError&) {
                     // No preset for this technique: the step renders the parameters as they are.
+                }
+                return out;
+            };
+            state = presetState(step);
+            // A snapshot is the best step that fits the refinement budget, judged like refinement:
+            // a step never measured nor predictable counts as too slow, the interactive one (at full
+            // size) always fits.
+            if (snapshotFor && mConfig.limits.refineBudgetMs > 0) {
+                while (step > static_cast<int>(Step::Interactive)) {
+                    const double predictedMs = predictRefineMs(scene->name, state, step);
+                    if (predictedMs > 0.0 && predictedMs <= mConfig.limits.refineBudgetMs) break;
+                    state = presetState(--step);
                 }
             }
             if (step == static_cast<int>(Step::Final) && state.frameParams.has("effects") &&
@@ -480,9 +537,10 @@ void Session::workerMain() {
         try {
             frame = renderer->render(state);
         } catch (const std::exception& e) {
-            broadcastText(errorMessage({"render_failed", e.what(), "", ""}));
-            if (mOnError) mOnError("render_failed");
-            continue;
+            // A failed render leaves the context in an unknown state: the session ends rather than
+            // failing again on every input.
+            fail(std::string("the frame could not be rendered: ") + e.what());
+            break;
         }
         permit.reset();
         if (step >= 0 && frame.width > 0 && frame.height > 0)
@@ -497,9 +555,8 @@ void Session::workerMain() {
                           ? encodeWebpLossless(frame.rgba8.data(), frame.width, frame.height)
                           : encodeImage(codec, frame.rgba8.data(), frame.width, frame.height, stream.quality);
         } catch (const std::exception& e) {
-            broadcastText(errorMessage({"render_failed", e.what(), "", ""}));
-            if (mOnError) mOnError("render_failed");
-            continue;
+            fail(std::string("the frame could not be encoded: ") + e.what());
+            break;
         }
         const double encodeMs = encodeClock.elapsedMs();
         ++frameId;

@@ -119,6 +119,12 @@ public:
     /// Seconds since the controller last steered (idle timeout).
     double idleSeconds() const;
     std::uint64_t framesRendered() const { return mFramesRendered.load(); }
+    /// True once the renderer failed (an exception from GL, the encoder or out of memory): the worker
+    /// has stopped and the session should end with failure() as its reason. `onFailure` (called on
+    /// the worker thread) wakes whoever ends it.
+    bool failed() const { return mFailed.load(); }
+    std::string failure() const;
+    void setFailureObserver(std::function<void()> onFailure) { mOnFailure = std::move(onFailure); }
     /// The scenes this session may load (the catalogue plus its uploads).
     std::vector<std::string> sceneNames() const;
 
@@ -130,6 +136,7 @@ private:
     bool readyLocked(std::chrono::steady_clock::time_point now) const;
     void workerMain();
     void broadcastText(const nlohmann::json& msg);
+    void fail(const std::string& reason);
 
     const std::string mId;
     const SessionConfig mConfig;
@@ -139,6 +146,9 @@ private:
     const std::string mUploadDir;
     FrameObserver mOnFrame;
     ErrorObserver mOnError;
+    std::function<void()> mOnFailure;
+    std::atomic<bool> mFailed{false};
+    std::string mFailure; ///< guarded by mMutex
 
     mutable std::mutex mMutex;
     std::condition_variable mCv;
