@@ -13,7 +13,7 @@ const EXPLANATIONS = {
     binary_not_accepted: 'The server accepts no binary messages.',
     rate_limited: 'Too many messages per second; the server dropped one.',
     read_only: 'This is a view-only link: the view cannot be steered from here.',
-    render_failed: 'The frame could not be rendered; the previous settings keep rendering.',
+    render_failed: 'The renderer failed and ended this session (the server goes on): press Connect to start a new one.',
     scene_load_failed: 'The scene could not be loaded; the previous scene keeps rendering.',
     hello_required: 'The connection did not start properly.',
     protocol_mismatch: 'This page and the server speak different protocol versions: reload the page.',

@@ -1,5 +1,7 @@
 // libFuzzer target for the scene loader: the bytes become a .glb (or, when they start with '{', a
-// .gltf) file that loadScene() reads. The loader's contract (scene/SceneLoader.h) is that only
+// .gltf) file that loadScene() reads. A .glb takes the server's upload path (no external files, the
+// default decoded-size budget of --max-decoded-mb, the client's name in errors); a .gltf the path of
+// a scene-directory file (external files inside its folder only, same budget). The loader's contract (scene/SceneLoader.h) is that only
 // gis::InputError leaves it: any other exception, a crash or a sanitizer report is a finding.
 #include <cstddef>
 #include <cstdint>
@@ -22,7 +24,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (size > 0) std::fwrite(data, 1, size, f);
     std::fclose(f);
     try {
-        const gis::Scene scene = gis::loadScene(path);
+        gis::SceneLoadOptions options;
+        options.displayName = json ? "file:fuzz.gltf" : "upload:fuzz.glb";
+        options.allowExternalFiles = json;
+        options.maxDecodedBytes = std::uint64_t(512) << 20; // below the fuzzer's 2 GiB RSS limit
+        const gis::Scene scene = gis::loadScene(path, options);
         (void)scene.triangleCount();
     } catch (const gis::InputError&) {
         // Rejected with a message: the expected outcome for most inputs.

@@ -74,3 +74,15 @@ TEST(ClientLink, TextCapAndCloseDropMessages) {
     EXPECT_FALSE(link.hasOutgoing());
     EXPECT_FALSE(link.offerFrame(1, "s", bytes("f")));
 }
+
+TEST(ClientLink, AcksOfFramesNeverOfferedAreRefused) {
+    gis::ClientLink link(gis::ClientRole::Controller, 2, [] {});
+    EXPECT_FALSE(link.ack(1)) << "nothing was offered yet";
+    ASSERT_TRUE(link.offerFrame(1, "s1", std::make_shared<const std::string>("f1")));
+    EXPECT_TRUE(link.windowFull() == false);
+    EXPECT_FALSE(link.ack(4294967295u));
+    EXPECT_EQ(link.inFlight(), 1u) << "a refused ack frees nothing";
+    EXPECT_TRUE(link.ack(1));
+    EXPECT_EQ(link.inFlight(), 0u);
+    EXPECT_EQ(link.newestOffered(), 1u);
+}
