@@ -923,6 +923,7 @@ struct WsServer::Impl {
     }
     void sendError(Connection& c, const ProtocolError& e) { sendDirect(c, errorMessage(e)); }
     void closeWith(Connection& c, const ProtocolError& e, int code) {
+        if (!c.helloDone) logRefusal(e.code, peerAddress(c.wsi) + ": " + e.message);
         sendError(c, e);
         c.closing = true;
         c.closeCode = code;
@@ -1562,10 +1563,12 @@ WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
     fs::create_directories(m.uploadRoot, ec);
     if (ec) throw InputError("--upload-dir", "cannot create '" + m.uploadRoot + "': " + ec.message());
     m.gate = std::make_unique<RenderGate>(m.config.renderSlots);
-    // API workers: up to the render slots (at most 4: each holds a GL context), sharing the gate.
-    m.workers =
-        std::make_unique<GlWorkerPool>(m.config.session.backend, std::clamp(m.config.renderSlots, 1, 4),
-                                       static_cast<std::size_t>(m.config.httpRenderQueue), m.gate.get());
+    // API workers share the gate with sessions but never hold its last slot: with two or more slots,
+    // API renders run on at most slots - 1 of them (and at most 4: each holds a GL context), so a
+    // burst of render requests cannot hold every session's controller behind it.
+    m.workers = std::make_unique<GlWorkerPool>(
+        m.config.session.backend, std::clamp(m.config.renderSlots - 1, 1, 4),
+        static_cast<std::size_t>(m.config.httpRenderQueue), m.gate.get());
 }
 
 WsServer::~WsServer() {

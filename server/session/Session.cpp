@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <optional>
 
 #include "core/Error.h"
@@ -430,7 +431,10 @@ void Session::workerMain() {
                 Stopwatch loadClock;
                 auto next =
                     mScenes->get(path, mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{});
+                std::error_code sizeError;
+                const auto bytes = std::filesystem::file_size(path, sizeError);
                 logInfo("session " + mId + ": scene " + validUtf8(sceneRequest) + " loaded (" +
+                        (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
                         std::to_string(next->triangleCount()) + " triangles, " +
                         std::to_string(static_cast<long>(loadClock.elapsedMs())) + " ms)");
                 renderer->setScene(next);

@@ -16,7 +16,7 @@
 //   main:      32x32, --technique none, --max-message-bytes 1 MiB, --hello-timeout 2,
 //              --request-timeout 2, a private --upload-dir
 //   strict:    --token secret, --max-pending-per-ip 8
-//   isolation: 64x64 rsm_gather, --refine-budget-ms 500
+//   isolation: 128x128 rsm_gather, --refine-budget-ms 500
 // Only loopback addresses (127.0.0.1, 127.0.0.2) are ever connected to; every loop is bounded.
 // Run: GI_SERVER=build/ci/bin/gi-server node --test tests/e2e/hostile.test.mjs
 import { after, before, test } from 'node:test';
@@ -52,7 +52,7 @@ before(async () => {
         ServerProcess.start([...SMALL, '--max-message-bytes', '1048576', '--hello-timeout', '2',
             '--request-timeout', '2', '--upload-dir', uploadDir]),
         ServerProcess.start([...SMALL, '--token', TOKEN, '--max-pending-per-ip', '8']),
-        ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'rsm_gather', '--size', '64x64',
+        ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'rsm_gather', '--size', '128x128',
             '--refine-budget-ms', '500']),
     ]);
     Object.assign(servers, { main, strict, isolation });
@@ -565,7 +565,14 @@ check('isolation: a viewer\'s snapshot does not stall the controller\'s interact
     const frame = await controller.frame('controller: interactive frame after the camera', (s) => s.quality === 'interactive' && s.frame > first.stats.frame, 10000);
     const interactiveMs = Date.now() - started;
     const snap = await viewer.frame('viewer: snapshot', (s) => s.snapshot === true, 30000);
+    const snapshotMs = Date.now() - started;
     console.log(`# isolation: interactive frame ${frame.stats.frame} after ${interactiveMs} ms; `
-        + `snapshot ${snap.stats.size.join('x')} after ${Date.now() - started} ms`);
-    assert.ok(interactiveMs <= 10000, `interactive frame after ${interactiveMs} ms`);
+        + `snapshot ${snap.stats.size.join('x')} (${snap.stats.quality}) after ${snapshotMs} ms`);
+    // rsm_gather's final preset gathers 65,536 VPLs: about 10 s at 128x128 on llvmpipe, far over the
+    // 500 ms budget. The snapshot takes the best step that fits instead, and the controller's answer
+    // never waits behind it.
+    assert.notEqual(snap.stats.quality, 'final', 'the snapshot did not render the over-budget final step');
+    assert.equal(snap.stats.size.join('x'), '128x128', 'a snapshot is full size');
+    assert.ok(interactiveMs <= 3000, `interactive frame after ${interactiveMs} ms`);
+    assert.ok(snapshotMs <= 5000, `snapshot after ${snapshotMs} ms`);
 });
