@@ -653,6 +653,14 @@ struct WsServer::Impl {
                 respond(wsi, pss, errorResponse(404, "not_found", "no POST endpoint " + uri));
                 return 0;
             }
+            if (std::stoull(length) > pss->http->bodyLimit) {
+                // Refused from its header: the body is not read.
+                respond(wsi, pss,
+                        errorResponse(413, "too_large",
+                                      "the body of " + length + " bytes exceeds " +
+                                          std::to_string(pss->http->bodyLimit) + " bytes for " + uri));
+                return 0;
+            }
             return 0; // the body follows (LWS_CALLBACK_HTTP_BODY)
         }
         if (uri == "/metrics") {
@@ -1566,9 +1574,9 @@ WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
     // API workers share the gate with sessions but never hold its last slot: with two or more slots,
     // API renders run on at most slots - 1 of them (and at most 4: each holds a GL context), so a
     // burst of render requests cannot hold every session's controller behind it.
-    m.workers = std::make_unique<GlWorkerPool>(
-        m.config.session.backend, std::clamp(m.config.renderSlots - 1, 1, 4),
-        static_cast<std::size_t>(m.config.httpRenderQueue), m.gate.get());
+    m.workers =
+        std::make_unique<GlWorkerPool>(m.config.session.backend, std::clamp(m.config.renderSlots - 1, 1, 4),
+                                       static_cast<std::size_t>(m.config.httpRenderQueue), m.gate.get());
 }
 
 WsServer::~WsServer() {

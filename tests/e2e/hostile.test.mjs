@@ -515,7 +515,7 @@ check('--token: a render without Authorization is 401 before its body and closed
     assert.equal(wrong.status, 401, 'a wrong token is 401');
 });
 
-check('HTTP: a chunked body is 411; Content-Length -5 is a prompt 400', async () => {
+check('HTTP: a chunked body is 411; Content-Length -5 is a prompt 400; a declared 1 GiB body a prompt 413 and a close', async () => {
     const server = servers.main;
     const body = JSON.stringify({ scene: 'builtin:cornell', technique: 'none', size: [32, 32] });
     const chunked = `POST /api/render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n`
@@ -526,6 +526,11 @@ check('HTTP: a chunked body is 411; Content-Length -5 is a prompt 400', async ()
     const b = await rawExchange(server.port, negative, { timeoutMs: 4000 });
     assert.equal(b.status, 400, `Content-Length -5: ${b.text.slice(0, 200)}`);
     assert.ok(b.firstByteMs <= 2000, `400 after ${b.firstByteMs} ms`);
+    // A body declared over the limit is refused from its header, never read: 413 and a close.
+    const huge = 'POST /api/render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: 1073741824\r\n\r\n{';
+    const c = await rawExchange(server.port, huge, { timeoutMs: 4000 });
+    assert.equal(c.status, 413, `Content-Length 1 GiB: ${c.text.slice(0, 200)}`);
+    assert.ok(c.closedMs !== null && c.closedMs <= 2000, `closed after ${c.closedMs} ms`);
     await assertHealthy(server, 'after the odd bodies');
 });
 
