@@ -7,21 +7,15 @@
 #include "analysis/EffectPlan.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 
 namespace {
 
 constexpr int kSize = 64;
 
 /// Relative RMSE of a against b over RGB (linear RGBA frames).
-double relativeRmse(const std::vector<float>& a, const std::vector<float>& b) {
-    double num = 0, den = 0;
-    for (size_t i = 0; i + 3 < b.size(); i += 4)
-        for (int c = 0; c < 3; ++c) {
-            num += (double(a[i + c]) - b[i + c]) * (double(a[i + c]) - b[i + c]);
-            den += double(b[i + c]) * b[i + c];
-        }
-    return den > 0 ? std::sqrt(num / den) : 0.0;
-}
 
 struct Pair {
     FrameOutput all, planned;
@@ -59,7 +53,7 @@ TEST(EffectPlanGl, DroppedEffectsStayWithinOnePercent) {
         const bool changed =
             p.plannedState.technique == "none" || !p.plannedState.techniqueParams.getBool("vpl_shadows");
         EXPECT_TRUE(changed) << scene << ": the plan should drop an effect";
-        EXPECT_LT(relativeRmse(p.planned.linear, p.all.linear), 0.01) << scene;
+        EXPECT_LT(relativeRmseOf(p.planned, p.all), 0.01) << scene;
     }
 }
 

@@ -14,6 +14,9 @@
 #include "scene/SceneLoader.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 
 namespace {
 
@@ -40,12 +43,6 @@ const Scene& galleryScene() {
     return scene;
 }
 
-size_t badValues(const FrameOutput& f) {
-    size_t bad = 0;
-    for (float v : f.linear)
-        if (!std::isfinite(v) || v < 0.0f) ++bad;
-    return bad;
-}
 
 // Mean linear RGB over the (2r+1)^2 block around pixel p (top-left origin).
 glm::dvec3 blockMean(const FrameOutput& f, glm::ivec2 p, int r) {

@@ -4,6 +4,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "analysis/Metrics.h"
 #include "render/FrameState.h"
 
 namespace gis::test {
@@ -39,6 +40,30 @@ glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h) {
     glm::vec4 clip = FrameRenderer::cameraViewProj(scene.cameras.front(), w, h) * glm::vec4(p, 1.0f);
     glm::vec2 ndc = glm::vec2(clip) / clip.w;
     return {static_cast<int>((ndc.x * 0.5f + 0.5f) * w), static_cast<int>((0.5f - ndc.y * 0.5f) * h)};
+}
+
+double relativeRmseOf(const std::vector<float>& test, int testChannels, const std::vector<float>& reference,
+                      int referenceChannels, std::size_t pixels) {
+    const int n = static_cast<int>(pixels);
+    return relativeRmse(ImageView{std::span<const float>(test.data(), pixels * testChannels), n, 1, testChannels},
+                        ImageView{std::span<const float>(reference.data(), pixels * referenceChannels), n, 1,
+                                  referenceChannels});
+}
+
+double relativeRmseOf(const FrameOutput& test, const FrameOutput& reference) {
+    return relativeRmseOf(test.linear, 4, reference.linear, 4, reference.linear.size() / 4);
+}
+
+std::size_t badValues(const FrameOutput& f) {
+    std::size_t bad = 0;
+    for (float v : f.linear)
+        if (!std::isfinite(v) || v < 0.0f) ++bad;
+    return bad;
+}
+
+double counter(const FrameOutput& f, const std::string& name) {
+    const auto& c = f.stats.at("counts");
+    return c.contains(name) ? c.at(name).get<double>() : 0.0;
 }
 
 bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>& rgb) {

@@ -26,6 +26,17 @@ FrameOutput renderScene(const std::string& scene, const std::string& technique, 
 /// Pixel (x, y), top-left origin, where world point p lands in the scene's default camera.
 glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h);
 
+/// Relative RMSE (analysis/Metrics.h: over the RGB channels, relative to the reference's RMS value) of
+/// `test` against `reference`, interleaved linear images of `pixels` pixels with 3 or 4 channels.
+double relativeRmseOf(const std::vector<float>& test, int testChannels, const std::vector<float>& reference,
+                      int referenceChannels, std::size_t pixels);
+/// The same for two frames' linear outputs (RGBA).
+double relativeRmseOf(const FrameOutput& test, const FrameOutput& reference);
+/// Linear output values that are NaN, infinite or negative.
+std::size_t badValues(const FrameOutput& f);
+/// A frame's stats counter (stats.counts.NAME), 0 when absent.
+double counter(const FrameOutput& f, const std::string& name);
+
 bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>& rgb);
 bool writePng(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);
 

@@ -15,6 +15,9 @@
 #include "render/FrameState.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 
 namespace {
 
@@ -79,16 +82,6 @@ float tanHalfFov(const Frame& f) {
 }
 
 // sqrt(mean((a - b)^2)) / sqrt(mean(b^2)) over RGB.
-double relativeRmse(const std::vector<float>& a, const std::vector<float>& b) {
-    double num = 0, den = 0;
-    for (size_t i = 0; i < b.size(); i += 4)
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(a[i + c]) - b[i + c];
-            num += d * d;
-            den += double(b[i + c]) * b[i + c];
-        }
-    return den > 0 ? std::sqrt(num / den) : 0.0;
-}
 
 } // namespace
 
@@ -265,7 +258,7 @@ TEST(LightTree, FullTraversalEqualsThePerTexelGather) {
     const Frame flat = render("builtin:cornell", "rsm_gather", 64, 64,
                               {{"rsm_size", rsm}, {"vpl_grid", rsm}, {"kernel", "disk"}});
     const Frame direct = render("builtin:cornell", "none", 64, 64, {{"rsm_size", rsm}});
-    const double totalError = relativeRmse(hier.out.linear, flat.out.linear);
+    const double totalError = relativeRmseOf(hier.out, flat.out);
     EXPECT_LT(totalError, 1e-3);
     // The indirect term alone (total minus the shared direct term) as well, a stricter view.
     std::vector<float> hi = hier.out.linear, fi = flat.out.linear;
@@ -273,7 +266,7 @@ TEST(LightTree, FullTraversalEqualsThePerTexelGather) {
         hi[i] -= direct.out.linear[i];
         fi[i] -= direct.out.linear[i];
     }
-    const double indirectError = relativeRmse(hi, fi);
+    const double indirectError = relativeRmseOf(hi, 4, fi, 4, fi.size() / 4);
     EXPECT_LT(indirectError, 1e-3);
     std::printf("full traversal vs per-texel gather: relative RMSE %.2e total, %.2e indirect\n", totalError,
                 indirectError);

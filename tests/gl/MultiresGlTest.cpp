@@ -10,16 +10,15 @@
 #include "gi/multires_splat/MultiresSplat.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 using gis::test::renderScene;
 
 namespace {
 
 using PatchSet = std::vector<std::array<int, 3>>;
 
-double relativeRmseOf(const FrameOutput& test, const FrameOutput& reference) {
-    return relativeRmse(ImageView{test.linear.data(), test.width, test.height, 4},
-                        ImageView{reference.linear.data(), reference.width, reference.height, 4});
-}
 
 // Covered pixels of the last frame: the coarsest level's coverage counts sum to them (-1 when the
 // image is a single level, which lives in the G-buffer rather than the atlas).

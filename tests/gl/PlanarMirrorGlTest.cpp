@@ -10,6 +10,9 @@
 #include "render/PlanarMirrors.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 
 namespace {
 
@@ -94,12 +97,6 @@ double count(const FrameOutput& f, const char* name) {
     return f.stats["counts"].value(name, -1.0);
 }
 
-size_t badValues(const FrameOutput& f) {
-    size_t bad = 0;
-    for (float v : f.linear)
-        if (!std::isfinite(v) || v < 0.0f) ++bad;
-    return bad;
-}
 
 bool hasPass(const FrameOutput& f, const std::string& name) {
     for (const auto& p : f.stats["passes"])

@@ -11,23 +11,16 @@ using namespace gis;
 
 namespace {
 
-// sqrt(mean((a - b)^2)) / sqrt(mean(b^2)) over RGB of the pixels both images cover. GL's linear frame
-// is RGBA (glChannels 4), the reference's RGB.
-double relativeRmse(const std::vector<float>& gl, size_t glChannels, const std::vector<float>& ref,
-                    int* covered) {
-    double num = 0, den = 0;
-    *covered = 0;
+// Pixels either image covers (background in both left out); GL's linear frame is RGBA (glChannels 4),
+// the reference's RGB. The error itself is analysis/Metrics.h's relative RMSE (test::relativeRmseOf).
+int coveredPixels(const std::vector<float>& gl, size_t glChannels, const std::vector<float>& ref) {
+    int covered = 0;
     for (size_t i = 0; i < ref.size() / 3; ++i) {
         const float* a = &gl[i * glChannels];
         const float* b = &ref[i * 3];
-        if (a[0] + a[1] + a[2] <= 0.0f && b[0] + b[1] + b[2] <= 0.0f) continue; // background in both
-        ++*covered;
-        for (int c = 0; c < 3; ++c) {
-            num += (double(a[c]) - b[c]) * (double(a[c]) - b[c]);
-            den += double(b[c]) * b[c];
-        }
+        if (a[0] + a[1] + a[2] > 0.0f || b[0] + b[1] + b[2] > 0.0f) ++covered;
     }
-    return den > 0 ? std::sqrt(num / den) : 0.0;
+    return covered;
 }
 
 } // namespace
@@ -74,9 +67,9 @@ TEST(ReferenceGl, RsmGatherApproachesOneBounceUnoccluded) {
         ASSERT_EQ(gl.linear.size(), static_cast<size_t>(w * h * 4));
         ASSERT_EQ(glDirect.linear.size(), gl.linear.size());
 
-        int covered = 0, coveredDirect = 0, coveredIndirect = 0;
-        const double total = relativeRmse(gl.linear, 4, ref.rgb, &covered);
-        const double direct = relativeRmse(glDirect.linear, 4, refDirect.rgb, &coveredDirect);
+        const int covered = coveredPixels(gl.linear, 4, ref.rgb);
+        const double total = test::relativeRmseOf(gl.linear, 4, ref.rgb, 3, ref.rgb.size() / 3);
+        const double direct = test::relativeRmseOf(glDirect.linear, 4, refDirect.rgb, 3, refDirect.rgb.size() / 3);
         // Indirect alone (each side's total minus its own direct term): the light-transport comparison.
         std::vector<float> glIndirect(ref.rgb.size()), refIndirect(ref.rgb.size());
         double glSum = 0, refSum = 0;
@@ -87,7 +80,7 @@ TEST(ReferenceGl, RsmGatherApproachesOneBounceUnoccluded) {
                 glSum += glIndirect[i * 3 + c];
                 refSum += refIndirect[i * 3 + c];
             }
-        const double indirect = relativeRmse(glIndirect, 3, refIndirect, &coveredIndirect);
+        const double indirect = test::relativeRmseOf(glIndirect, 3, refIndirect, 3, refIndirect.size() / 3);
         std::printf(
             "cornell-empty %dx%d, GL rsm_gather (rsm_size = vpl_grid = %d, min_distance 0) vs reference "
             "one-bounce-unoccluded (%d spp, %.2f s), relative RMSE over %d covered pixels: total %.4f, "

@@ -13,6 +13,9 @@
 #include "reference/ReferenceRenderer.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 
 namespace {
 
@@ -40,27 +43,7 @@ double count(const FrameOutput& f, const char* name) {
 }
 
 // sqrt(mean((a - b)^2)) / sqrt(mean(b^2)) over RGB, pixels where either image is non-black.
-double relativeRmse(const std::vector<float>& a, size_t aChannels, const std::vector<float>& b,
-                    size_t bChannels, size_t pixels) {
-    double num = 0, den = 0;
-    for (size_t i = 0; i < pixels; ++i) {
-        const float* x = &a[i * aChannels];
-        const float* y = &b[i * bChannels];
-        if (x[0] + x[1] + x[2] <= 0.0f && y[0] + y[1] + y[2] <= 0.0f) continue;
-        for (int c = 0; c < 3; ++c) {
-            num += (double(x[c]) - y[c]) * (double(x[c]) - y[c]);
-            den += double(y[c]) * y[c];
-        }
-    }
-    return den > 0 ? std::sqrt(num / den) : 0.0;
-}
 
-size_t badValues(const FrameOutput& f) {
-    size_t bad = 0;
-    for (float v : f.linear)
-        if (!std::isfinite(v) || v < 0.0f) ++bad;
-    return bad;
-}
 
 SecondOrder* technique() {
     return dynamic_cast<SecondOrder*>(test::sharedRenderer().technique());
@@ -233,8 +216,8 @@ TEST(SecondOrder, NegativeLightsMoveTowardsTheOneBounceReference) {
     EXPECT_GT(negative, 0.0);
     EXPECT_LT(negative, 0.5 * positive);
     const size_t pixels = static_cast<size_t>(w * h);
-    const double errWithout = relativeRmse(without.linear, 4, ref.rgb, 3, pixels);
-    const double errWith = relativeRmse(with.linear, 4, ref.rgb, 3, pixels);
+    const double errWithout = relativeRmseOf(without.linear, 4, ref.rgb, 3, pixels);
+    const double errWith = relativeRmseOf(with.linear, 4, ref.rgb, 3, pixels);
     // Measured on llvmpipe: 0.1055 without, 0.0974 with 128 negative lights (reference noise at
     // 512 spp included in both).
     std::printf("cornell %dx%d vs one-bounce (%d spp): relative RMSE %.4f without, %.4f with %g negative "
@@ -249,7 +232,7 @@ TEST(SecondOrder, NegativeLightsLeaveTheEmptyBoxAlone) {
     // (digest S.4 case 19a), so the negative lights must not change the image.
     const FrameOutput without = renderState("builtin:cornell-empty", 64, 64, {{"negative_count", 0}});
     const FrameOutput with = renderState("builtin:cornell-empty", 64, 64, {});
-    const double change = relativeRmse(with.linear, 4, without.linear, 4, 64 * 64);
+    const double change = relativeRmseOf(with.linear, 4, without.linear, 4, 64 * 64);
     EXPECT_LT(change, 0.005);
     EXPECT_EQ(count(with, "negative_clamped_fraction"), 0.0);
 }
@@ -299,7 +282,7 @@ TEST(SecondOrder, ThresholdExtremesAndDeterminism) {
         renderState("builtin:cornell", 64, 48, {{"lowres_factor", 1}, {"discontinuity_threshold", 2.0}});
     EXPECT_EQ(count(factorOne, "lowres_fraction"), 1.0);
     // The same lights at full resolution either way: equal up to summation order.
-    EXPECT_LT(relativeRmse(factorOne.linear, 4, full.linear, 4, 64 * 48), 1e-5);
+    EXPECT_LT(relativeRmseOf(factorOne.linear, 4, full.linear, 4, 64 * 48), 1e-5);
 
     const FrameOutput a = renderState("builtin:cornell", 64, 48, {});
     const FrameOutput b = renderState("builtin:cornell", 64, 48, {});

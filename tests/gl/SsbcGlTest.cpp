@@ -12,6 +12,9 @@
 #include "render/FrameState.h"
 
 using namespace gis;
+using test::badValues;
+using test::counter;
+using test::relativeRmseOf;
 using gis::test::renderScene;
 
 namespace {
@@ -19,10 +22,6 @@ namespace {
 constexpr int kW = 96, kH = 96;
 const std::string kCrease = "builtin:crease";
 
-double counter(const FrameOutput& f, const char* name) {
-    const auto& c = f.stats.at("counts");
-    return c.contains(name) ? c.at(name).get<double>() : 0.0;
-}
 
 // Mean RGB of `rgb` (stride channels per pixel) over the pixels where mask is set.
 double maskedMean(const std::vector<float>& rgb, int stride, const std::vector<std::uint8_t>& mask) {
