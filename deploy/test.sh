@@ -37,7 +37,7 @@ if [[ "$SANITIZE" == 1 ]]; then
         mapfile -t targets < <(ninja -C "$ROOT/build/asan-ci" -t targets all | grep -oE '^gis_[a-z_]+_tests' |
                                grep -vx gis_gl_tests | sort -u)
     else
-        targets=(gis_core_tests gis_scene_tests gis_render_tests gis_stability_tests)
+        targets=(gis_core_tests gis_scene_tests gis_frame_tests gis_job_tests gis_stability_tests)
     fi
     cmake --build "$ROOT/build/asan-ci" -j "$JOBS" --target "${targets[@]}"
     # Unbuilt test executables only add an unlabelled *_NOT_BUILT placeholder, which -L leaves out.

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/FrameRenderer.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 #include "scene/Scene.h"
 
 namespace gis::bench {

@@ -1,7 +1,7 @@
 // gi-bench report: docs/accuracy.md from a sweep (BenchSweep.cpp): per scene an error-versus-time
 // plot (gnuplot, when installed) with each technique's Pareto front, a table of the fronts, the seed
 // papers' tables as this renderer measures them beside the papers' own numbers, and the presets
-// chosen from the fronts (presets/presets.json, read by render/Presets.h).
+// chosen from the fronts (presets/presets.json, read by frame/Presets.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,7 +23,7 @@
 #include "app/BenchCommon.h"
 #include "core/Error.h"
 #include "gi/Technique.h"
-#include "render/Presets.h"
+#include "frame/Presets.h"
 
 namespace gis::bench {
 namespace {
@@ -434,10 +434,11 @@ int report(const std::vector<std::string>& args) {
           "\"final\": "
           "{...}}}, ...}`; a preset lists only the parameters that differ from the technique's defaults, so "
           "knobs "
-          "added later keep their defaults. `render/Presets.h` loads it (`presetParams(technique, name)`, "
+          "added later keep their defaults. `frame/Presets.h` loads it (`presetParams(technique, name)`, "
           "`applyPreset`; `$GI_PRESETS` overrides the path); `gi-render --preset NAME` applies one before "
           "any "
-          "`--param`; they are the steps the server's adaptive quality is to move between (gi-server does not read them yet).\n\n"
+          "`--param`; they are the steps the server's adaptive quality is to move between (gi-server does "
+          "not read them yet).\n\n"
           "| technique | preset | parameters | mean frame ms | mean rel. RMSE |\n|---|---|---|---|---|\n";
     for (const auto& p : presets)
         md << "| " << p.technique << " | " << p.name << " | " << p.changes << " | " << fmt(p.timeMs) << " | "

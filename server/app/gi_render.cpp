@@ -17,15 +17,15 @@
 #include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "encode/Encoder.h"
-#include "analysis/EffectPlan.h"
+#include "effects/EffectPlan.h"
 #include "analysis/Metrics.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
-#include "render/FrameParams.h"
+#include "frame/FrameParams.h"
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
-#include "render/Presets.h"
-#include "render/RenderRequest.h"
+#include "frame/Presets.h"
+#include "job/RenderRequest.h"
 #include "scene/SceneLoader.h"
 
 namespace {
@@ -130,7 +130,9 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
     } else {
         gis::ReferenceRenderer renderer(scene);
         image = renderer.render(state, ro, [&](int spp, double seconds) {
-            if (!o.quiet) std::fprintf(stderr, "\rgi-render: reference %s %d spp, %.1f s", ro.mode.c_str(), spp, seconds);
+            if (!o.quiet)
+                std::fprintf(stderr, "\rgi-render: reference %s %d spp, %.1f s", ro.mode.c_str(), spp,
+                             seconds);
         });
         if (!o.quiet) std::fprintf(stderr, "\n");
     }
@@ -146,15 +148,18 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
             std::vector<std::uint8_t> rgba8(rgba.size());
             for (size_t i = 0, n = srgb.size() / 3; i < n; ++i) {
                 for (int c = 0; c < 3; ++c)
-                    rgba8[i * 4 + c] = static_cast<std::uint8_t>(std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+                    rgba8[i * 4 + c] = static_cast<std::uint8_t>(
+                        std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
                 rgba8[i * 4 + 3] = 255;
             }
             gis::writeImageFile(o.out, image.width, image.height, rgba8, rgba, {{"gi:reference", ro.mode}},
                                 o.quality);
         }
     }
-    return {{"reference", ro.mode},  {"size", {image.width, image.height}}, {"spp", image.spp},
-            {"seconds", image.seconds}, {"cache_hit", hit}, {"key", image.key}, {"scene", o.scene}};
+    return {{"reference", ro.mode}, {"size", {image.width, image.height}},
+            {"spp", image.spp},     {"seconds", image.seconds},
+            {"cache_hit", hit},     {"key", image.key},
+            {"scene", o.scene}};
 }
 
 int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
@@ -164,8 +169,8 @@ int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
         if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
     } catch (...) {
     }
-    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
-                     text + "'"};
+    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "], got '" + text + "'"};
 }
 
 void parseSize(const std::string& text, int& w, int& h) {
@@ -177,9 +182,11 @@ void parseSize(const std::string& text, int& w, int& h) {
 
 void listTechniques() {
     int width = 0;
-    for (const auto& e : gis::techniqueRegistry()) width = std::max(width, static_cast<int>(e.info.name.size()));
     for (const auto& e : gis::techniqueRegistry())
-        std::printf("%-*s  %s [%s]\n", width, e.info.name.c_str(), e.info.description.c_str(), e.info.paper.c_str());
+        width = std::max(width, static_cast<int>(e.info.name.size()));
+    for (const auto& e : gis::techniqueRegistry())
+        std::printf("%-*s  %s [%s]\n", width, e.info.name.c_str(), e.info.description.c_str(),
+                    e.info.paper.c_str());
 }
 
 void writeText(const std::string& path, const std::string& text) {
@@ -297,28 +304,42 @@ int run(int argc, char** argv) {
             std::printf("%s parameters:\n%s", t.c_str(),
                         entry.info.params.empty() ? "  (none)\n" : entry.info.params.describe().c_str());
             return 0;
-        } else if (a == "--scene") o.scene = value(i);
-        else if (a == "--technique") o.technique = value(i);
-        else if (a == "--preset") o.preset = value(i);
+        } else if (a == "--scene")
+            o.scene = value(i);
+        else if (a == "--technique")
+            o.technique = value(i);
+        else if (a == "--preset")
+            o.preset = value(i);
         else if (a == "--param") {
             const std::string& kv = value(i);
             auto eq = kv.find('=');
-            if (eq == std::string::npos || eq == 0) throw UsageError{"--param must look like NAME=VALUE, got '" + kv + "'"};
+            if (eq == std::string::npos || eq == 0)
+                throw UsageError{"--param must look like NAME=VALUE, got '" + kv + "'"};
             o.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-        } else if (a == "--size") parseSize(value(i), o.width, o.height);
-        else if (a == "--out") o.out = value(i);
-        else if (a == "--stats") o.stats = value(i);
+        } else if (a == "--size")
+            parseSize(value(i), o.width, o.height);
+        else if (a == "--out")
+            o.out = value(i);
+        else if (a == "--stats")
+            o.stats = value(i);
         else if (a == "--quality")
             o.quality = parseInt("--quality", value(i), 1, 100);
         else if (a == "--request")
             o.request = value(i);
-        else if (a == "--frames") o.frames = parseInt("--frames", value(i), 1, 10000);
-        else if (a == "--gl") o.gl = value(i);
-        else if (a == "--no-timer-queries") o.timerQueries = false;
-        else if (a == "--quiet") o.quiet = true;
-        else if (a == "--explain") o.explain = true;
-        else if (a == "--reference") o.referenceMode = value(i);
-        else if (a == "--spp") o.reference.spp = parseInt("--spp", value(i), 1, 1000000);
+        else if (a == "--frames")
+            o.frames = parseInt("--frames", value(i), 1, 10000);
+        else if (a == "--gl")
+            o.gl = value(i);
+        else if (a == "--no-timer-queries")
+            o.timerQueries = false;
+        else if (a == "--quiet")
+            o.quiet = true;
+        else if (a == "--explain")
+            o.explain = true;
+        else if (a == "--reference")
+            o.referenceMode = value(i);
+        else if (a == "--spp")
+            o.reference.spp = parseInt("--spp", value(i), 1, 1000000);
         else if (a == "--time-budget") {
             const std::string& t = value(i);
             try {
@@ -328,8 +349,10 @@ int run(int argc, char** argv) {
             } catch (const std::exception&) {
                 throw UsageError{"--time-budget must be a positive number of seconds, got '" + t + "'"};
             }
-        } else if (a == "--seed") o.reference.seed = static_cast<std::uint64_t>(parseInt("--seed", value(i), 0, 2147483647));
-        else if (a == "--max-depth") o.reference.maxDepth = parseInt("--max-depth", value(i), 1, 64);
+        } else if (a == "--seed")
+            o.reference.seed = static_cast<std::uint64_t>(parseInt("--seed", value(i), 0, 2147483647));
+        else if (a == "--max-depth")
+            o.reference.maxDepth = parseInt("--max-depth", value(i), 1, 64);
         else if (a == "--caustic-min-roughness") {
             const std::string& t = value(i);
             try {
@@ -340,11 +363,14 @@ int run(int argc, char** argv) {
             } catch (const std::exception&) {
                 throw UsageError{"--caustic-min-roughness must be a roughness in [0, 1], got '" + t + "'"};
             }
-        }
-        else if (a == "--cache-dir") o.cacheDir = value(i);
-        else if (a == "--no-cache") o.useCache = false;
-        else if (a == "--compare") o.compare = value(i);
-        else throw UsageError{"unknown option '" + a + "' (see --help)"};
+        } else if (a == "--cache-dir")
+            o.cacheDir = value(i);
+        else if (a == "--no-cache")
+            o.useCache = false;
+        else if (a == "--compare")
+            o.compare = value(i);
+        else
+            throw UsageError{"unknown option '" + a + "' (see --help)"};
     }
     if (o.quiet) gis::setLogLevel(gis::LogLevel::Error);
     if (o.cacheDir.empty()) o.cacheDir = defaultCacheDir();
@@ -355,7 +381,8 @@ int run(int argc, char** argv) {
             for (const auto& m : modes) known += (known.empty() ? "" : ", ") + m;
             throw UsageError{"--reference must be one of " + known + ", got '" + o.referenceMode + "'"};
         }
-        if (!o.compare.empty()) throw UsageError{"--compare compares a GL frame: it cannot be used with --reference"};
+        if (!o.compare.empty())
+            throw UsageError{"--compare compares a GL frame: it cannot be used with --reference"};
     }
     if (!o.request.empty()) return runRequest(o);
     if (!o.out.empty() && !gis::codecForPath(o.out) && !gis::imageFileNeedsLinear(o.out))
@@ -406,8 +433,9 @@ int run(int argc, char** argv) {
         nlohmann::json summary = renderReference(o, *scene, state);
         if (!o.stats.empty()) writeText(o.stats, summary.dump(2));
         if (!o.quiet)
-            gis::logInfo("gi-render: reference " + o.referenceMode + " " + std::to_string(summary["spp"].get<int>()) +
-                         " spp in " + std::to_string(summary["seconds"].get<double>()) + " s" +
+            gis::logInfo("gi-render: reference " + o.referenceMode + " " +
+                         std::to_string(summary["spp"].get<int>()) + " spp in " +
+                         std::to_string(summary["seconds"].get<double>()) + " s" +
                          (summary["cache_hit"].get<bool>() ? " (from the cache)" : ""));
         return 0;
     }
@@ -416,13 +444,14 @@ int run(int argc, char** argv) {
         compareWith = gis::readReferenceExr(o.compare);
         if (compareWith.width != o.width || compareWith.height != o.height)
             throw UsageError{"--compare: '" + o.compare + "' is " + std::to_string(compareWith.width) + "x" +
-                             std::to_string(compareWith.height) + " but --size is " + std::to_string(o.width) + "x" +
-                             std::to_string(o.height)};
+                             std::to_string(compareWith.height) + " but --size is " +
+                             std::to_string(o.width) + "x" + std::to_string(o.height)};
     }
 
     auto context = gis::gl::createContext(backend);
     if (!o.quiet)
-        gis::logInfo("gl: " + context->info().backend + ", " + context->info().renderer + ", " + context->info().version);
+        gis::logInfo("gl: " + context->info().backend + ", " + context->info().renderer + ", " +
+                     context->info().version);
     gis::FrameRenderer renderer(o.timerQueries);
     renderer.setScene(scene);
 
@@ -440,8 +469,8 @@ int run(int argc, char** argv) {
     if (!o.compare.empty()) {
         gis::ImageView test(frame.linear.data(), frame.width, frame.height, 4);
         gis::ImageView ref(compareWith.rgb.data(), compareWith.width, compareWith.height, 3);
-        gis::ImageMetrics m = gis::compareImages(test, ref, gis::maskFromNonZero(ref),
-                                                 state.frameParams.getFloat("exposure"));
+        gis::ImageMetrics m =
+            gis::compareImages(test, ref, gis::maskFromNonZero(ref), state.frameParams.getFloat("exposure"));
         summary["compare"] = gis::toJson(m);
         summary["compare"]["reference"] = o.compare;
         std::cout << summary["compare"].dump(2) << "\n";
@@ -458,7 +487,8 @@ int run(int argc, char** argv) {
                            std::to_string(summary["frame_ms"].get<double>()) + " ms (median of " +
                            std::to_string(o.frames) + ")";
         for (const auto& p : summary["passes"])
-            line += "\n  " + p["name"].get<std::string>() + ": " + std::to_string(p["gpu_ms"].get<double>()) + " ms";
+            line += "\n  " + p["name"].get<std::string>() + ": " + std::to_string(p["gpu_ms"].get<double>()) +
+                    " ms";
         gis::logInfo(line);
     }
     return 0;

@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include "core/Error.h"
 #include "gi/Technique.h"
 #include "gi/hier_isr/HierIsr.h"
@@ -11,16 +13,30 @@
 namespace gis {
 
 const std::vector<TechniqueEntry>& techniqueRegistry() {
-    static const std::vector<TechniqueEntry> registry = {
-        {NoIndirect::info(), [] { return std::make_unique<NoIndirect>(); }},
-        {RsmGather::info(), [] { return std::make_unique<RsmGather>(); }},
-        {RsmGather::ssbcInfo(), [] { return std::make_unique<RsmGather>(); }},
-        {MultiresSplat::info(), [] { return std::make_unique<MultiresSplat>(); }},
-        {MultiresGather::info(), [] { return std::make_unique<MultiresGather>(); }},
-        {Isr::info(), [] { return std::make_unique<Isr>(); }},
-        {HierIsr::info(), [] { return std::make_unique<HierIsr>(); }},
-        {SecondOrder::info(), [] { return std::make_unique<SecondOrder>(); }},
-    };
+    // The GL implementation of each catalog entry, by name; every entry must have one.
+    static const std::vector<TechniqueEntry> registry = [] {
+        const std::vector<std::pair<std::string, std::function<std::unique_ptr<Technique>()>>>
+            implementations = {
+                {"none", [] { return std::make_unique<NoIndirect>(); }},
+                {"rsm_gather", [] { return std::make_unique<RsmGather>(); }},
+                {"ssbc", [] { return std::make_unique<RsmGather>(); }},
+                {"multires_splat", [] { return std::make_unique<MultiresSplat>(); }},
+                {"multires_gather", [] { return std::make_unique<MultiresGather>(); }},
+                {"isr", [] { return std::make_unique<Isr>(); }},
+                {"hier_isr", [] { return std::make_unique<HierIsr>(); }},
+                {"second_order", [] { return std::make_unique<SecondOrder>(); }},
+            };
+        std::vector<TechniqueEntry> out;
+        for (const TechniqueInfo& info : techniqueCatalog()) {
+            auto it = std::find_if(implementations.begin(), implementations.end(),
+                                   [&](const auto& impl) { return impl.first == info.name; });
+            GIS_ASSERT_MSG(it != implementations.end(),
+                           "technique '" + info.name + "' has no GL implementation");
+            out.push_back({info, it->second});
+        }
+        GIS_ASSERT(out.size() == implementations.size());
+        return out;
+    }();
     return registry;
 }
 

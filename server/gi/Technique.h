@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/Param.h"
+#include "gi/Catalog.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -52,16 +53,6 @@ struct FrameInputs {
 
 using Counters = std::map<std::string, double>;
 
-struct TechniqueInfo {
-    std::string name;        ///< registry key, e.g. "rsm_gather"
-    std::string description; ///< one line
-    std::string paper;       ///< seed paper and section
-    ParamTable params;
-    /// Whether the technique carries glossy VPL transport with these parameters (FrameInputs::glossy;
-    /// docs/nondiffuse.md); empty for none. The planner reads it without creating the technique.
-    std::function<bool(const ParamSet&)> glossyTransport;
-};
-
 class Technique {
 public:
     virtual ~Technique() = default;
@@ -82,9 +73,10 @@ struct TechniqueEntry {
     std::function<std::unique_ptr<Technique>()> create;
 };
 
-/// All techniques, in a stable order.
+/// All techniques with their GL implementations, in techniqueCatalog()'s order.
 const std::vector<TechniqueEntry>& techniqueRegistry();
-/// Throws gis::InputError listing the known names when `name` is unknown.
+/// Throws gis::InputError listing the known names when `name` is unknown. Code that needs no GL
+/// asks findTechniqueInfo() (gi/Catalog.h) instead.
 const TechniqueEntry& findTechnique(const std::string& name, const std::string& where = "technique");
 
 } // namespace gis

@@ -25,12 +25,13 @@
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Log.h"
+#include "frame/FrameParams.h"
+#include "frame/VplBudget.h"
 #include "gi/Technique.h"
 #include "net/Metrics.h"
 #include "net/RateLimiter.h"
-#include "render/FrameParams.h"
 #include "render/FrameRenderer.h"
-#include "render/RenderRequest.h"
+#include "job/RenderRequest.h"
 #include "scene/SceneLoader.h"
 #include "session/GlWorkerPool.h"
 #include "session/RenderGate.h"
@@ -766,7 +767,7 @@ struct WsServer::Impl {
                         throw InputError("/scene", e.reason());
                     }
                 };
-                const long vpls = maxVplEstimate(makeJobFrameState(*resolve(job->scene), *job));
+                const long vpls = vplEstimate(makeJobFrameState(*resolve(job->scene), *job));
                 if (vpls > maxVpls)
                     throw InputError("/params", "these parameters ask for up to " + std::to_string(vpls) +
                                                     " VPLs; the server allows " + std::to_string(maxVpls));

@@ -22,10 +22,10 @@
 #include <tbb/task_arena.h>
 
 #include "core/Error.h"
+#include "frame/LightModel.h"
 #include "reference/ContentHash.h"
 #include "reference/RayScene.h"
 #include "reference/Sampling.h"
-#include "render/FrameRenderer.h"
 
 namespace gis {
 namespace {
@@ -61,42 +61,6 @@ glm::vec3 unitOr(const glm::vec3& v, const glm::vec3& fallback) {
 glm::vec3 facing(const glm::vec3& n, const glm::vec3& towards) {
     return glm::dot(n, towards) < 0.0f ? -n : n;
 }
-
-bool finiteVec(const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-/// The light exactly as the shaders see it (FrameRenderer::render builds the same uniforms).
-struct LightModel {
-    bool on = false;
-    LightType type = LightType::Spot;
-    glm::vec3 position{0.0f};
-    glm::vec3 axis{0.0f, -1.0f, 0.0f}; ///< unit direction the light points along
-    glm::vec3 power{0.0f};             ///< intensity (cd, or lux for directional) times colour
-    float cosOuter = 0.0f;
-    float cosInner = 1.0f;
-
-    explicit LightModel(const FrameState& state) {
-        const Light& l = state.light;
-        on = state.lightEnabled && l.intensity > 0.0f && std::isfinite(l.intensity) && finiteVec(l.position);
-        type = l.type;
-        position = l.position;
-        axis = unitOr(l.direction, {0.0f, -1.0f, 0.0f});
-        glm::vec3 colour = glm::max(l.color, glm::vec3(0.0f));
-        if (!finiteVec(colour)) colour = glm::vec3(0.0f);
-        power = on ? l.intensity * colour : glm::vec3(0.0f);
-        cosOuter = std::cos(l.outerConeAngle);
-        cosInner = std::cos(l.innerConeAngle);
-    }
-
-    /// glTF KHR_lights_punctual cone attenuation, as spotFactor() in shaders/common.glsl.
-    float spotFactor(const glm::vec3& dirFromLight) const {
-        if (type != LightType::Spot) return 1.0f;
-        const float cd = glm::dot(axis, dirFromLight);
-        const float t = std::clamp((cd - cosOuter) / std::max(cosInner - cosOuter, 1e-4f), 0.0f, 1.0f);
-        return t * t;
-    }
-};
 
 /// A receiver or bounce vertex: the hit plus the normals turned to the side being shaded.
 struct Vertex {
@@ -177,7 +141,7 @@ public:
         float tfar = std::numeric_limits<float>::infinity();
         if (std::isfinite(dist)) tfar = glm::length(mLight.position - origin) - mEps;
         if (tfar > mEps && mRays.occluded(origin, l, 0.0f, tfar)) return glm::vec3(0.0f);
-        return mLight.power * scale;
+        return mLight.power() * scale;
     }
 
     /// True when vertex v reflects through a specular lobe (its material has one and effect_specular is
@@ -369,7 +333,8 @@ void validateReferenceOptions(const ReferenceOptions& options) {
 }
 
 ReferenceRenderer::ReferenceRenderer(const Scene& scene)
-    : mRays(std::make_unique<reference::RayScene>(scene)), mSceneDigest(reference::sceneDigest(scene)) {}
+    : mRays(std::make_unique<reference::RayScene>(scene)), mSceneDigest(reference::sceneDigest(scene)),
+      mBounds(scene.bounds) {}
 
 ReferenceRenderer::~ReferenceRenderer() = default;
 
@@ -391,9 +356,9 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
     // Rays through the pipeline's own projection: unproject NDC at the near (z = -1) and far (z = 1)
     // planes, so the reference sees exactly the GL frustum, clipping included. Double precision keeps
     // the inverse accurate for large far/near ratios.
-    const glm::dmat4 invViewProj =
-        glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
-    const LightModel light(state);
+    const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(cameraViewProj(state.camera, w, h)));
+    // The light exactly as the GL pipeline sees it (frame/LightModel.h).
+    const LightModel light = makeLightModel(state, mBounds);
     const ShadingModel shading(state);
     const Integrator integrator(*mRays, light, shading, mode, options.maxDepth, options.causticMinRoughness);
 

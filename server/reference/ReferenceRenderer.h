@@ -44,7 +44,7 @@
 #include <string>
 #include <vector>
 
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 #include "scene/Scene.h"
 
 namespace gis {
@@ -102,6 +102,7 @@ public:
 private:
     std::unique_ptr<reference::RayScene> mRays;
     std::string mSceneDigest; // scene part of the cache key, hashed once
+    Bounds mBounds;
 };
 
 /// "direct", "one-bounce-unoccluded", "one-bounce", "path".

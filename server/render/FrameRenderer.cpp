@@ -9,26 +9,11 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/Timer.h"
+#include "frame/LightModel.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
 namespace {
-
-// Spot cones wider than this get a light frustum of this half-angle: tan() grows without bound
-// towards 90 degrees. Radians (85 degrees).
-constexpr float kMaxLightHalfFov = 1.4835299f;
-
-glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
-    float len2 = glm::dot(v, v);
-    return len2 > 1e-24f ? v / std::sqrt(len2) : fallback;
-}
-
-glm::vec3 upFor(glm::vec3 forward, glm::vec3 preferred) {
-    glm::vec3 up = safeNormalize(preferred, {0, 1, 0});
-    if (std::abs(glm::dot(up, forward)) > 0.999f)
-        up = std::abs(forward.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
-    return up;
-}
 
 std::vector<std::uint8_t> readRgba8(const gl::Framebuffer& fbo, int attachment, int w, int h) {
     std::vector<std::uint8_t> pixels(static_cast<size_t>(w) * static_cast<size_t>(h) * 4);
@@ -69,39 +54,11 @@ std::vector<float> readRgba32f(const gl::Framebuffer& fbo, int attachment, int w
 
 } // namespace
 
-glm::mat4 FrameRenderer::cameraViewProj(const Camera& camera, int width, int height) {
-    glm::vec3 forward = safeNormalize(camera.target - camera.position, {0, 0, -1});
-    glm::mat4 view = glm::lookAt(camera.position, camera.position + forward, upFor(forward, camera.up));
-    float aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
-    float fov = std::clamp(camera.yfovRadians, 0.01f, 3.0f);
-    float znear = std::max(camera.znear, 1e-4f);
-    float zfar = std::max(camera.zfar, znear * 2.0f);
-    return glm::perspective(fov, aspect, znear, zfar) * view;
-}
-
-glm::mat4 FrameRenderer::lightViewProj(const Light& light, const Bounds& bounds, float* tanHalfFov) {
-    glm::vec3 dir = safeNormalize(light.direction, {0, -1, 0});
-    glm::mat4 view = glm::lookAt(light.position, light.position + dir, upFor(dir, {0, 1, 0}));
-    float half = std::clamp(light.outerConeAngle, 0.01f, kMaxLightHalfFov);
-    if (tanHalfFov) *tanHalfFov = std::tan(half);
-    // Scale-relative frustum (digest S.4 case 14): every term is a distance to the scene's bounds, so a
-    // scene scaled by s gets the same frustum scaled by s (absolute terms, a 1 m margin and a 1 mm near
-    // plane, clipped the geometry next to the light of a millimetre-scale scene).
-    const glm::vec3 lo = glm::min(bounds.min, bounds.max), hi = glm::max(bounds.min, bounds.max);
-    const float extent = glm::length(hi - lo);
-    float farthest = 0.0f;
-    for (int i = 0; i < 8; ++i) {
-        const glm::vec3 corner((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
-        farthest = std::max(farthest, glm::length(corner - light.position));
-    }
-    const float nearest = glm::length(glm::clamp(light.position, lo, hi) - light.position);
-    // Far plane: past the farthest bounds corner by 5% of the extent (room for the shadow lookup's
-    // normal offset). Near plane: half the way to the bounds for a light outside them, else 1e-3 of the
-    // far plane (geometry closer to a light inside the bounds than that is clipped).
-    float reach = farthest * 1.001f + 0.05f * extent;
-    if (!(reach > 0.0f) || !std::isfinite(reach)) reach = 1.0f; // no bounds, or a light on a point scene
-    const float znear = std::max(0.5f * nearest, reach * 1e-3f);
-    return glm::perspective(2.0f * half, 1.0f, znear, reach) * view;
+void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u) {
+    u.lightViewProj = light.viewProj;
+    u.lightPos = glm::vec4(light.position, light.intensity);
+    u.lightDir = glm::vec4(light.axis, light.cosOuter);
+    u.lightColor = glm::vec4(light.color, light.cosInner);
 }
 
 FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
@@ -207,24 +164,19 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
 
     // Frame uniforms.
     shader::FrameUniforms u{};
-    float tanHalf = 1.0f;
+    const LightModel light = makeLightModel(state, mScene->bounds);
+    const float tanHalf = light.tanHalfFov;
     u.viewProj = cameraViewProj(state.camera, state.width, state.height);
-    u.lightViewProj = lightViewProj(state.light, mScene->bounds, &tanHalf);
     u.cameraPos = glm::vec4(state.camera.position, 0.0f);
-    const bool lightOn =
-        state.lightEnabled && state.light.intensity > 0.0f && std::isfinite(state.light.intensity);
-    u.lightPos = glm::vec4(state.light.position, lightOn ? state.light.intensity : 0.0f);
-    u.lightDir =
-        glm::vec4(safeNormalize(state.light.direction, {0, -1, 0}), std::cos(state.light.outerConeAngle));
-    u.lightColor =
-        glm::vec4(glm::max(state.light.color, glm::vec3(0.0f)), std::cos(state.light.innerConeAngle));
+    const bool lightOn = light.on;
+    writeLightUniforms(light, u);
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
     u.rsmInfo = glm::vec4(rsmSize, tanHalf, mShadowSize, fp.getInt("pcf_radius"));
     u.toneInfo =
         glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
                   lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
-    u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f, fp.getFloat("glossy_split"),
-                              nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
+    u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f,
+                              fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
 

@@ -13,15 +13,21 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frame/FrameState.h"
+#include "frame/LightModel.h"
 #include "gi/Technique.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
-#include "render/FrameState.h"
+#include "gl/ShaderShared.h"
 #include "render/Reflections.h"
 #include "render/SceneGpu.h"
 
 namespace gis {
+
+/// The light's part of the frame uniforms (gFrame in shaders/shared): its frustum, position and
+/// intensity, axis and outer cone, colour and inner cone, which spotFactor() and the light passes read.
+void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u);
 
 struct FrameOutput {
     int width = 0;
@@ -46,12 +52,6 @@ public:
     Technique* technique() { return mTechnique.get(); }
     /// The planar mirrors of the current scene (after the first frame).
     const std::vector<MirrorPlane>& mirrors() const { return mReflections.mirrors(); }
-
-    /// Camera and spotlight matrices exactly as the pipeline builds them (also used by tests and
-    /// the reference renderer so both see the same view).
-    static glm::mat4 cameraViewProj(const Camera& camera, int width, int height);
-    static glm::mat4 lightViewProj(const Light& light, const Bounds& sceneBounds,
-                                   float* tanHalfFov = nullptr);
 
 private:
     void ensureTargets(int width, int height, int rsmSize, int shadowSize);

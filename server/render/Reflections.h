@@ -24,34 +24,13 @@
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "render/SceneGpu.h"
+#include "scene/SurfaceAnalysis.h"
 
 namespace gis {
 
 namespace shader {
 struct FrameUniforms;
 }
-
-/// A planar mirror: a flat mesh with a smooth metallic material.
-struct MirrorPlane {
-    int mesh = -1;                      ///< index into Scene::meshes
-    glm::vec3 point{0.0f};              ///< a point of the plane (m): the mesh's centroid
-    glm::vec3 normal{0.0f, 1.0f, 0.0f}; ///< unit; the side the mesh's vertex normals face
-    glm::vec3 f0{1.0f};                 ///< reflectance at normal incidence
-    float roughness = 0.0f;             ///< the material's, for the optional glossy blur
-};
-
-/// Which meshes of `scene` are planar mirrors: material metallic >= 0.9 and roughness <=
-/// maxRoughness, every vertex within 1e-4 of the mesh's extent from its best-fit plane, and a
-/// non-degenerate area. At most kMaxMirrors, the largest first.
-std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughness);
-inline constexpr int kMaxMirrors = 4;
-
-/// Whether a material's specular lobe is worth an indirect specular pass (environment probe or glossy
-/// VPL transport): metals always, dielectrics only below `split` roughness. A rough dielectric
-/// reflects a few percent (F0 = 0.04) of a blurred environment, close to what its diffuse lobe
-/// already gets; it keeps its direct highlights. So a glTF file of plain materials (roughness 1)
-/// runs no reflection pass.
-bool specularWorthAPass(const Material& m, float split);
 
 /// A curved object shaded by the environment probe that gets a local probe of its own, at its
 /// centre and blind to the object itself: the room probe sees such an object from outside, so it

@@ -10,15 +10,16 @@
 #include "core/Log.h"
 #include "core/Timer.h"
 #include "gi/Technique.h"
-#include "render/FrameParams.h"
+#include "frame/FrameParams.h"
+#include "frame/VplBudget.h"
 #include "render/FrameRenderer.h"
-#include "render/Presets.h"
-#include "render/RenderRequest.h"
-#include "render/StateJson.h"
+#include "frame/Presets.h"
+#include "job/RenderRequest.h"
+#include "frame/StateJson.h"
 #include "scene/SceneLoader.h"
 #include "session/RenderGate.h"
 #if GIS_HAVE_EFFECTS
-#include "analysis/EffectPlan.h"
+#include "effects/EffectPlan.h"
 #endif
 
 namespace gis {
@@ -70,20 +71,9 @@ double Session::predictRefineMs(const std::string& sceneName, const FrameState& 
     // their product), so a final preset with 256 times the VPLs is predicted before it runs.
     for (int other = step - 1; other >= 0; --other)
         if (auto c = mRefineCost.find(prefix + std::to_string(other)); c != mRefineCost.end())
-            return c->second.msPerPixel * pixels * static_cast<double>(std::max(1L, maxVplEstimate(state))) /
+            return c->second.msPerPixel * pixels * static_cast<double>(std::max(1L, vplEstimate(state))) /
                    static_cast<double>(c->second.vpls);
     return 0.0;
-}
-
-long maxVplEstimate(const FrameState& s) {
-    auto get = [](const ParamSet& p, const char* name) -> long { return p.has(name) ? p.getInt(name) : 0; };
-    long n = 0;
-    n = std::max(n, get(s.techniqueParams, "vpl_grid") * get(s.techniqueParams, "vpl_grid"));
-    n = std::max(n, get(s.techniqueParams, "isr_finest") * get(s.techniqueParams, "isr_finest"));
-    n = std::max(n, get(s.techniqueParams, "positive_count") + get(s.techniqueParams, "negative_count"));
-    if (s.technique == "hier_isr")
-        n = std::max(n, get(s.frameParams, "rsm_size") * get(s.frameParams, "rsm_size"));
-    return n;
 }
 
 Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes,
@@ -270,13 +260,12 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
             } catch (const InputError& e) {
                 throw ProtocolError{"unknown_technique", e.reason(), "/name", type};
             }
-            if (maxVplEstimate(next) > mConfig.limits.maxVpls)
-                throw ProtocolError{"limit_exceeded",
-                                    "technique '" + next.technique + "' asks for up to " +
-                                        std::to_string(maxVplEstimate(next)) +
-                                        " VPLs by default; the server allows " +
-                                        std::to_string(mConfig.limits.maxVpls),
-                                    "/name", type};
+            if (vplEstimate(next) > mConfig.limits.maxVpls)
+                throw ProtocolError{
+                    "limit_exceeded",
+                    "technique '" + next.technique + "' asks for up to " + std::to_string(vplEstimate(next)) +
+                        " VPLs by default; the server allows " + std::to_string(mConfig.limits.maxVpls),
+                    "/name", type};
             // Explicit technique parameters belonged to the previous technique.
             for (auto it = mExplicit.begin(); it != mExplicit.end();)
                 it = next.frameParams.has(it.key()) ? std::next(it) : mExplicit.erase(it);
@@ -288,9 +277,9 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
             } catch (const InputError& e) {
                 throw ProtocolError{"invalid_param", e.reason(), e.where(), type};
             }
-            if (maxVplEstimate(next) > mConfig.limits.maxVpls)
+            if (vplEstimate(next) > mConfig.limits.maxVpls)
                 throw ProtocolError{"limit_exceeded",
-                                    "these parameters ask for up to " + std::to_string(maxVplEstimate(next)) +
+                                    "these parameters ask for up to " + std::to_string(vplEstimate(next)) +
                                         " VPLs; the server allows " + std::to_string(mConfig.limits.maxVpls),
                                     "/values", type};
             mDesired = std::move(next);
@@ -479,7 +468,7 @@ void Session::workerMain() {
                     for (const auto& [k, v] : explicitParams.items())
                         if (preset.techniqueParams.has(k)) techniqueExplicit[k] = v;
                     preset.techniqueParams.apply(techniqueExplicit);
-                    if (maxVplEstimate(preset) <= mConfig.limits.maxVpls) out = std::move(preset);
+                    if (vplEstimate(preset) <= mConfig.limits.maxVpls) out = std::move(preset);
                 } catch (const InputError&) {
                     // No preset for this technique: the step renders the parameters as they are.
                 }
@@ -550,7 +539,7 @@ void Session::workerMain() {
         if (step >= 0 && frame.width > 0 && frame.height > 0)
             mRefineCost[scene->name + "/" + state.technique + "/" + std::to_string(step)] = {
                 renderClock.elapsedMs() / (static_cast<double>(frame.width) * frame.height),
-                std::max(1L, maxVplEstimate(state))};
+                std::max(1L, vplEstimate(state))};
         const ImageCodec codec = snapshotFor ? snapshotCodec : stream.codec;
         Stopwatch encodeClock;
         std::vector<std::uint8_t> encoded;

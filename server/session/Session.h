@@ -25,7 +25,7 @@
 
 #include "encode/Encoder.h"
 #include "gl/Platform.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 #include "session/ClientLink.h"
 #include "session/ProtocolMessages.h"
 #include "session/SceneCache.h"
@@ -181,9 +181,5 @@ private:
     std::atomic<std::uint64_t> mFramesRendered{0};
     std::thread mWorker;
 };
-
-/// Upper bound on the VPLs a state's parameters ask for (vpl_grid^2, isr_finest^2, positive_count +
-/// negative_count, rsm_size^2 for light trees), for the server's VPL limit.
-long maxVplEstimate(const FrameState& state);
 
 } // namespace gis

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "GlTestSupport.h"
-#include "analysis/EffectPlan.h"
+#include "effects/EffectPlan.h"
 
 using namespace gis;
 using test::badValues;

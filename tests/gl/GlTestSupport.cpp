@@ -5,7 +5,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include "analysis/Metrics.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
+#include "frame/LightModel.h"
 
 namespace gis::test {
 
@@ -37,7 +38,7 @@ FrameOutput renderScene(const std::string& sceneName, const std::string& techniq
 }
 
 glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h) {
-    glm::vec4 clip = FrameRenderer::cameraViewProj(scene.cameras.front(), w, h) * glm::vec4(p, 1.0f);
+    glm::vec4 clip = cameraViewProj(scene.cameras.front(), w, h) * glm::vec4(p, 1.0f);
     glm::vec2 ndc = glm::vec2(clip) / clip.w;
     return {static_cast<int>((ndc.x * 0.5f + 0.5f) * w), static_cast<int>((0.5f - ndc.y * 0.5f) * h)};
 }
@@ -45,9 +46,10 @@ glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h) {
 double relativeRmseOf(const std::vector<float>& test, int testChannels, const std::vector<float>& reference,
                       int referenceChannels, std::size_t pixels) {
     const int n = static_cast<int>(pixels);
-    return relativeRmse(ImageView{std::span<const float>(test.data(), pixels * testChannels), n, 1, testChannels},
-                        ImageView{std::span<const float>(reference.data(), pixels * referenceChannels), n, 1,
-                                  referenceChannels});
+    return relativeRmse(
+        ImageView{std::span<const float>(test.data(), pixels * testChannels), n, 1, testChannels},
+        ImageView{std::span<const float>(reference.data(), pixels * referenceChannels), n, 1,
+                  referenceChannels});
 }
 
 double relativeRmseOf(const FrameOutput& test, const FrameOutput& reference) {
@@ -76,7 +78,8 @@ bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>&
     std::vector<std::uint8_t> all(static_cast<size_t>(w) * h * spec.nchannels);
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, all.data())) return false;
     for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
-        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
+        for (int c = 0; c < 3; ++c)
+            rgb[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
     return true;
 }
 

@@ -8,11 +8,12 @@
 #include <memory>
 
 #include "GlTestSupport.h"
+#include "frame/LightModel.h"
 #include "gi/common/LightTree.h"
 #include "gi/hier_isr/HierIsr.h"
 #include "gi/isr/Isr.h"
 #include "gl/ShaderShared.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 using namespace gis;
 using test::badValues;
@@ -77,7 +78,7 @@ void expectFluxNear(glm::dvec3 actual, glm::dvec3 expected, double rel, const st
 
 float tanHalfFov(const Frame& f) {
     float t = 1.0f;
-    FrameRenderer::lightViewProj(f.state.light, f.scene->bounds, &t);
+    lightViewProj(f.state.light, f.scene->bounds, &t);
     return t;
 }
 

@@ -9,7 +9,7 @@
 
 #include "GlTestSupport.h"
 #include "core/Error.h"
-#include "render/RenderRequest.h"
+#include "job/RenderRequest.h"
 
 namespace {
 

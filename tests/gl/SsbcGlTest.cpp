@@ -9,19 +9,18 @@
 
 #include "GlTestSupport.h"
 #include "reference/ReferenceRenderer.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 using namespace gis;
+using gis::test::renderScene;
 using test::badValues;
 using test::counter;
 using test::relativeRmseOf;
-using gis::test::renderScene;
 
 namespace {
 
 constexpr int kW = 96, kH = 96;
 const std::string kCrease = "builtin:crease";
-
 
 // Mean RGB of `rgb` (stride channels per pixel) over the pixels where mask is set.
 double maskedMean(const std::vector<float>& rgb, int stride, const std::vector<std::uint8_t>& mask) {

@@ -29,8 +29,8 @@
 #include "core/Error.h"
 #include "core/Param.h"
 #include "gi/Technique.h"
-#include "render/FrameParams.h"
-#include "render/FrameState.h"
+#include "frame/FrameParams.h"
+#include "frame/FrameState.h"
 #include "scene/SceneLoader.h"
 
 namespace {

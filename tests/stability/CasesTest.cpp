@@ -11,12 +11,13 @@
 
 #include "StabilityLab.h"
 #include "StabilityScenes.h"
+#include "frame/LightModel.h"
 #include "gi/Technique.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/second_order/Halton.h"
 #include "gi/second_order/SecondOrder.h"
 #include "gl/ShaderShared.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 using namespace gis;
 using namespace gis::stability;
@@ -72,7 +73,7 @@ double indirectWindow(const Frame& f, int x, int y, int r) {
 }
 
 glm::ivec2 project(const Camera& cam, glm::vec3 p, int w, int h) {
-    const glm::vec4 clip = FrameRenderer::cameraViewProj(cam, w, h) * glm::vec4(p, 1.0f);
+    const glm::vec4 clip = cameraViewProj(cam, w, h) * glm::vec4(p, 1.0f);
     const glm::vec2 ndc = glm::vec2(clip) / clip.w;
     return {int((ndc.x * 0.5f + 0.5f) * w), int((0.5f - ndc.y * 0.5f) * h)};
 }
@@ -780,7 +781,7 @@ TEST_P(S4, C19_NegativeLights) {
     ASSERT_NE(so, nullptr);
     int positive = 0, outside = 0;
     const auto lights = so->readVpls(&positive);
-    const glm::mat4 vp = FrameRenderer::cameraViewProj(cam, 64, 64);
+    const glm::mat4 vp = cameraViewProj(cam, 64, 64);
     for (size_t i = size_t(positive); i < lights.size(); ++i) {
         if (lights[i].position.w <= 0) continue;
         const glm::vec4 clip = vp * glm::vec4(glm::vec3(lights[i].position), 1.0f);

@@ -11,7 +11,7 @@
 #include "StabilityScenes.h"
 #include "gi/Technique.h"
 #include "gl/ShaderShared.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 using namespace gis;
 using namespace gis::stability;

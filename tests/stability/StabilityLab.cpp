@@ -16,7 +16,7 @@
 #include "core/Error.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 namespace gis::stability {
 namespace {
@@ -224,7 +224,8 @@ FrameTextures locateFrameTextures(int w, int h, int rsm, GLuint indirect) {
     FrameTextures t;
     const std::vector<FboInfo> fbos = listFramebuffers();
     GLuint gFbo = 0;
-    if (const FboInfo* g = findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F, GL_RGBA8}, w, h, true)) {
+    if (const FboInfo* g =
+            findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F, GL_RGBA8}, w, h, true)) {
         gFbo = g->id;
         t.gPosition = g->colours[0].id;
         t.gNormal = g->colours[1].id;

@@ -12,7 +12,6 @@ namespace gis {
 namespace {
 
 constexpr int kGroup = 8;          // GIS_SSBC_GROUP in ssbc_common.glsl
-constexpr int kMaxIterations = 3;  // 002: "1 to 3 iterations"
 constexpr int kMaxVisited = 16384; // per pixel and step: bounds the frame time for tiny b
 constexpr double kDegToRad = 3.14159265358979 / 180.0;
 
@@ -21,81 +20,6 @@ int groupsFor(int n) {
 }
 
 } // namespace
-
-std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB, int defaultIterations) {
-    return {
-        {.name = "clamp_b",
-         .type = ParamType::Float,
-         .defaultValue = defaultClampB,
-         .min = 0.0,
-         .max = 1e4,
-         .unit = "1/m^2",
-         .help = "K3 bound b on the VPL geometry term, E = Phi/pi min(G, b) (radius 1/sqrt(b) where G > b); "
-                 "0 = off, the technique's own kernel",
-         .source = "002 G_b (no value given; digest S.5 item 1)"},
-        {.name = "ssbc_iterations",
-         .type = ParamType::Int,
-         .defaultValue = static_cast<double>(defaultIterations),
-         .min = 0,
-         .max = kMaxIterations,
-         .unit = "steps",
-         .help =
-             "screen-space bias compensation steps T_r^k on the clamped image (0 = off; needs clamp_b > 0)",
-         .source = "002 Eq. 3, §4 (1 to 3)"},
-        {.name = "ssbc_solid_angle",
-         .type = ParamType::Float,
-         .defaultValue = 0.08,
-         .min = 0.0,
-         .max = 4.0,
-         .unit = "sr",
-         .help = "refine a compensation sample whose solid angle A cos / d^2 exceeds this",
-         .source = "002 §4.2 (0.08 sr)"},
-        {.name = "ssbc_discontinuity_angle",
-         .type = ParamType::Float,
-         .defaultValue = 0.04,
-         .min = 0.0,
-         .max = 4.0,
-         .unit = "sr",
-         .help = "refine a sample spanning a discontinuity only above this solid angle",
-         .source = "002 §4.2 (about 0.04)"},
-        {.name = "ssbc_grazing_angle",
-         .type = ParamType::Float,
-         .defaultValue = 80.0,
-         .min = 1.0,
-         .max = 90.0,
-         .unit = "deg",
-         .help = "normal-view angle beyond which a pixel's area fades quadratically in cos (90 = no fade)",
-         .source = "002 §4.3 (80 deg; falloff curve chosen)"},
-        {.name = "ssbc_input",
-         .type = ParamType::Enum,
-         .defaultValue = 0,
-         .help = "what step 1 integrates: direct + clamped indirect (002, for multi-bounce VPLs) or the "
-                 "direct light only (the exact one-bounce residual of single-bounce VPLs)",
-         .source = "002 Eq. 3 (illumination); direct is an engineering option",
-         .options = {"illumination", "direct"}},
-        {.name = "ssbc_levels",
-         .type = ParamType::Int,
-         .defaultValue = 7,
-         .min = 1,
-         .max = 12,
-         .unit = "levels",
-         .help = "compensation mip levels including full resolution (7: 16^2 coarsest at 1024^2); the image "
-                 "does not depend on it, the time does",
-         .source = "002 §4.2 uses 64^2 at 1024^2 (5 levels); 7 measured faster here (docs/ssbc.md)"},
-        {.name = "ssbc_blur",
-         .type = ParamType::Bool,
-         .defaultValue = 0,
-         .help = "edge-preserving 5x5 cross-bilateral blur of the summed compensation only (normal and "
-                 "relative-distance falloffs, covered pixels only, energy conserving) before it is added",
-         .source = "002 §4.4 (optional bilateral Gaussian; kernel and falloffs chosen, docs/ssbc.md)"},
-        {.name = "ssbc_half_resolution",
-         .type = ParamType::Bool,
-         .defaultValue = 0,
-         .help = "integrate one receiver per 2x2 block (level-1 means) and upsample bilaterally (nearest "
-                 "block where all weights vanish); needs ssbc_levels >= 2",
-         .source = "002 §5 (bilateral upsampling; nearest-sample fallback instead of recomputation)"},
-    };
-}
 
 float vplInverseClampB(const ParamSet& params) {
     if (!params.has("clamp_b")) return 0.0f;

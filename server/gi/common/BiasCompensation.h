@@ -71,6 +71,7 @@
 
 #include "core/Param.h"
 #include "gi/Technique.h"
+#include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -80,7 +81,6 @@ namespace gis {
 /// clamp_b, ssbc_iterations, ssbc_solid_angle, ssbc_discontinuity_angle, ssbc_grazing_angle,
 /// ssbc_input, ssbc_levels, ssbc_blur, ssbc_half_resolution; `defaultClampB` and `defaultIterations` let a
 /// preset (`ssbc`) turn them on.
-std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB = 0.0, int defaultIterations = 0);
 
 /// 1/b for vpl_transport.glsl's uVplInvClampB (0: clamp off).
 float vplInverseClampB(const ParamSet& params);

@@ -13,6 +13,7 @@
 
 #include "core/Param.h"
 #include "gi/Technique.h"
+#include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -22,7 +23,6 @@ namespace gis {
 
 /// coarsest_size, depth_metric, depth_threshold, depth_derivative_threshold, normal_metric,
 /// normal_threshold, curvature_threshold, diagonal_refine, detail_alpha.
-std::vector<ParamSpec> eyeHierarchyParamSpecs();
 
 struct EyeLevel {
     int x = 0, y = 0;          ///< atlas offset (texels)

@@ -7,40 +7,6 @@
 
 namespace gis {
 
-std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel) {
-    std::vector<ParamSpec> specs = {
-        {.name = "vpl_grid",
-         .type = ParamType::Int,
-         .defaultValue = 16,
-         .min = 1,
-         .max = 256,
-         .unit = "VPLs per side",
-         .help = "VPLs on a regular RSM grid, vpl_grid^2 in total (<= rsm_size)",
-         .source = "000 §3.1; 001 Table 1 uses 256 VPLs",
-         .logScale = true},
-        {.name = "kernel",
-         .type = ParamType::Enum,
-         .defaultValue = static_cast<double>(defaultKernel),
-         .help = "VPL kernel: point with distance clamp (000 Eq. 2) or disk-to-point form factor (001 Eq. 1)",
-         .source = "000 Eq. 2; 001 Eq. 1",
-         .options = {"point", "disk"}},
-        {.name = "min_distance",
-         .type = ParamType::Float,
-         .defaultValue = 0.1,
-         .min = 0.0,
-         .max = 1.0,
-         .unit = "m",
-         .help = "point kernel only: distance clamp of the 1/d^2 falloff (bounds the r->0 singularity)",
-         .source = "000 Fig. 13 (value not given; chosen)"},
-    };
-    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
-    return specs;
-}
-
-VplKernel vplKernel(const ParamSet& params) {
-    return params.getEnum("kernel") == "disk" ? VplKernel::Disk : VplKernel::Point;
-}
-
 KernelPrograms::KernelPrograms(const std::vector<gl::ShaderStage>& stages,
                                const std::vector<std::pair<std::string, std::string>>& defines) {
     auto with = [&](const char* kernel) {

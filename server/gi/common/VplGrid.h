@@ -8,18 +8,12 @@
 
 #include "core/Param.h"
 #include "gi/Technique.h"
+#include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 
 namespace gis {
-
-enum class VplKernel { Point = 0, Disk = 1 }; ///< values match GIS_KERNEL_* in vpl_transport.glsl
-
-/// `vpl_grid`, `kernel` (point|disk, default as given), `min_distance` (point kernel only) and the
-/// K3 clamp / bias compensation parameters (biasCompensationParamSpecs, all off by default).
-std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel);
-VplKernel vplKernel(const ParamSet& params);
 
 /// One program per kernel, built with GIS_VPL_KERNEL defined (see vpl_transport.glsl).
 class KernelPrograms {

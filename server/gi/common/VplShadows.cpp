@@ -4,32 +4,6 @@
 
 namespace gis {
 
-std::vector<ParamSpec> vplShadowParamSpecs() {
-    return {
-        {.name = "vpl_shadows",
-         .type = ParamType::Bool,
-         .defaultValue = 0,
-         .help = "indirect visibility: a cube shadow map per VPL (off = no indirect shadows, as 000/001/003)",
-         .source = "002 (imperfect shadow maps); exact maps chosen, docs/ssbc.md"},
-        {.name = "vpl_shadow_size",
-         .type = ParamType::Int,
-         .defaultValue = 32,
-         .min = 8,
-         .max = 256,
-         .unit = "texels",
-         .help = "side of each cube face of a VPL shadow map",
-         .source = "eng"},
-        {.name = "vpl_shadow_bias",
-         .type = ParamType::Float,
-         .defaultValue = 0.02,
-         .min = 0.0,
-         .max = 0.5,
-         .unit = "fraction of distance",
-         .help = "receiver offset along its normal and depth tolerance, as a fraction of the VPL distance",
-         .source = "eng"},
-    };
-}
-
 VplShadows::VplShadows() {
     mProgram = gl::Program::build(
         {{GL_VERTEX_SHADER, "gi/common/vpl_shadow.vert"}, {GL_FRAGMENT_SHADER, "gi/common/vpl_shadow.frag"}});

@@ -13,13 +13,12 @@
 
 #include "core/Param.h"
 #include "gi/Technique.h"
+#include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 
 namespace gis {
-
-std::vector<ParamSpec> vplShadowParamSpecs();
 
 class VplShadows {
 public:

@@ -69,41 +69,6 @@ std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
     return cut;
 }
 
-TechniqueInfo HierIsr::info() {
-    std::vector<ParamSpec> specs = {
-        {.name = "tau",
-         .type = ParamType::Float,
-         .defaultValue = 0.01,
-         .min = 0.0,
-         .max = 1.0,
-         .unit = "fraction of I",
-         .help = "refine a light node while its bounded contribution may exceed tau * I (0: full "
-                 "traversal, 1: coarsest level only)",
-         .source = "001 Eqs. 6-8 (no value given; chosen for <5% error at 1/10 the full gather's time)"},
-        {.name = "hier_coarsest",
-         .type = ParamType::Int,
-         .defaultValue = 16,
-         .min = 1,
-         .max = 256,
-         .unit = "patches per side",
-         .help = "where every receiver's traversal starts: the tree level with at most this many patches per "
-                 "side",
-         .source = "001 §3.5 (16^2)"},
-        {.name = "max_depth",
-         .type = ParamType::Int,
-         .defaultValue = 256,
-         .min = 1,
-         .max = 1024,
-         .unit = "patches per side",
-         .help = "finest tree level a traversal visits (maximal traversal depth), clamped to rsm_size",
-         .source = "001 §3.5, Figs. 12-13"},
-    };
-    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
-    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
-    return {"hier_isr", "hierarchical image-space radiosity: per-receiver cuts through the light tree",
-            "001 §3.5", ParamTable(std::move(specs))};
-}
-
 HierIsr::HierIsr() {
     mGather = gl::Program::build(
         {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/hier_isr/gather.frag"}});

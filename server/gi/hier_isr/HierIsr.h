@@ -87,7 +87,6 @@ std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
 
 class HierIsr final : public Technique {
 public:
-    static TechniqueInfo info();
     HierIsr();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

@@ -11,47 +11,6 @@ namespace {
 constexpr int kSelectGroup = 256; // local_size_x of isr/select.comp
 }
 
-TechniqueInfo Isr::info() {
-    std::vector<ParamSpec> specs = {
-        {.name = "isr_coarsest",
-         .type = ParamType::Int,
-         .defaultValue = 16,
-         .min = 1,
-         .max = 256,
-         .unit = "patches per side",
-         .help = "coarsest light patches: the tree level with at most this many patches per side",
-         .source = "001 §3.4, Fig. 7 (16^2)"},
-        {.name = "isr_finest",
-         .type = ParamType::Int,
-         .defaultValue = 64,
-         .min = 1,
-         .max = 256,
-         .unit = "patches per side",
-         .help = "finest light patches (maximum VPL subdivision), clamped to rsm_size",
-         .source = "001 Fig. 10 (64^2)"},
-        {.name = "light_depth_threshold",
-         .type = ParamType::Float,
-         .defaultValue = 0.2,
-         .min = 0.0,
-         .max = 1.0,
-         .unit = "fraction of light distance",
-         .help =
-             "refine a light patch where (max - min) distance to the light exceeds this fraction of the min",
-         .source = "001 §3.4 (no value given; chosen)"},
-        {.name = "light_normal_threshold",
-         .type = ParamType::Float,
-         .defaultValue = 0.25,
-         .min = 0.0,
-         .max = 2.0,
-         .help = "refine a light patch where any normal component's range exceeds this",
-         .source = "001 §3.4 (no value given); 000 Figs. 11-12 eye-space quality setting"},
-    };
-    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
-    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
-    return {"isr", "image-space radiosity: per-frame light-space patches gathered at stencil receivers",
-            "001 §3.4", ParamTable(std::move(specs))};
-}
-
 Isr::Isr() {
     mSelect = gl::Program::build({{GL_COMPUTE_SHADER, "gi/isr/select.comp"}});
     // The gather is multires_gather's, always with the disk kernel (001 Eq. 1).

@@ -53,7 +53,6 @@ namespace gis {
 
 class Isr final : public Technique {
 public:
-    static TechniqueInfo info();
     Isr();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

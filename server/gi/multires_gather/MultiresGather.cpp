@@ -2,13 +2,6 @@
 
 namespace gis {
 
-TechniqueInfo MultiresGather::info() {
-    std::vector<ParamSpec> specs = vplParamSpecs(VplKernel::Disk);
-    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
-    return {"multires_gather", "stencil-selected multiresolution gather from grid VPLs, upsampled",
-            "001 §3.2", ParamTable(std::move(specs))};
-}
-
 MultiresGather::MultiresGather() {
     mGather = KernelPrograms({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
                               {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}});

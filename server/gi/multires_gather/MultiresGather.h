@@ -31,7 +31,6 @@ namespace gis {
 
 class MultiresGather final : public Technique {
 public:
-    static TechniqueInfo info();
     MultiresGather();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

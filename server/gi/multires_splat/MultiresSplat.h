@@ -48,7 +48,6 @@ namespace gis {
 
 class MultiresSplat final : public Technique {
 public:
-    static TechniqueInfo info();
     MultiresSplat();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

@@ -8,9 +8,6 @@ namespace gis {
 
 class NoIndirect final : public Technique {
 public:
-    static TechniqueInfo info() {
-        return {"none", "direct light only (no indirect illumination)", "baseline", ParamTable{}};
-    }
     void resize(int, int) override {}
     void execute(const FrameInputs&, const ParamSet&, gl::PassTimer&, Counters&) override {}
     const gl::Texture* indirect() const override { return nullptr; }

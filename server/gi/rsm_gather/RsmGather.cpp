@@ -6,30 +6,7 @@
 
 namespace gis {
 
-namespace {
-std::vector<ParamSpec> withShadows(std::vector<ParamSpec> specs) {
-    for (auto& s : vplShadowParamSpecs()) specs.push_back(std::move(s));
-    return specs;
-}
-} // namespace
-
-TechniqueInfo RsmGather::info() {
-    return {"rsm_gather", "full-resolution gather from VPLs on a regular RSM grid", "000 §3, Eq. 2",
-            ParamTable(withShadows(vplParamSpecs(VplKernel::Point))), [](const ParamSet&) { return true; }};
-}
-
-TechniqueInfo RsmGather::ssbcInfo() {
-    // 002's configuration on rsm_gather's pipeline: the K3 clamp on and one compensation step
-    // (docs/ssbc.md). Only the defaults differ, so `rsm_gather --param clamp_b=..,ssbc_iterations=1`
-    // renders the same image.
-    std::vector<ParamSpec> specs = withShadows(vplParamSpecs(VplKernel::Point));
-    for (auto& s : specs) {
-        if (s.name == "clamp_b") s.defaultValue = kSsbcDefaultClampB;
-        if (s.name == "ssbc_iterations") s.defaultValue = 1;
-    }
-    return {"ssbc", "clamped grid-VPL gather (K3) with screen-space bias compensation", "002 §3-4",
-            ParamTable(std::move(specs)), [](const ParamSet&) { return true; }};
-}
+namespace {} // namespace
 
 RsmGather::RsmGather() {
     mGather = KernelPrograms(

@@ -38,10 +38,6 @@ namespace gis {
 
 class RsmGather final : public Technique {
 public:
-    static TechniqueInfo info();
-    /// The `ssbc` preset (002): this pipeline with clamp_b = kSsbcDefaultClampB, ssbc_iterations 1.
-    static TechniqueInfo ssbcInfo();
-    static constexpr double kSsbcDefaultClampB = 10.0; // 1/m^2: r = 1/sqrt(b) = 0.32 m
     RsmGather();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

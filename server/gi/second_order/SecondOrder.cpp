@@ -6,21 +6,22 @@
 #include <glm/gtc/matrix_inverse.hpp>
 
 #include "gi/common/VplGrid.h"
+#include "gi/second_order/Limits.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
 namespace {
 
-constexpr int kMaxPositive = 1024;
-constexpr int kMaxNegative = 1024;
+using second_order::kMaxNegative;
+using second_order::kMaxPositive;
+using second_order::kNoFixupThreshold;
+
 // Candidate pixels examined per requested negative light: S_neg is zero on most of the image
 // (surfaces with every light in front of them), so the first negative_count back-lit candidates in
 // Halton order are kept out of this many. Fewer back-lit pixels give fewer negative lights, each
 // still standing for its share of the frustum's solid angle (unbiased).
 constexpr int kCandidatesPerNegative = 8;
 constexpr int kMaxCandidates = kCandidatesPerNegative * kMaxNegative;
-// The discontinuity threshold at which the fix-up is switched off (100% low resolution).
-constexpr double kNoFixupThreshold = 2.0;
 // A negative light's area is (solid angle) * d^2 / cos(view angle); the cosine is clamped here so a
 // sample on a surface seen edge-on stands for at most 10x its perpendicular footprint.
 constexpr float kMinCosView = 0.1f;
@@ -33,57 +34,6 @@ bool finite(glm::vec3 v) {
 }
 
 } // namespace
-
-TechniqueInfo SecondOrder::info() {
-    std::vector<ParamSpec> specs = {
-        {.name = "positive_count",
-         .type = ParamType::Int,
-         .defaultValue = 256,
-         .min = 0,
-         .max = kMaxPositive,
-         .unit = "lights",
-         .help = "indirect lights: the first Halton sphere points inside the spot cone, looked up in the RSM",
-         .source = "003 §3.1, Table 1 (100-450)"},
-        {.name = "negative_count",
-         .type = ParamType::Int,
-         .defaultValue = 128,
-         .min = 0,
-         .max = kMaxNegative,
-         .unit = "lights",
-         .help =
-             "negative indirect lights placed on back-lit camera-visible points (0 = no indirect shadows)",
-         .source = "003 §3.3, Table 1 (half the positive count)"},
-        {.name = "discontinuity_threshold",
-         .type = ParamType::Float,
-         .defaultValue = 0.05,
-         .min = 0.0,
-         .max = kNoFixupThreshold,
-         .unit = "",
-         .help = "full-resolution fix-up where 1 - n.n' or plane distance / eye distance to a low-res "
-                 "neighbour reaches this; 0 = all full resolution, 2 = no fix-up",
-         .source = "003 §3.5 (no value given; chosen, docs/second_order.md)"},
-        {.name = "lowres_factor",
-         .type = ParamType::Int,
-         .defaultValue = 2,
-         .min = 1,
-         .max = 8,
-         .unit = "px per side",
-         .help = "full-resolution pixels per low-resolution texel side",
-         .source = "003 §3.5 (2x2)"},
-        {.name = "min_distance",
-         .type = ParamType::Float,
-         .defaultValue = 0.1,
-         .min = 0.0,
-         .max = 1.0,
-         .unit = "m",
-         .help = "distance clamp of the 1/d^2 falloff of positive and negative lights",
-         .source = "003 §3.2 (no clamp given; chosen as for the other point kernels)"},
-    };
-    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
-    return {"second_order",
-            "Halton indirect lights with negative lights for indirect shadows, low-res + fix-up",
-            "003 §3.1-3.5", ParamTable(std::move(specs))};
-}
 
 SecondOrder::SecondOrder() {
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};

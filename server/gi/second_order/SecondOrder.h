@@ -60,7 +60,6 @@ struct Vpl;
 
 class SecondOrder final : public Technique {
 public:
-    static TechniqueInfo info();
     SecondOrder();
     void resize(int width, int height) override;
     void execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

@@ -2,8 +2,8 @@
 // calls for the effect and one that does not.
 #include <gtest/gtest.h>
 
-#include "analysis/EffectPlan.h"
-#include "render/FrameState.h"
+#include "effects/EffectPlan.h"
+#include "frame/FrameState.h"
 #include "scene/SceneLoader.h"
 
 namespace {

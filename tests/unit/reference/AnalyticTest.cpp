@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "ReferenceTestScenes.h"
+#include "frame/LightModel.h"
 #include "reference/ReferenceRenderer.h"
-#include "render/FrameRenderer.h"
 
 using namespace gis;
 using namespace gis::test;
@@ -16,7 +16,7 @@ namespace {
 
 // The camera ray through pixel (px, py)'s centre, built independently of the renderer.
 void pixelRay(const Camera& cam, int w, int h, int px, int py, glm::dvec3& origin, glm::dvec3& dir) {
-    const glm::dmat4 inv = glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(cam, w, h)));
+    const glm::dmat4 inv = glm::inverse(glm::dmat4(cameraViewProj(cam, w, h)));
     const double nx = 2.0 * (px + 0.5) / w - 1.0, ny = 1.0 - 2.0 * (py + 0.5) / h;
     const glm::dvec4 a = inv * glm::dvec4(nx, ny, -1.0, 1.0), b = inv * glm::dvec4(nx, ny, 1.0, 1.0);
     origin = glm::dvec3(a) / a.w;

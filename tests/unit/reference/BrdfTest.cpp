@@ -10,7 +10,7 @@
 #include "core/Error.h"
 #include "reference/ReferenceRenderer.h"
 #include "reference/Sampling.h"
-#include "render/FrameParams.h"
+#include "frame/FrameParams.h"
 #include "scene/Brdf.h"
 
 using namespace gis;

@@ -7,7 +7,7 @@
 
 #include <glm/glm.hpp>
 
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 #include "scene/SceneLoader.h"
 
 namespace gis::test {

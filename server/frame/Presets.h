@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 namespace gis {
 

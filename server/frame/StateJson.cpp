@@ -1,6 +1,6 @@
 // Camera and light JSON (StateJson.h): the semantics Session.cpp had inline, with the checks the
 // protocol schemas make repeated here so that a caller without a schema gets the same answers.
-#include "render/StateJson.h"
+#include "frame/StateJson.h"
 
 #include <algorithm>
 #include <cmath>

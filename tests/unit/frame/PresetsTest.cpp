@@ -5,9 +5,9 @@
 #include <unistd.h>
 
 #include "core/Error.h"
-#include "gi/Technique.h"
-#include "render/FrameState.h"
-#include "render/Presets.h"
+#include "gi/Catalog.h"
+#include "frame/FrameState.h"
+#include "frame/Presets.h"
 #include "scene/SceneLoader.h"
 
 namespace {
@@ -74,7 +74,7 @@ TEST(Presets, CommittedFileAppliesToEveryTechniqueItNames) {
     gis::Scene scene = gis::loadScene("builtin:cornell");
     for (const auto& [technique, byName] : presets["techniques"].items()) {
         bool registered = false;
-        for (const auto& e : gis::techniqueRegistry()) registered |= e.info.name == technique;
+        for (const auto& info : gis::techniqueCatalog()) registered |= info.name == technique;
         if (!registered) continue;
         for (const auto& name : gis::knownPresets()) {
             gis::FrameState state = gis::makeFrameState(scene, technique);

@@ -19,7 +19,7 @@
 
 #include "encode/Encoder.h"
 #include "render/FrameRenderer.h"
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 #include "scene/Scene.h"
 
 namespace gis {

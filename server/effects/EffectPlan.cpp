@@ -1,4 +1,4 @@
-#include "analysis/EffectPlan.h"
+#include "effects/EffectPlan.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,11 +8,12 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 
-#include "gi/Technique.h"
+#include "frame/LightModel.h"
+#include "frame/VplBudget.h"
+#include "gi/Catalog.h"
 #include "reference/RayScene.h"
 #include "reference/Sampling.h"
-#include "render/FrameRenderer.h"
-#include "render/Reflections.h"
+#include "scene/SurfaceAnalysis.h"
 #include "scene/Brdf.h"
 
 namespace gis {
@@ -111,8 +112,7 @@ EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, 
     const int w = std::max(state.width, 1), h = std::max(state.height, 1);
     const int gx = w >= h ? kLevelGrid : std::max(2, kLevelGrid * w / h);
     const int gy = w >= h ? std::max(2, kLevelGrid * h / w) : kLevelGrid;
-    const glm::dmat4 invViewProj =
-        glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
+    const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(cameraViewProj(state.camera, w, h)));
     struct Sample {
         bool hit = false;
         float distance = 0.0f;
@@ -131,14 +131,11 @@ EffectDecision planCoarsestLevel(const RayScene& rays, const FrameState& state, 
             s.distance = glm::length(hit.position - state.camera.position);
             s.normal = facing(hit.shadingNormal, -dir);
         }
-    const double depthThreshold = state.techniqueParams.has("depth_threshold")
-                                      ? state.techniqueParams.getFloat("depth_threshold")
-                                      : 0.1;
-    const double normalThreshold = state.techniqueParams.has("normal_threshold")
-                                       ? state.techniqueParams.getFloat("normal_threshold")
-                                       : 0.25;
-    const bool diagonal =
-        !state.techniqueParams.has("diagonal_refine") || state.techniqueParams.getBool("diagonal_refine");
+    // Only techniques with the eye hierarchy (TechniqueInfo::eyeHierarchy) come here; its own
+    // thresholds decide.
+    const double depthThreshold = state.techniqueParams.getFloat("depth_threshold");
+    const double normalThreshold = state.techniqueParams.getFloat("normal_threshold");
+    const bool diagonal = state.techniqueParams.getBool("diagonal_refine");
     // Whole fraction per candidate level, among the patches with geometry (empty ones are never lit).
     std::string densities;
     int chosen = 0;
@@ -257,8 +254,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     const double aspect = static_cast<double>(w) / h;
     const int gx = std::max(1, static_cast<int>(std::lround(std::sqrt(options.viewSamples * aspect))));
     const int gy = std::max(1, options.viewSamples / gx);
-    const glm::dmat4 invViewProj =
-        glm::inverse(glm::dmat4(FrameRenderer::cameraViewProj(state.camera, w, h)));
+    const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(cameraViewProj(state.camera, w, h)));
     std::vector<Point> receivers;
     receivers.reserve(static_cast<size_t>(gx) * gy);
     std::vector<glm::vec3> emission;
@@ -320,7 +316,8 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
 
     // 3. Per receiver: direct (hard shadow), one bounce without and with x-y visibility, and the part of
     //    the unoccluded bounce the clamp min(G, b) removes.
-    const bool hasClamp = state.techniqueParams.has("clamp_b");
+    const TechniqueInfo& technique = findTechniqueInfo(state.technique);
+    const bool hasClamp = technique.biasCompensation;
     const double clampB = hasClamp ? state.techniqueParams.getFloat("clamp_b") : 0.0;
     double truthSq = 0.0, indirectSq = 0.0, occlusionSq = 0.0, compensationSq = 0.0;
     double pairsWeighted = 0.0, pairsOccludedWeighted = 0.0;
@@ -380,8 +377,9 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
 
     // Cost model inputs.
     const double pixels = static_cast<double>(w) * h;
-    const bool hasGrid = state.techniqueParams.has("vpl_grid");
-    const double vplCount = hasGrid ? std::pow(state.techniqueParams.getInt("vpl_grid"), 2.0) : 256.0;
+    // The technique's own VPL count (TechniqueInfo::vplEstimate); 256 for one without VPLs.
+    const long estimated = vplEstimate(state);
+    const double vplCount = estimated > 0 ? static_cast<double>(estimated) : 256.0;
     const double gatherMs = vplCount * pixels * kGatherNsPerPair * 1e-6;
     const double triangles = static_cast<double>(scene.triangleCount());
 
@@ -440,7 +438,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         d.measurement = "estimated relative RMSE of ignoring indirect visibility";
         d.value = relative(occlusionSq);
         d.threshold = options.occlusionThreshold;
-        d.available = state.techniqueParams.has("vpl_shadows");
+        d.available = technique.vplVisibility;
         d.costMs = d.available ? vplCount * pixels * kShadowNsPerPair * 1e-6 +
                                      vplCount * triangles * 1e-3 * kShadowMsPerVplPerKTri
                                : 0.0;
@@ -460,7 +458,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         d.measurement = "estimated relative RMSE of the energy clamp_b removes";
         d.value = relative(compensationSq);
         d.threshold = options.compensationThreshold;
-        d.available = state.techniqueParams.has("ssbc_iterations") && clampB > 0.0;
+        d.available = technique.biasCompensation && clampB > 0.0;
         d.costMs = d.available ? pixels * kCompensationNsPerPixel * 1e-6 : 0.0;
         if (!indirectOn)
             d.reason = "the bounce is off";
@@ -485,7 +483,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
             state.frameParams.has("mirror_depth") ? state.frameParams.getInt("mirror_depth") : 1;
         const float mirrorRoughness =
             state.frameParams.has("mirror_roughness") ? state.frameParams.getFloat("mirror_roughness") : 0.1f;
-        const TechniqueInfo& info = findTechnique(state.technique).info;
+        const TechniqueInfo& info = findTechniqueInfo(state.technique);
         const bool glossyAvailable = info.glossyTransport && info.glossyTransport(state.techniqueParams);
         std::vector<bool> mirrorMesh(scene.meshes.size(), false);
         if (mirrorDepth > 0)
@@ -551,7 +549,7 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     }
 
     // Multiresolution level limit: where the eye-space hierarchy should start refining.
-    if (state.techniqueParams.has("coarsest_size")) decide(planCoarsestLevel(rays, state, plan.rays), true);
+    if (technique.eyeHierarchy) decide(planCoarsestLevel(rays, state, plan.rays), true);
 
     plan.analysisMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -559,15 +557,19 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
 }
 
 void applyEffectPlan(FrameState& state, const EffectPlan& plan) {
+    const TechniqueInfo* technique = &findTechniqueInfo(state.technique);
     for (const EffectDecision& d : plan.decisions) {
         if (!d.applied) continue;
         if (d.effect == "direct") {
             // Forcing it on cannot light a scene without a spotlight; it only keeps the light as it is.
             if (!d.enabled) state.lightEnabled = false;
         } else if (d.effect == "indirect") {
-            if (!d.enabled && state.technique != "none") setTechnique(state, "none", "effect_indirect");
+            if (!d.enabled && state.technique != "none") {
+                setTechnique(state, "none", "effect_indirect");
+                technique = &findTechniqueInfo(state.technique);
+            }
         } else if (d.effect == "occlusion") {
-            if (state.techniqueParams.has("vpl_shadows"))
+            if (technique->vplVisibility)
                 state.techniqueParams.set("vpl_shadows", d.enabled, "effect_occlusion");
         } else if (d.effect == "specular" || d.effect == "glossy" || d.effect == "env" ||
                    d.effect == "mirrors") {
@@ -576,11 +578,10 @@ void applyEffectPlan(FrameState& state, const EffectPlan& plan) {
             const std::string name = "effect_" + d.effect;
             if (state.frameParams.has(name)) state.frameParams.set(name, d.enabled ? "on" : "off", "effects");
         } else if (d.effect == "levels") {
-            if (state.techniqueParams.has("coarsest_size") && d.value >= 1.0)
+            if (technique->eyeHierarchy && d.value >= 1.0)
                 state.techniqueParams.set("coarsest_size", static_cast<int>(d.value), "effects");
         } else if (d.effect == "compensation") {
-            if (state.techniqueParams.has("ssbc_iterations") && state.techniqueParams.has("clamp_b") &&
-                state.techniqueParams.getFloat("clamp_b") > 0.0) {
+            if (technique->biasCompensation && state.techniqueParams.getFloat("clamp_b") > 0.0) {
                 const int now = state.techniqueParams.getInt("ssbc_iterations");
                 state.techniqueParams.set("ssbc_iterations", d.enabled ? std::max(now, 1) : 0,
                                           "effect_compensation");

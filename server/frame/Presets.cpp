@@ -1,4 +1,4 @@
-#include "render/Presets.h"
+#include "frame/Presets.h"
 
 #include <algorithm>
 #include <cstdlib>

@@ -31,7 +31,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 #include "scene/Scene.h"
 
 namespace gis {

@@ -1,11 +1,11 @@
-#include "render/FrameState.h"
+#include "frame/FrameState.h"
 
 #include <algorithm>
 
 #include "core/Error.h"
 #include "core/Log.h"
-#include "gi/Technique.h"
-#include "render/FrameParams.h"
+#include "gi/Catalog.h"
+#include "frame/FrameParams.h"
 
 namespace gis {
 
@@ -19,7 +19,8 @@ FrameState makeFrameState(const Scene& scene, const std::string& technique) {
     } else {
         s.lightEnabled = false;
         if (!scene.lights.empty())
-            logWarn("render: scene '" + scene.name + "' has no spot light; point and directional lights are not rendered yet");
+            logWarn("render: scene '" + scene.name +
+                    "' has no spot light; point and directional lights are not rendered yet");
     }
     s.frameParams = ParamSet(frameParamTable());
     setTechnique(s, technique);
@@ -27,27 +28,31 @@ FrameState makeFrameState(const Scene& scene, const std::string& technique) {
 }
 
 void setTechnique(FrameState& state, const std::string& technique, const std::string& where) {
-    const TechniqueEntry& entry = findTechnique(technique, where);
-    state.technique = entry.info.name;
-    state.techniqueParams = ParamSet(entry.info.params);
+    const TechniqueInfo& info = findTechniqueInfo(technique, where);
+    state.technique = info.name;
+    state.techniqueParams = ParamSet(info.params);
 }
 
-void setParam(FrameState& state, const std::string& name, const nlohmann::json& value, const std::string& where) {
+void setParam(FrameState& state, const std::string& name, const nlohmann::json& value,
+              const std::string& where) {
     if (state.frameParams.has(name)) return state.frameParams.set(name, value, where);
     if (state.techniqueParams.has(name)) return state.techniqueParams.set(name, value, where);
     std::string known;
     for (const auto& s : state.frameParams.table().specs()) known += (known.empty() ? "" : ", ") + s.name;
     for (const auto& s : state.techniqueParams.table().specs()) known += ", " + s.name;
-    throw InputError(where, "unknown parameter '" + name + "' for technique '" + state.technique + "' (known: " + known + ")");
+    throw InputError(where, "unknown parameter '" + name + "' for technique '" + state.technique +
+                                "' (known: " + known + ")");
 }
 
-void setParamFromString(FrameState& state, const std::string& name, const std::string& text, const std::string& where) {
+void setParamFromString(FrameState& state, const std::string& name, const std::string& text,
+                        const std::string& where) {
     if (state.frameParams.has(name)) return state.frameParams.setFromString(name, text, where);
     if (state.techniqueParams.has(name)) return state.techniqueParams.setFromString(name, text, where);
     setParam(state, name, nullptr, where); // throws the unknown-parameter error
 }
 
-std::vector<std::string> applyParams(FrameState& state, const nlohmann::json& values, const std::string& where) {
+std::vector<std::string> applyParams(FrameState& state, const nlohmann::json& values,
+                                     const std::string& where) {
     if (!values.is_object()) throw InputError(where, "expected an object of parameter values");
     FrameState copy = state;
     for (const auto& [k, v] : values.items()) setParam(copy, k, v, where + "/" + k);

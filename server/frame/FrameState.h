@@ -13,7 +13,7 @@ namespace gis {
 
 struct FrameState {
     Camera camera;
-    Light light;            ///< the spotlight the pipeline renders (from the scene, or as the client moved it)
+    Light light; ///< the spotlight the pipeline renders (from the scene, or as the client moved it)
     bool lightEnabled = true;
     int width = 512;
     int height = 512;
@@ -36,10 +36,13 @@ FrameState makeFrameState(const Scene& scene, const std::string& technique);
 /// Switches technique, resetting its parameters to that technique's defaults.
 void setTechnique(FrameState& state, const std::string& technique, const std::string& where = "technique");
 /// Sets one parameter by name, in the frame table or the technique's table. Throws InputError.
-void setParam(FrameState& state, const std::string& name, const nlohmann::json& value, const std::string& where);
-void setParamFromString(FrameState& state, const std::string& name, const std::string& text, const std::string& where);
+void setParam(FrameState& state, const std::string& name, const nlohmann::json& value,
+              const std::string& where);
+void setParamFromString(FrameState& state, const std::string& name, const std::string& text,
+                        const std::string& where);
 /// Applies {name: value, ...} all or nothing. Returns the names that changed.
-std::vector<std::string> applyParams(FrameState& state, const nlohmann::json& values, const std::string& where);
+std::vector<std::string> applyParams(FrameState& state, const nlohmann::json& values,
+                                     const std::string& where);
 /// Both tables' values merged into one object.
 nlohmann::json paramsJson(const FrameState& state);
 

@@ -1,6 +1,6 @@
 // One-shot render requests (RenderRequest.h): schema check with hints per field, the semantic checks
 // of the parameter tables and StateJson, and the render/encode/compare sequence gi-render shares.
-#include "render/RenderRequest.h"
+#include "job/RenderRequest.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,9 +10,9 @@
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Timer.h"
-#include "render/FrameParams.h"
-#include "render/Presets.h"
-#include "render/StateJson.h"
+#include "frame/FrameParams.h"
+#include "frame/Presets.h"
+#include "frame/StateJson.h"
 #if GIS_HAVE_REFERENCE && GIS_HAVE_ANALYSIS
 #include "analysis/Metrics.h"
 #include "reference/ReferenceRenderer.h"
@@ -21,7 +21,7 @@
 #define GIS_RENDER_JOB_COMPARE 0
 #endif
 #if GIS_HAVE_EFFECTS
-#include "analysis/EffectPlan.h"
+#include "effects/EffectPlan.h"
 #endif
 
 namespace gis {

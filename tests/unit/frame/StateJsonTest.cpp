@@ -5,8 +5,8 @@
 #include <functional>
 
 #include "core/Error.h"
-#include "render/FrameState.h"
-#include "render/StateJson.h"
+#include "frame/FrameState.h"
+#include "frame/StateJson.h"
 #include "scene/SceneLoader.h"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <functional>
 
 #include "core/Error.h"
-#include "render/RenderRequest.h"
+#include "job/RenderRequest.h"
 #include "scene/SceneLoader.h"
 
 namespace {

@@ -1,0 +1,59 @@
+// The GL-free half of every technique (DESIGN.md §4): name, paper, parameter table and the
+// capabilities other layers ask about, so that the frame description, the CPU reference, the effect
+// plan, the server's limits and the client read them without linking the renderer (CMake target
+// gis_catalog, below frame/). Each technique's folder defines its entry in Info.cpp;
+// gi/Technique.h pairs the entries with the GL implementations, in the same order.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/Param.h"
+
+namespace gis {
+
+struct TechniqueInfo {
+    std::string name;        ///< registry key, e.g. "rsm_gather"
+    std::string description; ///< one line
+    std::string paper;       ///< seed paper and section
+    ParamTable params;
+    /// Whether the technique carries glossy VPL transport with these parameters (FrameInputs::glossy;
+    /// docs/nondiffuse.md); empty for none. The planner reads it without creating the technique.
+    std::function<bool(const ParamSet&)> glossyTransport;
+    /// The most VPLs (or virtual lights) one frame with these technique and frame parameters uses:
+    /// what --max-vpls bounds and what the refinement predictor scales by. Empty: none.
+    std::function<long(const ParamSet& technique, const ParamSet& frame)> vplEstimate;
+    /// Effect knobs the effect plan may set (docs/effects.md): the multiresolution eye hierarchy
+    /// (coarsest_size and the discontinuity thresholds of gi/common/ParamSpecs.h), VPL visibility
+    /// (vpl_shadows) and bias compensation (clamp_b, ssbc_iterations).
+    bool eyeHierarchy = false;
+    bool vplVisibility = false;
+    bool biasCompensation = false;
+};
+
+/// Every technique, in the registry's stable order.
+const std::vector<TechniqueInfo>& techniqueCatalog();
+/// Throws gis::InputError(where, ...) listing the known names when `name` is unknown.
+const TechniqueInfo& findTechniqueInfo(const std::string& name, const std::string& where = "technique");
+
+/// x^2 for VPL grids and light-tree sides (a long, so 256^2 and 1024^2 fit).
+inline long squared(long x) {
+    return x * x;
+}
+/// vplEstimate of the grid-VPL techniques: vpl_grid^2.
+inline long gridVplEstimate(const ParamSet& technique, const ParamSet&) {
+    return squared(technique.getInt("vpl_grid"));
+}
+
+// The entries, one per technique folder (gi/<name>/Info.cpp).
+TechniqueInfo noIndirectInfo();
+TechniqueInfo rsmGatherInfo();
+TechniqueInfo ssbcInfo();
+TechniqueInfo multiresSplatInfo();
+TechniqueInfo multiresGatherInfo();
+TechniqueInfo isrInfo();
+TechniqueInfo hierIsrInfo();
+TechniqueInfo secondOrderInfo();
+
+} // namespace gis

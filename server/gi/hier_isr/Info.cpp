@@ -1,0 +1,51 @@
+// The catalog entry of `hier_isr` (hierarchical image-space radiosity): its parameter table and capabilities,
+// GL-free (gi/Catalog.h). The passes are in HierIsr.cpp.
+#include "gi/Catalog.h"
+#include "gi/common/ParamSpecs.h"
+
+namespace gis {
+
+TechniqueInfo hierIsrInfo() {
+    std::vector<ParamSpec> specs = {
+        {.name = "tau",
+         .type = ParamType::Float,
+         .defaultValue = 0.01,
+         .min = 0.0,
+         .max = 1.0,
+         .unit = "fraction of I",
+         .help = "refine a light node while its bounded contribution may exceed tau * I (0: full "
+                 "traversal, 1: coarsest level only)",
+         .source = "001 Eqs. 6-8 (no value given; chosen for <5% error at 1/10 the full gather's time)"},
+        {.name = "hier_coarsest",
+         .type = ParamType::Int,
+         .defaultValue = 16,
+         .min = 1,
+         .max = 256,
+         .unit = "patches per side",
+         .help = "where every receiver's traversal starts: the tree level with at most this many patches per "
+                 "side",
+         .source = "001 §3.5 (16^2)"},
+        {.name = "max_depth",
+         .type = ParamType::Int,
+         .defaultValue = 256,
+         .min = 1,
+         .max = 1024,
+         .unit = "patches per side",
+         .help = "finest tree level a traversal visits (maximal traversal depth), clamped to rsm_size",
+         .source = "001 §3.5, Figs. 12-13"},
+    };
+    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
+    TechniqueInfo info{"hier_isr",
+                       "hierarchical image-space radiosity: per-receiver cuts through the light tree",
+                       "001 §3.5", ParamTable(std::move(specs))};
+    // Every RSM texel is a leaf of the light tree: a full traversal reaches rsm_size^2 lights.
+    info.vplEstimate = [](const ParamSet&, const ParamSet& frame) {
+        return squared(frame.getInt("rsm_size"));
+    };
+    info.eyeHierarchy = true;
+    info.biasCompensation = true;
+    return info;
+}
+
+} // namespace gis

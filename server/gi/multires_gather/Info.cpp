@@ -1,0 +1,19 @@
+// The catalog entry of `multires_gather` (multiresolution gather): its parameter table and capabilities,
+// GL-free (gi/Catalog.h). The passes are in MultiresGather.cpp.
+#include "gi/Catalog.h"
+#include "gi/common/ParamSpecs.h"
+
+namespace gis {
+
+TechniqueInfo multiresGatherInfo() {
+    std::vector<ParamSpec> specs = vplParamSpecs(VplKernel::Disk);
+    for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    TechniqueInfo info{"multires_gather", "stencil-selected multiresolution gather from grid VPLs, upsampled",
+                       "001 §3.2", ParamTable(std::move(specs))};
+    info.vplEstimate = gridVplEstimate;
+    info.eyeHierarchy = true;
+    info.biasCompensation = true;
+    return info;
+}
+
+} // namespace gis

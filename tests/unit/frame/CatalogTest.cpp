@@ -1,0 +1,48 @@
+// The technique catalog (gi/Catalog.h) without GL: every capability a technique claims is backed by
+// the parameters it declares, and the VPL estimate follows the parameters it names.
+#include <gtest/gtest.h>
+
+#include "core/Error.h"
+#include "frame/FrameParams.h"
+#include "frame/FrameState.h"
+#include "frame/VplBudget.h"
+#include "gi/Catalog.h"
+
+namespace gis {
+namespace {
+
+TEST(Catalog, CapabilitiesAreBackedByTheDeclaredParameters) {
+    ASSERT_EQ(techniqueCatalog().size(), 8u);
+    for (const TechniqueInfo& info : techniqueCatalog()) {
+        const ParamTable& p = info.params;
+        EXPECT_EQ(info.vplVisibility, p.find("vpl_shadows") != nullptr) << info.name;
+        EXPECT_EQ(info.biasCompensation, p.find("clamp_b") != nullptr && p.find("ssbc_iterations") != nullptr)
+            << info.name;
+        EXPECT_EQ(info.eyeHierarchy,
+                  p.find("coarsest_size") != nullptr && p.find("depth_threshold") != nullptr &&
+                      p.find("normal_threshold") != nullptr && p.find("diagonal_refine") != nullptr)
+            << info.name;
+        EXPECT_EQ(static_cast<bool>(info.vplEstimate), info.name != "none") << info.name;
+    }
+    EXPECT_THROW(findTechniqueInfo("nope"), InputError);
+}
+
+TEST(Catalog, VplEstimatesFollowEachTechniquesParameters) {
+    auto estimate = [](const std::string& technique, const nlohmann::json& params) {
+        FrameState s;
+        s.frameParams = ParamSet(frameParamTable());
+        setTechnique(s, technique);
+        applyParams(s, params, "test");
+        return vplEstimate(s);
+    };
+    EXPECT_EQ(estimate("none", nlohmann::json::object()), 0);
+    EXPECT_EQ(estimate("rsm_gather", {{"vpl_grid", 64}}), 64 * 64);
+    EXPECT_EQ(estimate("multires_splat", {{"vpl_grid", 256}}), 65536);
+    EXPECT_EQ(estimate("isr", {{"isr_finest", 32}}), 32 * 32);
+    EXPECT_EQ(estimate("hier_isr", {{"rsm_size", 512}}), 512 * 512)
+        << "a full traversal reaches every RSM texel";
+    EXPECT_EQ(estimate("second_order", {{"positive_count", 100}, {"negative_count", 50}}), 150);
+}
+
+} // namespace
+} // namespace gis
