@@ -54,6 +54,8 @@ Renders a scene with a global-illumination technique and writes the image and pe
   --list-techniques     list the techniques and exit
   --list-params TECH    list the frame parameters and TECH's parameters and exit
   --list-scenes         list the built-in scenes and exit
+  --list-resources      after rendering, print the frame's named resources (name, producer, format,
+                        size: the G-buffer, each light's shadow map and RSM, direct, indirect, ...)
   --explain             print the effect plan (which effects run, why, measured values, estimated
                         cost; docs/effects.md); exits after it unless --out, --stats or --compare is
                         given. --param effects=auto applies the plan, effect_NAME=on|off forces one
@@ -110,6 +112,7 @@ struct Options {
     bool useCache = true;
     std::string compare;
     bool explain = false;
+    bool listResources = false;
 };
 
 std::string defaultCacheDir() {
@@ -336,6 +339,8 @@ int run(int argc, char** argv) {
             o.quiet = true;
         else if (a == "--explain")
             o.explain = true;
+        else if (a == "--list-resources")
+            o.listResources = true;
         else if (a == "--reference")
             o.referenceMode = value(i);
         else if (a == "--spp")
@@ -461,6 +466,12 @@ int run(int argc, char** argv) {
     for (int f = 0; f < o.frames; ++f) {
         frame = renderer.render(state, wantLinear);
         stats.push_back(frame.stats);
+    }
+    if (o.listResources) {
+        std::printf("%-28s %-12s %-18s %s\n", "resource", "producer", "format", "size");
+        for (const gis::FrameResource& r : renderer.resources().list())
+            std::printf("%-28s %-12s %-18s %dx%d\n", r.name.c_str(), r.producer.c_str(), r.format.c_str(),
+                        r.width, r.height);
     }
     nlohmann::json summary = gis::medianStats(stats);
     summary["scene"] = o.scene;

@@ -15,6 +15,7 @@
 
 #include "core/Param.h"
 #include "gi/Catalog.h"
+#include "gl/FrameResources.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -28,6 +29,9 @@ struct FrameUniforms;
 /// The frame pipeline's products a technique may read. Textures are owned by the renderer.
 struct FrameInputs {
     int width = 0, height = 0;
+    /// Everything the frame produced before the technique, by name (gbuffer.*, light[i].*, direct);
+    /// the pointers below are the same textures, kept for the techniques that predate the table.
+    const FrameResources* resources = nullptr;
     const gl::Texture* gPosition = nullptr; ///< RGBA32F world position, w = 1 where covered
     const gl::Texture* gNormal = nullptr;   ///< RGBA16F unit normal facing the camera
     const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 linear diffuse albedo rho_d (scene/Brdf.h)

@@ -1,6 +1,8 @@
 #include "gl/Shader.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -111,6 +113,60 @@ std::string mapShaderLog(const std::string& log, const std::vector<std::string>&
     return out;
 }
 
+namespace {
+
+bool isSamplerOrImage(GLenum type) {
+    switch (type) {
+    case GL_SAMPLER_1D:
+    case GL_SAMPLER_2D:
+    case GL_SAMPLER_3D:
+    case GL_SAMPLER_CUBE:
+    case GL_SAMPLER_2D_SHADOW:
+    case GL_SAMPLER_2D_ARRAY:
+    case GL_SAMPLER_2D_ARRAY_SHADOW:
+    case GL_SAMPLER_CUBE_SHADOW:
+    case GL_SAMPLER_CUBE_MAP_ARRAY:
+    case GL_SAMPLER_BUFFER:
+    case GL_INT_SAMPLER_2D:
+    case GL_UNSIGNED_INT_SAMPLER_2D:
+    case GL_INT_SAMPLER_BUFFER:
+    case GL_UNSIGNED_INT_SAMPLER_BUFFER:
+    case GL_IMAGE_2D:
+    case GL_IMAGE_2D_ARRAY:
+    case GL_IMAGE_3D:
+    case GL_IMAGE_CUBE:
+    case GL_INT_IMAGE_2D:
+    case GL_UNSIGNED_INT_IMAGE_2D:
+    case GL_IMAGE_BUFFER:
+        return true;
+    default:
+        return false;
+    }
+}
+
+} // namespace
+
+std::vector<Program::Active> Program::activeUniforms(GLuint program) {
+    std::vector<Active> out;
+    GLint count = 0;
+    glGetProgramInterfaceiv(program, GL_UNIFORM, GL_ACTIVE_RESOURCES, &count);
+    const GLenum props[] = {GL_NAME_LENGTH, GL_TYPE, GL_LOCATION, GL_BLOCK_INDEX};
+    for (GLint i = 0; i < count; ++i) {
+        GLint values[4] = {};
+        glGetProgramResourceiv(program, GL_UNIFORM, static_cast<GLuint>(i), 4, props, 4, nullptr, values);
+        if (values[3] != -1) continue; // a member of a uniform block: set through the block
+        std::string name(static_cast<std::size_t>(std::max(values[0], 1)), '\0');
+        glGetProgramResourceName(program, GL_UNIFORM, static_cast<GLuint>(i), values[0], nullptr,
+                                 name.data());
+        name.resize(std::strlen(name.c_str()));
+        if (name.size() > 3 && name.compare(name.size() - 3, 3, "[0]") == 0) name.resize(name.size() - 3);
+        Active a{name, values[2], static_cast<GLenum>(values[1]), -1};
+        if (isSamplerOrImage(a.type) && a.location >= 0) glGetUniformiv(program, a.location, &a.unit);
+        out.push_back(std::move(a));
+    }
+    return out;
+}
+
 Program Program::build(const std::vector<ShaderStage>& stages,
                        const std::vector<std::pair<std::string, std::string>>& defines,
                        const std::vector<std::string>& feedbackVaryings) {
@@ -146,7 +202,35 @@ Program Program::build(const std::vector<ShaderStage>& stages,
         for (const auto& s : stages) names += " shaders/" + s.path;
         throw Error("gl: failed to link" + names + ":\n" + log);
     }
-    return Program(program);
+    std::string label;
+    for (const auto& s : stages) label += " shaders/" + s.path;
+    return Program(program, activeUniforms(program), label);
+}
+
+const Program::Active* Program::find(std::string_view name) const {
+    for (const Active& a : mActive)
+        if (a.name == name) return &a;
+    return nullptr;
+}
+
+bool Program::has(std::string_view name) const {
+    return find(name) != nullptr;
+}
+
+UniformLocation Program::location(std::string_view name) const {
+    const Active* a = find(name);
+    if (!a || a->location < 0)
+        throw Error("gl: the program of" + mLabel + " has no active uniform '" + std::string(name) +
+                    "' (misspelt, or unused in the shader and removed by the linker)");
+    return {a->location};
+}
+
+TextureUnit Program::textureUnit(std::string_view name) const {
+    const Active* a = find(name);
+    if (!a || a->unit < 0)
+        throw Error("gl: the program of" + mLabel + " has no active sampler or image '" + std::string(name) +
+                    "'");
+    return {static_cast<GLuint>(a->unit)};
 }
 
 } // namespace gis::gl

@@ -5,12 +5,22 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "gl/Objects.h"
 
 namespace gis::gl {
+
+/// A plain uniform of a linked program, resolved once (Program::location): setting it needs no lookup.
+struct UniformLocation {
+    GLint location = -1;
+};
+/// The texture unit of a sampler or image uniform, from its `layout(binding = N)` (Program::textureUnit).
+struct TextureUnit {
+    GLuint unit = 0;
+};
 
 struct ShaderStage {
     GLenum type;      ///< GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER
@@ -28,8 +38,28 @@ public:
                          const std::vector<std::string>& feedbackVaryings = {});
     GLint uniform(const char* name) const { return glGetUniformLocation(id(), name); }
 
+    /// The active uniform `name` (not in a block), checked against what the linker kept: a missing or
+    /// misspelt name throws gis::Error naming the program's files, where the program is built, so a
+    /// typo never turns into a silent -1 at draw time.
+    UniformLocation location(std::string_view name) const;
+    /// The unit of the active sampler or image uniform `name`; throws like location().
+    TextureUnit textureUnit(std::string_view name) const;
+    /// Whether the linked program has the active uniform `name` (a define may compile one out).
+    bool has(std::string_view name) const;
+
 private:
-    using Object::Object;
+    struct Active {
+        std::string name;
+        GLint location = -1;
+        GLenum type = 0;
+        GLint unit = -1; ///< samplers and images: the binding
+    };
+    explicit Program(GLuint id, std::vector<Active> active, std::string label)
+        : Object(id), mActive(std::move(active)), mLabel(std::move(label)) {}
+    static std::vector<Active> activeUniforms(GLuint program);
+    const Active* find(std::string_view name) const;
+    std::vector<Active> mActive; ///< read from the linked program once
+    std::string mLabel;          ///< " shaders/a.vert shaders/b.frag" for errors
 };
 
 /// The fully expanded source of one stage, and the file table its #line numbers refer to.

@@ -10,6 +10,7 @@
 #include "core/Log.h"
 #include "core/Timer.h"
 #include "frame/LightModel.h"
+#include "gl/Pass.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
@@ -64,11 +65,29 @@ void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u) {
 FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     const gl::ShaderStage meshVert{GL_VERTEX_SHADER, "render/mesh.vert"};
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
-    mShadowProgram = gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, "render/shadow.frag"}});
-    mRsmProgram = gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, "render/rsm.frag"}});
-    mGBufferProgram = gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, "render/gbuffer.frag"}});
-    mDirectProgram = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
-    mCompositeProgram = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/composite.frag"}});
+    auto meshPass = [&](const char* fragment) {
+        MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}), {}};
+        p.view = p.program.location("uView");
+        return p;
+    };
+    mShadowPass = meshPass("render/shadow.frag");
+    mRsmPass = meshPass("render/rsm.frag");
+    mGBufferPass = meshPass("render/gbuffer.frag");
+    mDirectPass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
+    const gl::Program& d = mDirectPass.program;
+    mDirectPass.position = d.textureUnit("gPosition");
+    mDirectPass.normal = d.textureUnit("gNormal");
+    mDirectPass.albedo = d.textureUnit("gAlbedo");
+    mDirectPass.emissive = d.textureUnit("gEmissive");
+    mDirectPass.shadow = d.textureUnit("gShadowMap");
+    mDirectPass.specular = d.textureUnit("gSpecular");
+    mCompositePass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/composite.frag"}});
+    const gl::Program& c = mCompositePass.program;
+    mCompositePass.direct = c.textureUnit("gDirect");
+    mCompositePass.indirect = c.textureUnit("gIndirect");
+    mCompositePass.reflection = c.textureUnit("gReflection");
+    mCompositePass.hasIndirect = c.location("uHasIndirect");
+    mCompositePass.hasReflection = c.location("uHasReflection");
     mFrameUbo = gl::Buffer::create(sizeof(shader::FrameUniforms));
     mEmptyVao = gl::VertexArray::create();
     gl::checkErrors("renderer setup");
@@ -151,6 +170,73 @@ void FrameRenderer::ensureTechnique(const std::string& name, int width, int heig
     }
 }
 
+void FrameRenderer::renderShadowMap(int light) {
+    // Depth only, with a slope-scaled offset against acne.
+    gl::Pass pass(mTimer, "shadow_map");
+    pass.target(mShadowFbo, mShadowSize, mShadowSize)
+        .depthTest(GL_LESS)
+        .clearDepth()
+        .polygonOffset(2.0f, 4.0f);
+    pass.use(mShadowPass.program).set(mShadowPass.view, 1);
+    mSceneGpu->draw(mShadowPass.program, false);
+    mResources.publish(FrameResources::light(light, "shadow"), "shadow_map", mShadowDepth);
+}
+
+void FrameRenderer::renderRsm(int light, int rsmSize) {
+    gl::Pass pass(mTimer, "rsm");
+    pass.target(mRsmFbo, rsmSize, rsmSize).depthTest(GL_LESS).clearColor(4).clearDepth();
+    pass.use(mRsmPass.program).set(mRsmPass.view, 1);
+    mSceneGpu->draw(mRsmPass.program, true);
+    mResources.publish(FrameResources::light(light, "rsm.position"), "rsm", mRsmPosition);
+    mResources.publish(FrameResources::light(light, "rsm.normal"), "rsm", mRsmNormal);
+    mResources.publish(FrameResources::light(light, "rsm.flux"), "rsm", mRsmFlux);
+    mResources.publish(FrameResources::light(light, "rsm.specular"), "rsm", mRsmSpecular);
+}
+
+void FrameRenderer::renderGBuffer(int width, int height) {
+    gl::Pass pass(mTimer, "gbuffer");
+    pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
+    pass.use(mGBufferPass.program).set(mGBufferPass.view, 0);
+    mSceneGpu->draw(mGBufferPass.program, true);
+    mResources.publish("gbuffer.position", "gbuffer", mGPosition);
+    mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
+    mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);
+    mResources.publish("gbuffer.emissive", "gbuffer", mGEmissive);
+    mResources.publish("gbuffer.specular", "gbuffer", mGSpecular);
+    mResources.publish("gbuffer.depth", "gbuffer", mGDepth);
+}
+
+void FrameRenderer::renderDirect() {
+    // The viewport is the G-buffer's, set by the pass before.
+    gl::Pass pass(mTimer, "direct");
+    glBindFramebuffer(GL_FRAMEBUFFER, mDirectFbo.id());
+    const DirectPass& d = mDirectPass;
+    pass.use(d.program)
+        .texture(d.position, mResources.get("gbuffer.position"))
+        .texture(d.normal, mResources.get("gbuffer.normal"))
+        .texture(d.albedo, mResources.get("gbuffer.albedo"))
+        .texture(d.emissive, mResources.get("gbuffer.emissive"))
+        .texture(d.shadow, mResources.get(FrameResources::light(0, "shadow")))
+        .texture(d.specular, mResources.get("gbuffer.specular"));
+    pass.drawFullscreen(mEmptyVao);
+    mResources.publish("direct", "direct", mDirect);
+}
+
+void FrameRenderer::composite(int width, int height, const gl::Texture* indirect,
+                              const gl::Texture* reflection) {
+    gl::Pass pass(mTimer, "composite");
+    const CompositePass& c = mCompositePass;
+    const gl::Texture& direct = mResources.get("direct");
+    pass.target(mCompositeFbo, width, height).use(c.program);
+    pass.set(c.hasIndirect, indirect ? 1 : 0).set(c.hasReflection, reflection ? 1 : 0);
+    pass.texture(c.direct, direct)
+        .texture(c.indirect, indirect ? *indirect : direct)
+        .texture(c.reflection, reflection ? *reflection : direct);
+    pass.drawFullscreen(mEmptyVao);
+    mResources.publish("display", "composite", mDisplay);
+    mResources.publish("linear", "composite", mLinear);
+}
+
 FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     GIS_ASSERT(mSceneGpu != nullptr);
     GIS_ASSERT(state.width > 0 && state.height > 0);
@@ -183,79 +269,30 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     mTimer.beginFrame();
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
-    const float zero[4] = {0, 0, 0, 0};
-    const float one = 1.0f;
+    renderShadowMap(0);
+    renderRsm(0, rsmSize);
+    renderGBuffer(state.width, state.height);
+    renderDirect();
 
-    // 1. Shadow map (depth only, slope-scaled offset against acne).
-    mTimer.begin("shadow_map");
-    glBindFramebuffer(GL_FRAMEBUFFER, mShadowFbo.id());
-    glViewport(0, 0, mShadowSize, mShadowSize);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glClearNamedFramebufferfv(mShadowFbo.id(), GL_DEPTH, 0, &one);
-    glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(2.0f, 4.0f);
-    glUseProgram(mShadowProgram.id());
-    glUniform1i(mShadowProgram.uniform("uView"), 1);
-    mSceneGpu->draw(mShadowProgram, false);
-    glDisable(GL_POLYGON_OFFSET_FILL);
-    mTimer.end();
-
-    // 2. Reflective shadow map.
-    mTimer.begin("rsm");
-    glBindFramebuffer(GL_FRAMEBUFFER, mRsmFbo.id());
-    glViewport(0, 0, rsmSize, rsmSize);
-    for (int i = 0; i < 4; ++i) glClearNamedFramebufferfv(mRsmFbo.id(), GL_COLOR, i, zero);
-    glClearNamedFramebufferfv(mRsmFbo.id(), GL_DEPTH, 0, &one);
-    glUseProgram(mRsmProgram.id());
-    glUniform1i(mRsmProgram.uniform("uView"), 1);
-    mSceneGpu->draw(mRsmProgram, true);
-    mTimer.end();
-
-    // 3. Eye G-buffer.
-    mTimer.begin("gbuffer");
-    glBindFramebuffer(GL_FRAMEBUFFER, mGBufferFbo.id());
-    glViewport(0, 0, state.width, state.height);
-    for (int i = 0; i < 5; ++i) glClearNamedFramebufferfv(mGBufferFbo.id(), GL_COLOR, i, zero);
-    glClearNamedFramebufferfv(mGBufferFbo.id(), GL_DEPTH, 0, &one);
-    glUseProgram(mGBufferProgram.id());
-    glUniform1i(mGBufferProgram.uniform("uView"), 0);
-    mSceneGpu->draw(mGBufferProgram, true);
-    glDisable(GL_DEPTH_TEST);
-    mTimer.end();
-
-    // 4. Direct light.
-    mTimer.begin("direct");
-    glBindFramebuffer(GL_FRAMEBUFFER, mDirectFbo.id());
-    glUseProgram(mDirectProgram.id());
-    glBindTextureUnit(0, mGPosition.id());
-    glBindTextureUnit(1, mGNormal.id());
-    glBindTextureUnit(2, mGAlbedo.id());
-    glBindTextureUnit(3, mGEmissive.id());
-    glBindTextureUnit(4, mShadowDepth.id());
-    glBindTextureUnit(5, mGSpecular.id());
-    glBindVertexArray(mEmptyVao.id());
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    mTimer.end();
-
-    // 5. The technique's indirect passes.
+    // The technique's indirect passes read the G-buffer, the RSM and the direct light by name.
     Counters counters;
     FrameInputs in;
     in.width = state.width;
     in.height = state.height;
-    in.gPosition = &mGPosition;
-    in.gNormal = &mGNormal;
-    in.gAlbedo = &mGAlbedo;
-    in.gSpecular = &mGSpecular;
+    in.resources = &mResources;
+    in.gPosition = &mResources.get("gbuffer.position");
+    in.gNormal = &mResources.get("gbuffer.normal");
+    in.gAlbedo = &mResources.get("gbuffer.albedo");
+    in.gSpecular = &mResources.get("gbuffer.specular");
     in.rsmSize = rsmSize;
-    in.rsmPosition = &mRsmPosition;
-    in.rsmNormal = &mRsmNormal;
-    in.rsmFlux = &mRsmFlux;
-    in.rsmSpecular = &mRsmSpecular;
+    in.rsmPosition = &mResources.get(FrameResources::light(0, "rsm.position"));
+    in.rsmNormal = &mResources.get(FrameResources::light(0, "rsm.normal"));
+    in.rsmFlux = &mResources.get(FrameResources::light(0, "rsm.flux"));
+    in.rsmSpecular = &mResources.get(FrameResources::light(0, "rsm.specular"));
     in.glossy = nonDiffuse.glossy;
     in.glossyMinRoughness = fp.getFloat("glossy_split");
     in.lightEnabled = lightOn;
-    in.direct = &mDirect;
+    in.direct = &mResources.get("direct");
     in.frame = &u;
     in.drawGeometry = [this](const gl::Program& program, int instances) {
         mSceneGpu->draw(program, false, instances);
@@ -263,18 +300,23 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+    const gl::Texture* indirect = mTechnique->indirect();
+    if (indirect)
+        mResources.publish("indirect", "technique", *indirect);
+    else
+        mResources.withdraw("indirect");
 
-    // 6. Reflections: environment probe and planar mirrors (docs/nondiffuse.md).
+    // Reflections: environment probe and planar mirrors (docs/nondiffuse.md).
     ReflectionInputs rin;
     rin.width = state.width;
     rin.height = state.height;
-    rin.gPosition = &mGPosition;
-    rin.gNormal = &mGNormal;
-    rin.gAlbedo = &mGAlbedo;
-    rin.gSpecular = &mGSpecular;
-    rin.direct = &mDirect;
-    rin.indirect = mTechnique->indirect();
-    rin.shadowMap = &mShadowDepth;
+    rin.gPosition = in.gPosition;
+    rin.gNormal = in.gNormal;
+    rin.gAlbedo = in.gAlbedo;
+    rin.gSpecular = in.gSpecular;
+    rin.direct = in.direct;
+    rin.indirect = indirect;
+    rin.shadowMap = &mResources.get(FrameResources::light(0, "shadow"));
     rin.frame = &u;
     rin.scene = mScene.get();
     rin.sceneGpu = mSceneGpu.get();
@@ -284,21 +326,12 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     glDisable(GL_BLEND);
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_DEPTH_TEST);
+    if (reflection)
+        mResources.publish("reflection", "reflections", *reflection);
+    else
+        mResources.withdraw("reflection");
 
-    // 7. Composite and tone map.
-    mTimer.begin("composite");
-    glBindFramebuffer(GL_FRAMEBUFFER, mCompositeFbo.id());
-    glViewport(0, 0, state.width, state.height);
-    glUseProgram(mCompositeProgram.id());
-    const gl::Texture* indirect = mTechnique->indirect();
-    glUniform1i(mCompositeProgram.uniform("uHasIndirect"), indirect ? 1 : 0);
-    glUniform1i(mCompositeProgram.uniform("uHasReflection"), reflection ? 1 : 0);
-    glBindTextureUnit(0, mDirect.id());
-    glBindTextureUnit(1, indirect ? indirect->id() : mDirect.id());
-    glBindTextureUnit(2, reflection ? reflection->id() : mDirect.id());
-    glBindVertexArray(mEmptyVao.id());
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    mTimer.end();
+    composite(state.width, state.height, indirect, reflection);
 
     FrameOutput out;
     out.width = state.width;

@@ -16,6 +16,7 @@
 #include "frame/FrameState.h"
 #include "frame/LightModel.h"
 #include "gi/Technique.h"
+#include "gl/FrameResources.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -52,16 +53,39 @@ public:
     Technique* technique() { return mTechnique.get(); }
     /// The planar mirrors of the current scene (after the first frame).
     const std::vector<MirrorPlane>& mirrors() const { return mReflections.mirrors(); }
+    /// What the last frame produced, by name (gl/FrameResources.h; `gi-render --list-resources`).
+    const FrameResources& resources() const { return mResources; }
 
 private:
     void ensureTargets(int width, int height, int rsmSize, int shadowSize);
     void ensureTechnique(const std::string& name, int width, int height);
+    // The frame's stages, in order; each publishes what it writes in mResources.
+    void renderShadowMap(int light);
+    void renderRsm(int light, int rsmSize);
+    void renderGBuffer(int width, int height);
+    void renderDirect();
+    void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
 
     std::shared_ptr<const Scene> mScene;
     std::unique_ptr<SceneGpu> mSceneGpu;
     gl::PassTimer mTimer;
+    FrameResources mResources;
 
-    gl::Program mShadowProgram, mRsmProgram, mGBufferProgram, mDirectProgram, mCompositeProgram;
+    /// A scene-drawing program and its view selector (mesh.vert: 0 camera, 1 light).
+    struct MeshPass {
+        gl::Program program;
+        gl::UniformLocation view;
+    };
+    MeshPass mShadowPass, mRsmPass, mGBufferPass;
+    struct DirectPass {
+        gl::Program program;
+        gl::TextureUnit position, normal, albedo, emissive, shadow, specular;
+    } mDirectPass;
+    struct CompositePass {
+        gl::Program program;
+        gl::TextureUnit direct, indirect, reflection;
+        gl::UniformLocation hasIndirect, hasReflection;
+    } mCompositePass;
     gl::Buffer mFrameUbo;
     gl::VertexArray mEmptyVao;
 

@@ -13,6 +13,7 @@
 
 #include "GlTestSupport.h"
 #include "gi/Technique.h"
+#include "gl/Pass.h"
 
 namespace gis::test {
 namespace {
@@ -41,6 +42,7 @@ TEST(FrameHashes, EveryTechniqueAndBuiltinSceneRendersTheRecordedBytes) {
     if (!table.is_object()) table = nlohmann::json::object();
 
     nlohmann::json hashes = nlohmann::json::object();
+    const long glErrorsBefore = gl::passCheckErrors();
     for (const auto& scene : builtinSceneNames())
         for (const auto& entry : techniqueRegistry()) {
             const FrameOutput out = renderScene("builtin:" + scene, entry.info.name, kSize, kSize);
@@ -49,10 +51,16 @@ TEST(FrameHashes, EveryTechniqueAndBuiltinSceneRendersTheRecordedBytes) {
             hashes[scene + "/" + entry.info.name] = hex(h);
         }
 
+    if (gl::passChecksEnabled()) {
+        EXPECT_EQ(gl::passCheckErrors() - glErrorsBefore, 0)
+            << "GL errors in the passes (the log names them)";
+    }
+
     if (std::getenv("GIS_UPDATE_FRAME_HASHES")) {
         table[gl.backend] = {{"renderer", gl.renderer}, {"size", kSize}, {"hashes", hashes}};
         std::ofstream(kTable) << table.dump(2) << "\n";
-        GTEST_SKIP() << "recorded " << hashes.size() << " frame hashes for " << gl.backend << " in " << kTable;
+        GTEST_SKIP() << "recorded " << hashes.size() << " frame hashes for " << gl.backend << " in "
+                     << kTable;
     }
     const nlohmann::json& recorded = table.value(gl.backend, nlohmann::json::object());
     if (recorded.value("renderer", "") != gl.renderer)

@@ -47,8 +47,7 @@ struct Result {
 Result runInjected(const std::string& technique, const RenderSpec& spec, const Frame& frame, Injection inj) {
     FrameRenderer& renderer = rendererFor(technique);
     const int w = spec.width, h = spec.height, rsm = frame.rsmFlux.width;
-    const gl::Texture* ownIndirect = renderer.technique()->indirect();
-    const FrameTextures src = locateFrameTextures(w, h, rsm, ownIndirect ? ownIndirect->id() : 0);
+    const FrameTextures src = frameTextures(renderer);
     Result r;
     if (!src.gPosition || !src.rsmPosition || !src.direct) {
         ADD_FAILURE() << "frame textures not found by introspection";

@@ -120,61 +120,6 @@ TexInfo texInfo(GLuint id) {
     return t;
 }
 
-struct FboInfo {
-    GLuint id = 0;
-    std::vector<TexInfo> colours; ///< attachments 0..n-1 that are textures
-    bool hasDepth = false;
-};
-
-std::vector<FboInfo> listFramebuffers() {
-    std::vector<FboInfo> out;
-    const GLuint limit = nameLimit(true);
-    for (GLuint id = 1; id < limit; ++id) {
-        if (!glIsFramebuffer(id)) continue;
-        FboInfo f;
-        f.id = id;
-        for (int i = 0; i < 8; ++i) {
-            GLint type = GL_NONE;
-            glGetNamedFramebufferAttachmentParameteriv(id, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                                                       GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-            if (type != GL_TEXTURE) break;
-            GLint name = 0;
-            glGetNamedFramebufferAttachmentParameteriv(id, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                                                       GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
-            f.colours.push_back(texInfo(static_cast<GLuint>(name)));
-        }
-        for (GLenum a : {GL_DEPTH_ATTACHMENT, GL_STENCIL_ATTACHMENT}) {
-            GLint type = GL_NONE;
-            glGetNamedFramebufferAttachmentParameteriv(id, a, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-            if (type != GL_NONE) f.hasDepth = true;
-        }
-        out.push_back(std::move(f));
-    }
-    glGetError(); // queries on incomplete attachments may set GL_INVALID_*; not the frame's error
-    return out;
-}
-
-bool matches(const FboInfo& f, const std::vector<GLenum>& formats, int w, int h, bool depth) {
-    if (f.colours.size() != formats.size() || f.hasDepth != depth) return false;
-    for (size_t i = 0; i < formats.size(); ++i)
-        if (f.colours[i].format != formats[i] || f.colours[i].width != w || f.colours[i].height != h)
-            return false;
-    return true;
-}
-
-/// The unique framebuffer with this signature, or null (absent or ambiguous).
-const FboInfo* findUnique(const std::vector<FboInfo>& fbos, const std::vector<GLenum>& formats, int w, int h,
-                          bool depth, GLuint excludeTexture = 0) {
-    const FboInfo* found = nullptr;
-    for (const FboInfo& f : fbos) {
-        if (!matches(f, formats, w, h, depth)) continue;
-        if (excludeTexture && f.colours[0].id == excludeTexture) continue;
-        if (found) return nullptr;
-        found = &f;
-    }
-    return found;
-}
-
 std::string frameName(const RenderSpec& s) {
     std::ostringstream o;
     o << s.technique << " on " << (s.scene ? s.scene->name : "?") << " " << s.width << "x" << s.height << " "
@@ -220,31 +165,20 @@ namespace {
 int gDeepLastCount = 0; // texture levels read by the last countNonFiniteTextures
 } // namespace
 
-FrameTextures locateFrameTextures(int w, int h, int rsm, GLuint indirect) {
+FrameTextures frameTextures(const FrameRenderer& renderer) {
+    const FrameResources& r = renderer.resources();
+    auto id = [&](const std::string& name) {
+        const gl::Texture* t = r.find(name);
+        return t ? t->id() : 0u;
+    };
     FrameTextures t;
-    const std::vector<FboInfo> fbos = listFramebuffers();
-    GLuint gFbo = 0;
-    if (const FboInfo* g =
-            findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F, GL_RGBA8}, w, h, true)) {
-        gFbo = g->id;
-        t.gPosition = g->colours[0].id;
-        t.gNormal = g->colours[1].id;
-        t.gAlbedo = g->colours[2].id;
-    }
-    if (const FboInfo* s = findUnique(fbos, {GL_RGBA32F, GL_RGBA16F, GL_RGBA32F, GL_RGBA8}, rsm, rsm, true)) {
-        t.rsmPosition = s->colours[0].id;
-        t.rsmNormal = s->colours[1].id;
-        t.rsmFlux = s->colours[2].id;
-    }
-    if (const FboInfo* d = findUnique(fbos, {GL_RGBA32F}, w, h, false, indirect)) {
-        t.direct = d->colours[0].id;
-    } else if (gFbo) {
-        // Ambiguous (second_order's full-resolution irradiance has the same signature): the renderer
-        // creates the direct-light framebuffer right after the G-buffer's, and Mesa names objects in
-        // creation order.
-        for (const FboInfo& f : fbos)
-            if (f.id == gFbo + 1 && matches(f, {GL_RGBA32F}, w, h, false)) t.direct = f.colours[0].id;
-    }
+    t.gPosition = id("gbuffer.position");
+    t.gNormal = id("gbuffer.normal");
+    t.gAlbedo = id("gbuffer.albedo");
+    t.rsmPosition = id(FrameResources::light(0, "rsm.position"));
+    t.rsmNormal = id(FrameResources::light(0, "rsm.normal"));
+    t.rsmFlux = id(FrameResources::light(0, "rsm.flux"));
+    t.direct = id("direct");
     return t;
 }
 
@@ -392,10 +326,9 @@ Frame renderRaw(const RenderSpec& spec) {
     f.glErrorText = slot.glErrorText;
     f.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
-    // Buffers reachable without widening FrameRenderer: its framebuffers have unique signatures.
-    const int w = spec.width, h = spec.height, r = params["rsm_size"].get<int>();
+    const int w = spec.width, h = spec.height;
     const gl::Texture* ind = slot.renderer->technique() ? slot.renderer->technique()->indirect() : nullptr;
-    const FrameTextures tex = locateFrameTextures(w, h, r, ind ? ind->id() : 0);
+    const FrameTextures tex = frameTextures(*slot.renderer);
     if (tex.gPosition) {
         f.gPosition = readTexture(tex.gPosition);
         f.gNormal = readTexture(tex.gNormal);

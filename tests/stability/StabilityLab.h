@@ -112,14 +112,14 @@ Frame renderRaw(const RenderSpec& spec);
 /// directly (NaN injection).
 FrameRenderer& rendererFor(const std::string& technique);
 
-/// GL names of the renderer's targets in the current context, found by their framebuffer
-/// signatures after a frame of size w x h with RSM side rsm; 0 where not found (or ambiguous).
+/// GL names of the renderer's targets after its last frame, read from its frame resources by name
+/// (gl/FrameResources.h); 0 where the frame did not publish one.
 struct FrameTextures {
     GLuint gPosition = 0, gNormal = 0, gAlbedo = 0;
     GLuint rsmPosition = 0, rsmNormal = 0, rsmFlux = 0;
     GLuint direct = 0;
 };
-FrameTextures locateFrameTextures(int w, int h, int rsm, GLuint indirect);
+FrameTextures frameTextures(const FrameRenderer& renderer);
 
 /// Reads every float texture level of the current context except `exclude`; returns the number of
 /// non-finite values and describes the first offender in `first`.
