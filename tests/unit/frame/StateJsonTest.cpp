@@ -1,4 +1,4 @@
-// Camera and light JSON (render/StateJson.h): what each field does, the errors' JSON pointers, all or
+// Camera and light JSON (frame/StateJson.h): what each field does, the errors' JSON pointers, all or
 // nothing on error, and the round trip through cameraJson/lightJson.
 #include <gtest/gtest.h>
 
