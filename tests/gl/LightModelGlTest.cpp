@@ -3,12 +3,8 @@
 // the renderer writes them (writeLightUniforms), agree for every light type, cone and direction.
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
 
-#include <unistd.h>
-
+#include "../common/ShaderProbe.h"
 #include "GlTestSupport.h"
 #include "frame/LightModel.h"
 #include "gl/Shader.h"
@@ -31,22 +27,7 @@ void main() {
 std::vector<float> shaderSpotFactors(const LightModel& light, const std::vector<glm::vec4>& directions) {
     sharedContext();
     static gl::Program program;
-    if (!program) {
-        const auto dir =
-            std::filesystem::temp_directory_path() / ("gis_light_probe_" + std::to_string(::getpid()));
-        std::filesystem::create_directories(dir / "probe");
-        std::ofstream(dir / "probe/spot.comp") << kProbe;
-        const char* previous = std::getenv("GI_SHADER_DIR");
-        const std::string saved = previous ? previous : "";
-        ::setenv("GI_SHADER_DIR", dir.c_str(),
-                 1); // the probe file; includes fall back to the embedded copies
-        program = gl::Program::build({{GL_COMPUTE_SHADER, "probe/spot.comp"}});
-        if (previous)
-            ::setenv("GI_SHADER_DIR", saved.c_str(), 1);
-        else
-            ::unsetenv("GI_SHADER_DIR");
-        std::filesystem::remove_all(dir);
-    }
+    if (!program) program = buildComputeProbe("spot", kProbe);
     shader::FrameUniforms u{};
     writeLightUniforms(light, u);
     gl::Buffer frame = gl::Buffer::create(sizeof u, &u);

@@ -13,6 +13,7 @@
 #include <glm/gtc/constants.hpp>
 #include <unistd.h>
 
+#include "../common/ShaderProbe.h"
 #include "StabilityLab.h"
 #include "gl/Shader.h"
 
@@ -56,21 +57,7 @@ void main() {
 std::vector<Result> evaluate(const std::vector<Pair>& pairs, float clampB) {
     rendererFor("rsm_gather"); // a current context
     static gl::Program program;
-    if (!program) {
-        const auto dir =
-            std::filesystem::temp_directory_path() / ("gis_kernel_probe_" + std::to_string(::getpid()));
-        std::filesystem::create_directories(dir / "stability");
-        std::ofstream(dir / "stability/kernel_probe.comp") << kProbe;
-        const char* previous = std::getenv("GI_SHADER_DIR");
-        const std::string saved = previous ? previous : "";
-        ::setenv("GI_SHADER_DIR", dir.c_str(), 1);
-        program = gl::Program::build({{GL_COMPUTE_SHADER, "stability/kernel_probe.comp"}});
-        if (previous)
-            ::setenv("GI_SHADER_DIR", saved.c_str(), 1);
-        else
-            ::unsetenv("GI_SHADER_DIR");
-        std::filesystem::remove_all(dir);
-    }
+    if (!program) program = test::buildComputeProbe("kernel_probe", kProbe);
     gl::Buffer in = gl::Buffer::create(static_cast<GLsizeiptr>(pairs.size() * sizeof(Pair)), pairs.data());
     gl::Buffer out = gl::Buffer::create(static_cast<GLsizeiptr>(pairs.size() * sizeof(Result)));
     glUseProgram(program.id());
@@ -178,7 +165,8 @@ TEST_F(KernelCell, C02_GrazingBackFacing) {
     EXPECT_NEAR(rb[0].k.z, 1.0 / glm::pi<double>(), 1e-6) << "K4 = Phi/pi cos cos / d^2 on the back side";
     EXPECT_EQ(rb[1].k.z, 0.0f) << "K4 on the front side";
     EXPECT_GT(rb[1].k.x, 0.0f) << "K1 on the front side";
-    note("grazing / back-facing contributions", "exactly 0 (K1, K2, K3); K4 only on the back side (Phi/pi at 1 m)");
+    note("grazing / back-facing contributions",
+         "exactly 0 (K1, K2, K3); K4 only on the back side (Phi/pi at 1 m)");
 }
 
 // Case 14 (linearity): splitting every VPL into two at the same position with half the flux leaves
@@ -189,7 +177,8 @@ TEST_F(KernelCell, C14_ScaleAndLinearity) {
     std::vector<Pair> whole, half;
     const float phi = 3.0f;
     for (float d : {1e-4f, 0.05f, 0.3f, 2.0f, 40.0f})
-        for (const glm::vec3& dir : {glm::vec3(0, 1, 0), glm::normalize(glm::vec3(1, 1, 0.5f)), glm::vec3(0, -1, 0)}) {
+        for (const glm::vec3& dir :
+             {glm::vec3(0, 1, 0), glm::normalize(glm::vec3(1, 1, 0.5f)), glm::vec3(0, -1, 0)}) {
             whole.push_back(pair({0, 0, 0}, {0, 1, 0}, d * dir, -dir, 1e-2f, phi, 0.1f));
             half.push_back(pair({0, 0, 0}, {0, 1, 0}, d * dir, -dir, 1e-2f, 0.5f * phi, 0.1f));
         }

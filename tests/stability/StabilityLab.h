@@ -4,8 +4,8 @@
 // shares, and the results table written by the run (docs/stability.md).
 //
 // What a frame check reads: the final linear radiance (FrameOutput), the technique's indirect()
-// texture, and, found through GL object introspection (glIsFramebuffer + attachment queries on the
-// technique's own context), the G-buffer, the RSM and the direct-light target. With `deep` set it
+// texture, and, by name from the renderer's frame resources (gl/FrameResources.h), the G-buffer, the
+// RSM and the direct-light target. With `deep` set it
 // also reads back every floating-point texture level alive in that context (eye-hierarchy atlases,
 // SSBC mip chains, low-resolution buffers), which is how NaN in a mip chain is caught.
 #pragma once
