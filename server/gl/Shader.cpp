@@ -217,6 +217,11 @@ bool Program::has(std::string_view name) const {
     return find(name) != nullptr;
 }
 
+UniformLocation Program::optionalLocation(std::string_view name) const {
+    const Active* a = find(name);
+    return {a ? a->location : -1};
+}
+
 UniformLocation Program::location(std::string_view name) const {
     const Active* a = find(name);
     if (!a || a->location < 0)

@@ -46,6 +46,9 @@ public:
     TextureUnit textureUnit(std::string_view name) const;
     /// Whether the linked program has the active uniform `name` (a define may compile one out).
     bool has(std::string_view name) const;
+    /// location(), or location -1 (which glUniform* ignores) when the program does not use `name`:
+    /// for uniforms of a shared include that some programs leave unused.
+    UniformLocation optionalLocation(std::string_view name) const;
 
 private:
     struct Active {

@@ -53,12 +53,13 @@ int log2Floor(int v) {
 
 struct EnvProbe::Impl {
     gl::Program forward, prefilter, apply, brdfTable;
+    MaterialSlots forwardMaterials;
     gl::Texture lut; ///< kBrdfTableSize^2 RGBA32F: rg GGX (A, B), ba Phong (A, B)
     gl::VertexArray emptyVao;
-    CubeTexture source;      ///< rendered radiance, full mip chain
+    CubeTexture source; ///< rendered radiance, full mip chain
     /// Per probe (0: the room probe, 1..: local probes), level k = roughness k / (levels - 1).
     CubeTexture prefiltered[1 + kMaxLocalProbes];
-    gl::Texture depth;       ///< env_size^2, shared by the six faces
+    gl::Texture depth; ///< env_size^2, shared by the six faces
     gl::Framebuffer faceFbo[6];
     bool fboOk = false;
     int size = 0;
@@ -83,6 +84,7 @@ EnvProbe::EnvProbe() : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
     m.forward = gl::Program::build(
         {{GL_VERTEX_SHADER, "render/forward.vert"}, {GL_FRAGMENT_SHADER, "render/forward.frag"}});
+    m.forwardMaterials = MaterialSlots::of(m.forward);
     m.prefilter = gl::Program::build({{GL_COMPUTE_SHADER, "render/env_prefilter.comp"}});
     m.apply = gl::Program::build(
         {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "render/env_apply.frag"}});
@@ -182,7 +184,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
             glClearNamedFramebufferfv(m.faceFbo[f].id(), GL_DEPTH, 0, &one);
             const glm::mat4 vp = faceViewProj(f, probe, zNear, zFar);
             glUniformMatrix4fv(m.forward.uniform("uViewProj"), 1, GL_FALSE, &vp[0][0]);
-            in.sceneGpu->draw(m.forward, true, 1, probes[p].skipMesh);
+            in.sceneGpu->draw(m.forward, &m.forwardMaterials, 1, probes[p].skipMesh);
         }
         glDisable(GL_DEPTH_TEST);
         glGenerateTextureMipmap(m.source.id);

@@ -65,14 +65,15 @@ void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u) {
 FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     const gl::ShaderStage meshVert{GL_VERTEX_SHADER, "render/mesh.vert"};
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
-    auto meshPass = [&](const char* fragment) {
-        MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}), {}};
+    auto meshPass = [&](const char* fragment, bool allMaterials) {
+        MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}), {}, {}};
         p.view = p.program.location("uView");
+        p.materials = MaterialSlots::of(p.program, allMaterials);
         return p;
     };
-    mShadowPass = meshPass("render/shadow.frag");
-    mRsmPass = meshPass("render/rsm.frag");
-    mGBufferPass = meshPass("render/gbuffer.frag");
+    mShadowPass = meshPass("render/shadow.frag", false);
+    mRsmPass = meshPass("render/rsm.frag", false);
+    mGBufferPass = meshPass("render/gbuffer.frag", true);
     mDirectPass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
     const gl::Program& d = mDirectPass.program;
     mDirectPass.position = d.textureUnit("gPosition");
@@ -178,7 +179,7 @@ void FrameRenderer::renderShadowMap(int light) {
         .clearDepth()
         .polygonOffset(2.0f, 4.0f);
     pass.use(mShadowPass.program).set(mShadowPass.view, 1);
-    mSceneGpu->draw(mShadowPass.program, false);
+    mSceneGpu->draw(mShadowPass.program, nullptr);
     mResources.publish(FrameResources::light(light, "shadow"), "shadow_map", mShadowDepth);
 }
 
@@ -186,7 +187,7 @@ void FrameRenderer::renderRsm(int light, int rsmSize) {
     gl::Pass pass(mTimer, "rsm");
     pass.target(mRsmFbo, rsmSize, rsmSize).depthTest(GL_LESS).clearColor(4).clearDepth();
     pass.use(mRsmPass.program).set(mRsmPass.view, 1);
-    mSceneGpu->draw(mRsmPass.program, true);
+    mSceneGpu->draw(mRsmPass.program, &mRsmPass.materials);
     mResources.publish(FrameResources::light(light, "rsm.position"), "rsm", mRsmPosition);
     mResources.publish(FrameResources::light(light, "rsm.normal"), "rsm", mRsmNormal);
     mResources.publish(FrameResources::light(light, "rsm.flux"), "rsm", mRsmFlux);
@@ -197,7 +198,7 @@ void FrameRenderer::renderGBuffer(int width, int height) {
     gl::Pass pass(mTimer, "gbuffer");
     pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
     pass.use(mGBufferPass.program).set(mGBufferPass.view, 0);
-    mSceneGpu->draw(mGBufferPass.program, true);
+    mSceneGpu->draw(mGBufferPass.program, &mGBufferPass.materials);
     mResources.publish("gbuffer.position", "gbuffer", mGPosition);
     mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
     mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);
@@ -295,7 +296,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.direct = &mResources.get("direct");
     in.frame = &u;
     in.drawGeometry = [this](const gl::Program& program, int instances) {
-        mSceneGpu->draw(program, false, instances);
+        mSceneGpu->draw(program, nullptr, instances);
     };
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);

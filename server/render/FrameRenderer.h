@@ -75,6 +75,7 @@ private:
     struct MeshPass {
         gl::Program program;
         gl::UniformLocation view;
+        MaterialSlots materials;
     };
     MeshPass mShadowPass, mRsmPass, mGBufferPass;
     struct DirectPass {

@@ -70,6 +70,7 @@ struct Level {
 
 struct PlanarMirrors::Impl {
     gl::Program stencil, forward, indirect, blur, apply;
+    MaterialSlots forwardMaterials;
     gl::VertexArray emptyVao;
     gl::Query anySamples;
     int width = 0, height = 0;
@@ -121,6 +122,7 @@ PlanarMirrors::PlanarMirrors() : mImpl(std::make_unique<Impl>()) {
     mImpl->stencil = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_stencil.frag"}});
     mImpl->forward = gl::Program::build(
         {{GL_VERTEX_SHADER, "render/forward.vert"}, {GL_FRAGMENT_SHADER, "render/forward.frag"}});
+    mImpl->forwardMaterials = MaterialSlots::of(mImpl->forward);
     mImpl->indirect = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_indirect.frag"}});
     mImpl->blur = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_blur.frag"}});
     mImpl->apply = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_apply.frag"}});
@@ -262,7 +264,7 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
             glUniformMatrix4fv(viewProjLoc, 1, GL_FALSE, glm::value_ptr(vp));
             glUniform4f(clipLoc, n.x, n.y, n.z, d);
             glUniform3f(eyeLoc, v.eye.x, v.eye.y, v.eye.z);
-            in.sceneGpu->draw(s.forward, true);
+            in.sceneGpu->draw(s.forward, &s.forwardMaterials);
             previous.push_back(static_cast<int>(views.size()));
             views.push_back(v);
         }

@@ -87,25 +87,38 @@ void SceneGpu::setSurfaceIds(const std::vector<int>& idOfMesh) {
     }
 }
 
-void SceneGpu::draw(const gl::Program& program, bool withMaterials, int instances, int skipMesh) const {
+MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
+    auto slot = [&](const char* name) {
+        return complete ? program.location(name) : program.optionalLocation(name);
+    };
+    MaterialSlots m;
+    m.baseColor = slot("uBaseColor");
+    m.emissive = slot("uEmissive");
+    m.hasTexture = slot("uHasTexture");
+    m.metalRoughSpec = slot("uMetalRoughSpec");
+    m.mirrorId = slot("uMirrorId");
+    if (complete || program.has("uBaseColorTex")) m.baseColorTexture = program.textureUnit("uBaseColorTex");
+    return m;
+}
+
+void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int instances, int skipMesh) const {
+    // The caller has bound the program; `materials` were resolved from it.
     glBindVertexArray(mVao.id());
-    const GLint baseColor = program.uniform("uBaseColor");
-    const GLint emissive = program.uniform("uEmissive");
-    const GLint hasTexture = program.uniform("uHasTexture");
-    const GLint metalRoughSpec = program.uniform("uMetalRoughSpec");
-    const GLint mirrorId = program.uniform("uMirrorId");
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
-        if (withMaterials) {
+        if (materials) {
+            const MaterialSlots& s = *materials;
             const Material& m = mMaterials[static_cast<size_t>(d.material)];
-            glUniform4f(baseColor, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
-            glUniform3f(metalRoughSpec, m.metallic, m.roughness, m.specular);
-            glUniform1i(mirrorId, d.surfaceId);
-            glUniform3f(emissive, m.emissive.r, m.emissive.g, m.emissive.b);
+            glUniform4f(s.baseColor.location, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
+            glUniform3f(s.metalRoughSpec.location, m.metallic, m.roughness, m.specular);
+            glUniform1i(s.mirrorId.location, d.surfaceId);
+            glUniform3f(s.emissive.location, m.emissive.r, m.emissive.g, m.emissive.b);
             const bool textured =
                 m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());
-            glUniform1i(hasTexture, textured ? 1 : 0);
-            if (textured) glBindTextureUnit(0, mTextures[static_cast<size_t>(m.baseColorTexture)].id());
+            glUniform1i(s.hasTexture.location, textured ? 1 : 0);
+            if (textured)
+                glBindTextureUnit(s.baseColorTexture.unit,
+                                  mTextures[static_cast<size_t>(m.baseColorTexture)].id());
         }
         glDrawElementsInstancedBaseVertex(
             GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,

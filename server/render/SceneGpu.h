@@ -10,14 +10,26 @@
 
 namespace gis {
 
+/// The material uniforms of a scene-drawing program (shaders/render/material.glsl), resolved once
+/// where the program is built, so the draw loop looks nothing up.
+struct MaterialSlots {
+    gl::UniformLocation baseColor, emissive, hasTexture, metalRoughSpec, mirrorId;
+    gl::TextureUnit baseColorTexture;
+    /// `program`'s slots. With `complete`, every one must be active (the G-buffer's program, which
+    /// reads them all: a misspelt name in material.glsl fails there); otherwise the ones a program
+    /// leaves unused are skipped.
+    static MaterialSlots of(const gl::Program& program, bool complete = false);
+};
+
 class SceneGpu {
 public:
     /// Uploads everything; throws gis::Error on GL failure (a load boundary).
     explicit SceneGpu(const Scene& scene);
     /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
-    /// when `withMaterials`. `skipMesh` (an index into Scene::meshes) is left out: a local
-    /// environment probe does not see the object it belongs to.
-    void draw(const gl::Program& program, bool withMaterials, int instances = 1, int skipMesh = -1) const;
+    /// through `materials` (null: none, as for depth-only passes). `skipMesh` (an index into
+    /// Scene::meshes) is left out: a local environment probe does not see the object it belongs to.
+    void draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
+              int skipMesh = -1) const;
     std::size_t triangleCount() const { return mTriangles; }
     /// The reflector id of each mesh, written by the G-buffer into the normal's w
     /// (shaders/render/gbuffer.frag): k + 1 for planar mirror k, -(k + 1) for the object of local
@@ -30,7 +42,7 @@ private:
         GLsizei indexCount = 0;
         GLint baseVertex = 0;
         int material = 0;
-        int mesh = 0;    ///< index into Scene::meshes
+        int mesh = 0;      ///< index into Scene::meshes
         int surfaceId = 0; ///< reflector id (setSurfaceIds)
     };
     gl::Buffer mVertices;
