@@ -166,11 +166,9 @@ std::string bearerToken(const std::string& header) {
 /// listening socket, logs and libraries need, so that accept() never fails with EMFILE.
 int connectionCapFromFileLimit(int maxSessions) {
     rlimit limit{};
-    long files = 1024;
-    if (getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
-        files = static_cast<long>(limit.rlim_cur);
-    else if (getrlimit(RLIMIT_NOFILE, &limit) == 0)
-        files = 1 << 20;
+    long files = 1024; // the common default, when the limit cannot be read
+    if (getrlimit(RLIMIT_NOFILE, &limit) == 0)
+        files = limit.rlim_cur == RLIM_INFINITY ? 1L << 20 : static_cast<long>(limit.rlim_cur);
     const long reserve = 64 + 16L * maxSessions;
     return static_cast<int>(std::clamp(files - reserve, 16L, 1L << 20));
 }

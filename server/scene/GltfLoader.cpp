@@ -82,7 +82,7 @@ struct LoadContext {
     }
 };
 
-bool isDotDotSegment(const std::string& rel) {
+bool hasDotDotSegment(const std::string& rel) {
     std::size_t start = 0;
     while (start <= rel.size()) {
         std::size_t end = rel.find_first_of("/\\", start);
@@ -114,7 +114,7 @@ bool externalAllowed(LoadContext& c, const std::string& absPath) {
         logWarn("scene: sandbox: " + c.name + " asked for external file '" + validUtf8(*uri) + "' (refused)");
         return false;
     }
-    if (uri->empty() || (*uri)[0] == '/' || (*uri)[0] == '\\' || isDotDotSegment(*uri) ||
+    if (uri->empty() || (*uri)[0] == '/' || (*uri)[0] == '\\' || hasDotDotSegment(*uri) ||
         uri->find(':') != std::string::npos) {
         c.refuse("refers to '" + validUtf8(*uri) +
                  "', outside its own folder; external buffers and images must be relative paths below the "
