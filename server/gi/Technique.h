@@ -26,33 +26,46 @@ namespace shader {
 struct FrameUniforms;
 }
 
-/// The frame pipeline's products a technique may read. Textures are owned by the renderer.
+/// The frame pipeline's products a technique may read. Textures are owned by the renderer and read
+/// from the frame's resource table by name (gl/FrameResources.h, docs/architecture.md):
+///   gbuffer.position  RGBA32F world position, w = 1 where covered
+///   gbuffer.normal    RGBA16F unit normal facing the camera
+///   gbuffer.albedo    RGBA8 linear diffuse albedo rho_d (scene/Brdf.h)
+///   gbuffer.specular  RGBA8: rgb F0, a perceptual roughness (F0 = 0: no lobe)
+///   light[i].rsm.position  RGBA32F, w = 1 where a surface was hit
+///   light[i].rsm.normal    RGBA16F, facing the light
+///   light[i].rsm.flux      RGBA32F diffusely reflected flux per texel
+///   light[i].rsm.specular  RGBA8: rgb F0, a roughness of the texel's surface
+///   direct            RGBA32F shadowed direct radiance plus emission
 struct FrameInputs {
     int width = 0, height = 0;
-    /// Everything the frame produced before the technique, by name (gbuffer.*, light[i].*, direct);
-    /// the pointers below are the same textures, kept for the techniques that predate the table.
+    /// Everything the frame produced before the technique, by name.
     const FrameResources* resources = nullptr;
-    const gl::Texture* gPosition = nullptr; ///< RGBA32F world position, w = 1 where covered
-    const gl::Texture* gNormal = nullptr;   ///< RGBA16F unit normal facing the camera
-    const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 linear diffuse albedo rho_d (scene/Brdf.h)
-    const gl::Texture* gSpecular = nullptr; ///< RGBA8: rgb F0, a perceptual roughness (F0 = 0: no lobe)
-    int rsmSize = 0;
-    const gl::Texture* rsmPosition = nullptr; ///< RGBA32F, w = 1 where a surface was hit
-    const gl::Texture* rsmNormal = nullptr;   ///< RGBA16F, facing the light
-    const gl::Texture* rsmFlux = nullptr;     ///< RGBA32F diffusely reflected flux per texel
-    const gl::Texture* rsmSpecular = nullptr; ///< RGBA8: rgb F0, a roughness of the texel's surface
+    int rsmSize = 0; ///< texels per side of each light's RSM
     /// Glossy VPL transport (effect_glossy): when true, a technique whose glossyTransport() is true
     /// adds the specular lobe (lobe: frame shadingInfo.x) at receivers whose roughness is at least
     /// glossyMinRoughness; smoother receivers get theirs from the reflection passes.
     bool glossy = false;
     float glossyMinRoughness = 0.35f;
     bool lightEnabled = true;
-    const gl::Texture* direct = nullptr;          ///< RGBA32F shadowed direct radiance plus emission
     const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
     /// Draws the scene's triangles (world-space positions at attribute 0) with `program` bound,
     /// `instances` times; techniques see geometry only through this (VPL shadow maps).
     std::function<void(const gl::Program& program, int instances)> drawGeometry;
     float sceneExtent = 1.0f; ///< diagonal of the scene's bounds (m), > 0
+
+    /// The resource `name`, or nullptr when the frame did not produce it.
+    const gl::Texture* find(const std::string& name) const {
+        return resources ? resources->find(name) : nullptr;
+    }
+    /// The resource `name`; asserts that the frame produced it.
+    const gl::Texture& get(const std::string& name) const;
+    /// The resource NAME of light `index`: light[index].NAME.
+    const gl::Texture& light(int index, const std::string& name) const {
+        return get(FrameResources::light(index, name));
+    }
+    /// Whether the G-buffer, light 0's RSM and the direct light are all published.
+    bool complete() const;
 };
 
 using Counters = std::map<std::string, double>;

@@ -1,5 +1,6 @@
 #include "gl/Pass.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <string>
@@ -30,18 +31,23 @@ long passCheckErrors() {
     return gPassErrors.load();
 }
 
-Pass::Pass(PassTimer& timer, const char* name) : mTimer(timer), mName(name) {
-    mTimer.begin(name);
+Pass::Pass(PassTimer& timer, std::string name) : mTimer(&timer), mName(std::move(name)) {
+    mTimer->begin(mName);
 }
+
+Pass::Pass(std::string name) : mTimer(nullptr), mName(std::move(name)) {}
 
 Pass::~Pass() {
     if (mPolygonOffset) glDisable(GL_POLYGON_OFFSET_FILL);
     if (mDepthTest) glDisable(GL_DEPTH_TEST);
-    mTimer.end();
+    if (mBlend) glDisable(GL_BLEND);
+    if (mCull) glDisable(GL_CULL_FACE);
+    for (const BlockBinding& b : mBoundBlocks) glBindBufferBase(b.target, b.index, 0);
+    if (mTimer) mTimer->end();
     if (passChecksEnabled()) {
         for (GLenum e = glGetError(); e != GL_NO_ERROR; e = glGetError()) {
             ++gPassErrors;
-            logError("gl: pass '" + std::string(mName) + "': GL error 0x" + [&] {
+            logError("gl: pass '" + mName + "': GL error 0x" + [&] {
                 static const char* hex = "0123456789abcdef";
                 std::string out;
                 for (int s = 12; s >= 0; s -= 4) out += hex[(e >> s) & 15];
@@ -83,13 +89,90 @@ Pass& Pass::polygonOffset(float factor, float units) {
     return *this;
 }
 
+Pass& Pass::blendAdd() {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    mBlend = true;
+    return *this;
+}
+
+Pass& Pass::cullFace(GLenum face) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(face);
+    mCull = true;
+    return *this;
+}
+
 Pass& Pass::use(const Program& program) {
     glUseProgram(program.id());
     return *this;
 }
 
 Pass& Pass::texture(TextureUnit unit, const Texture& texture) {
-    glBindTextureUnit(unit.unit, texture.id());
+    if (unit.unit != kNoUnit) glBindTextureUnit(unit.unit, texture.id());
+    return *this;
+}
+
+Pass& Pass::texture(TextureUnit unit, const Texture* texture) {
+    if (unit.unit != kNoUnit) glBindTextureUnit(unit.unit, texture ? texture->id() : 0);
+    return *this;
+}
+
+Pass& Pass::image(ImageUnit unit, const Texture& texture, GLenum access, GLenum format, int level) {
+    glBindImageTexture(unit.unit, texture.id(), level, GL_FALSE, 0, access, format);
+    return *this;
+}
+
+Pass& Pass::imageLayered(ImageUnit unit, const Texture& texture, GLenum access, GLenum format, int level) {
+    glBindImageTexture(unit.unit, texture.id(), level, GL_TRUE, 0, access, format);
+    return *this;
+}
+
+Pass& Pass::buffer(BlockBinding block, const Buffer& buffer) {
+    glBindBufferBase(block.target, block.index, buffer.id());
+    mBoundBlocks.push_back(block);
+    return *this;
+}
+
+Pass& Pass::buffer(BlockBinding block, const Buffer& buffer, GLintptr offset, GLsizeiptr bytes) {
+    glBindBufferRange(block.target, block.index, buffer.id(), offset, bytes);
+    mBoundBlocks.push_back(block);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, const glm::vec2& value) {
+    glUniform2f(u.location, value.x, value.y);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, const glm::vec3& value) {
+    glUniform3f(u.location, value.x, value.y, value.z);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, const glm::vec4& value) {
+    glUniform4f(u.location, value.x, value.y, value.z, value.w);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, const glm::ivec2& value) {
+    glUniform2i(u.location, value.x, value.y);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, const glm::mat4& value) {
+    glUniformMatrix4fv(u.location, 1, GL_FALSE, &value[0][0]);
+    return *this;
+}
+
+Pass& Pass::dispatch(int groupsX, int groupsY, int groupsZ) {
+    glDispatchCompute(static_cast<GLuint>(std::max(groupsX, 0)), static_cast<GLuint>(std::max(groupsY, 0)),
+                      static_cast<GLuint>(std::max(groupsZ, 0)));
+    return *this;
+}
+
+Pass& Pass::barrier(GLbitfield bits) {
+    glMemoryBarrier(bits);
     return *this;
 }
 

@@ -4,11 +4,15 @@
 // when it was built (gl/Shader.h: Program::textureUnit, Program::location), so a misspelt name fails
 // where the program is built instead of being ignored at draw time.
 //
-// At scope end the pass disables what it enabled (depth test, polygon offset, blending), ends its
-// timer slot and, when pass checks are on (GI_GL_CHECK_PASSES=1, as the GL tests run, or a debug
-// build), reads glGetError and logs the pass's name with the error; passCheckErrors() counts them.
+// At scope end the pass disables what it enabled (depth test, polygon offset, blending, face
+// culling), unbinds the storage blocks it bound, ends its timer slot (a pass built without a timer
+// is a sub-step of a timed one) and, when pass checks are on (GI_GL_CHECK_PASSES=1, as the GL tests run, or a
+// debug build), reads glGetError and logs the pass's name with the error; passCheckErrors() counts them.
 // Passes never throw: they sit on the per-frame path.
 #pragma once
+
+#include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -20,7 +24,9 @@ namespace gis::gl {
 
 class Pass {
 public:
-    Pass(PassTimer& timer, const char* name);
+    Pass(PassTimer& timer, std::string name);
+    /// An untimed pass: a sub-step inside a timed pass (timer slots never nest).
+    explicit Pass(std::string name);
     ~Pass();
     Pass(const Pass&) = delete;
     Pass& operator=(const Pass&) = delete;
@@ -33,19 +39,43 @@ public:
     Pass& depthTest(GLenum func = GL_LESS);
     /// Slope-scaled depth offset for the pass's triangles (shadow maps against acne).
     Pass& polygonOffset(float factor, float units);
+    /// Additive blending (ONE, ONE) for the pass's draws: accumulating lights or splats.
+    Pass& blendAdd();
+    Pass& cullFace(GLenum face = GL_BACK);
     Pass& use(const Program& program);
     Pass& texture(TextureUnit unit, const Texture& texture);
+    /// Binds `texture`, or unbinds the unit when it is null (an input the shader does not read then).
+    Pass& texture(TextureUnit unit, const Texture* texture);
+    /// Binds `level` of `texture` for image load/store (layer 0 of an array or cube).
+    Pass& image(ImageUnit unit, const Texture& texture, GLenum access, GLenum format = GL_RGBA32F,
+                int level = 0);
+    /// Binds all layers (or cube faces) of `level` of `texture` for image load/store.
+    Pass& imageLayered(ImageUnit unit, const Texture& texture, GLenum access, GLenum format, int level = 0);
+    /// Binds all of `buffer` (or `bytes` from `offset`) at the block's binding point.
+    Pass& buffer(BlockBinding block, const Buffer& buffer);
+    Pass& buffer(BlockBinding block, const Buffer& buffer, GLintptr offset, GLsizeiptr bytes);
     Pass& set(UniformLocation u, int value);
     Pass& set(UniformLocation u, float value);
+    Pass& set(UniformLocation u, const glm::vec2& value);
+    Pass& set(UniformLocation u, const glm::vec3& value);
+    Pass& set(UniformLocation u, const glm::vec4& value);
+    Pass& set(UniformLocation u, const glm::ivec2& value);
+    Pass& set(UniformLocation u, const glm::mat4& value);
     /// A fullscreen triangle (shaders/render/fullscreen.vert) with `emptyVao` bound.
     void drawFullscreen(const VertexArray& emptyVao);
+    /// Dispatches groupsX x groupsY x groupsZ work groups of the compute program in use.
+    Pass& dispatch(int groupsX, int groupsY = 1, int groupsZ = 1);
+    Pass& barrier(GLbitfield bits);
 
 private:
-    PassTimer& mTimer;
-    const char* mName;
+    PassTimer* mTimer;
+    std::string mName;
     GLuint mFbo = 0;
     bool mDepthTest = false;
     bool mPolygonOffset = false;
+    bool mBlend = false;
+    bool mCull = false;
+    std::vector<BlockBinding> mBoundBlocks;
 };
 
 /// Whether passes check glGetError at their end (GI_GL_CHECK_PASSES=1, or a build without NDEBUG).

@@ -65,9 +65,20 @@ void expandInto(const std::string& path, ExpandedSource& out, std::set<std::stri
     if (isRoot && !versionSeen) throw Error("gl: shader 'shaders/" + path + "' has no #version line");
 }
 
-GLuint compileStage(const ShaderStage& stage,
-                    const std::vector<std::pair<std::string, std::string>>& defines) {
+// The names of plain uniforms the source declares (before preprocessing, so a declaration inside an
+// #if counts): optionalLocation refuses names no stage declares, which catches misspellings of
+// uniforms that a define or the linker may legitimately remove.
+void collectDeclaredUniforms(const std::string& text, std::set<std::string>& out) {
+    static const std::regex declRe(
+        R"(\buniform\s+(?:(?:readonly|writeonly|coherent|restrict|volatile|highp|mediump|lowp)\s+)*\w+\s+(\w+)\s*[;\[=])");
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), declRe); it != std::sregex_iterator(); ++it)
+        out.insert((*it)[1].str());
+}
+
+GLuint compileStage(const ShaderStage& stage, const std::vector<std::pair<std::string, std::string>>& defines,
+                    std::set<std::string>& declared) {
     ExpandedSource src = expandShader(stage.path, defines);
+    collectDeclaredUniforms(src.text, declared);
     GLuint shader = glCreateShader(stage.type);
     const char* text = src.text.c_str();
     glShaderSource(shader, 1, &text, nullptr);
@@ -114,6 +125,21 @@ std::string mapShaderLog(const std::string& log, const std::vector<std::string>&
 }
 
 namespace {
+
+bool isImage(GLenum type) {
+    switch (type) {
+    case GL_IMAGE_2D:
+    case GL_IMAGE_2D_ARRAY:
+    case GL_IMAGE_3D:
+    case GL_IMAGE_CUBE:
+    case GL_INT_IMAGE_2D:
+    case GL_UNSIGNED_INT_IMAGE_2D:
+    case GL_IMAGE_BUFFER:
+        return true;
+    default:
+        return false;
+    }
+}
 
 bool isSamplerOrImage(GLenum type) {
     switch (type) {
@@ -167,14 +193,35 @@ std::vector<Program::Active> Program::activeUniforms(GLuint program) {
     return out;
 }
 
+std::vector<Program::Block> Program::activeBlocks(GLuint program) {
+    std::vector<Block> out;
+    for (GLenum iface : {GL_SHADER_STORAGE_BLOCK, GL_UNIFORM_BLOCK}) {
+        GLint count = 0;
+        glGetProgramInterfaceiv(program, iface, GL_ACTIVE_RESOURCES, &count);
+        const GLenum props[] = {GL_NAME_LENGTH, GL_BUFFER_BINDING};
+        for (GLint i = 0; i < count; ++i) {
+            GLint values[2] = {};
+            glGetProgramResourceiv(program, iface, static_cast<GLuint>(i), 2, props, 2, nullptr, values);
+            std::string name(static_cast<std::size_t>(std::max(values[0], 1)), '\0');
+            glGetProgramResourceName(program, iface, static_cast<GLuint>(i), values[0], nullptr, name.data());
+            name.resize(std::strlen(name.c_str()));
+            const GLenum target =
+                iface == GL_SHADER_STORAGE_BLOCK ? GL_SHADER_STORAGE_BUFFER : GL_UNIFORM_BUFFER;
+            out.push_back({name, {target, static_cast<GLuint>(std::max(values[1], 0))}});
+        }
+    }
+    return out;
+}
+
 Program Program::build(const std::vector<ShaderStage>& stages,
                        const std::vector<std::pair<std::string, std::string>>& defines,
                        const std::vector<std::string>& feedbackVaryings) {
     GLuint program = glCreateProgram();
     std::vector<GLuint> shaders;
+    std::set<std::string> declared;
     try {
         for (const auto& stage : stages) {
-            shaders.push_back(compileStage(stage, defines));
+            shaders.push_back(compileStage(stage, defines, declared));
             glAttachShader(program, shaders.back());
         }
     } catch (...) {
@@ -204,7 +251,7 @@ Program Program::build(const std::vector<ShaderStage>& stages,
     }
     std::string label;
     for (const auto& s : stages) label += " shaders/" + s.path;
-    return Program(program, activeUniforms(program), label);
+    return Program(program, activeUniforms(program), activeBlocks(program), std::move(declared), label);
 }
 
 const Program::Active* Program::find(std::string_view name) const {
@@ -218,8 +265,19 @@ bool Program::has(std::string_view name) const {
 }
 
 UniformLocation Program::optionalLocation(std::string_view name) const {
+    if (!mDeclared.count(std::string(name)))
+        throw Error("gl: no stage of" + mLabel + " declares the uniform '" + std::string(name) +
+                    "' (misspelt?)");
     const Active* a = find(name);
     return {a ? a->location : -1};
+}
+
+TextureUnit Program::optionalTextureUnit(std::string_view name) const {
+    if (!mDeclared.count(std::string(name)))
+        throw Error("gl: no stage of" + mLabel + " declares the sampler '" + std::string(name) +
+                    "' (misspelt?)");
+    const Active* a = find(name);
+    return {a && a->unit >= 0 && !isImage(a->type) ? static_cast<GLuint>(a->unit) : kNoUnit};
 }
 
 UniformLocation Program::location(std::string_view name) const {
@@ -232,10 +290,32 @@ UniformLocation Program::location(std::string_view name) const {
 
 TextureUnit Program::textureUnit(std::string_view name) const {
     const Active* a = find(name);
-    if (!a || a->unit < 0)
-        throw Error("gl: the program of" + mLabel + " has no active sampler or image '" + std::string(name) +
-                    "'");
+    if (!a || a->unit < 0 || isImage(a->type))
+        throw Error("gl: the program of" + mLabel + " has no active sampler '" + std::string(name) + "'");
     return {static_cast<GLuint>(a->unit)};
+}
+
+ImageUnit Program::imageUnit(std::string_view name) const {
+    const Active* a = find(name);
+    if (!a || a->unit < 0 || !isImage(a->type))
+        throw Error("gl: the program of" + mLabel + " has no active image '" + std::string(name) + "'");
+    return {static_cast<GLuint>(a->unit)};
+}
+
+BlockBinding Program::block(std::string_view name, GLenum target) const {
+    for (const Block& b : mBlocks)
+        if (b.name == name && b.binding.target == target) return b.binding;
+    throw Error("gl: the program of" + mLabel + " has no active " +
+                (target == GL_SHADER_STORAGE_BUFFER ? "storage" : "uniform") + " block '" +
+                std::string(name) + "'");
+}
+
+BlockBinding Program::storageBlock(std::string_view name) const {
+    return block(name, GL_SHADER_STORAGE_BUFFER);
+}
+
+BlockBinding Program::uniformBlock(std::string_view name) const {
+    return block(name, GL_UNIFORM_BUFFER);
 }
 
 } // namespace gis::gl

@@ -4,6 +4,7 @@
 // compile errors are reported as shaders/<file>:<line>.
 #pragma once
 
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -17,9 +18,21 @@ namespace gis::gl {
 struct UniformLocation {
     GLint location = -1;
 };
-/// The texture unit of a sampler or image uniform, from its `layout(binding = N)` (Program::textureUnit).
+/// The texture unit of a sampler uniform, from its `layout(binding = N)` (Program::textureUnit).
 struct TextureUnit {
     GLuint unit = 0;
+};
+/// A TextureUnit for a sampler the program does not use: binding to it is skipped by gl::Pass.
+inline constexpr GLuint kNoUnit = ~0u;
+/// The image unit of an image uniform, from its `layout(binding = N)` (Program::imageUnit).
+struct ImageUnit {
+    GLuint unit = 0;
+};
+/// The binding point of a shader storage or uniform block, from its `layout(binding = N)`
+/// (Program::storageBlock, Program::uniformBlock).
+struct BlockBinding {
+    GLenum target = GL_SHADER_STORAGE_BUFFER;
+    GLuint index = 0;
 };
 
 struct ShaderStage {
@@ -36,19 +49,29 @@ public:
     static Program build(const std::vector<ShaderStage>& stages,
                          const std::vector<std::pair<std::string, std::string>>& defines = {},
                          const std::vector<std::string>& feedbackVaryings = {});
+    // TRANSITIONAL: removed once every pass resolves its uniforms through location().
     GLint uniform(const char* name) const { return glGetUniformLocation(id(), name); }
 
     /// The active uniform `name` (not in a block), checked against what the linker kept: a missing or
     /// misspelt name throws gis::Error naming the program's files, where the program is built, so a
     /// typo never turns into a silent -1 at draw time.
     UniformLocation location(std::string_view name) const;
-    /// The unit of the active sampler or image uniform `name`; throws like location().
+    /// The unit of the active sampler uniform `name`; throws like location().
     TextureUnit textureUnit(std::string_view name) const;
+    /// The unit of the active image uniform `name`; throws like location().
+    ImageUnit imageUnit(std::string_view name) const;
+    /// The binding of the active shader storage block `name` (the block's name, not its instance's).
+    BlockBinding storageBlock(std::string_view name) const;
+    /// The binding of the active uniform block `name`.
+    BlockBinding uniformBlock(std::string_view name) const;
     /// Whether the linked program has the active uniform `name` (a define may compile one out).
     bool has(std::string_view name) const;
     /// location(), or location -1 (which glUniform* ignores) when the program does not use `name`:
-    /// for uniforms of a shared include that some programs leave unused.
+    /// for uniforms of a shared include that some programs leave unused. `name` must still be
+    /// declared by one of the program's sources (else it throws: a misspelling).
     UniformLocation optionalLocation(std::string_view name) const;
+    /// textureUnit(), or kNoUnit when the program does not use the declared sampler `name`.
+    TextureUnit optionalTextureUnit(std::string_view name) const;
 
 private:
     struct Active {
@@ -57,12 +80,22 @@ private:
         GLenum type = 0;
         GLint unit = -1; ///< samplers and images: the binding
     };
-    explicit Program(GLuint id, std::vector<Active> active, std::string label)
-        : Object(id), mActive(std::move(active)), mLabel(std::move(label)) {}
+    struct Block {
+        std::string name;
+        BlockBinding binding;
+    };
+    explicit Program(GLuint id, std::vector<Active> active, std::vector<Block> blocks,
+                     std::set<std::string> declared, std::string label)
+        : Object(id), mActive(std::move(active)), mBlocks(std::move(blocks)), mDeclared(std::move(declared)),
+          mLabel(std::move(label)) {}
     static std::vector<Active> activeUniforms(GLuint program);
+    static std::vector<Block> activeBlocks(GLuint program);
     const Active* find(std::string_view name) const;
+    BlockBinding block(std::string_view name, GLenum target) const;
     std::vector<Active> mActive; ///< read from the linked program once
-    std::string mLabel;          ///< " shaders/a.vert shaders/b.frag" for errors
+    std::vector<Block> mBlocks;
+    std::set<std::string> mDeclared; ///< plain uniforms the sources declare (optionalLocation)
+    std::string mLabel;              ///< " shaders/a.vert shaders/b.frag" for errors
 };
 
 /// The fully expanded source of one stage, and the file table its #line numbers refer to.

@@ -65,15 +65,18 @@ void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u) {
 FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     const gl::ShaderStage meshVert{GL_VERTEX_SHADER, "render/mesh.vert"};
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
-    auto meshPass = [&](const char* fragment, bool allMaterials) {
+    // The shadow map draws depth only: its program reads no material.
+    enum class Materials { None, Used, All };
+    auto meshPass = [&](const char* fragment, Materials materials) {
         MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}), {}, {}};
         p.view = p.program.location("uView");
-        p.materials = MaterialSlots::of(p.program, allMaterials);
+        if (materials != Materials::None)
+            p.materials = MaterialSlots::of(p.program, materials == Materials::All);
         return p;
     };
-    mShadowPass = meshPass("render/shadow.frag", false);
-    mRsmPass = meshPass("render/rsm.frag", false);
-    mGBufferPass = meshPass("render/gbuffer.frag", true);
+    mShadowPass = meshPass("render/shadow.frag", Materials::None);
+    mRsmPass = meshPass("render/rsm.frag", Materials::Used);
+    mGBufferPass = meshPass("render/gbuffer.frag", Materials::All);
     mDirectPass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
     const gl::Program& d = mDirectPass.program;
     mDirectPass.position = d.textureUnit("gPosition");
@@ -281,19 +284,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.width = state.width;
     in.height = state.height;
     in.resources = &mResources;
-    in.gPosition = &mResources.get("gbuffer.position");
-    in.gNormal = &mResources.get("gbuffer.normal");
-    in.gAlbedo = &mResources.get("gbuffer.albedo");
-    in.gSpecular = &mResources.get("gbuffer.specular");
     in.rsmSize = rsmSize;
-    in.rsmPosition = &mResources.get(FrameResources::light(0, "rsm.position"));
-    in.rsmNormal = &mResources.get(FrameResources::light(0, "rsm.normal"));
-    in.rsmFlux = &mResources.get(FrameResources::light(0, "rsm.flux"));
-    in.rsmSpecular = &mResources.get(FrameResources::light(0, "rsm.specular"));
     in.glossy = nonDiffuse.glossy;
     in.glossyMinRoughness = fp.getFloat("glossy_split");
     in.lightEnabled = lightOn;
-    in.direct = &mResources.get("direct");
     in.frame = &u;
     in.drawGeometry = [this](const gl::Program& program, int instances) {
         mSceneGpu->draw(program, nullptr, instances);
@@ -311,11 +305,11 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     ReflectionInputs rin;
     rin.width = state.width;
     rin.height = state.height;
-    rin.gPosition = in.gPosition;
-    rin.gNormal = in.gNormal;
-    rin.gAlbedo = in.gAlbedo;
-    rin.gSpecular = in.gSpecular;
-    rin.direct = in.direct;
+    rin.gPosition = &mResources.get("gbuffer.position");
+    rin.gNormal = &mResources.get("gbuffer.normal");
+    rin.gAlbedo = &mResources.get("gbuffer.albedo");
+    rin.gSpecular = &mResources.get("gbuffer.specular");
+    rin.direct = &mResources.get("direct");
     rin.indirect = indirect;
     rin.shadowMap = &mResources.get(FrameResources::light(0, "shadow"));
     rin.frame = &u;

@@ -58,10 +58,10 @@ struct RsmTotals {
 RsmTotals rsmTotals(const FrameInputs& in) {
     const size_t n = static_cast<size_t>(in.rsmSize) * static_cast<size_t>(in.rsmSize);
     std::vector<float> pos(n * 4), flux(n * 4);
-    glGetTextureImage(in.rsmPosition->id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pos.size() * 4),
-                      pos.data());
-    glGetTextureImage(in.rsmFlux->id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(flux.size() * 4),
-                      flux.data());
+    glGetTextureImage(in.find(FrameResources::light(0, "rsm.position"))->id(), 0, GL_RGBA, GL_FLOAT,
+                      static_cast<GLsizei>(pos.size() * 4), pos.data());
+    glGetTextureImage(in.find(FrameResources::light(0, "rsm.flux"))->id(), 0, GL_RGBA, GL_FLOAT,
+                      static_cast<GLsizei>(flux.size() * 4), flux.data());
     RsmTotals t;
     for (size_t i = 0; i < n; ++i) {
         if (pos[i * 4 + 3] < 0.5f) continue;

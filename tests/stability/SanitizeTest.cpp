@@ -74,18 +74,20 @@ Result runInjected(const std::string& technique, const RenderSpec& spec, const F
     shader::FrameUniforms u{};
     glGetNamedBufferSubData(static_cast<GLuint>(ubo), 0, sizeof u, &u);
 
+    FrameResources resources;
+    resources.publish("gbuffer.position", "test", gPos);
+    resources.publish("gbuffer.normal", "test", gNrm);
+    resources.publish("gbuffer.albedo", "test", gAlb);
+    resources.publish(FrameResources::light(0, "rsm.position"), "test", rPos);
+    resources.publish(FrameResources::light(0, "rsm.normal"), "test", rNrm);
+    resources.publish(FrameResources::light(0, "rsm.flux"), "test", rFlux);
+    resources.publish("direct", "test", direct);
     FrameInputs in;
     in.width = w;
     in.height = h;
-    in.gPosition = &gPos;
-    in.gNormal = &gNrm;
-    in.gAlbedo = &gAlb;
+    in.resources = &resources;
     in.rsmSize = rsm;
-    in.rsmPosition = &rPos;
-    in.rsmNormal = &rNrm;
-    in.rsmFlux = &rFlux;
     in.lightEnabled = true;
-    in.direct = &direct;
     in.frame = &u;
     in.drawGeometry = [](const gl::Program&, int) {};
     in.sceneExtent = glm::length(spec.scene->bounds.max - spec.scene->bounds.min);

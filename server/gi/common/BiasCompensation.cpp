@@ -98,9 +98,9 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
     const int iterations = std::clamp(params.getInt("ssbc_iterations"), 0, kMaxIterations);
     const double b = params.getFloat("clamp_b");
     counters["ssbc_energy_added"] = 0;
-    if (iterations == 0 || !(b > 0.0) || !std::isfinite(b) || !in.frame || !in.direct || !in.gPosition ||
-        !in.gNormal || !in.gAlbedo || in.width <= 0 || in.height <= 0 || indirect.width() != in.width ||
-        indirect.height() != in.height)
+    if (iterations == 0 || !(b > 0.0) || !std::isfinite(b) || !in.frame || !in.find("direct") ||
+        !in.find("gbuffer.position") || !in.find("gbuffer.normal") || !in.find("gbuffer.albedo") ||
+        in.width <= 0 || in.height <= 0 || indirect.width() != in.width || indirect.height() != in.height)
         return;
 
     // Camera intrinsics from the view-projection: for a perspective projection P and a rigid view V,
@@ -128,9 +128,9 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
     glUniform3f(mBase.uniform("uForward"), forward.x, forward.y, forward.z);
     glUniform1f(mBase.uniform("uCosGrazing"), cosGrazing);
     glUniform1i(mBase.uniform("uWithIndirect"), params.getEnum("ssbc_input") == "direct" ? 0 : 1);
-    glBindTextureUnit(0, in.gPosition->id());
-    glBindTextureUnit(1, in.gNormal->id());
-    glBindTextureUnit(2, in.direct->id());
+    glBindTextureUnit(0, in.find("gbuffer.position")->id());
+    glBindTextureUnit(1, in.find("gbuffer.normal")->id());
+    glBindTextureUnit(2, in.find("direct")->id());
     glBindTextureUnit(3, indirect.id());
     glBindImageTexture(0, mGeo.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(1, mNormal.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -176,7 +176,7 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
         glBindTextureUnit(0, mGeo.id());
         glBindTextureUnit(1, mNormal.id());
         glBindTextureUnit(2, mIllum[src].id());
-        glBindTextureUnit(3, in.gAlbedo->id());
+        glBindTextureUnit(3, in.find("gbuffer.albedo")->id());
         glBindImageTexture(0, target.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, mIllum[dst].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         if (half) {
@@ -198,7 +198,7 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
             glBindTextureUnit(0, mGeo.id());
             glBindTextureUnit(1, mNormal.id());
             glBindTextureUnit(2, mHalf.id());
-            glBindTextureUnit(3, in.gAlbedo->id());
+            glBindTextureUnit(3, in.find("gbuffer.albedo")->id());
             glBindImageTexture(0, target.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
             glBindImageTexture(1, mIllum[dst].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
             glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);

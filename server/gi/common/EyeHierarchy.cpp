@@ -126,9 +126,9 @@ void EyeHierarchy::endIlluminationPass() const {
 }
 
 void EyeHierarchy::bindPixels(const FrameInputs& in) const {
-    glBindTextureUnit(8, in.gPosition->id());
-    glBindTextureUnit(9, in.gNormal->id());
-    glBindTextureUnit(10, in.gAlbedo->id());
+    glBindTextureUnit(8, in.find("gbuffer.position")->id());
+    glBindTextureUnit(9, in.find("gbuffer.normal")->id());
+    glBindTextureUnit(10, in.find("gbuffer.albedo")->id());
 }
 
 void EyeHierarchy::bindUniforms() const {
@@ -229,9 +229,9 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     glUniform1i(mResolve.uniform("uIrradiance"), irradiance ? 1 : 0);
     glUniform1i(mResolve.uniform("uInterpolate"), irradiance ? 1 : 0);
     glUniform1f(mResolve.uniform("uDetailAlpha"), static_cast<float>(params.getFloat("detail_alpha")));
-    glBindTextureUnit(0, in.gPosition->id());
-    glBindTextureUnit(1, in.gNormal->id());
-    glBindTextureUnit(2, in.gAlbedo->id());
+    glBindTextureUnit(0, in.find("gbuffer.position")->id());
+    glBindTextureUnit(1, in.find("gbuffer.normal")->id());
+    glBindTextureUnit(2, in.find("gbuffer.albedo")->id());
     glBindTextureUnit(3, mReconstructed.id());
     glBindTextureUnit(4, mIllumination.id());
     glTextureBarrier();

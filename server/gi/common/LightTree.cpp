@@ -53,7 +53,7 @@ void LightTree::bind() const {
 void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
     mLastInputs = in;
     mValid = false;
-    if (in.rsmSize <= 0 || !in.rsmPosition) return;
+    if (in.rsmSize <= 0 || !in.find(FrameResources::light(0, "rsm.position"))) return;
     ensureLayout(in.rsmSize);
     counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
     counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);
@@ -62,9 +62,9 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
     timer.begin("light_tree");
     glUseProgram(mBuild.id());
     bind();
-    glBindTextureUnit(0, in.rsmPosition->id());
-    glBindTextureUnit(1, in.rsmNormal->id());
-    glBindTextureUnit(2, in.rsmFlux->id());
+    glBindTextureUnit(0, in.find(FrameResources::light(0, "rsm.position"))->id());
+    glBindTextureUnit(1, in.find(FrameResources::light(0, "rsm.normal"))->id());
+    glBindTextureUnit(2, in.find(FrameResources::light(0, "rsm.flux"))->id());
     const GLint levelLoc = mBuild.uniform("uLevel");
     // Level 1's dispatch writes level 0 too (light_tree_build.comp); then one dispatch per level.
     for (size_t l = 1; l < mLevels.size(); ++l) {

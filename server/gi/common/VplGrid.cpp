@@ -36,10 +36,12 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
     glUseProgram(mExtract.id());
     glUniform1i(mExtract.uniform("uGrid"), grid);
     glUniform1i(mExtract.uniform("uRsmSize"), in.rsmSize);
-    glBindTextureUnit(0, in.rsmPosition->id());
-    glBindTextureUnit(1, in.rsmNormal->id());
-    glBindTextureUnit(2, in.rsmFlux->id());
-    glBindTextureUnit(3, in.rsmSpecular ? in.rsmSpecular->id() : 0);
+    glBindTextureUnit(0, in.find(FrameResources::light(0, "rsm.position"))->id());
+    glBindTextureUnit(1, in.find(FrameResources::light(0, "rsm.normal"))->id());
+    glBindTextureUnit(2, in.find(FrameResources::light(0, "rsm.flux"))->id());
+    glBindTextureUnit(3, in.find(FrameResources::light(0, "rsm.specular"))
+                             ? in.find(FrameResources::light(0, "rsm.specular"))->id()
+                             : 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mGlossy.id());
     glDispatchCompute(static_cast<GLuint>((mCount + 63) / 64), 1, 1);

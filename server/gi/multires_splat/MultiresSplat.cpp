@@ -127,11 +127,11 @@ bool MultiresSplat::glossyTransport(const ParamSet& params) const {
 }
 
 void MultiresSplat::bindGlossy(const gl::Program& program, const FrameInputs& in, bool perVpl) const {
-    const bool glossy = perVpl && in.glossy && in.gSpecular != nullptr;
+    const bool glossy = perVpl && in.glossy && in.find("gbuffer.specular") != nullptr;
     glUniform1i(program.uniform("uGlossy"), glossy ? 1 : 0);
     glUniform1f(program.uniform("uGlossyMinRoughness"), in.glossyMinRoughness);
     if (!glossy) return;
-    glBindTextureUnit(14, in.gSpecular->id());
+    glBindTextureUnit(14, in.find("gbuffer.specular")->id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mVpls.glossyBuffer().id());
 }
 

@@ -34,14 +34,14 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         glUniform1f(gather.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
         setVplClamp(gather, params);
         mShadows.bind(gather, in, params);
-        glBindTextureUnit(0, in.gPosition->id());
-        glBindTextureUnit(1, in.gNormal->id());
-        glBindTextureUnit(2, in.gAlbedo->id());
-        const bool glossy = in.glossy && in.gSpecular != nullptr;
+        glBindTextureUnit(0, in.find("gbuffer.position")->id());
+        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
+        glBindTextureUnit(2, in.find("gbuffer.albedo")->id());
+        const bool glossy = in.glossy && in.find("gbuffer.specular") != nullptr;
         glUniform1i(gather.uniform("uGlossy"), glossy ? 1 : 0);
         glUniform1f(gather.uniform("uGlossyMinRoughness"), in.glossyMinRoughness);
         if (glossy) {
-            glBindTextureUnit(3, in.gSpecular->id());
+            glBindTextureUnit(3, in.find("gbuffer.specular")->id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mVpls.glossyBuffer().id());
         }
         glBindVertexArray(mEmptyVao.id());

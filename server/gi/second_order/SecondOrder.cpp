@@ -126,9 +126,9 @@ int SecondOrder::placePositive(const FrameInputs& in, gl::PassTimer& timer, Coun
     glUniform1i(mPlacePositive.uniform("uRsmSize"), in.rsmSize);
     const double coneSolidAngle = 2.0 * 3.14159265358979323846 * (1.0 - cosOuter);
     glUniform1f(mPlacePositive.uniform("uSampleSolidAngle"), static_cast<float>(coneSolidAngle / count));
-    glBindTextureUnit(0, in.rsmPosition->id());
-    glBindTextureUnit(1, in.rsmNormal->id());
-    glBindTextureUnit(2, in.rsmFlux->id());
+    glBindTextureUnit(0, in.find(FrameResources::light(0, "rsm.position"))->id());
+    glBindTextureUnit(1, in.find(FrameResources::light(0, "rsm.normal"))->id());
+    glBindTextureUnit(2, in.find(FrameResources::light(0, "rsm.flux"))->id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mSamples.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
@@ -206,8 +206,8 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
     glUniform1f(mPlaceNegative.uniform("uFrustumSolidAngle"), static_cast<float>(frustumSolidAngle));
     glUniform1f(mPlaceNegative.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
     glUniform1f(mPlaceNegative.uniform("uMinCosView"), kMinCosView);
-    glBindTextureUnit(0, in.gPosition->id());
-    glBindTextureUnit(1, in.gNormal->id());
+    glBindTextureUnit(0, in.find("gbuffer.position")->id());
+    glBindTextureUnit(1, in.find("gbuffer.normal")->id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mCandidates.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
@@ -248,7 +248,8 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
 
     mPositiveSlots = in.lightEnabled ? params.getInt("positive_count") : 0;
     mNegativeSlots = std::clamp(params.getInt("negative_count"), 0, kMaxNegative);
-    if (!in.frame || !in.gPosition || !in.gNormal || !in.gAlbedo || !in.rsmPosition || in.rsmSize <= 0 ||
+    if (!in.frame || !in.find("gbuffer.position") || !in.find("gbuffer.normal") ||
+        !in.find("gbuffer.albedo") || !in.find(FrameResources::light(0, "rsm.position")) || in.rsmSize <= 0 ||
         in.width <= 0 || in.height <= 0)
         mPositiveSlots = 0;
     if (mPositiveSlots <= 0) {
@@ -280,8 +281,8 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
         glViewport(0, 0, lowW, lowH);
         glUseProgram(mLowGeometry.id());
         glUniform1i(mLowGeometry.uniform("uFactor"), factor);
-        glBindTextureUnit(0, in.gPosition->id());
-        glBindTextureUnit(1, in.gNormal->id());
+        glBindTextureUnit(0, in.find("gbuffer.position")->id());
+        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
         glBindVertexArray(mEmptyVao.id());
         glDrawArrays(GL_TRIANGLES, 0, 3);
         timer.end();
@@ -307,8 +308,8 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
         glUniform1i(mDiscontinuity.uniform("uFactor"), factor);
         glUniform2i(mDiscontinuity.uniform("uLowSize"), lowW, lowH);
         glUniform1f(mDiscontinuity.uniform("uThreshold"), static_cast<float>(threshold));
-        glBindTextureUnit(0, in.gPosition->id());
-        glBindTextureUnit(1, in.gNormal->id());
+        glBindTextureUnit(0, in.find("gbuffer.position")->id());
+        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
         glBindTextureUnit(2, mLowPosition.id());
         glBindTextureUnit(3, mLowNormal.id());
         glEnable(GL_STENCIL_TEST);
@@ -324,8 +325,8 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
         glClearNamedFramebufferfv(mFixupFbo.id(), GL_COLOR, 0, zero);
         glStencilFunc(GL_EQUAL, 1, 0xFF);
         glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-        glBindTextureUnit(0, in.gPosition->id());
-        glBindTextureUnit(1, in.gNormal->id());
+        glBindTextureUnit(0, in.find("gbuffer.position")->id());
+        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
         gather(mGather, slots, minDistance, counters);
         glDisable(GL_STENCIL_TEST);
         timer.end();
@@ -337,10 +338,10 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
     glUniform1i(mResolve.uniform("uFactor"), factor);
     glUniform2i(mResolve.uniform("uLowSize"), lowW, lowH);
     glUniform1i(mResolve.uniform("uFixup"), fixup ? 1 : 0);
-    glUniform1i(mResolve.uniform("uHasDirect"), in.direct ? 1 : 0);
-    glBindTextureUnit(0, in.gPosition->id());
-    glBindTextureUnit(1, in.gAlbedo->id());
-    glBindTextureUnit(2, in.direct ? in.direct->id() : in.gAlbedo->id());
+    glUniform1i(mResolve.uniform("uHasDirect"), in.find("direct") ? 1 : 0);
+    glBindTextureUnit(0, in.find("gbuffer.position")->id());
+    glBindTextureUnit(1, in.find("gbuffer.albedo")->id());
+    glBindTextureUnit(2, in.find("direct") ? in.find("direct")->id() : in.find("gbuffer.albedo")->id());
     glBindTextureUnit(3, mFlag.id());
     glBindTextureUnit(4, mFullIrradiance.id());
     glBindTextureUnit(5, mLowIrradiance.id());
