@@ -42,6 +42,8 @@ Pass::~Pass() {
     if (mDepthTest) glDisable(GL_DEPTH_TEST);
     if (mBlend) glDisable(GL_BLEND);
     if (mCull) glDisable(GL_CULL_FACE);
+    if (mStencil) glDisable(GL_STENCIL_TEST);
+    if (mColorMasked) glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     for (const BlockBinding& b : mBoundBlocks) glBindBufferBase(b.target, b.index, 0);
     if (mTimer) mTimer->end();
     if (passChecksEnabled()) {
@@ -89,6 +91,42 @@ Pass& Pass::polygonOffset(float factor, float units) {
     return *this;
 }
 
+Pass& Pass::viewport(int x, int y, int width, int height) {
+    glViewport(x, y, width, height);
+    return *this;
+}
+
+Pass& Pass::clearDepthStencil(float depth, int stencil) {
+    glClearNamedFramebufferfi(mFbo, GL_DEPTH_STENCIL, 0, depth, stencil);
+    return *this;
+}
+
+Pass& Pass::blend(GLenum srcRgb, GLenum dstRgb, GLenum srcAlpha, GLenum dstAlpha) {
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(srcRgb, dstRgb, srcAlpha, dstAlpha);
+    mBlend = true;
+    return *this;
+}
+
+Pass& Pass::stencil(GLenum func, int ref, GLenum stencilFail, GLenum depthFail, GLenum pass) {
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(func, ref, 0xFF);
+    glStencilOp(stencilFail, depthFail, pass);
+    mStencil = true;
+    return *this;
+}
+
+Pass& Pass::noColorWrites() {
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    mColorMasked = true;
+    return *this;
+}
+
+Pass& Pass::textureBarrier() {
+    glTextureBarrier();
+    return *this;
+}
+
 Pass& Pass::blendAdd() {
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -129,12 +167,14 @@ Pass& Pass::imageLayered(ImageUnit unit, const Texture& texture, GLenum access, 
 }
 
 Pass& Pass::buffer(BlockBinding block, const Buffer& buffer) {
+    if (block.index == kNoUnit) return *this;
     glBindBufferBase(block.target, block.index, buffer.id());
     mBoundBlocks.push_back(block);
     return *this;
 }
 
 Pass& Pass::buffer(BlockBinding block, const Buffer& buffer, GLintptr offset, GLsizeiptr bytes) {
+    if (block.index == kNoUnit) return *this;
     glBindBufferRange(block.target, block.index, buffer.id(), offset, bytes);
     mBoundBlocks.push_back(block);
     return *this;
@@ -173,6 +213,17 @@ Pass& Pass::dispatch(int groupsX, int groupsY, int groupsZ) {
 
 Pass& Pass::barrier(GLbitfield bits) {
     glMemoryBarrier(bits);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, unsigned value) {
+    glUniform1ui(u.location, value);
+    return *this;
+}
+
+Pass& Pass::dispatchIndirect(const Buffer& commands, GLintptr offset) {
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, commands.id());
+    glDispatchComputeIndirect(offset);
     return *this;
 }
 

@@ -5,10 +5,10 @@
 // where the program is built instead of being ignored at draw time.
 //
 // At scope end the pass disables what it enabled (depth test, polygon offset, blending, face
-// culling), unbinds the storage blocks it bound, ends its timer slot (a pass built without a timer
-// is a sub-step of a timed one) and, when pass checks are on (GI_GL_CHECK_PASSES=1, as the GL tests run, or a
-// debug build), reads glGetError and logs the pass's name with the error; passCheckErrors() counts them.
-// Passes never throw: they sit on the per-frame path.
+// culling, stencil test, colour masking), unbinds the storage blocks it bound, ends its timer slot (a pass
+// built without a timer is a sub-step of a timed one) and, when pass checks are on (GI_GL_CHECK_PASSES=1, as
+// the GL tests run, or a debug build), reads glGetError and logs the pass's name with the error;
+// passCheckErrors() counts them. Passes never throw: they sit on the per-frame path.
 #pragma once
 
 #include <string>
@@ -39,8 +39,20 @@ public:
     Pass& depthTest(GLenum func = GL_LESS);
     /// Slope-scaled depth offset for the pass's triangles (shadow maps against acne).
     Pass& polygonOffset(float factor, float units);
+    /// A sub-rectangle of the target (an atlas level).
+    Pass& viewport(int x, int y, int width, int height);
+    Pass& clearDepthStencil(float depth, int stencil);
     /// Additive blending (ONE, ONE) for the pass's draws: accumulating lights or splats.
     Pass& blendAdd();
+    /// Blending with separate colour and alpha factors.
+    Pass& blend(GLenum srcRgb, GLenum dstRgb, GLenum srcAlpha, GLenum dstAlpha);
+    /// Stencil test `func` against `ref` (mask 0xFF) with the operations for stencil fail, depth fail
+    /// and pass.
+    Pass& stencil(GLenum func, int ref, GLenum stencilFail, GLenum depthFail, GLenum pass);
+    /// Writes no colour (a stencil- or depth-only draw) until the pass ends.
+    Pass& noColorWrites();
+    /// Makes this pass's earlier writes to a texture visible to its later reads (glTextureBarrier).
+    Pass& textureBarrier();
     Pass& cullFace(GLenum face = GL_BACK);
     Pass& use(const Program& program);
     Pass& texture(TextureUnit unit, const Texture& texture);
@@ -55,6 +67,7 @@ public:
     Pass& buffer(BlockBinding block, const Buffer& buffer);
     Pass& buffer(BlockBinding block, const Buffer& buffer, GLintptr offset, GLsizeiptr bytes);
     Pass& set(UniformLocation u, int value);
+    Pass& set(UniformLocation u, unsigned value);
     Pass& set(UniformLocation u, float value);
     Pass& set(UniformLocation u, const glm::vec2& value);
     Pass& set(UniformLocation u, const glm::vec3& value);
@@ -65,6 +78,8 @@ public:
     void drawFullscreen(const VertexArray& emptyVao);
     /// Dispatches groupsX x groupsY x groupsZ work groups of the compute program in use.
     Pass& dispatch(int groupsX, int groupsY = 1, int groupsZ = 1);
+    /// Dispatches the work-group counts stored at `offset` in `commands`.
+    Pass& dispatchIndirect(const Buffer& commands, GLintptr offset = 0);
     Pass& barrier(GLbitfield bits);
 
 private:
@@ -75,6 +90,8 @@ private:
     bool mPolygonOffset = false;
     bool mBlend = false;
     bool mCull = false;
+    bool mStencil = false;
+    bool mColorMasked = false;
     std::vector<BlockBinding> mBoundBlocks;
 };
 

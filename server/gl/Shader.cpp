@@ -314,6 +314,12 @@ BlockBinding Program::storageBlock(std::string_view name) const {
     return block(name, GL_SHADER_STORAGE_BUFFER);
 }
 
+BlockBinding Program::optionalStorageBlock(std::string_view name) const {
+    for (const Block& b : mBlocks)
+        if (b.name == name && b.binding.target == GL_SHADER_STORAGE_BUFFER) return b.binding;
+    return {GL_SHADER_STORAGE_BUFFER, kNoUnit};
+}
+
 BlockBinding Program::uniformBlock(std::string_view name) const {
     return block(name, GL_UNIFORM_BUFFER);
 }

@@ -64,12 +64,17 @@ public:
     BlockBinding storageBlock(std::string_view name) const;
     /// The binding of the active uniform block `name`.
     BlockBinding uniformBlock(std::string_view name) const;
+    /// storageBlock(), or a binding gl::Pass skips (index kNoUnit) when the program does not use the
+    /// block (a define compiled out its reads).
+    BlockBinding optionalStorageBlock(std::string_view name) const;
     /// Whether the linked program has the active uniform `name` (a define may compile one out).
     bool has(std::string_view name) const;
     /// location(), or location -1 (which glUniform* ignores) when the program does not use `name`:
     /// for uniforms of a shared include that some programs leave unused. `name` must still be
     /// declared by one of the program's sources (else it throws: a misspelling).
     UniformLocation optionalLocation(std::string_view name) const;
+    /// Whether one of the program's sources declares the plain uniform `name` (used or not).
+    bool declares(std::string_view name) const { return mDeclared.count(std::string(name)) > 0; }
     /// textureUnit(), or kNoUnit when the program does not use the declared sampler `name`.
     TextureUnit optionalTextureUnit(std::string_view name) const;
 

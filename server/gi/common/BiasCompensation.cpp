@@ -27,17 +27,78 @@ float vplInverseClampB(const ParamSet& params) {
     return b > 0.0 && std::isfinite(b) ? static_cast<float>(1.0 / b) : 0.0f;
 }
 
-void setVplClamp(const gl::Program& program, const ParamSet& params) {
-    const GLint loc = program.uniform("uVplInvClampB");
-    if (loc >= 0) glProgramUniform1f(program.id(), loc, vplInverseClampB(params));
-}
-
 BiasCompensation::BiasCompensation() {
-    mBase = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_base.comp"}});
-    mReduce = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_reduce.comp"}});
-    mIntegrate = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_integrate.comp"}});
-    mUpsample = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_upsample.comp"}});
-    mBlur = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_blur.comp"}});
+    BaseProgram& base = mBase;
+    base.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_base.comp"}});
+    const gl::Program& b = base.program;
+    base.tanHalfFov = b.location("uTanHalfFov");
+    base.forward = b.location("uForward");
+    base.cosGrazing = b.location("uCosGrazing");
+    base.withIndirect = b.location("uWithIndirect");
+    base.position = b.textureUnit("gPosition");
+    base.normal = b.textureUnit("gNormal");
+    base.direct = b.textureUnit("uDirect");
+    base.indirect = b.textureUnit("uIndirect");
+    base.geoOut = b.imageUnit("uGeoOut");
+    base.normalOut = b.imageUnit("uNormalOut");
+    base.illumOut = b.imageUnit("uIllumOut");
+    base.sums = b.optionalStorageBlock("SsbcSums");
+
+    ReduceProgram& reduce = mReduce;
+    reduce.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_reduce.comp"}});
+    const gl::Program& r = reduce.program;
+    reduce.level = r.optionalLocation("uLevel");
+    reduce.mode = r.location("uMode");
+    reduce.outSize = r.location("uOutSize");
+    reduce.childReal = r.location("uChildReal");
+    reduce.geoIn = r.imageUnit("uGeoIn");
+    reduce.geoOut = r.imageUnit("uGeoOut");
+    reduce.normalIn = r.imageUnit("uNormalIn");
+    reduce.normalOut = r.imageUnit("uNormalOut");
+    reduce.illumIn = r.imageUnit("uIllumIn");
+    reduce.illumOut = r.imageUnit("uIllumOut");
+
+    IntegrateProgram& integrate = mIntegrate;
+    integrate.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_integrate.comp"}});
+    const gl::Program& i = integrate.program;
+    integrate.b = i.location("uB");
+    integrate.r = i.location("uR");
+    integrate.tanHalfFov = i.location("uTanHalfFov");
+    integrate.levels = i.location("uLevels");
+    integrate.solidAngle = i.location("uSolidAngle");
+    integrate.discAngle = i.location("uDiscAngle");
+    integrate.maxVisited = i.location("uMaxVisited");
+    integrate.slot = i.location("uSlot");
+    integrate.receiverLevel = i.location("uReceiverLevel");
+    integrate.geo = i.textureUnit("uGeo");
+    integrate.normal = i.textureUnit("uNormal");
+    integrate.illum = i.textureUnit("uIllum");
+    integrate.albedo = i.textureUnit("gAlbedo");
+    integrate.indirect = i.imageUnit("uIndirect");
+    integrate.nextIllum = i.imageUnit("uNextIllum");
+    integrate.halfOut = i.imageUnit("uHalfOut");
+    integrate.sums = i.optionalStorageBlock("SsbcSums");
+
+    UpsampleProgram& upsample = mUpsample;
+    upsample.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_upsample.comp"}});
+    const gl::Program& u = upsample.program;
+    upsample.slot = u.location("uSlot");
+    upsample.geo = u.textureUnit("uGeo");
+    upsample.normal = u.textureUnit("uNormal");
+    upsample.half = u.textureUnit("uHalf");
+    upsample.albedo = u.textureUnit("gAlbedo");
+    upsample.target = u.imageUnit("uTarget");
+    upsample.nextIllum = u.imageUnit("uNextIllum");
+    upsample.sums = u.optionalStorageBlock("SsbcSums");
+
+    BlurProgram& blur = mBlur;
+    blur.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/ssbc_blur.comp"}});
+    blur.pass = blur.program.location("uPass");
+    blur.geo = blur.program.textureUnit("uGeo");
+    blur.normal = blur.program.textureUnit("uNormal");
+    blur.source = blur.program.textureUnit("uSource");
+    blur.out = blur.program.imageUnit("uOut");
+    blur.sums = blur.program.optionalStorageBlock("SsbcSums");
 }
 
 void BiasCompensation::ensure(int width, int height, int levels) {
@@ -70,26 +131,23 @@ void BiasCompensation::ensure(int width, int height, int levels) {
 }
 
 // mode 0: geometry and illumination mips of mIllum[illumIndex]; 1: illumination only.
-void BiasCompensation::reduce(int mode, int illumIndex) {
-    glUseProgram(mReduce.id());
-    glUniform1i(mReduce.uniform("uMode"), mode);
+void BiasCompensation::reduce(gl::Pass& pass, int mode, int illumIndex) {
+    const ReduceProgram& r = mReduce;
+    pass.use(r.program).set(r.mode, mode);
     for (int l = 1; l < mLevels; ++l) {
         const int w = mPadW >> l, h = mPadH >> l;
         const int child = l - 1;
         const int realW = (mWidth + (1 << child) - 1) >> child, realH = (mHeight + (1 << child) - 1) >> child;
-        glUniform1i(mReduce.uniform("uLevel"), l);
-        glUniform2i(mReduce.uniform("uOutSize"), w, h);
-        glUniform2i(mReduce.uniform("uChildReal"), realW, realH);
-        glBindImageTexture(0, mGeo.id(), child, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glBindImageTexture(1, mGeo.id(), l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glBindImageTexture(2, mNormal.id(), child, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glBindImageTexture(3, mNormal.id(), l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glBindImageTexture(4, mIllum[illumIndex].id(), child, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glBindImageTexture(5, mIllum[illumIndex].id(), l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glDispatchCompute(static_cast<GLuint>(groupsFor(w)), static_cast<GLuint>(groupsFor(h)), 1);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        pass.set(r.level, l).set(r.outSize, glm::ivec2(w, h)).set(r.childReal, glm::ivec2(realW, realH));
+        pass.image(r.geoIn, mGeo, GL_READ_ONLY, GL_RGBA32F, child)
+            .image(r.geoOut, mGeo, GL_WRITE_ONLY, GL_RGBA32F, l)
+            .image(r.normalIn, mNormal, GL_READ_ONLY, GL_RGBA32F, child)
+            .image(r.normalOut, mNormal, GL_WRITE_ONLY, GL_RGBA32F, l)
+            .image(r.illumIn, mIllum[illumIndex], GL_READ_ONLY, GL_RGBA32F, child)
+            .image(r.illumOut, mIllum[illumIndex], GL_WRITE_ONLY, GL_RGBA32F, l);
+        pass.dispatch(groupsFor(w), groupsFor(h)).barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     }
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
 void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, const gl::Texture& indirect,
@@ -121,24 +179,28 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
     const double grazing = std::clamp(params.getFloat("ssbc_grazing_angle"), 1.0, 90.0);
     const float cosGrazing = grazing >= 90.0 ? 0.0f : static_cast<float>(std::cos(grazing * kDegToRad));
 
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mSums.id());
-    timer.begin("ssbc_mips");
-    glUseProgram(mBase.id());
-    glUniform1f(mBase.uniform("uTanHalfFov"), tanHalfFov);
-    glUniform3f(mBase.uniform("uForward"), forward.x, forward.y, forward.z);
-    glUniform1f(mBase.uniform("uCosGrazing"), cosGrazing);
-    glUniform1i(mBase.uniform("uWithIndirect"), params.getEnum("ssbc_input") == "direct" ? 0 : 1);
-    glBindTextureUnit(0, in.find("gbuffer.position")->id());
-    glBindTextureUnit(1, in.find("gbuffer.normal")->id());
-    glBindTextureUnit(2, in.find("direct")->id());
-    glBindTextureUnit(3, indirect.id());
-    glBindImageTexture(0, mGeo.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, mNormal.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(2, mIllum[0].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    reduce(0, 0);
-    timer.end();
+    const gl::Texture& position = in.get("gbuffer.position");
+    const gl::Texture& normal = in.get("gbuffer.normal");
+    const gl::Texture& albedo = in.get("gbuffer.albedo");
+    {
+        gl::Pass pass(timer, "ssbc_mips");
+        const BaseProgram& p = mBase;
+        pass.use(p.program)
+            .set(p.tanHalfFov, tanHalfFov)
+            .set(p.forward, forward)
+            .set(p.cosGrazing, cosGrazing)
+            .set(p.withIndirect, params.getEnum("ssbc_input") == "direct" ? 0 : 1);
+        pass.texture(p.position, position)
+            .texture(p.normal, normal)
+            .texture(p.direct, in.get("direct"))
+            .texture(p.indirect, indirect)
+            .buffer(p.sums, mSums);
+        pass.image(p.geoOut, mGeo, GL_WRITE_ONLY)
+            .image(p.normalOut, mNormal, GL_WRITE_ONLY)
+            .image(p.illumOut, mIllum[0], GL_WRITE_ONLY);
+        pass.dispatch(groupsX, groupsY).barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        reduce(pass, 0, 0);
+    }
 
     // Optional modes: the blur needs the steps' sum on its own (it must not blur the technique's
     // indirect light), so the steps then add into mAccum; half resolution needs a level 1.
@@ -151,82 +213,66 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
         glClearTexImage(mAccum.id(), 0, GL_RGBA, GL_FLOAT, zero);
     }
     const int halfGroupsX = half ? groupsFor(mPadW / 2) : 0, halfGroupsY = half ? groupsFor(mPadH / 2) : 0;
+    const GLbitfield stepBarrier =
+        GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT;
 
     const float r = static_cast<float>(1.0 / std::sqrt(b));
     for (int k = 1; k <= iterations; ++k) {
         const int src = (k - 1) & 1, dst = k & 1;
         if (k > 1) {
-            timer.begin("ssbc_mips_" + std::to_string(k));
-            reduce(1, src);
-            timer.end();
+            gl::Pass pass(timer, "ssbc_mips_" + std::to_string(k));
+            reduce(pass, 1, src);
         }
-        timer.begin("ssbc_integrate_" + std::to_string(k));
-        glUseProgram(mIntegrate.id());
-        glUniform1f(mIntegrate.uniform("uB"), static_cast<float>(b));
-        glUniform1f(mIntegrate.uniform("uR"), r);
-        glUniform1f(mIntegrate.uniform("uTanHalfFov"), tanHalfFov);
-        glUniform1i(mIntegrate.uniform("uLevels"), levels);
-        glUniform1f(mIntegrate.uniform("uSolidAngle"),
-                    static_cast<float>(params.getFloat("ssbc_solid_angle")));
-        glUniform1f(mIntegrate.uniform("uDiscAngle"),
-                    static_cast<float>(params.getFloat("ssbc_discontinuity_angle")));
-        glUniform1i(mIntegrate.uniform("uMaxVisited"), kMaxVisited);
-        glUniform1i(mIntegrate.uniform("uSlot"), k);
-        glUniform1i(mIntegrate.uniform("uReceiverLevel"), half ? 1 : 0);
-        glBindTextureUnit(0, mGeo.id());
-        glBindTextureUnit(1, mNormal.id());
-        glBindTextureUnit(2, mIllum[src].id());
-        glBindTextureUnit(3, in.find("gbuffer.albedo")->id());
-        glBindImageTexture(0, target.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(1, mIllum[dst].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        if (half) {
-            // Half resolution: the integrate writes only mHalf, its counters go to mHalfSums.
-            glBindImageTexture(2, mHalf.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mHalfSums.id());
-            glDispatchCompute(static_cast<GLuint>(halfGroupsX), static_cast<GLuint>(halfGroupsY), 1);
-        } else {
-            glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
+        {
+            gl::Pass pass(timer, "ssbc_integrate_" + std::to_string(k));
+            const IntegrateProgram& p = mIntegrate;
+            pass.use(p.program)
+                .set(p.b, static_cast<float>(b))
+                .set(p.r, r)
+                .set(p.tanHalfFov, tanHalfFov)
+                .set(p.levels, levels)
+                .set(p.solidAngle, static_cast<float>(params.getFloat("ssbc_solid_angle")))
+                .set(p.discAngle, static_cast<float>(params.getFloat("ssbc_discontinuity_angle")))
+                .set(p.maxVisited, kMaxVisited)
+                .set(p.slot, k)
+                .set(p.receiverLevel, half ? 1 : 0);
+            pass.texture(p.geo, mGeo)
+                .texture(p.normal, mNormal)
+                .texture(p.illum, mIllum[src])
+                .texture(p.albedo, albedo);
+            pass.image(p.indirect, target, GL_READ_WRITE).image(p.nextIllum, mIllum[dst], GL_WRITE_ONLY);
+            if (half) {
+                // Half resolution: the integrate writes only mHalf, its counters go to mHalfSums.
+                pass.image(p.halfOut, mHalf, GL_WRITE_ONLY).buffer(p.sums, mHalfSums);
+                pass.dispatch(halfGroupsX, halfGroupsY);
+            } else {
+                pass.buffer(p.sums, mSums).dispatch(groupsX, groupsY);
+            }
+            pass.barrier(stepBarrier);
         }
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                        GL_BUFFER_UPDATE_BARRIER_BIT);
-        timer.end();
         if (half) {
-            timer.begin("ssbc_upsample_" + std::to_string(k));
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mSums.id());
-            glUseProgram(mUpsample.id());
-            glUniform1i(mUpsample.uniform("uSlot"), k);
-            glBindTextureUnit(0, mGeo.id());
-            glBindTextureUnit(1, mNormal.id());
-            glBindTextureUnit(2, mHalf.id());
-            glBindTextureUnit(3, in.find("gbuffer.albedo")->id());
-            glBindImageTexture(0, target.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-            glBindImageTexture(1, mIllum[dst].id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-            glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                            GL_BUFFER_UPDATE_BARRIER_BIT);
-            timer.end();
+            gl::Pass pass(timer, "ssbc_upsample_" + std::to_string(k));
+            const UpsampleProgram& p = mUpsample;
+            pass.use(p.program).set(p.slot, k).buffer(p.sums, mSums);
+            pass.texture(p.geo, mGeo)
+                .texture(p.normal, mNormal)
+                .texture(p.half, mHalf)
+                .texture(p.albedo, albedo);
+            pass.image(p.target, target, GL_READ_WRITE).image(p.nextIllum, mIllum[dst], GL_WRITE_ONLY);
+            pass.dispatch(groupsX, groupsY).barrier(stepBarrier);
         }
     }
 
     if (blur) {
-        timer.begin("ssbc_blur");
-        glUseProgram(mBlur.id());
-        glBindTextureUnit(0, mGeo.id());
-        glBindTextureUnit(1, mNormal.id());
+        gl::Pass pass(timer, "ssbc_blur");
+        const BlurProgram& p = mBlur;
+        const GLbitfield blurBarrier = GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT;
+        pass.use(p.program).texture(p.geo, mGeo).texture(p.normal, mNormal).buffer(p.sums, mSums);
         // Pass 0: mAccum / W -> mBlurTmp; pass 1: gather into the indirect radiance.
-        glUniform1i(mBlur.uniform("uPass"), 0);
-        glBindTextureUnit(2, mAccum.id());
-        glBindImageTexture(0, mBlurTmp.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glDispatchCompute(static_cast<GLuint>(groupsFor(in.width)), static_cast<GLuint>(groupsFor(in.height)),
-                          1);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-        glUniform1i(mBlur.uniform("uPass"), 1);
-        glBindTextureUnit(2, mBlurTmp.id());
-        glBindImageTexture(0, indirect.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glDispatchCompute(static_cast<GLuint>(groupsFor(in.width)), static_cast<GLuint>(groupsFor(in.height)),
-                          1);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-        timer.end();
+        pass.set(p.pass, 0).texture(p.source, mAccum).image(p.out, mBlurTmp, GL_WRITE_ONLY);
+        pass.dispatch(groupsFor(in.width), groupsFor(in.height)).barrier(blurBarrier);
+        pass.set(p.pass, 1).texture(p.source, mBlurTmp).image(p.out, indirect, GL_READ_WRITE);
+        pass.dispatch(groupsFor(in.width), groupsFor(in.height)).barrier(blurBarrier);
     }
 
     // Counters: one read-back of the per-group sums (synchronises with the last step).
@@ -273,7 +319,6 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
     counters["ssbc_samples_mean"] = covered > 0 ? visited / covered : 0.0;
     counters["ssbc_samples_max"] = maxVisited;
     counters["ssbc_levels"] = levels;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
 }
 
 } // namespace gis

@@ -73,6 +73,7 @@
 #include "gi/Technique.h"
 #include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
+#include "gl/Pass.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 
@@ -84,8 +85,6 @@ namespace gis {
 
 /// 1/b for vpl_transport.glsl's uVplInvClampB (0: clamp off).
 float vplInverseClampB(const ParamSet& params);
-/// Sets uVplInvClampB on `program` (bound or not) from clamp_b.
-void setVplClamp(const gl::Program& program, const ParamSet& params);
 
 class BiasCompensation {
 public:
@@ -97,9 +96,41 @@ public:
 
 private:
     void ensure(int width, int height, int levels);
-    void reduce(int mode, int illumIndex);
+    void reduce(gl::Pass& pass, int mode, int illumIndex);
 
-    gl::Program mBase, mReduce, mIntegrate, mUpsample, mBlur;
+    struct BaseProgram {
+        gl::Program program;
+        gl::UniformLocation tanHalfFov, forward, cosGrazing, withIndirect;
+        gl::TextureUnit position, normal, direct, indirect;
+        gl::ImageUnit geoOut, normalOut, illumOut;
+        gl::BlockBinding sums;
+    } mBase;
+    struct ReduceProgram {
+        gl::Program program;
+        gl::UniformLocation level, mode, outSize, childReal;
+        gl::ImageUnit geoIn, geoOut, normalIn, normalOut, illumIn, illumOut;
+    } mReduce;
+    struct IntegrateProgram {
+        gl::Program program;
+        gl::UniformLocation b, r, tanHalfFov, levels, solidAngle, discAngle, maxVisited, slot, receiverLevel;
+        gl::TextureUnit geo, normal, illum, albedo;
+        gl::ImageUnit indirect, nextIllum, halfOut;
+        gl::BlockBinding sums;
+    } mIntegrate;
+    struct UpsampleProgram {
+        gl::Program program;
+        gl::UniformLocation slot;
+        gl::TextureUnit geo, normal, half, albedo;
+        gl::ImageUnit target, nextIllum;
+        gl::BlockBinding sums;
+    } mUpsample;
+    struct BlurProgram {
+        gl::Program program;
+        gl::UniformLocation pass;
+        gl::TextureUnit geo, normal, source;
+        gl::ImageUnit out;
+        gl::BlockBinding sums;
+    } mBlur;
     gl::Texture mGeo, mNormal, mIllum[2];
     gl::Texture mAccum, mBlurTmp; // ssbc_blur: summed compensation, and it over its kernel weight
     gl::Texture mHalf;            // ssbc_half_resolution: one step's compensation per 2x2 block

@@ -24,22 +24,72 @@ std::vector<EyeLevel> eyeLevelLayout(int width, int height, int coarsestSize, in
     return levels;
 }
 
+EyeInputHandles::EyeInputHandles(const gl::Program& p) {
+    auto unit = [&](const char* name) {
+        return p.declares(name) ? p.optionalTextureUnit(name) : gl::TextureUnit{gl::kNoUnit};
+    };
+    geoPosition = unit("uGeoPosition");
+    geoNormal = unit("uGeoNormal");
+    pixelPosition = unit("gPosition");
+    pixelNormal = unit("gNormal");
+    pixelAlbedo = unit("gAlbedo");
+    atlasPosition = unit("uAtlasPosition");
+    atlasNormal = unit("uAtlasNormal");
+    atlasAlbedo = unit("uAtlasAlbedo");
+}
+
+EyeHierarchy::ReduceProgram::ReduceProgram(gl::Program built)
+    : program(std::move(built)), level(program.location("uLevel")),
+      // Level 1 (GIS_FROM_GBUFFER) reads the G-buffer instead of the level below.
+      geo{program.optionalTextureUnit("uGeoPosition"), program.optionalTextureUnit("uGeoNormal"),
+          program.optionalTextureUnit("uGeoAlbedo"),   program.optionalTextureUnit("uDepthInfo"),
+          program.optionalTextureUnit("uNormalMin"),   program.optionalTextureUnit("uNormalMax")},
+      inputs(program) {}
+
 EyeHierarchy::EyeHierarchy() {
     // Every pass is a full-screen draw clipped by the viewport to one level: llvmpipe shades
     // fragments faster than it runs image load/store compute (the mipmap: 36 ms as compute, 23 ms
     // as fragments at 512^2).
-    const auto pass = [](const char* fragment) {
+    const auto build = [](const char* fragment,
+                          const std::vector<std::pair<std::string, std::string>>& defines = {}) {
         return gl::Program::build(
-            {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, fragment}});
+            {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, fragment}}, defines);
     };
-    mReduceFromPixels = gl::Program::build(
-        {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/common/eye_mip_reduce.frag"}},
-        {{"GIS_FROM_GBUFFER", "1"}});
-    mReduce = pass("gi/common/eye_mip_reduce.frag");
-    mFlagsProgram = pass("gi/common/eye_flags.frag");
-    mReceivers = pass("gi/common/eye_receivers.frag");
-    mUpsample = pass("gi/common/eye_upsample.frag");
-    mResolve = pass("gi/common/eye_resolve.frag");
+    mReduceFromPixels =
+        std::make_unique<ReduceProgram>(build("gi/common/eye_mip_reduce.frag", {{"GIS_FROM_GBUFFER", "1"}}));
+    mReduce = std::make_unique<ReduceProgram>(build("gi/common/eye_mip_reduce.frag"));
+
+    mFlagsProgram.program = build("gi/common/eye_flags.frag");
+    mFlagsProgram.discFlags = mFlagsProgram.program.textureUnit("uDiscFlags");
+
+    ReceiversProgram& r = mReceivers;
+    r.program = build("gi/common/eye_receivers.frag");
+    r.flags = r.program.textureUnit("uFlags");
+    r.counts = r.program.storageBlock("ReceiverCounts");
+    r.inputs = EyeInputHandles(r.program);
+
+    UpsampleProgram& u = mUpsample;
+    u.program = build("gi/common/eye_upsample.frag");
+    u.interpolate = u.program.location("uInterpolate");
+    u.level = u.program.location("uLevel");
+    u.rendered = u.program.textureUnit("uRendered");
+    u.reconstructed = u.program.textureUnit("uReconstructed");
+    u.atlasPosition = u.program.textureUnit("uAtlasPosition");
+    u.atlasNormal = u.program.textureUnit("uAtlasNormal");
+
+    ResolveProgram& v = mResolve;
+    v.program = build("gi/common/eye_resolve.frag");
+    v.irradiance = v.program.location("uIrradiance");
+    v.interpolate = v.program.location("uInterpolate");
+    v.detailAlpha = v.program.location("uDetailAlpha");
+    v.position = v.program.textureUnit("gPosition");
+    v.normal = v.program.textureUnit("gNormal");
+    v.albedo = v.program.textureUnit("gAlbedo");
+    v.reconstructed = v.program.textureUnit("uReconstructed");
+    v.rendered = v.program.textureUnit("uRendered");
+    v.atlasPosition = v.program.optionalTextureUnit("uAtlasPosition");
+    v.atlasNormal = v.program.optionalTextureUnit("uAtlasNormal");
+
     mEmptyVao = gl::VertexArray::create();
     mUbo = gl::Buffer::create(sizeof(shader::EyeHierarchyUniforms));
     mCounts = gl::Buffer::create(sizeof(mLastCounts), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
@@ -104,31 +154,23 @@ void EyeHierarchy::uploadUniforms(const ParamSet& params) {
     mUbo.upload(0, sizeof u, &u);
 }
 
-void EyeHierarchy::beginIlluminationPass(const FrameInputs& in, bool stencil) const {
-    glBindFramebuffer(GL_FRAMEBUFFER, mIllumFbo.id());
-    glViewport(0, 0, mAtlasWidth, mAtlasHeight);
-    glBindTextureUnit(0, mGeoPosition.id());
-    glBindTextureUnit(1, mGeoNormal.id());
-    bindPixels(in);
-    glBindVertexArray(mEmptyVao.id());
-    if (stencil) {
-        glEnable(GL_STENCIL_TEST);
-        glStencilFunc(GL_EQUAL, 1, 0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-    }
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+void EyeHierarchy::beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& handles,
+                                         const FrameInputs& in, bool stencil) const {
+    pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight);
+    bindInputs(pass, handles, in);
+    if (stencil) pass.stencil(GL_EQUAL, 1, GL_KEEP, GL_KEEP, GL_KEEP);
+    pass.blend(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
 }
 
-void EyeHierarchy::endIlluminationPass() const {
-    glDisable(GL_BLEND);
-    glDisable(GL_STENCIL_TEST);
-}
-
-void EyeHierarchy::bindPixels(const FrameInputs& in) const {
-    glBindTextureUnit(8, in.find("gbuffer.position")->id());
-    glBindTextureUnit(9, in.find("gbuffer.normal")->id());
-    glBindTextureUnit(10, in.find("gbuffer.albedo")->id());
+void EyeHierarchy::bindInputs(gl::Pass& pass, const EyeInputHandles& h, const FrameInputs& in) const {
+    pass.texture(h.geoPosition, mGeoPosition)
+        .texture(h.geoNormal, mGeoNormal)
+        .texture(h.atlasPosition, mGeoPosition)
+        .texture(h.atlasNormal, mGeoNormal)
+        .texture(h.atlasAlbedo, mGeoAlbedo)
+        .texture(h.pixelPosition, in.get("gbuffer.position"))
+        .texture(h.pixelNormal, in.get("gbuffer.normal"))
+        .texture(h.pixelAlbedo, in.get("gbuffer.albedo"));
 }
 
 void EyeHierarchy::bindUniforms() const {
@@ -140,55 +182,41 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     uploadUniforms(params);
     bindUniforms();
 
-    timer.begin("eye_mipmap");
-    glBindVertexArray(mEmptyVao.id());
-    glBindFramebuffer(GL_FRAMEBUFFER, mGeoFbo.id());
-    bindPixels(in);
-    const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
-                                 &mDepthInfo,   &mNormalMin, &mNormalMax};
-    for (int i = 0; i < 6; ++i) glBindTextureUnit(static_cast<GLuint>(i), geo[i]->id());
-    for (size_t l = 1; l < mLevels.size(); ++l) {
-        const gl::Program& program = l == 1 ? mReduceFromPixels : mReduce;
-        glUseProgram(program.id());
-        glTextureBarrier(); // level l - 1 is complete before level l reads it
-        glUniform1i(program.uniform("uLevel"), static_cast<int>(l));
-        glViewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+    {
+        gl::Pass pass(timer, "eye_mipmap");
+        pass.target(mGeoFbo, mAtlasWidth, mAtlasHeight);
+        const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
+                                     &mDepthInfo,   &mNormalMin, &mNormalMax};
+        for (int i = 0; i < 6; ++i) pass.texture(mReduce->geo[static_cast<size_t>(i)], *geo[i]);
+        bindInputs(pass, mReduceFromPixels->inputs, in);
+        for (size_t l = 1; l < mLevels.size(); ++l) {
+            const ReduceProgram& program = l == 1 ? *mReduceFromPixels : *mReduce;
+            pass.use(program.program).textureBarrier(); // level l - 1 is complete before level l reads it
+            pass.set(program.level, static_cast<int>(l))
+                .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
+                .drawFullscreen(mEmptyVao);
+        }
     }
-    timer.end();
 
     // The diagonal rule reads neighbours' discontinuity marks, so the flags follow the mipmap.
-    timer.begin("refine_flags");
-    if (mLevels.size() > 1) {
-        glBindFramebuffer(GL_FRAMEBUFFER, mFlagsFbo.id());
-        glUseProgram(mFlagsProgram.id());
-        glBindTextureUnit(7, mDiscFlags.id());
-        glViewport(mWidth, 0, mAtlasWidth - mWidth, mAtlasHeight); // the level column only
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+    {
+        gl::Pass pass(timer, "refine_flags");
+        if (mLevels.size() > 1) {
+            pass.target(mFlagsFbo, mAtlasWidth, mAtlasHeight)
+                .use(mFlagsProgram.program)
+                .texture(mFlagsProgram.discFlags, mDiscFlags)
+                .viewport(mWidth, 0, mAtlasWidth - mWidth, mAtlasHeight) // the level column only
+                .drawFullscreen(mEmptyVao);
+        }
     }
-    timer.end();
 
-    timer.begin("stencil_setup");
-    glBindFramebuffer(GL_FRAMEBUFFER, mIllumFbo.id());
-    glViewport(0, 0, mAtlasWidth, mAtlasHeight);
-    const float zero[4] = {0, 0, 0, 0};
-    glClearNamedFramebufferfv(mIllumFbo.id(), GL_COLOR, 0, zero);
-    glClearNamedFramebufferfi(mIllumFbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    gl::Pass pass(timer, "stencil_setup");
+    pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight).clearColor(1).clearDepthStencil(1.0f, 0);
     const GLuint zeroCounts[GIS_MAX_EYE_LEVELS] = {};
     mCounts.upload(0, sizeof zeroCounts, zeroCounts);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mCounts.id());
-    glUseProgram(mReceivers.id());
-    glBindTextureUnit(6, mFlags.id());
-    bindPixels(in);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glEnable(GL_STENCIL_TEST);
-    glStencilFunc(GL_ALWAYS, 1, 0xFF);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-    glBindVertexArray(mEmptyVao.id());
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDisable(GL_STENCIL_TEST);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    timer.end();
+    pass.use(mReceivers.program).buffer(mReceivers.counts, mCounts).texture(mReceivers.flags, mFlags);
+    bindInputs(pass, mReceivers.inputs, in);
+    pass.noColorWrites().stencil(GL_ALWAYS, 1, GL_KEEP, GL_KEEP, GL_REPLACE).drawFullscreen(mEmptyVao);
 }
 
 void EyeHierarchy::countReceivers(Counters& counters, int coveredPixels) {
@@ -208,35 +236,32 @@ void EyeHierarchy::countReceivers(Counters& counters, int coveredPixels) {
 void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bool irradiance,
                                const gl::Framebuffer& indirectTarget, gl::PassTimer& timer) {
     bindUniforms();
-    timer.begin("upsample");
-    glBindVertexArray(mEmptyVao.id());
-    glBindFramebuffer(GL_FRAMEBUFFER, mReconFbo.id());
-    glUseProgram(mUpsample.id());
-    glUniform1i(mUpsample.uniform("uInterpolate"), irradiance ? 1 : 0);
-    glBindTextureUnit(0, mIllumination.id());
-    glBindTextureUnit(1, mReconstructed.id());
-    glBindTextureUnit(11, mGeoPosition.id()); // receiver geometry for the upsampling's edge weights
-    glBindTextureUnit(12, mGeoNormal.id());
+    gl::Pass pass(timer, "upsample");
+    const UpsampleProgram& u = mUpsample;
+    pass.target(mReconFbo, mAtlasWidth, mAtlasHeight).use(u.program).set(u.interpolate, irradiance ? 1 : 0);
+    pass.texture(u.rendered, mIllumination)
+        .texture(u.reconstructed, mReconstructed)
+        .texture(u.atlasPosition, mGeoPosition) // receiver geometry for the upsampling's edge weights
+        .texture(u.atlasNormal, mGeoNormal);
     for (int l = static_cast<int>(mLevels.size()) - 1; l >= 1; --l) {
-        glTextureBarrier(); // level l + 1 is complete before level l reads it
-        glUniform1i(mUpsample.uniform("uLevel"), l);
-        glViewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        pass.textureBarrier(); // level l + 1 is complete before level l reads it
+        pass.set(u.level, l)
+            .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
+            .drawFullscreen(mEmptyVao);
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, indirectTarget.id());
-    glViewport(0, 0, in.width, in.height);
-    glUseProgram(mResolve.id());
-    glUniform1i(mResolve.uniform("uIrradiance"), irradiance ? 1 : 0);
-    glUniform1i(mResolve.uniform("uInterpolate"), irradiance ? 1 : 0);
-    glUniform1f(mResolve.uniform("uDetailAlpha"), static_cast<float>(params.getFloat("detail_alpha")));
-    glBindTextureUnit(0, in.find("gbuffer.position")->id());
-    glBindTextureUnit(1, in.find("gbuffer.normal")->id());
-    glBindTextureUnit(2, in.find("gbuffer.albedo")->id());
-    glBindTextureUnit(3, mReconstructed.id());
-    glBindTextureUnit(4, mIllumination.id());
-    glTextureBarrier();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    timer.end();
+    const ResolveProgram& v = mResolve;
+    pass.target(indirectTarget, in.width, in.height).use(v.program);
+    pass.set(v.irradiance, irradiance ? 1 : 0)
+        .set(v.interpolate, irradiance ? 1 : 0)
+        .set(v.detailAlpha, static_cast<float>(params.getFloat("detail_alpha")));
+    pass.texture(v.position, in.get("gbuffer.position"))
+        .texture(v.normal, in.get("gbuffer.normal"))
+        .texture(v.albedo, in.get("gbuffer.albedo"))
+        .texture(v.reconstructed, mReconstructed)
+        .texture(v.rendered, mIllumination)
+        .texture(v.atlasPosition, mGeoPosition)
+        .texture(v.atlasNormal, mGeoNormal);
+    pass.textureBarrier().drawFullscreen(mEmptyVao);
 }
 
 std::vector<std::array<int, 3>> EyeHierarchy::readReceiverSet() const {

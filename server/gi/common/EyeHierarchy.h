@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "gi/Technique.h"
 #include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
+#include "gl/Pass.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 #include "gl/ShaderShared.h"
@@ -34,6 +36,18 @@ struct EyeLevel {
 /// others stacked in a column to its right. Pure, so tests can check it without GL.
 std::vector<EyeLevel> eyeLevelLayout(int width, int height, int coarsestSize, int* atlasWidth,
                                      int* atlasHeight);
+
+/// The hierarchy's textures a receiving program samples, by the names the shared includes give them:
+/// the atlas means of a gather (uGeoPosition, uGeoNormal), level 0's G-buffer pixels
+/// (eye_pixel.glsl: gPosition, gNormal, gAlbedo) and the coarse patches (eye_patch.glsl:
+/// uAtlasPosition, uAtlasNormal, uAtlasAlbedo). Names the program does not declare stay unbound.
+struct EyeInputHandles {
+    EyeInputHandles() = default;
+    explicit EyeInputHandles(const gl::Program& program);
+    gl::TextureUnit geoPosition{gl::kNoUnit}, geoNormal{gl::kNoUnit};
+    gl::TextureUnit pixelPosition{gl::kNoUnit}, pixelNormal{gl::kNoUnit}, pixelAlbedo{gl::kNoUnit};
+    gl::TextureUnit atlasPosition{gl::kNoUnit}, atlasNormal{gl::kNoUnit}, atlasAlbedo{gl::kNoUnit};
+};
 
 class EyeHierarchy {
 public:
@@ -61,16 +75,17 @@ public:
     const gl::Texture& geoNormal() const { return mGeoNormal; }
     const gl::Texture& geoAlbedo() const { return mGeoAlbedo; }
     const gl::Texture& flags() const { return mFlags; }
-    /// State every pass that lights receivers shares: the illumination atlas as target, the atlas
-    /// geometry at units 0 and 1, the G-buffer (level 0) via bindPixels, an empty VAO, additive rgb
-    /// with alpha marking data, and (`stencil`) the receiver stencil test. Undone by
-    /// endIlluminationPass().
-    void beginIlluminationPass(const FrameInputs& in, bool stencil) const;
-    void endIlluminationPass() const;
+    /// State every pass that lights receivers shares, set on `pass` (its program in use): the
+    /// illumination atlas as target, the hierarchy's textures the program reads (bindInputs),
+    /// additive rgb with alpha marking data, and (`stencil`) the receiver stencil test. The pass
+    /// undoes it at its end.
+    void beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& handles, const FrameInputs& in,
+                               bool stencil) const;
     /// Binds the hierarchy's uniform block at GIS_UBO_EYE (every pass using eye_hierarchy.glsl).
     void bindUniforms() const;
-    /// Binds the G-buffer (level 0) at units 8, 9, 10 as eye_pixel.glsl expects.
-    void bindPixels(const FrameInputs& in) const;
+    /// Binds the hierarchy's textures and the G-buffer (level 0) where `handles` name them.
+    void bindInputs(gl::Pass& pass, const EyeInputHandles& handles, const FrameInputs& in) const;
+    const gl::VertexArray& emptyVao() const { return mEmptyVao; }
     const std::array<unsigned, GIS_MAX_EYE_LEVELS>& lastReceiverCounts() const { return mLastCounts; }
 
     /// Test hook: the receiver stencil read back as (level, x, y) triples, sorted.
@@ -79,7 +94,38 @@ public:
 private:
     void uploadUniforms(const ParamSet& params);
 
-    gl::Program mReduceFromPixels, mReduce, mFlagsProgram, mReceivers, mUpsample, mResolve;
+    struct ReduceProgram {
+        explicit ReduceProgram(gl::Program built);
+        gl::Program program;
+        gl::UniformLocation level;
+        std::array<gl::TextureUnit, 6> geo; ///< position, normal, albedo, depth info, normal min, max
+        EyeInputHandles inputs;
+    };
+    struct FlagsProgram {
+        gl::Program program;
+        gl::TextureUnit discFlags;
+    };
+    struct ReceiversProgram {
+        gl::Program program;
+        gl::TextureUnit flags;
+        gl::BlockBinding counts;
+        EyeInputHandles inputs;
+    };
+    struct UpsampleProgram {
+        gl::Program program;
+        gl::UniformLocation interpolate, level;
+        gl::TextureUnit rendered, reconstructed, atlasPosition, atlasNormal;
+    };
+    struct ResolveProgram {
+        gl::Program program;
+        gl::UniformLocation irradiance, interpolate, detailAlpha;
+        gl::TextureUnit position, normal, albedo, reconstructed, rendered, atlasPosition, atlasNormal;
+    };
+    std::unique_ptr<ReduceProgram> mReduceFromPixels, mReduce;
+    FlagsProgram mFlagsProgram;
+    ReceiversProgram mReceivers;
+    UpsampleProgram mUpsample;
+    ResolveProgram mResolve;
     gl::VertexArray mEmptyVao;
     gl::Buffer mUbo, mCounts;
     std::vector<EyeLevel> mLevels;

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/Error.h"
+#include "gl/Pass.h"
 
 namespace gis {
 
@@ -26,7 +27,13 @@ int lightLevelForResolution(const std::vector<LightLevel>& levels, int resolutio
 }
 
 LightTree::LightTree() {
-    mBuild = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/light_tree_build.comp"}});
+    gl::Program p = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/light_tree_build.comp"}});
+    mBuild = {{},
+              p.location("uLevel"),
+              p.textureUnit("uRsmPosition"),
+              p.textureUnit("uRsmNormal"),
+              p.textureUnit("uRsmFlux")};
+    mBuild.program = std::move(p);
     mUbo = gl::Buffer::create(sizeof(shader::LightTreeUniforms));
 }
 
@@ -59,22 +66,21 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
     counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);
     if (!in.lightEnabled) return;
 
-    timer.begin("light_tree");
-    glUseProgram(mBuild.id());
-    bind();
-    glBindTextureUnit(0, in.find(FrameResources::light(0, "rsm.position"))->id());
-    glBindTextureUnit(1, in.find(FrameResources::light(0, "rsm.normal"))->id());
-    glBindTextureUnit(2, in.find(FrameResources::light(0, "rsm.flux"))->id());
-    const GLint levelLoc = mBuild.uniform("uLevel");
-    // Level 1's dispatch writes level 0 too (light_tree_build.comp); then one dispatch per level.
-    for (size_t l = 1; l < mLevels.size(); ++l) {
-        if (l > 1) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); // level l - 1 is complete
-        glUniform1i(levelLoc, static_cast<int>(l));
-        const int count = mLevels[l].side * mLevels[l].side;
-        glDispatchCompute(static_cast<GLuint>((count + 63) / 64), 1, 1);
+    {
+        gl::Pass pass(timer, "light_tree");
+        pass.use(mBuild.program);
+        bind();
+        pass.texture(mBuild.position, in.light(0, "rsm.position"))
+            .texture(mBuild.normal, in.light(0, "rsm.normal"))
+            .texture(mBuild.flux, in.light(0, "rsm.flux"));
+        // Level 1's dispatch writes level 0 too (light_tree_build.comp); then one dispatch per level.
+        for (size_t l = 1; l < mLevels.size(); ++l) {
+            if (l > 1) pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT); // level l - 1 is complete
+            const int count = mLevels[l].side * mLevels[l].side;
+            pass.set(mBuild.level, static_cast<int>(l)).dispatch((count + 63) / 64);
+        }
+        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    timer.end();
     mValid = true;
 }
 

@@ -58,7 +58,11 @@ public:
 private:
     void ensureLayout(int rsmSize);
 
-    gl::Program mBuild;
+    struct BuildProgram {
+        gl::Program program;
+        gl::UniformLocation level;
+        gl::TextureUnit position, normal, flux;
+    } mBuild;
     gl::Buffer mNodes, mUbo;
     std::vector<LightLevel> mLevels;
     int mRsmSize = 0;

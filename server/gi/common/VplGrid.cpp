@@ -7,19 +7,42 @@
 
 namespace gis {
 
-KernelPrograms::KernelPrograms(const std::vector<gl::ShaderStage>& stages,
-                               const std::vector<std::pair<std::string, std::string>>& defines) {
-    auto with = [&](const char* kernel) {
-        auto all = defines;
-        all.emplace_back("GIS_VPL_KERNEL", kernel);
-        return all;
-    };
-    mPoint = gl::Program::build(stages, with("GIS_KERNEL_POINT"));
-    mDisk = gl::Program::build(stages, with("GIS_KERNEL_DISK"));
+std::vector<std::pair<std::string, std::string>>
+kernelDefines(VplKernel kernel, const std::vector<std::pair<std::string, std::string>>& defines) {
+    auto all = defines;
+    all.emplace_back("GIS_VPL_KERNEL", kernel == VplKernel::Disk ? "GIS_KERNEL_DISK" : "GIS_KERNEL_POINT");
+    return all;
+}
+
+VplTransportHandles::VplTransportHandles(const gl::Program& program)
+    : invClampB(program.optionalLocation("uVplInvClampB")), hasGlossy(program.declares("uGlossy")) {
+    if (hasGlossy) {
+        glossy = program.optionalLocation("uGlossy");
+        glossyMinRoughness = program.optionalLocation("uGlossyMinRoughness");
+        glossyVpls = program.optionalStorageBlock("VplGlossyBuffer");
+    }
+}
+
+void VplTransportHandles::set(gl::Pass& pass, const ParamSet& params, bool glossyOn, float minRoughness,
+                              const gl::Buffer* glossyData) const {
+    pass.set(invClampB, vplInverseClampB(params));
+    if (!hasGlossy) return;
+    pass.set(glossy, glossyOn ? 1 : 0).set(glossyMinRoughness, minRoughness);
+    if (glossyOn && glossyData) pass.buffer(glossyVpls, *glossyData);
 }
 
 VplGrid::VplGrid() {
-    mExtract = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/vpl_extract.comp"}});
+    gl::Program p = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/vpl_extract.comp"}});
+    mExtract = {{},
+                p.location("uGrid"),
+                p.location("uRsmSize"),
+                p.textureUnit("gRsmPosition"),
+                p.textureUnit("gRsmNormal"),
+                p.textureUnit("gRsmFlux"),
+                p.textureUnit("gRsmSpecular"),
+                p.storageBlock("VplOut"),
+                p.storageBlock("VplGlossyOut")};
+    mExtract.program = std::move(p);
 }
 
 int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Counters& counters) {
@@ -32,21 +55,15 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
     if (mGlossy.size() < glossyBytes) mGlossy = gl::Buffer::create(glossyBytes);
     if (mCount == 0) return 0;
 
-    timer.begin("vpl_extract");
-    glUseProgram(mExtract.id());
-    glUniform1i(mExtract.uniform("uGrid"), grid);
-    glUniform1i(mExtract.uniform("uRsmSize"), in.rsmSize);
-    glBindTextureUnit(0, in.find(FrameResources::light(0, "rsm.position"))->id());
-    glBindTextureUnit(1, in.find(FrameResources::light(0, "rsm.normal"))->id());
-    glBindTextureUnit(2, in.find(FrameResources::light(0, "rsm.flux"))->id());
-    glBindTextureUnit(3, in.find(FrameResources::light(0, "rsm.specular"))
-                             ? in.find(FrameResources::light(0, "rsm.specular"))->id()
-                             : 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mGlossy.id());
-    glDispatchCompute(static_cast<GLuint>((mCount + 63) / 64), 1, 1);
-    glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    timer.end();
+    const ExtractProgram& e = mExtract;
+    gl::Pass pass(timer, "vpl_extract");
+    pass.use(e.program).set(e.grid, grid).set(e.rsmSize, in.rsmSize);
+    pass.texture(e.position, in.light(0, "rsm.position"))
+        .texture(e.normal, in.light(0, "rsm.normal"))
+        .texture(e.flux, in.light(0, "rsm.flux"))
+        .texture(e.specular, in.find(FrameResources::light(0, "rsm.specular")));
+    pass.buffer(e.vpls, mVpls).buffer(e.glossy, mGlossy);
+    pass.dispatch((mCount + 63) / 64).barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     return mCount;
 }
 

@@ -4,27 +4,52 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/Param.h"
 #include "gi/Technique.h"
 #include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
+#include "gl/Pass.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 
 namespace gis {
 
-/// One program per kernel, built with GIS_VPL_KERNEL defined (see vpl_transport.glsl).
-class KernelPrograms {
+/// The defines of one kernel variant: `defines` plus GIS_VPL_KERNEL (see vpl_transport.glsl).
+std::vector<std::pair<std::string, std::string>>
+kernelDefines(VplKernel kernel, const std::vector<std::pair<std::string, std::string>>& defines);
+
+/// One program per kernel, built with GIS_VPL_KERNEL defined. `P` holds a program and the handles
+/// it resolved: it is constructed from the built gl::Program (so a bad name fails here).
+template <class P> class KernelPrograms {
 public:
     KernelPrograms() = default;
     explicit KernelPrograms(const std::vector<gl::ShaderStage>& stages,
-                            const std::vector<std::pair<std::string, std::string>>& defines = {});
-    const gl::Program& get(VplKernel kernel) const { return kernel == VplKernel::Disk ? mDisk : mPoint; }
+                            const std::vector<std::pair<std::string, std::string>>& defines = {})
+        : mPoint(std::make_unique<P>(gl::Program::build(stages, kernelDefines(VplKernel::Point, defines)))),
+          mDisk(std::make_unique<P>(gl::Program::build(stages, kernelDefines(VplKernel::Disk, defines)))) {}
+    const P& get(VplKernel kernel) const { return kernel == VplKernel::Disk ? *mDisk : *mPoint; }
 
 private:
-    gl::Program mPoint, mDisk;
+    std::unique_ptr<P> mPoint, mDisk;
+};
+
+/// The uniforms every VPL receiver program shares through vpl_transport.glsl and
+/// vpl_glossy.glsl, resolved once (optional: a program may include a file and not use all of it).
+struct VplTransportHandles {
+    VplTransportHandles() = default;
+    /// Resolves the glossy uniforms when a source of `program` declares them (vpl_glossy.glsl).
+    explicit VplTransportHandles(const gl::Program& program);
+    gl::UniformLocation invClampB;                  ///< 1/b (m^-2), 0: no clamp
+    gl::UniformLocation glossy, glossyMinRoughness; ///< vpl_glossy.glsl (when built with it)
+    gl::BlockBinding glossyVpls;                    ///< VplGlossyBuffer (when built with it)
+    bool hasGlossy = false;
+    /// Sets the clamp from clamp_b and, with vpl_glossy.glsl, the glossy switch; binds the glossy
+    /// VPL data when `glossyOn`.
+    void set(gl::Pass& pass, const ParamSet& params, bool glossyOn, float minRoughness,
+             const gl::Buffer* glossyData) const;
 };
 
 /// Binds the first `count` VPLs of `vpls` batch by batch (GIS_MAX_VPLS_PER_BATCH each) at
@@ -46,7 +71,12 @@ public:
     int forEachBatch(const std::function<void(int batchCount)>& draw) const;
 
 private:
-    gl::Program mExtract;
+    struct ExtractProgram {
+        gl::Program program;
+        gl::UniformLocation grid, rsmSize;
+        gl::TextureUnit position, normal, flux, specular;
+        gl::BlockBinding vpls, glossy;
+    } mExtract;
     gl::Buffer mVpls;
     gl::Buffer mGlossy;
     int mCount = 0;

@@ -4,9 +4,16 @@
 
 namespace gis {
 
+VplShadowHandles::VplShadowHandles(const gl::Program& p)
+    : enabled(p.optionalLocation("uVplShadows")), shadowed(p.optionalLocation("uVplShadowed")),
+      far(p.optionalLocation("uVplShadowFar")), bias(p.optionalLocation("uVplShadowBias")),
+      maps(p.optionalTextureUnit("uVplShadowMaps")) {}
+
 VplShadows::VplShadows() {
-    mProgram = gl::Program::build(
+    gl::Program p = gl::Program::build(
         {{GL_VERTEX_SHADER, "gi/common/vpl_shadow.vert"}, {GL_FRAGMENT_SHADER, "gi/common/vpl_shadow.frag"}});
+    mProgram = {{}, p.location("uFirstVpl"), p.location("uFar"), p.storageBlock("VplBuffer")};
+    mProgram.program = std::move(p);
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &mMaxLayers);
 }
 
@@ -27,31 +34,25 @@ int VplShadows::render(const FrameInputs& in, const ParamSet& params, const gl::
         mSize = size;
         mLayers = layers;
     }
-    timer.begin("vpl_shadows");
-    glBindFramebuffer(GL_FRAMEBUFFER, mFbo.id());
-    glViewport(0, 0, size, size);
-    const float one = 1.0f;
-    glClearNamedFramebufferfv(mFbo.id(), GL_DEPTH, 0, &one);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glUseProgram(mProgram.id());
-    glUniform1i(mProgram.uniform("uFirstVpl"), 0);
-    glUniform1f(mProgram.uniform("uFar"), in.sceneExtent);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, vpls.id());
-    in.drawGeometry(mProgram, layers);
-    glDisable(GL_DEPTH_TEST);
-    timer.end();
+    {
+        gl::Pass pass(timer, "vpl_shadows");
+        pass.target(mFbo, size, size).clearDepth().depthTest(GL_LESS);
+        pass.use(mProgram.program).set(mProgram.firstVpl, 0).set(mProgram.far, in.sceneExtent);
+        pass.buffer(mProgram.vpls, vpls);
+        in.drawGeometry(mProgram.program, layers);
+    }
     mShadowed = shadowed;
     counters["vpl_shadowed"] = shadowed;
     return shadowed;
 }
 
-void VplShadows::bind(const gl::Program& program, const FrameInputs& in, const ParamSet& params) const {
-    glUniform1i(program.uniform("uVplShadows"), mShadowed > 0 ? 1 : 0);
-    glUniform1i(program.uniform("uVplShadowed"), mShadowed);
-    glUniform1f(program.uniform("uVplShadowFar"), in.sceneExtent);
-    glUniform1f(program.uniform("uVplShadowBias"), static_cast<float>(params.getFloat("vpl_shadow_bias")));
-    if (mShadowed > 0) glBindTextureUnit(7, mMaps.id());
+void VplShadows::bind(gl::Pass& pass, const VplShadowHandles& h, const FrameInputs& in,
+                      const ParamSet& params) const {
+    pass.set(h.enabled, mShadowed > 0 ? 1 : 0)
+        .set(h.shadowed, mShadowed)
+        .set(h.far, in.sceneExtent)
+        .set(h.bias, static_cast<float>(params.getFloat("vpl_shadow_bias")));
+    if (mShadowed > 0) pass.texture(h.maps, mMaps);
 }
 
 } // namespace gis

@@ -15,10 +15,19 @@
 #include "gi/Technique.h"
 #include "gi/common/ParamSpecs.h"
 #include "gl/Objects.h"
+#include "gl/Pass.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 
 namespace gis {
+
+/// The lookup uniforms of vpl_shadow.glsl in a receiving program, resolved once.
+struct VplShadowHandles {
+    VplShadowHandles() = default;
+    explicit VplShadowHandles(const gl::Program& program);
+    gl::UniformLocation enabled, shadowed, far, bias;
+    gl::TextureUnit maps{gl::kNoUnit};
+};
 
 class VplShadows {
 public:
@@ -27,11 +36,16 @@ public:
     /// is on; returns the number of VPLs that have one (0 when off).
     int render(const FrameInputs& in, const ParamSet& params, const gl::Buffer& vpls, int vplCount,
                gl::PassTimer& timer, Counters& counters);
-    /// Sets the lookup uniforms of vpl_shadow.glsl on `program` (bound) and binds the maps at unit 7.
-    void bind(const gl::Program& program, const FrameInputs& in, const ParamSet& params) const;
+    /// Sets the lookup uniforms of vpl_shadow.glsl in `pass` (its program in use) and binds the maps.
+    void bind(gl::Pass& pass, const VplShadowHandles& handles, const FrameInputs& in,
+              const ParamSet& params) const;
 
 private:
-    gl::Program mProgram;
+    struct MapProgram {
+        gl::Program program;
+        gl::UniformLocation firstVpl, far;
+        gl::BlockBinding vpls;
+    } mProgram;
     gl::Texture mMaps;
     gl::Framebuffer mFbo;
     int mSize = 0, mLayers = 0, mShadowed = 0, mMaxLayers = 0;

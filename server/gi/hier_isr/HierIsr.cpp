@@ -70,8 +70,16 @@ std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
 }
 
 HierIsr::HierIsr() {
-    mGather = gl::Program::build(
+    GatherProgram& g = mGather;
+    g.program = gl::Program::build(
         {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/hier_isr/gather.frag"}});
+    g.startLevel = g.program.location("uStartLevel");
+    g.leafLevel = g.program.location("uLeafLevel");
+    g.refineMode = g.program.location("uRefineMode");
+    g.tau = g.program.location("uTau");
+    g.stats = g.program.storageBlock("CutStats");
+    g.transport = VplTransportHandles(g.program);
+    g.eye = EyeInputHandles(g.program);
     mStats = gl::Buffer::create(6 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
 }
 
@@ -86,23 +94,24 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
 
     const GLuint zero[6] = {};
     mStats.upload(0, sizeof zero, zero);
-    timer.begin("vpl_gather");
-    if (mTree.valid()) {
-        const LightCutSettings s = lightCutSettings(mTree.levels(), params.getInt("hier_coarsest"),
-                                                    params.getInt("max_depth"), params.getFloat("tau"));
-        glUseProgram(mGather.id());
-        setVplClamp(mGather, params);
-        glUniform1i(mGather.uniform("uStartLevel"), s.startLevel);
-        glUniform1i(mGather.uniform("uLeafLevel"), s.leafLevel);
-        glUniform1i(mGather.uniform("uRefineMode"), static_cast<int>(s.mode));
-        glUniform1f(mGather.uniform("uTau"), s.tau);
-        mTree.bind();
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, mStats.id());
-        mEye.beginIlluminationPass(in, true);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        mEye.endIlluminationPass();
+    {
+        gl::Pass pass(timer, "vpl_gather");
+        if (mTree.valid()) {
+            const LightCutSettings s = lightCutSettings(mTree.levels(), params.getInt("hier_coarsest"),
+                                                        params.getInt("max_depth"), params.getFloat("tau"));
+            const GatherProgram& g = mGather;
+            pass.use(g.program);
+            g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
+            pass.set(g.startLevel, s.startLevel)
+                .set(g.leafLevel, s.leafLevel)
+                .set(g.refineMode, static_cast<int>(s.mode))
+                .set(g.tau, s.tau);
+            mTree.bind();
+            pass.buffer(g.stats, mStats);
+            mEye.beginIlluminationPass(pass, g.eye, in, true);
+            pass.drawFullscreen(mEye.emptyVao());
+        }
     }
-    timer.end();
 
     mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);

@@ -63,6 +63,7 @@
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/LightTree.h"
+#include "gi/common/VplGrid.h"
 
 namespace gis {
 
@@ -100,7 +101,13 @@ private:
     LightTree mTree;
     EyeHierarchy mEye;
     BiasCompensation mSsbc;
-    gl::Program mGather;
+    struct GatherProgram {
+        gl::Program program;
+        gl::UniformLocation startLevel, leafLevel, refineMode, tau;
+        gl::BlockBinding stats;
+        VplTransportHandles transport;
+        EyeInputHandles eye;
+    } mGather;
     gl::Buffer mStats;
     IndirectTarget mIndirect;
 };

@@ -12,11 +12,26 @@ constexpr int kSelectGroup = 256; // local_size_x of isr/select.comp
 }
 
 Isr::Isr() {
-    mSelect = gl::Program::build({{GL_COMPUTE_SHADER, "gi/isr/select.comp"}});
+    SelectProgram& s = mSelect;
+    s.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/isr/select.comp"}});
+    s.phase = s.program.location("uPhase");
+    s.finest = s.program.location("uFinest");
+    s.coarsest = s.program.location("uCoarsest");
+    s.first = s.program.location("uFirst");
+    s.nodeCount = s.program.location("uNodeCount");
+    s.capacity = s.program.location("uCapacity");
+    s.depthThreshold = s.program.location("uDepthThreshold");
+    s.normalThreshold = s.program.location("uNormalThreshold");
+    s.counts = s.program.storageBlock("IsrCounts");
+    s.vpls = s.program.storageBlock("IsrVpls");
     // The gather is multires_gather's, always with the disk kernel (001 Eq. 1).
-    mGather = gl::Program::build({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
-                                  {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}},
-                                 {{"GIS_VPL_KERNEL", "GIS_KERNEL_DISK"}});
+    GatherProgram& g = mGather;
+    g.program = gl::Program::build({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
+                                    {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}},
+                                   kernelDefines(VplKernel::Disk, {}));
+    g.vplCount = g.program.location("uVplCount");
+    g.transport = VplTransportHandles(g.program);
+    g.eye = EyeInputHandles(g.program);
 }
 
 void Isr::resize(int width, int height) {
@@ -43,31 +58,27 @@ int Isr::select(const ParamSet& params, gl::PassTimer& timer, Counters& counters
     if (mCounts.size() < countBytes)
         mCounts = gl::Buffer::create(countBytes, nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
 
-    timer.begin("isr_select");
-    const GLuint zero = 0;
-    glClearNamedBufferSubData(mCounts.id(), GL_R32UI, 0, header, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    glUseProgram(mSelect.id());
-    mTree.bind();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, mCounts.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, mVpls.id());
-    glUniform1i(mSelect.uniform("uFinest"), finest);
-    glUniform1i(mSelect.uniform("uCoarsest"), coarsest);
-    glUniform1i(mSelect.uniform("uFirst"), first);
-    glUniform1i(mSelect.uniform("uNodeCount"), nodeCount);
-    glUniform1i(mSelect.uniform("uCapacity"), capacity);
-    glUniform1f(mSelect.uniform("uDepthThreshold"),
-                static_cast<float>(params.getFloat("light_depth_threshold")));
-    glUniform1f(mSelect.uniform("uNormalThreshold"),
-                static_cast<float>(params.getFloat("light_normal_threshold")));
-    for (int phase = 0; phase < 2; ++phase) {
-        glUniform1i(mSelect.uniform("uPhase"), phase);
-        glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    }
-    glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint counts[1 + GIS_MAX_LIGHT_LEVELS] = {};
-    glGetNamedBufferSubData(mCounts.id(), 0, header, counts);
-    timer.end();
+    {
+        gl::Pass pass(timer, "isr_select");
+        const GLuint zero = 0;
+        glClearNamedBufferSubData(mCounts.id(), GL_R32UI, 0, header, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+        const SelectProgram& s = mSelect;
+        pass.use(s.program);
+        mTree.bind();
+        pass.buffer(s.counts, mCounts).buffer(s.vpls, mVpls);
+        pass.set(s.finest, finest)
+            .set(s.coarsest, coarsest)
+            .set(s.first, first)
+            .set(s.nodeCount, nodeCount)
+            .set(s.capacity, capacity)
+            .set(s.depthThreshold, static_cast<float>(params.getFloat("light_depth_threshold")))
+            .set(s.normalThreshold, static_cast<float>(params.getFloat("light_normal_threshold")));
+        for (int phase = 0; phase < 2; ++phase)
+            pass.set(s.phase, phase).dispatch(groups).barrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glGetNamedBufferSubData(mCounts.id(), 0, header, counts);
+    }
 
     const int count = static_cast<int>(std::min<GLuint>(counts[0], static_cast<GLuint>(capacity)));
     counters["vpl_count"] = count;
@@ -82,19 +93,18 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
     if (!mTree.valid()) counters["vpl_count"] = 0;
     mEye.build(in, params, timer);
 
-    timer.begin("vpl_gather");
-    if (mVplCount > 0) {
-        glUseProgram(mGather.id());
-        setVplClamp(mGather, params);
-        mEye.beginIlluminationPass(in, true);
-        const GLint countLoc = mGather.uniform("uVplCount");
-        counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
-            glUniform1i(countLoc, count);
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-        });
-        mEye.endIlluminationPass();
+    {
+        gl::Pass pass(timer, "vpl_gather");
+        if (mVplCount > 0) {
+            const GatherProgram& g = mGather;
+            pass.use(g.program);
+            g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
+            mEye.beginIlluminationPass(pass, g.eye, in, true);
+            counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
+                pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao());
+            });
+        }
     }
-    timer.end();
 
     mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);

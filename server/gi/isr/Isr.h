@@ -48,6 +48,7 @@
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/EyeHierarchy.h"
 #include "gi/common/LightTree.h"
+#include "gi/common/VplGrid.h"
 
 namespace gis {
 
@@ -69,7 +70,18 @@ private:
     LightTree mTree;
     EyeHierarchy mEye;
     BiasCompensation mSsbc;
-    gl::Program mSelect, mGather;
+    struct SelectProgram {
+        gl::Program program;
+        gl::UniformLocation phase, finest, coarsest, first, nodeCount, capacity, depthThreshold,
+            normalThreshold;
+        gl::BlockBinding counts, vpls;
+    } mSelect;
+    struct GatherProgram {
+        gl::Program program;
+        gl::UniformLocation vplCount;
+        VplTransportHandles transport;
+        EyeInputHandles eye;
+    } mGather;
     gl::Buffer mVpls, mCounts;
     int mVplCount = 0;
     IndirectTarget mIndirect;

@@ -2,9 +2,14 @@
 
 namespace gis {
 
+MultiresGather::GatherProgram::GatherProgram(gl::Program built)
+    : program(std::move(built)),
+      minDistance(program.optionalLocation("uMinDistance")) /* point kernel only */,
+      vplCount(program.location("uVplCount")), transport(program), eye(program) {}
+
 MultiresGather::MultiresGather() {
-    mGather = KernelPrograms({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
-                              {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}});
+    mGather = KernelPrograms<GatherProgram>({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
+                                             {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}});
 }
 
 void MultiresGather::resize(int width, int height) {
@@ -16,20 +21,17 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mEye.build(in, params, timer);
 
-    timer.begin("vpl_gather");
-    if (vplCount > 0) {
-        const gl::Program& gather = mGather.get(vplKernel(params));
-        glUseProgram(gather.id());
-        glUniform1f(gather.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
-        setVplClamp(gather, params);
-        mEye.beginIlluminationPass(in, true);
-        counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
-            glUniform1i(gather.uniform("uVplCount"), count);
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-        });
-        mEye.endIlluminationPass();
+    {
+        gl::Pass pass(timer, "vpl_gather");
+        if (vplCount > 0) {
+            const GatherProgram& g = mGather.get(vplKernel(params));
+            pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
+            g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
+            mEye.beginIlluminationPass(pass, g.eye, in, true);
+            counters["vpl_batches"] = mVpls.forEachBatch(
+                [&](int count) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
+        }
     }
-    timer.end();
 
     mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);

@@ -41,7 +41,14 @@ public:
 private:
     VplGrid mVpls;
     EyeHierarchy mEye;
-    KernelPrograms mGather;
+    struct GatherProgram {
+        explicit GatherProgram(gl::Program built);
+        gl::Program program;
+        gl::UniformLocation minDistance, vplCount;
+        VplTransportHandles transport;
+        EyeInputHandles eye;
+    };
+    KernelPrograms<GatherProgram> mGather;
     BiasCompensation mSsbc;
     IndirectTarget mIndirect;
 };

@@ -7,20 +7,53 @@
 
 namespace gis {
 
+MultiresSplat::ShadingHandles::ShadingHandles(const gl::Program& p)
+    : perVpl(p.location("uPerVpl")), minDistance(p.optionalLocation("uMinDistance")),
+      phongKs(p.optionalLocation("uPhongKs")), phongExponent(p.optionalLocation("uPhongExponent")),
+      patchSpecular(p.optionalTextureUnit("uPatchSpecular")), vpls(p.storageBlock("VplBuffer")), transport(p),
+      eye(p) {}
+
+MultiresSplat::SplatProgram::SplatProgram(gl::Program built)
+    : program(std::move(built)), atlasSize(program.location("uAtlasSize")),
+      splatList(program.optionalStorageBlock("SplatList")), shading(program) {}
+
+MultiresSplat::RefineProgram::RefineProgram(gl::Program built)
+    : program(std::move(built)), level(program.location("uLevel")), capacity(program.location("uCapacity")),
+      illumThreshold(program.location("uIllumThreshold")), flags(program.textureUnit("uFlags")),
+      inList(program.storageBlock("InList")), nextList(program.storageBlock("NextList")),
+      splatList(program.storageBlock("SplatList")), counters(program.storageBlock("Counters")),
+      shading(program) {}
+
 MultiresSplat::MultiresSplat() {
-    mSeed = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/seed.comp"}});
-    mRefine = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/refine.comp"}});
-    mAdvance = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/advance.comp"}});
-    mSplat = KernelPrograms({{GL_VERTEX_SHADER, "gi/multires_splat/splat.vert"},
-                             {GL_FRAGMENT_SHADER, "gi/multires_splat/splat.frag"}});
+    SeedProgram& seed = mSeed;
+    seed.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/seed.comp"}});
+    seed.items = seed.program.location("uItems");
+    seed.capacity = seed.program.location("uCapacity");
+    seed.flags = seed.program.textureUnit("uFlags");
+    seed.nextList = seed.program.storageBlock("NextList");
+    seed.counters = seed.program.storageBlock("Counters");
+    seed.eye = EyeInputHandles(seed.program);
+    mRefine = std::make_unique<RefineProgram>(
+        gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/refine.comp"}}));
+    AdvanceProgram& advance = mAdvance;
+    advance.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_splat/advance.comp"}});
+    advance.mode = advance.program.location("uMode");
+    advance.capacity = advance.program.location("uCapacity");
+    advance.instances = advance.program.location("uInstances");
+    advance.counters = advance.program.storageBlock("Counters");
+    const std::vector<gl::ShaderStage> splat = {{GL_VERTEX_SHADER, "gi/multires_splat/splat.vert"},
+                                                {GL_FRAGMENT_SHADER, "gi/multires_splat/splat.frag"}};
+    mSplat = KernelPrograms<SplatProgram>(splat);
     mCounters = gl::Buffer::create(sizeof(shader::SubsplatCounters), nullptr,
                                    GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
-    mRefineTf = gl::Program::build({{GL_VERTEX_SHADER, "gi/multires_splat/refine_tf.vert"},
-                                    {GL_GEOMETRY_SHADER, "gi/multires_splat/refine_tf.geom"}},
-                                   {}, {"gNext", "gl_NextBuffer", "gSplat"});
-    const std::vector<gl::ShaderStage> tfSplat = {{GL_VERTEX_SHADER, "gi/multires_splat/splat.vert"},
-                                                  {GL_FRAGMENT_SHADER, "gi/multires_splat/splat.frag"}};
-    mSplatTf = KernelPrograms(tfSplat, {{"GIS_ITEM_ATTRIBUTE", "1"}});
+    RefineTfProgram& tf = mRefineTf;
+    tf.program = gl::Program::build({{GL_VERTEX_SHADER, "gi/multires_splat/refine_tf.vert"},
+                                     {GL_GEOMETRY_SHADER, "gi/multires_splat/refine_tf.geom"}},
+                                    {}, {"gNext", "gl_NextBuffer", "gSplat"});
+    tf.level = tf.program.location("uLevel");
+    tf.flags = tf.program.textureUnit("uFlags");
+    tf.eye = EyeInputHandles(tf.program);
+    mSplatTf = KernelPrograms<SplatProgram>(splat, {{"GIS_ITEM_ATTRIBUTE", "1"}});
     mItemVao = gl::VertexArray::create();
     glEnableVertexArrayAttrib(mItemVao.id(), 0);
     glVertexArrayAttribIFormat(mItemVao.id(), 0, 2, GL_UNSIGNED_INT, 0);
@@ -66,16 +99,15 @@ void MultiresSplat::ensureFeedbackLists() {
     mTfSeedCount = static_cast<GLsizei>(seed.size() / 2);
 }
 
-void MultiresSplat::refineWithFeedback(const FrameInputs& in, Counters& counters) {
+void MultiresSplat::refineWithFeedback(gl::Pass& pass, const FrameInputs& in) {
     ensureFeedbackLists();
     const int levels = static_cast<int>(mTfLevels.size());
     glEnable(GL_RASTERIZER_DISCARD);
-    glUseProgram(mRefineTf.id());
-    glBindTextureUnit(6, mEye.flags().id());
-    mEye.bindPixels(in);
+    pass.use(mRefineTf.program).texture(mRefineTf.flags, mEye.flags());
+    mEye.bindInputs(pass, mRefineTf.eye, in);
     glBindVertexArray(mItemVao.id());
     for (int level = levels - 1; level >= 0; --level) {
-        glUniform1i(mRefineTf.uniform("uLevel"), level);
+        pass.set(mRefineTf.level, level);
         glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, mTfo[level].id());
         glBeginQueryIndexed(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, 1, mTfWritten[level].id());
         glBeginTransformFeedback(GL_POINTS);
@@ -91,7 +123,6 @@ void MultiresSplat::refineWithFeedback(const FrameInputs& in, Counters& counters
     }
     glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
     glDisable(GL_RASTERIZER_DISCARD);
-    (void)counters;
 }
 
 void MultiresSplat::splatFeedbackLists(int vplCount) {
@@ -126,13 +157,15 @@ bool MultiresSplat::glossyTransport(const ParamSet& params) const {
     return kInfo.glossyTransport(params);
 }
 
-void MultiresSplat::bindGlossy(const gl::Program& program, const FrameInputs& in, bool perVpl) const {
+void MultiresSplat::setShading(gl::Pass& pass, const ShadingHandles& h, const FrameInputs& in,
+                               const ParamSet& params, bool perVpl) const {
+    pass.set(h.perVpl, perVpl ? 1 : 0)
+        .set(h.minDistance, static_cast<float>(params.getFloat("min_distance")))
+        .set(h.phongKs, static_cast<float>(params.getFloat("phong_ks")))
+        .set(h.phongExponent, static_cast<float>(params.getFloat("phong_exponent")));
     const bool glossy = perVpl && in.glossy && in.find("gbuffer.specular") != nullptr;
-    glUniform1i(program.uniform("uGlossy"), glossy ? 1 : 0);
-    glUniform1f(program.uniform("uGlossyMinRoughness"), in.glossyMinRoughness);
-    if (!glossy) return;
-    glBindTextureUnit(14, in.find("gbuffer.specular")->id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mVpls.glossyBuffer().id());
+    h.transport.set(pass, params, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
+    if (glossy) pass.texture(h.patchSpecular, in.get("gbuffer.specular"));
 }
 
 void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
@@ -150,103 +183,84 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
     const int levels = static_cast<int>(mEye.levels().size());
     const EyeLevel& coarsest = mEye.levels().back();
 
-    timer.begin("subsplat_refine");
-    shader::SubsplatCounters zero{};
-    long long seedWanted = 0;
-    if (vplCount > 0 && !feedback) {
-        seedWanted = static_cast<long long>(coarsest.width) * coarsest.height * (perVpl ? vplCount : 1);
-        // Seed items beyond the int range the seed pass indexes are dropped and reported like the
-        // list cap's (counts.w), never silently.
-        zero.counts.w =
-            static_cast<GLuint>(std::min<long long>(std::max(seedWanted - (1LL << 30), 0LL), ~0u));
-    }
-    mCounters.upload(0, sizeof zero, &zero);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, mCounters.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.buffer().id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, mSplatList.id());
-    glBindTextureUnit(6, mEye.flags().id());
-    mEye.bindPixels(in);
-    glBindTextureUnit(11, mEye.geoPosition().id());
-    glBindTextureUnit(12, mEye.geoNormal().id());
-    glBindTextureUnit(13, mEye.geoAlbedo().id());
-    if (vplCount > 0 && feedback) {
-        refineWithFeedback(in, counters);
-    } else if (vplCount > 0) {
-        const int seedItems = static_cast<int>(std::min<long long>(seedWanted, 1 << 30));
-        // The seed fills the "next" list; each level then advances (next -> input, indirect
-        // dispatch size) and refines.
-        const gl::Buffer* current = &mListB;
-        const gl::Buffer* next = &mListA;
-        glUseProgram(mSeed.id());
-        glUniform1i(mSeed.uniform("uItems"), seedItems);
-        glUniform1ui(mSeed.uniform("uCapacity"), mCapacity);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, next->id());
-        // 2D: coarsest texels x VPLs / 64 exceeds GL_MAX_COMPUTE_WORK_GROUP_COUNT's guaranteed 65535 in
-        // one dimension at 128^2 VPLs (GL_INVALID_VALUE and no light before this was split).
-        const GLuint groups = static_cast<GLuint>((seedItems + GIS_SUBSPLAT_GROUP - 1) / GIS_SUBSPLAT_GROUP);
-        const GLuint groupsX = std::min<GLuint>(groups, GIS_SUBSPLAT_MAX_GROUPS_X);
-        glDispatchCompute(groupsX, groupsX > 0 ? (groups + groupsX - 1) / groupsX : 1, 1);
-
-        glUseProgram(mRefine.id());
-        glUniform1ui(mRefine.uniform("uCapacity"), mCapacity);
-        glUniform1f(mRefine.uniform("uIllumThreshold"),
-                    static_cast<float>(params.getFloat("illum_threshold")));
-        glUniform1i(mRefine.uniform("uPerVpl"), perVpl ? 1 : 0);
-        glUniform1f(mRefine.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
-        setVplClamp(mRefine, params);
-        glUniform1f(mRefine.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
-        glUniform1f(mRefine.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
-        bindGlossy(mRefine, in, perVpl);
-        glUseProgram(mAdvance.id());
-        glUniform1i(mAdvance.uniform("uMode"), 0);
-        glUniform1ui(mAdvance.uniform("uCapacity"), mCapacity);
-        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, mCounters.id());
-        for (int level = levels - 1; level >= 0; --level) {
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-            glUseProgram(mAdvance.id());
-            glDispatchCompute(1, 1, 1);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-            std::swap(current, next);
-            glUseProgram(mRefine.id());
-            glUniform1i(mRefine.uniform("uLevel"), level);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, current->id());
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, next->id());
-            glDispatchComputeIndirect(0);
+    {
+        gl::Pass pass(timer, "subsplat_refine");
+        shader::SubsplatCounters zero{};
+        long long seedWanted = 0;
+        if (vplCount > 0 && !feedback) {
+            seedWanted = static_cast<long long>(coarsest.width) * coarsest.height * (perVpl ? vplCount : 1);
+            // Seed items beyond the int range the seed pass indexes are dropped and reported like the
+            // list cap's (counts.w), never silently.
+            zero.counts.w =
+                static_cast<GLuint>(std::min<long long>(std::max(seedWanted - (1LL << 30), 0LL), ~0u));
         }
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(mAdvance.id());
-        glUniform1i(mAdvance.uniform("uMode"), 1);
-        glUniform1ui(mAdvance.uniform("uCapacity"), mCapacity);
-        glUniform1ui(mAdvance.uniform("uInstances"), perVpl ? 1u : static_cast<GLuint>(vplCount));
-        glDispatchCompute(1, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-    }
-    timer.end();
+        mCounters.upload(0, sizeof zero, &zero);
+        const RefineProgram& r = *mRefine;
+        pass.buffer(r.counters, mCounters)
+            .buffer(r.shading.vpls, mVpls.buffer())
+            .buffer(r.splatList, mSplatList);
+        if (vplCount > 0 && feedback) {
+            refineWithFeedback(pass, in);
+        } else if (vplCount > 0) {
+            const int seedItems = static_cast<int>(std::min<long long>(seedWanted, 1 << 30));
+            // The seed fills the "next" list; each level then advances (next -> input, indirect
+            // dispatch size) and refines.
+            const gl::Buffer* current = &mListB;
+            const gl::Buffer* next = &mListA;
+            pass.use(mSeed.program).set(mSeed.items, seedItems).set(mSeed.capacity, mCapacity);
+            pass.texture(mSeed.flags, mEye.flags()).buffer(mSeed.nextList, *next);
+            mEye.bindInputs(pass, mSeed.eye, in);
+            // 2D: coarsest texels x VPLs / 64 exceeds GL_MAX_COMPUTE_WORK_GROUP_COUNT's guaranteed 65535 in
+            // one dimension at 128^2 VPLs (GL_INVALID_VALUE and no light before this was split).
+            const int groups = (seedItems + GIS_SUBSPLAT_GROUP - 1) / GIS_SUBSPLAT_GROUP;
+            const int groupsX = std::min(groups, static_cast<int>(GIS_SUBSPLAT_MAX_GROUPS_X));
+            pass.dispatch(groupsX, groupsX > 0 ? (groups + groupsX - 1) / groupsX : 1);
 
-    timer.begin("subsplat_splat");
-    if (vplCount > 0) {
-        const gl::Program& splat = (feedback ? mSplatTf : mSplat).get(vplKernel(params));
-        glUseProgram(splat.id());
-        glUniform2i(splat.uniform("uAtlasSize"), mEye.atlasWidth(), mEye.atlasHeight());
-        glUniform1i(splat.uniform("uPerVpl"), perVpl ? 1 : 0);
-        glUniform1f(splat.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
-        setVplClamp(splat, params);
-        glUniform1f(splat.uniform("uPhongKs"), static_cast<float>(params.getFloat("phong_ks")));
-        glUniform1f(splat.uniform("uPhongExponent"), static_cast<float>(params.getFloat("phong_exponent")));
-        bindGlossy(splat, in, perVpl);
-        mEye.beginIlluminationPass(in, false); // every list item is a receiver: no stencil
-        if (feedback) {
-            glBindVertexArray(mItemVao.id());
-            splatFeedbackLists(vplCount);
-        } else {
-            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCounters.id());
-            glDrawArraysIndirect(GL_POINTS,
-                                 reinterpret_cast<const void*>(offsetof(shader::SubsplatCounters, draw)));
-            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+            pass.use(r.program)
+                .set(r.capacity, mCapacity)
+                .set(r.illumThreshold, static_cast<float>(params.getFloat("illum_threshold")))
+                .texture(r.flags, mEye.flags());
+            setShading(pass, r.shading, in, params, perVpl);
+            mEye.bindInputs(pass, r.shading.eye, in);
+            pass.use(mAdvance.program).set(mAdvance.mode, 0).set(mAdvance.capacity, mCapacity);
+            for (int level = levels - 1; level >= 0; --level) {
+                pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT);
+                pass.use(mAdvance.program)
+                    .dispatch(1)
+                    .barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+                std::swap(current, next);
+                pass.use(r.program).set(r.level, level).buffer(r.inList, *current).buffer(r.nextList, *next);
+                pass.dispatchIndirect(mCounters);
+            }
+            pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            pass.use(mAdvance.program)
+                .set(mAdvance.mode, 1)
+                .set(mAdvance.capacity, mCapacity)
+                .set(mAdvance.instances, perVpl ? 1u : static_cast<GLuint>(vplCount))
+                .dispatch(1)
+                .barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
         }
-        mEye.endIlluminationPass();
     }
-    timer.end();
+
+    {
+        gl::Pass pass(timer, "subsplat_splat");
+        if (vplCount > 0) {
+            const SplatProgram& splat = (feedback ? mSplatTf : mSplat).get(vplKernel(params));
+            pass.use(splat.program).set(splat.atlasSize, glm::ivec2(mEye.atlasWidth(), mEye.atlasHeight()));
+            setShading(pass, splat.shading, in, params, perVpl);
+            pass.buffer(splat.shading.vpls, mVpls.buffer()).buffer(splat.splatList, mSplatList);
+            mEye.beginIlluminationPass(pass, splat.shading.eye, in, false); // every list item is a receiver
+            if (feedback) {
+                glBindVertexArray(mItemVao.id());
+                splatFeedbackLists(vplCount);
+            } else {
+                glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCounters.id());
+                glDrawArraysIndirect(GL_POINTS,
+                                     reinterpret_cast<const void*>(offsetof(shader::SubsplatCounters, draw)));
+                glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+            }
+        }
+    }
 
     mEye.reconstruct(in, params, !perVpl, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);

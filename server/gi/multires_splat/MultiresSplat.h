@@ -62,22 +62,69 @@ public:
     std::vector<std::array<int, 3>> readSplatPatches() const;
 
 private:
-    void bindGlossy(const gl::Program& program, const FrameInputs& in, bool perVpl) const;
+    /// The uniforms splat_common.glsl gives the refinement and the splat, resolved once.
+    struct ShadingHandles {
+        explicit ShadingHandles(const gl::Program& program);
+        gl::UniformLocation perVpl, minDistance, phongKs, phongExponent;
+        gl::TextureUnit patchSpecular;
+        gl::BlockBinding vpls;
+        VplTransportHandles transport;
+        EyeInputHandles eye;
+    };
+    struct SplatProgram {
+        explicit SplatProgram(gl::Program built);
+        gl::Program program;
+        gl::UniformLocation atlasSize;
+        gl::BlockBinding splatList; ///< absent from the transform-feedback variant (items as attributes)
+        ShadingHandles shading;
+    };
+    struct RefineProgram {
+        explicit RefineProgram(gl::Program built);
+        gl::Program program;
+        gl::UniformLocation level, capacity, illumThreshold;
+        gl::TextureUnit flags;
+        gl::BlockBinding inList, nextList, splatList, counters;
+        ShadingHandles shading;
+    };
+    struct SeedProgram {
+        gl::Program program;
+        gl::UniformLocation items, capacity;
+        gl::TextureUnit flags;
+        gl::BlockBinding nextList, counters;
+        EyeInputHandles eye;
+    };
+    struct AdvanceProgram {
+        gl::Program program;
+        gl::UniformLocation mode, capacity, instances;
+        gl::BlockBinding counters;
+    };
+    struct RefineTfProgram {
+        gl::Program program;
+        gl::UniformLocation level;
+        gl::TextureUnit flags;
+        EyeInputHandles eye;
+    };
+
+    /// The shading uniforms and, for per-VPL refinement with glossy transport, the glossy inputs.
+    void setShading(gl::Pass& pass, const ShadingHandles& h, const FrameInputs& in, const ParamSet& params,
+                    bool perVpl) const;
     void ensureCapacity(GLuint items);
     void ensureFeedbackLists();
-    void refineWithFeedback(const FrameInputs& in, Counters& counters);
+    void refineWithFeedback(gl::Pass& pass, const FrameInputs& in);
     void splatFeedbackLists(int vplCount);
 
     VplGrid mVpls;
     EyeHierarchy mEye;
     BiasCompensation mSsbc;
-    gl::Program mSeed, mRefine, mAdvance;
-    KernelPrograms mSplat;
+    SeedProgram mSeed;
+    std::unique_ptr<RefineProgram> mRefine;
+    AdvanceProgram mAdvance;
+    KernelPrograms<SplatProgram> mSplat;
     gl::Buffer mListA, mListB, mSplatList, mCounters;
     GLuint mCapacity = 0;
     // Transform-feedback lists, one set per eye level.
-    gl::Program mRefineTf;
-    KernelPrograms mSplatTf;
+    RefineTfProgram mRefineTf;
+    KernelPrograms<SplatProgram> mSplatTf;
     gl::VertexArray mItemVao;
     gl::Buffer mTfSeed;
     GLsizei mTfSeedCount = 0;

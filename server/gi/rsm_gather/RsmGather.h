@@ -48,7 +48,15 @@ public:
 private:
     VplGrid mVpls;
     VplShadows mShadows;
-    KernelPrograms mGather;
+    struct GatherProgram {
+        explicit GatherProgram(gl::Program built);
+        gl::Program program;
+        gl::UniformLocation minDistance, vplCount, vplFirst;
+        gl::TextureUnit position, normal, albedo, specular;
+        VplTransportHandles transport;
+        VplShadowHandles shadows;
+    };
+    KernelPrograms<GatherProgram> mGather;
     BiasCompensation mSsbc;
     IndirectTarget mIndirect;
     gl::VertexArray mEmptyVao;

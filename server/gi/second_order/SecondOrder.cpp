@@ -37,15 +37,74 @@ bool finite(glm::vec3 v) {
 
 SecondOrder::SecondOrder() {
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
-    mPlacePositive = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_positive.comp"}});
-    mPlaceNegative = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_negative.comp"}});
-    mLowGeometry =
+    PlacePositiveProgram& pp = mPlacePositive;
+    pp.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_positive.comp"}});
+    pp.count = pp.program.location("uCount");
+    pp.rsmSize = pp.program.location("uRsmSize");
+    pp.sampleSolidAngle = pp.program.location("uSampleSolidAngle");
+    pp.position = pp.program.textureUnit("gRsmPosition");
+    pp.normal = pp.program.textureUnit("gRsmNormal");
+    pp.flux = pp.program.textureUnit("gRsmFlux");
+    pp.vpls = pp.program.storageBlock("VplOut");
+    pp.samples = pp.program.storageBlock("Samples");
+    pp.stats = pp.program.optionalStorageBlock("SecondOrderStats");
+
+    PlaceNegativeProgram& pn = mPlaceNegative;
+    pn.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_negative.comp"}});
+    pn.positiveCount = pn.program.location("uPositiveCount");
+    pn.negativeCount = pn.program.location("uNegativeCount");
+    pn.candidateCount = pn.program.location("uCandidateCount");
+    pn.frustumSolidAngle = pn.program.location("uFrustumSolidAngle");
+    pn.minDistance = pn.program.location("uMinDistance");
+    pn.minCosView = pn.program.location("uMinCosView");
+    pn.position = pn.program.textureUnit("gPosition");
+    pn.normal = pn.program.textureUnit("gNormal");
+    pn.vpls = pn.program.storageBlock("Vpls");
+    pn.candidates = pn.program.storageBlock("Candidates");
+    pn.stats = pn.program.optionalStorageBlock("SecondOrderStats");
+
+    LowGeometryProgram& lg = mLowGeometry;
+    lg.program =
         gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/lowres_gbuffer.frag"}});
-    mGather = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/gather.frag"}},
-                                 {{"GIS_VPL_KERNEL", "GIS_KERNEL_POINT"}});
-    mDiscontinuity =
-        gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/discontinuity.frag"}});
-    mResolve = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/resolve.frag"}});
+    lg.factor = lg.program.location("uFactor");
+    lg.position = lg.program.textureUnit("gPosition");
+    lg.normal = lg.program.textureUnit("gNormal");
+
+    GatherProgram& g = mGather;
+    g.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/gather.frag"}},
+                                   kernelDefines(VplKernel::Point, {}));
+    g.minDistance = g.program.location("uMinDistance");
+    g.vplCount = g.program.location("uVplCount");
+    g.batchFirst = g.program.location("uBatchFirst");
+    g.position = g.program.textureUnit("gPosition");
+    g.normal = g.program.textureUnit("gNormal");
+    g.stats = g.program.optionalStorageBlock("SecondOrderStats");
+    g.transport = VplTransportHandles(g.program);
+
+    DiscontinuityProgram& d = mDiscontinuity;
+    d.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/discontinuity.frag"}});
+    d.factor = d.program.location("uFactor");
+    d.lowSize = d.program.location("uLowSize");
+    d.threshold = d.program.location("uThreshold");
+    d.position = d.program.textureUnit("gPosition");
+    d.normal = d.program.textureUnit("gNormal");
+    d.lowPosition = d.program.textureUnit("gLowPosition");
+    d.lowNormal = d.program.textureUnit("gLowNormal");
+
+    ResolveProgram& r = mResolve;
+    r.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "gi/second_order/resolve.frag"}});
+    r.factor = r.program.location("uFactor");
+    r.lowSize = r.program.location("uLowSize");
+    r.fixup = r.program.location("uFixup");
+    r.hasDirect = r.program.location("uHasDirect");
+    r.position = r.program.textureUnit("gPosition");
+    r.albedo = r.program.textureUnit("gAlbedo");
+    r.direct = r.program.textureUnit("gDirect");
+    r.flag = r.program.textureUnit("gFlag");
+    r.fullIrradiance = r.program.textureUnit("gFullIrradiance");
+    r.lowIrradiance = r.program.textureUnit("gLowIrradiance");
+    r.lowPosition = r.program.textureUnit("gLowPosition");
+    r.stats = r.program.optionalStorageBlock("SecondOrderStats");
     mEmptyVao = gl::VertexArray::create();
     mSamples = gl::Buffer::create(kMaxPositive * sizeof(glm::vec4));
     mCandidates = gl::Buffer::create(kMaxCandidates * sizeof(glm::ivec4));
@@ -120,21 +179,20 @@ int SecondOrder::placePositive(const FrameInputs& in, gl::PassTimer& timer, Coun
     }
     mSamples.upload(0, static_cast<GLsizeiptr>(uv.size() * sizeof(glm::vec4)), uv.data());
 
-    timer.begin("vpl_place");
-    glUseProgram(mPlacePositive.id());
-    glUniform1i(mPlacePositive.uniform("uCount"), count);
-    glUniform1i(mPlacePositive.uniform("uRsmSize"), in.rsmSize);
-    const double coneSolidAngle = 2.0 * 3.14159265358979323846 * (1.0 - cosOuter);
-    glUniform1f(mPlacePositive.uniform("uSampleSolidAngle"), static_cast<float>(coneSolidAngle / count));
-    glBindTextureUnit(0, in.find(FrameResources::light(0, "rsm.position"))->id());
-    glBindTextureUnit(1, in.find(FrameResources::light(0, "rsm.normal"))->id());
-    glBindTextureUnit(2, in.find(FrameResources::light(0, "rsm.flux"))->id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mSamples.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
-    timer.end();
+    {
+        gl::Pass pass(timer, "vpl_place");
+        const PlacePositiveProgram& p = mPlacePositive;
+        const double coneSolidAngle = 2.0 * 3.14159265358979323846 * (1.0 - cosOuter);
+        pass.use(p.program)
+            .set(p.count, count)
+            .set(p.rsmSize, in.rsmSize)
+            .set(p.sampleSolidAngle, static_cast<float>(coneSolidAngle / count));
+        pass.texture(p.position, in.light(0, "rsm.position"))
+            .texture(p.normal, in.light(0, "rsm.normal"))
+            .texture(p.flux, in.light(0, "rsm.flux"));
+        pass.buffer(p.vpls, mVpls).buffer(p.samples, mSamples).buffer(p.stats, mStats);
+        pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+    }
     return count;
 }
 
@@ -198,42 +256,35 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
     if (candidates == 0) return 0;
     mCandidates.upload(0, static_cast<GLsizeiptr>(pixels.size() * sizeof(glm::ivec4)), pixels.data());
 
-    timer.begin("negative_place");
-    glUseProgram(mPlaceNegative.id());
-    glUniform1i(mPlaceNegative.uniform("uPositiveCount"), positiveCount);
-    glUniform1i(mPlaceNegative.uniform("uNegativeCount"), mNegativeSlots);
-    glUniform1i(mPlaceNegative.uniform("uCandidateCount"), candidates);
-    glUniform1f(mPlaceNegative.uniform("uFrustumSolidAngle"), static_cast<float>(frustumSolidAngle));
-    glUniform1f(mPlaceNegative.uniform("uMinDistance"), static_cast<float>(params.getFloat("min_distance")));
-    glUniform1f(mPlaceNegative.uniform("uMinCosView"), kMinCosView);
-    glBindTextureUnit(0, in.find("gbuffer.position")->id());
-    glBindTextureUnit(1, in.find("gbuffer.normal")->id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mVpls.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, mCandidates.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
-    timer.end();
+    {
+        gl::Pass pass(timer, "negative_place");
+        const PlaceNegativeProgram& p = mPlaceNegative;
+        pass.use(p.program)
+            .set(p.positiveCount, positiveCount)
+            .set(p.negativeCount, mNegativeSlots)
+            .set(p.candidateCount, candidates)
+            .set(p.frustumSolidAngle, static_cast<float>(frustumSolidAngle))
+            .set(p.minDistance, static_cast<float>(params.getFloat("min_distance")))
+            .set(p.minCosView, kMinCosView);
+        pass.texture(p.position, in.get("gbuffer.position")).texture(p.normal, in.get("gbuffer.normal"));
+        pass.buffer(p.vpls, mVpls).buffer(p.candidates, mCandidates).buffer(p.stats, mStats);
+        pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+    }
     return mNegativeSlots;
 }
 
-void SecondOrder::gather(const gl::Program& program, int slots, float minDistance, Counters& counters) {
-    glUseProgram(program.id());
-    glUniform1f(program.uniform("uMinDistance"), minDistance);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
-    glBindVertexArray(mEmptyVao.id());
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE); // signed sums: negative lights carry negative flux
-    const GLint countLoc = program.uniform("uVplCount");
-    const GLint firstLoc = program.uniform("uBatchFirst");
+void SecondOrder::gather(gl::Pass& pass, const gl::Texture& position, const gl::Texture& normal,
+                         const ParamSet& params, int slots, Counters& counters) {
+    const GatherProgram& g = mGather;
+    pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
+    g.transport.set(pass, params, false, 0.0f, nullptr);
+    pass.texture(g.position, position).texture(g.normal, normal).buffer(g.stats, mStats);
+    pass.blendAdd(); // signed sums: negative lights carry negative flux
     int first = 0;
     counters["vpl_batches"] = forEachVplBatch(mVpls, slots, [&](int count) {
-        glUniform1i(countLoc, count);
-        glUniform1i(firstLoc, first);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        pass.set(g.vplCount, count).set(g.batchFirst, first).drawFullscreen(mEmptyVao);
         first += count;
     });
-    glDisable(GL_BLEND);
 }
 
 void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
@@ -266,93 +317,74 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
     }
     mNegativeSlots = placeNegative(in, params, mPositiveSlots, timer, counters);
     const int slots = mPositiveSlots + mNegativeSlots;
-    const float minDistance = static_cast<float>(params.getFloat("min_distance"));
-    setVplClamp(mGather, params);
     const int factor = std::clamp(params.getInt("lowres_factor"), 1, 8);
     const int lowW = (in.width + factor - 1) / factor, lowH = (in.height + factor - 1) / factor;
     const double threshold = params.getFloat("discontinuity_threshold");
     const bool fixup = threshold < kNoFixupThreshold;
     // Threshold 0 flags every covered pixel (discontinuity.frag), so no low-res value is ever used.
     const bool lowres = threshold > 0.0;
+    const gl::Texture& position = in.get("gbuffer.position");
+    const gl::Texture& normal = in.get("gbuffer.normal");
 
     if (lowres) {
-        timer.begin("lowres_gbuffer");
-        glBindFramebuffer(GL_FRAMEBUFFER, mLowGeometryFbo.id());
-        glViewport(0, 0, lowW, lowH);
-        glUseProgram(mLowGeometry.id());
-        glUniform1i(mLowGeometry.uniform("uFactor"), factor);
-        glBindTextureUnit(0, in.find("gbuffer.position")->id());
-        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
-        glBindVertexArray(mEmptyVao.id());
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        timer.end();
-
-        timer.begin("lowres_gather");
-        glBindFramebuffer(GL_FRAMEBUFFER, mLowIrradianceFbo.id());
-        glViewport(0, 0, lowW, lowH);
-        glClearNamedFramebufferfv(mLowIrradianceFbo.id(), GL_COLOR, 0, zero);
-        glBindTextureUnit(0, mLowPosition.id());
-        glBindTextureUnit(1, mLowNormal.id());
-        gather(mGather, slots, minDistance, counters);
-        timer.end();
+        {
+            gl::Pass pass(timer, "lowres_gbuffer");
+            const LowGeometryProgram& lg = mLowGeometry;
+            pass.target(mLowGeometryFbo, lowW, lowH).use(lg.program).set(lg.factor, factor);
+            pass.texture(lg.position, position).texture(lg.normal, normal).drawFullscreen(mEmptyVao);
+        }
+        gl::Pass pass(timer, "lowres_gather");
+        pass.target(mLowIrradianceFbo, lowW, lowH).clearColor(1);
+        gather(pass, mLowPosition, mLowNormal, params, slots, counters);
     }
 
     GLuint flagged = 0;
-    glViewport(0, 0, in.width, in.height);
     if (fixup) {
-        timer.begin("discontinuity");
-        glBindFramebuffer(GL_FRAMEBUFFER, mFlagFbo.id());
-        glClearNamedFramebufferfv(mFlagFbo.id(), GL_COLOR, 0, zero);
-        glClearNamedFramebufferfi(mFlagFbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
-        glUseProgram(mDiscontinuity.id());
-        glUniform1i(mDiscontinuity.uniform("uFactor"), factor);
-        glUniform2i(mDiscontinuity.uniform("uLowSize"), lowW, lowH);
-        glUniform1f(mDiscontinuity.uniform("uThreshold"), static_cast<float>(threshold));
-        glBindTextureUnit(0, in.find("gbuffer.position")->id());
-        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
-        glBindTextureUnit(2, mLowPosition.id());
-        glBindTextureUnit(3, mLowNormal.id());
-        glEnable(GL_STENCIL_TEST);
-        glStencilFunc(GL_ALWAYS, 1, 0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-        glBeginQuery(GL_SAMPLES_PASSED, mFlaggedQuery.id());
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        glEndQuery(GL_SAMPLES_PASSED);
-        timer.end();
-
-        timer.begin("fixup_gather");
-        glBindFramebuffer(GL_FRAMEBUFFER, mFixupFbo.id());
-        glClearNamedFramebufferfv(mFixupFbo.id(), GL_COLOR, 0, zero);
-        glStencilFunc(GL_EQUAL, 1, 0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-        glBindTextureUnit(0, in.find("gbuffer.position")->id());
-        glBindTextureUnit(1, in.find("gbuffer.normal")->id());
-        gather(mGather, slots, minDistance, counters);
-        glDisable(GL_STENCIL_TEST);
-        timer.end();
+        {
+            gl::Pass pass(timer, "discontinuity");
+            const DiscontinuityProgram& d = mDiscontinuity;
+            pass.target(mFlagFbo, in.width, in.height).clearColor(1).clearDepthStencil(1.0f, 0);
+            pass.use(d.program)
+                .set(d.factor, factor)
+                .set(d.lowSize, glm::ivec2(lowW, lowH))
+                .set(d.threshold, static_cast<float>(threshold));
+            pass.texture(d.position, position)
+                .texture(d.normal, normal)
+                .texture(d.lowPosition, mLowPosition)
+                .texture(d.lowNormal, mLowNormal);
+            pass.stencil(GL_ALWAYS, 1, GL_KEEP, GL_KEEP, GL_REPLACE);
+            glBeginQuery(GL_SAMPLES_PASSED, mFlaggedQuery.id());
+            pass.drawFullscreen(mEmptyVao);
+            glEndQuery(GL_SAMPLES_PASSED);
+        }
+        gl::Pass pass(timer, "fixup_gather");
+        pass.target(mFixupFbo, in.width, in.height).clearColor(1);
+        pass.stencil(GL_EQUAL, 1, GL_KEEP, GL_KEEP, GL_KEEP);
+        gather(pass, position, normal, params, slots, counters);
     }
 
-    timer.begin("resolve");
-    glBindFramebuffer(GL_FRAMEBUFFER, mResolveFbo.id());
-    glUseProgram(mResolve.id());
-    glUniform1i(mResolve.uniform("uFactor"), factor);
-    glUniform2i(mResolve.uniform("uLowSize"), lowW, lowH);
-    glUniform1i(mResolve.uniform("uFixup"), fixup ? 1 : 0);
-    glUniform1i(mResolve.uniform("uHasDirect"), in.find("direct") ? 1 : 0);
-    glBindTextureUnit(0, in.find("gbuffer.position")->id());
-    glBindTextureUnit(1, in.find("gbuffer.albedo")->id());
-    glBindTextureUnit(2, in.find("direct") ? in.find("direct")->id() : in.find("gbuffer.albedo")->id());
-    glBindTextureUnit(3, mFlag.id());
-    glBindTextureUnit(4, mFullIrradiance.id());
-    glBindTextureUnit(5, mLowIrradiance.id());
-    glBindTextureUnit(6, mLowPosition.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, mStats.id());
-    glBindVertexArray(mEmptyVao.id());
-    glBeginQuery(GL_SAMPLES_PASSED, mCoveredQuery.id());
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glEndQuery(GL_SAMPLES_PASSED);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    timer.end();
+    {
+        gl::Pass pass(timer, "resolve");
+        const ResolveProgram& r = mResolve;
+        const gl::Texture* direct = in.find("direct");
+        pass.target(mResolveFbo, in.width, in.height).use(r.program);
+        pass.set(r.factor, factor)
+            .set(r.lowSize, glm::ivec2(lowW, lowH))
+            .set(r.fixup, fixup ? 1 : 0)
+            .set(r.hasDirect, direct ? 1 : 0);
+        pass.texture(r.position, position)
+            .texture(r.albedo, in.get("gbuffer.albedo"))
+            .texture(r.direct, direct ? *direct : in.get("gbuffer.albedo"))
+            .texture(r.flag, mFlag)
+            .texture(r.fullIrradiance, mFullIrradiance)
+            .texture(r.lowIrradiance, mLowIrradiance)
+            .texture(r.lowPosition, mLowPosition)
+            .buffer(r.stats, mStats);
+        glBeginQuery(GL_SAMPLES_PASSED, mCoveredQuery.id());
+        pass.drawFullscreen(mEmptyVao);
+        glEndQuery(GL_SAMPLES_PASSED);
+        pass.barrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    }
 
     // Counters: waits for the frame's last pass (the composite reads its output next anyway).
     GLuint covered = 0;

@@ -49,6 +49,7 @@
 
 #include "gi/Technique.h"
 #include "gi/common/BiasCompensation.h"
+#include "gi/common/VplGrid.h"
 #include "gi/second_order/Halton.h"
 #include "gl/Shader.h"
 
@@ -79,10 +80,48 @@ private:
     int placePositive(const FrameInputs& in, gl::PassTimer& timer, Counters& counters);
     int placeNegative(const FrameInputs& in, const ParamSet& params, int positiveCount, gl::PassTimer& timer,
                       Counters& counters);
-    void gather(const gl::Program& program, int slots, float minDistance, Counters& counters);
+    /// The VPL and negative-light gather into the pass's target, with `position` and `normal` as the
+    /// receivers (low-resolution or full G-buffer).
+    void gather(gl::Pass& pass, const gl::Texture& position, const gl::Texture& normal,
+                const ParamSet& params, int slots, Counters& counters);
 
     ConeCache mLightCone, mCameraCone;
-    gl::Program mPlacePositive, mPlaceNegative, mLowGeometry, mGather, mDiscontinuity, mResolve;
+    struct PlacePositiveProgram {
+        gl::Program program;
+        gl::UniformLocation count, rsmSize, sampleSolidAngle;
+        gl::TextureUnit position, normal, flux;
+        gl::BlockBinding vpls, samples, stats;
+    } mPlacePositive;
+    struct PlaceNegativeProgram {
+        gl::Program program;
+        gl::UniformLocation positiveCount, negativeCount, candidateCount, frustumSolidAngle, minDistance,
+            minCosView;
+        gl::TextureUnit position, normal;
+        gl::BlockBinding vpls, candidates, stats;
+    } mPlaceNegative;
+    struct LowGeometryProgram {
+        gl::Program program;
+        gl::UniformLocation factor;
+        gl::TextureUnit position, normal;
+    } mLowGeometry;
+    struct GatherProgram {
+        gl::Program program;
+        gl::UniformLocation minDistance, vplCount, batchFirst;
+        gl::TextureUnit position, normal;
+        gl::BlockBinding stats;
+        VplTransportHandles transport;
+    } mGather;
+    struct DiscontinuityProgram {
+        gl::Program program;
+        gl::UniformLocation factor, lowSize, threshold;
+        gl::TextureUnit position, normal, lowPosition, lowNormal;
+    } mDiscontinuity;
+    struct ResolveProgram {
+        gl::Program program;
+        gl::UniformLocation factor, lowSize, fixup, hasDirect;
+        gl::TextureUnit position, albedo, direct, flag, fullIrradiance, lowIrradiance, lowPosition;
+        gl::BlockBinding stats;
+    } mResolve;
     BiasCompensation mSsbc;
     gl::VertexArray mEmptyVao;
     gl::Buffer mSamples, mCandidates, mVpls, mStats;
