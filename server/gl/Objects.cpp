@@ -65,6 +65,21 @@ Framebuffer Framebuffer::create() {
     return Framebuffer(id);
 }
 
+Framebuffer Framebuffer::of(const std::string& label, std::initializer_list<const Texture*> colors,
+                            const Texture* depth) {
+    Framebuffer fbo = create();
+    int index = 0;
+    for (const Texture* t : colors) fbo.attachColor(index++, *t);
+    if (depth) {
+        if (depth->format() == GL_DEPTH24_STENCIL8)
+            fbo.attachDepthStencil(*depth);
+        else
+            fbo.attachDepth(*depth);
+    }
+    fbo.finish(index, label);
+    return fbo;
+}
+
 void Framebuffer::attachColor(int index, const Texture& texture, int level) {
     glNamedFramebufferTexture(id(), GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index), texture.id(), level);
 }

@@ -3,6 +3,7 @@
 // Only server/gl and the pass code that issues draw calls read id().
 #pragma once
 
+#include <initializer_list>
 #include <string>
 #include <utility>
 
@@ -100,6 +101,10 @@ class Framebuffer : public Object<FramebufferTraits> {
 public:
     Framebuffer() = default;
     static Framebuffer create();
+    /// A complete target: `colors` at attachments 0.., `depth` (a GL_DEPTH24_STENCIL8 texture is
+    /// attached as depth and stencil) and the draw buffers selected; throws gis::Error naming `label`.
+    static Framebuffer of(const std::string& label, std::initializer_list<const Texture*> colors,
+                          const Texture* depth = nullptr);
     void attachColor(int index, const Texture& texture, int level = 0);
     void attachDepth(const Texture& texture, int level = 0);
     void attachDepthStencil(const Texture& texture, int level = 0); ///< GL_DEPTH24_STENCIL8 texture

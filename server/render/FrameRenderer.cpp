@@ -111,9 +111,7 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadow
         mShadowDepth.setFilter(GL_LINEAR, GL_LINEAR); // hardware 2x2 PCF with the compare mode
         glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
         glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-        mShadowFbo = gl::Framebuffer::create();
-        mShadowFbo.attachDepth(mShadowDepth);
-        mShadowFbo.finish(0, "shadow map");
+        mShadowFbo = gl::Framebuffer::of("shadow map", {}, &mShadowDepth);
         mShadowSize = shadowSize;
     }
     if (rsmSize != mRsmSize) {
@@ -122,13 +120,8 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadow
         mRsmFlux = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
         mRsmSpecular = gl::Texture::create2D(GL_RGBA8, rsmSize, rsmSize);
         mRsmDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, rsmSize, rsmSize);
-        mRsmFbo = gl::Framebuffer::create();
-        mRsmFbo.attachColor(0, mRsmPosition);
-        mRsmFbo.attachColor(1, mRsmNormal);
-        mRsmFbo.attachColor(2, mRsmFlux);
-        mRsmFbo.attachColor(3, mRsmSpecular);
-        mRsmFbo.attachDepth(mRsmDepth);
-        mRsmFbo.finish(4, "reflective shadow map");
+        mRsmFbo = gl::Framebuffer::of("reflective shadow map",
+                                      {&mRsmPosition, &mRsmNormal, &mRsmFlux, &mRsmSpecular}, &mRsmDepth);
         mRsmSize = rsmSize;
     }
     if (width != mWidth || height != mHeight) {
@@ -138,24 +131,13 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadow
         mGEmissive = gl::Texture::create2D(GL_RGBA16F, width, height);
         mGSpecular = gl::Texture::create2D(GL_RGBA8, width, height);
         mGDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, width, height);
-        mGBufferFbo = gl::Framebuffer::create();
-        mGBufferFbo.attachColor(0, mGPosition);
-        mGBufferFbo.attachColor(1, mGNormal);
-        mGBufferFbo.attachColor(2, mGAlbedo);
-        mGBufferFbo.attachColor(3, mGEmissive);
-        mGBufferFbo.attachColor(4, mGSpecular);
-        mGBufferFbo.attachDepth(mGDepth);
-        mGBufferFbo.finish(5, "G-buffer");
+        mGBufferFbo = gl::Framebuffer::of(
+            "G-buffer", {&mGPosition, &mGNormal, &mGAlbedo, &mGEmissive, &mGSpecular}, &mGDepth);
         mDirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-        mDirectFbo = gl::Framebuffer::create();
-        mDirectFbo.attachColor(0, mDirect);
-        mDirectFbo.finish(1, "direct light");
+        mDirectFbo = gl::Framebuffer::of("direct light", {&mDirect});
         mDisplay = gl::Texture::create2D(GL_RGBA8, width, height);
         mLinear = gl::Texture::create2D(GL_RGBA32F, width, height);
-        mCompositeFbo = gl::Framebuffer::create();
-        mCompositeFbo.attachColor(0, mDisplay);
-        mCompositeFbo.attachColor(1, mLinear);
-        mCompositeFbo.finish(2, "composite");
+        mCompositeFbo = gl::Framebuffer::of("composite", {&mDisplay, &mLinear});
         mWidth = width;
         mHeight = height;
     }

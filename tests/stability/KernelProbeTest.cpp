@@ -61,7 +61,7 @@ std::vector<Result> evaluate(const std::vector<Pair>& pairs, float clampB) {
     gl::Buffer in = gl::Buffer::create(static_cast<GLsizeiptr>(pairs.size() * sizeof(Pair)), pairs.data());
     gl::Buffer out = gl::Buffer::create(static_cast<GLsizeiptr>(pairs.size() * sizeof(Result)));
     glUseProgram(program.id());
-    glUniform1f(program.uniform("uVplInvClampB"), clampB > 0 ? 1.0f / clampB : 0.0f);
+    glUniform1f(program.location("uVplInvClampB").location, clampB > 0 ? 1.0f / clampB : 0.0f);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.id());
     glDispatchCompute(static_cast<GLuint>(pairs.size()), 1, 1);

@@ -107,25 +107,15 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     mNormalMax = gl::Texture::create2D(GL_RGBA16F, aw, ah);
     mFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
     mDiscFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
-    mGeoFbo = gl::Framebuffer::create();
-    const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
-                                 &mDepthInfo,   &mNormalMin, &mNormalMax};
-    for (int i = 0; i < 6; ++i) mGeoFbo.attachColor(i, *geo[i]);
-    mGeoFbo.attachColor(6, mDiscFlags);
-    mGeoFbo.finish(7, "eye hierarchy mipmaps");
-    mFlagsFbo = gl::Framebuffer::create();
-    mFlagsFbo.attachColor(0, mFlags);
-    mFlagsFbo.finish(1, "eye refinement flags");
-    mReconFbo = gl::Framebuffer::create();
+    mGeoFbo =
+        gl::Framebuffer::of("eye hierarchy mipmaps", {&mGeoPosition, &mGeoNormal, &mGeoAlbedo, &mDepthInfo,
+                                                      &mNormalMin, &mNormalMax, &mDiscFlags});
+    mFlagsFbo = gl::Framebuffer::of("eye refinement flags", {&mFlags});
     mIllumination = gl::Texture::create2D(GL_RGBA32F, aw, ah);
     mReconstructed = gl::Texture::create2D(GL_RGBA32F, aw, ah);
     mStencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, aw, ah);
-    mIllumFbo = gl::Framebuffer::create();
-    mIllumFbo.attachColor(0, mIllumination);
-    mIllumFbo.attachDepthStencil(mStencil);
-    mIllumFbo.finish(1, "multiresolution illumination buffer");
-    mReconFbo.attachColor(0, mReconstructed);
-    mReconFbo.finish(1, "reconstructed illumination");
+    mIllumFbo = gl::Framebuffer::of("multiresolution illumination buffer", {&mIllumination}, &mStencil);
+    mReconFbo = gl::Framebuffer::of("reconstructed illumination", {&mReconstructed});
     // Padding texels must read as empty even before the first frame writes them.
     const float zero[4] = {0, 0, 0, 0};
     for (const gl::Texture* t : {&mGeoPosition, &mGeoNormal, &mGeoAlbedo, &mDepthInfo, &mNormalMin,

@@ -12,9 +12,7 @@ struct IndirectTarget {
 
     void resize(int width, int height, const char* label) {
         texture = gl::Texture::create2D(GL_RGBA32F, width, height);
-        framebuffer = gl::Framebuffer::create();
-        framebuffer.attachColor(0, texture);
-        framebuffer.finish(1, label);
+        framebuffer = gl::Framebuffer::of(label, {&texture});
     }
 };
 

@@ -28,9 +28,8 @@ int VplShadows::render(const FrameInputs& in, const ParamSet& params, const gl::
         mMaps = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, size, size, layers);
         mMaps.setFilter(GL_NEAREST, GL_NEAREST);
         mMaps.setWrap(GL_CLAMP_TO_EDGE);
-        mFbo = gl::Framebuffer::create();
-        mFbo.attachDepth(mMaps); // all layers: the vertex shader picks one per instance
-        mFbo.finish(0, "VPL shadow maps");
+        // All layers attached: the vertex shader picks one per instance.
+        mFbo = gl::Framebuffer::of("VPL shadow maps", {}, &mMaps);
         mSize = size;
         mLayers = layers;
     }

@@ -124,24 +124,12 @@ void SecondOrder::resize(int width, int height) {
     mFullIrradiance = gl::Texture::create2D(GL_RGBA32F, width, height);
     mIndirect = gl::Texture::create2D(GL_RGBA32F, width, height);
 
-    mLowGeometryFbo = gl::Framebuffer::create();
-    mLowGeometryFbo.attachColor(0, mLowPosition);
-    mLowGeometryFbo.attachColor(1, mLowNormal);
-    mLowGeometryFbo.finish(2, "second_order low-res G-buffer");
-    mLowIrradianceFbo = gl::Framebuffer::create();
-    mLowIrradianceFbo.attachColor(0, mLowIrradiance);
-    mLowIrradianceFbo.finish(1, "second_order low-res irradiance");
-    mFlagFbo = gl::Framebuffer::create();
-    mFlagFbo.attachColor(0, mFlag);
-    mFlagFbo.attachDepthStencil(mStencil);
-    mFlagFbo.finish(1, "second_order discontinuity");
-    mFixupFbo = gl::Framebuffer::create();
-    mFixupFbo.attachColor(0, mFullIrradiance);
-    mFixupFbo.attachDepthStencil(mStencil);
-    mFixupFbo.finish(1, "second_order fix-up");
-    mResolveFbo = gl::Framebuffer::create();
-    mResolveFbo.attachColor(0, mIndirect);
-    mResolveFbo.finish(1, "second_order indirect");
+    mLowGeometryFbo = gl::Framebuffer::of("second_order low-res G-buffer", {&mLowPosition, &mLowNormal});
+    mLowIrradianceFbo = gl::Framebuffer::of("second_order low-res irradiance", {&mLowIrradiance});
+    // The discontinuity pass marks the stencil that the fix-up gather then tests.
+    mFlagFbo = gl::Framebuffer::of("second_order discontinuity", {&mFlag}, &mStencil);
+    mFixupFbo = gl::Framebuffer::of("second_order fix-up", {&mFullIrradiance}, &mStencil);
+    mResolveFbo = gl::Framebuffer::of("second_order indirect", {&mIndirect});
 }
 
 const halton::ConeSamples& SecondOrder::cone(ConeCache& cache, double cosHalfAngle, int count) {
