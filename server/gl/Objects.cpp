@@ -49,6 +49,23 @@ Texture Texture::create2D(GLenum internalFormat, int width, int height, int leve
     return t;
 }
 
+Texture Texture::createCube(GLenum internalFormat, int size, int levels) {
+    GIS_ASSERT(size > 0 && levels > 0);
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_CUBE_MAP, 1, &id);
+    glTextureStorage2D(id, levels, internalFormat, size, size);
+    Texture t(id);
+    t.mWidth = size;
+    t.mHeight = size;
+    t.mLevels = levels;
+    t.mFormat = internalFormat;
+    t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
+    t.setWrap(GL_CLAMP_TO_EDGE);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(id, GL_TEXTURE_MAX_LEVEL, levels - 1);
+    return t;
+}
+
 void Texture::setFilter(GLenum minFilter, GLenum magFilter) {
     glTextureParameteri(id(), GL_TEXTURE_MIN_FILTER, static_cast<GLint>(minFilter));
     glTextureParameteri(id(), GL_TEXTURE_MAG_FILTER, static_cast<GLint>(magFilter));
@@ -57,6 +74,10 @@ void Texture::setFilter(GLenum minFilter, GLenum magFilter) {
 void Texture::setWrap(GLenum wrap) {
     glTextureParameteri(id(), GL_TEXTURE_WRAP_S, static_cast<GLint>(wrap));
     glTextureParameteri(id(), GL_TEXTURE_WRAP_T, static_cast<GLint>(wrap));
+}
+
+void Texture::generateMipmap() {
+    glGenerateTextureMipmap(id());
 }
 
 Framebuffer Framebuffer::create() {
@@ -90,6 +111,22 @@ void Framebuffer::attachDepth(const Texture& texture, int level) {
 
 void Framebuffer::attachDepthStencil(const Texture& texture, int level) {
     glNamedFramebufferTexture(id(), GL_DEPTH_STENCIL_ATTACHMENT, texture.id(), level);
+}
+
+void Framebuffer::attachColorLayer(int index, const Texture& texture, int layer, int level) {
+    glNamedFramebufferTextureLayer(id(), GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index), texture.id(),
+                                   level, layer);
+}
+
+bool Framebuffer::tryFinish(int colorCount) {
+    GLenum buffers[8];
+    GIS_ASSERT(colorCount >= 0 && colorCount <= 8);
+    for (int i = 0; i < colorCount; ++i) buffers[i] = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i);
+    if (colorCount == 0)
+        glNamedFramebufferDrawBuffer(id(), GL_NONE);
+    else
+        glNamedFramebufferDrawBuffers(id(), colorCount, buffers);
+    return glCheckNamedFramebufferStatus(id(), GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
 }
 
 void Framebuffer::finish(int colorCount, const std::string& label) {

@@ -83,6 +83,9 @@ public:
     Texture() = default;
     static Texture create2D(GLenum internalFormat, int width, int height, int levels = 1);
     static Texture create2DArray(GLenum internalFormat, int width, int height, int layers);
+    /// A cube map of `size`^2 texels per face and `levels` mip levels, filtered for samplerCube:
+    /// trilinear minification, linear magnification, clamp-to-edge on all three axes.
+    static Texture createCube(GLenum internalFormat, int size, int levels);
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     GLenum format() const { return mFormat; }
@@ -90,6 +93,8 @@ public:
     /// Nearest or linear filtering and clamp-to-edge wrapping.
     void setFilter(GLenum minFilter, GLenum magFilter);
     void setWrap(GLenum wrap);
+    /// Fills levels 1.. from level 0 (box filter).
+    void generateMipmap();
 
 private:
     using Object::Object;
@@ -108,8 +113,14 @@ public:
     void attachColor(int index, const Texture& texture, int level = 0);
     void attachDepth(const Texture& texture, int level = 0);
     void attachDepthStencil(const Texture& texture, int level = 0); ///< GL_DEPTH24_STENCIL8 texture
+    /// Attaches one layer of an array texture, or one face (layer 0..5: +X, -X, +Y, -Y, +Z, -Z) of a
+    /// cube map, as colour attachment `index`.
+    void attachColorLayer(int index, const Texture& texture, int layer, int level = 0);
     /// Selects the draw buffers 0..count-1 and checks completeness; throws gis::Error naming `label`.
     void finish(int colorCount, const std::string& label);
+    /// finish() for targets (re)allocated on the per-frame path, which never throws: returns whether
+    /// the framebuffer is complete.
+    [[nodiscard]] bool tryFinish(int colorCount);
 
 private:
     using Object::Object;

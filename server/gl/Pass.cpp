@@ -42,8 +42,14 @@ Pass::~Pass() {
     if (mDepthTest) glDisable(GL_DEPTH_TEST);
     if (mBlend) glDisable(GL_BLEND);
     if (mCull) glDisable(GL_CULL_FACE);
-    if (mStencil) glDisable(GL_STENCIL_TEST);
     if (mColorMasked) glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    if (mStencil) {
+        glDisable(GL_STENCIL_TEST);
+        glStencilMask(0xFF);
+    }
+    if (mFrontFace) glFrontFace(GL_CCW);
+    for (GLenum i = 0; i < 8; ++i)
+        if (mClipDistances & (1u << i)) glDisable(GL_CLIP_DISTANCE0 + i);
     for (const BlockBinding& b : mBoundBlocks) glBindBufferBase(b.target, b.index, 0);
     if (mTimer) mTimer->end();
     if (passChecksEnabled()) {
@@ -77,6 +83,11 @@ Pass& Pass::clearDepth(float depth) {
     return *this;
 }
 
+Pass& Pass::clearDepthStencil(float depth, int stencil) {
+    glClearNamedFramebufferfi(mFbo, GL_DEPTH_STENCIL, 0, depth, stencil);
+    return *this;
+}
+
 Pass& Pass::depthTest(GLenum func) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(func);
@@ -93,11 +104,6 @@ Pass& Pass::polygonOffset(float factor, float units) {
 
 Pass& Pass::viewport(int x, int y, int width, int height) {
     glViewport(x, y, width, height);
-    return *this;
-}
-
-Pass& Pass::clearDepthStencil(float depth, int stencil) {
-    glClearNamedFramebufferfi(mFbo, GL_DEPTH_STENCIL, 0, depth, stencil);
     return *this;
 }
 
@@ -138,6 +144,31 @@ Pass& Pass::cullFace(GLenum face) {
     glEnable(GL_CULL_FACE);
     glCullFace(face);
     mCull = true;
+    return *this;
+}
+
+Pass& Pass::stencilTest(bool write) {
+    glEnable(GL_STENCIL_TEST);
+    glStencilMask(write ? 0xFF : 0x00);
+    glStencilOp(GL_KEEP, GL_KEEP, write ? GL_REPLACE : GL_KEEP);
+    mStencil = true;
+    return *this;
+}
+
+Pass& Pass::stencilFunc(GLenum func, GLint ref) {
+    glStencilFunc(func, ref, 0xFF);
+    return *this;
+}
+
+Pass& Pass::clipDistance(int index) {
+    glEnable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(index));
+    mClipDistances |= 1u << index;
+    return *this;
+}
+
+Pass& Pass::frontFace(GLenum mode) {
+    glFrontFace(mode);
+    mFrontFace = true;
     return *this;
 }
 
@@ -200,6 +231,16 @@ Pass& Pass::set(UniformLocation u, const glm::ivec2& value) {
     return *this;
 }
 
+Pass& Pass::set(UniformLocation u, const glm::ivec3& value) {
+    glUniform3i(u.location, value.x, value.y, value.z);
+    return *this;
+}
+
+Pass& Pass::set(UniformLocation u, std::span<const glm::vec3> values) {
+    if (!values.empty()) glUniform3fv(u.location, static_cast<GLsizei>(values.size()), &values[0].x);
+    return *this;
+}
+
 Pass& Pass::set(UniformLocation u, const glm::mat4& value) {
     glUniformMatrix4fv(u.location, 1, GL_FALSE, &value[0][0]);
     return *this;
@@ -240,6 +281,15 @@ Pass& Pass::set(UniformLocation u, float value) {
 void Pass::drawFullscreen(const VertexArray& emptyVao) {
     glBindVertexArray(emptyVao.id());
     glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+bool Pass::drawFullscreenAnySamples(const VertexArray& emptyVao, const Query& anySamples) {
+    glBeginQuery(GL_ANY_SAMPLES_PASSED, anySamples.id());
+    drawFullscreen(emptyVao);
+    glEndQuery(GL_ANY_SAMPLES_PASSED);
+    GLuint any = 0;
+    glGetQueryObjectuiv(anySamples.id(), GL_QUERY_RESULT, &any);
+    return any != 0;
 }
 
 } // namespace gis::gl

@@ -5,12 +5,14 @@
 // where the program is built instead of being ignored at draw time.
 //
 // At scope end the pass disables what it enabled (depth test, polygon offset, blending, face
-// culling, stencil test, colour masking), unbinds the storage blocks it bound, ends its timer slot (a pass
-// built without a timer is a sub-step of a timed one) and, when pass checks are on (GI_GL_CHECK_PASSES=1, as
-// the GL tests run, or a debug build), reads glGetError and logs the pass's name with the error;
-// passCheckErrors() counts them. Passes never throw: they sit on the per-frame path.
+// culling, stencil test, clip distances, colour masking; the front face goes back to GL_CCW and the stencil
+// write mask to 0xFF), unbinds the storage blocks it bound, ends its timer slot (a pass built without a timer
+// is a sub-step of a timed one) and, when pass checks are on (GI_GL_CHECK_PASSES=1, as the GL tests run, or a
+// debug build), reads glGetError and logs the pass's name with the error; passCheckErrors() counts them.
+// Passes never throw: they sit on the per-frame path.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,12 +38,14 @@ public:
     /// Clears colour attachments 0..count-1 of the bound target to 0 (the last `target`).
     Pass& clearColor(int count);
     Pass& clearDepth(float depth = 1.0f);
+    /// Clears the depth-stencil attachment of the bound target (write masks at their defaults, which
+    /// passes restore).
+    Pass& clearDepthStencil(float depth = 1.0f, int stencil = 0);
     Pass& depthTest(GLenum func = GL_LESS);
     /// Slope-scaled depth offset for the pass's triangles (shadow maps against acne).
     Pass& polygonOffset(float factor, float units);
     /// A sub-rectangle of the target (an atlas level).
     Pass& viewport(int x, int y, int width, int height);
-    Pass& clearDepthStencil(float depth, int stencil);
     /// Additive blending (ONE, ONE) for the pass's draws: accumulating lights or splats.
     Pass& blendAdd();
     /// Blending with separate colour and alpha factors.
@@ -54,6 +58,17 @@ public:
     /// Makes this pass's earlier writes to a texture visible to its later reads (glTextureBarrier).
     Pass& textureBarrier();
     Pass& cullFace(GLenum face = GL_BACK);
+    /// Enables the stencil test. With `write`, fragments that pass replace the stored value with the
+    /// reference (write mask 0xFF); without, the stencil buffer is only read (write mask 0). The test
+    /// itself is stencilFunc's, set per draw.
+    Pass& stencilTest(bool write);
+    /// The stencil test of the following draws: `func` (GL_ALWAYS, GL_EQUAL, ...) of `ref` against the
+    /// stored value, all 8 bits.
+    Pass& stencilFunc(GLenum func, GLint ref);
+    /// Enables the user clip distance gl_ClipDistance[index] (the vertex shader must write it).
+    Pass& clipDistance(int index = 0);
+    /// The winding of front faces for the following draws (GL_CW inside an odd number of mirrors).
+    Pass& frontFace(GLenum mode);
     Pass& use(const Program& program);
     Pass& texture(TextureUnit unit, const Texture& texture);
     /// Binds `texture`, or unbinds the unit when it is null (an input the shader does not read then).
@@ -73,9 +88,15 @@ public:
     Pass& set(UniformLocation u, const glm::vec3& value);
     Pass& set(UniformLocation u, const glm::vec4& value);
     Pass& set(UniformLocation u, const glm::ivec2& value);
+    Pass& set(UniformLocation u, const glm::ivec3& value);
     Pass& set(UniformLocation u, const glm::mat4& value);
+    /// A vec3 array uniform, from element 0 (Program::location of the array's name).
+    Pass& set(UniformLocation u, std::span<const glm::vec3> values);
     /// A fullscreen triangle (shaders/render/fullscreen.vert) with `emptyVao` bound.
     void drawFullscreen(const VertexArray& emptyVao);
+    /// drawFullscreen() counted by `anySamples` (a GL_ANY_SAMPLES_PASSED query): waits for the result
+    /// and returns whether any sample passed the tests.
+    bool drawFullscreenAnySamples(const VertexArray& emptyVao, const Query& anySamples);
     /// Dispatches groupsX x groupsY x groupsZ work groups of the compute program in use.
     Pass& dispatch(int groupsX, int groupsY = 1, int groupsZ = 1);
     /// Dispatches the work-group counts stored at `offset` in `commands`.
@@ -92,6 +113,8 @@ private:
     bool mCull = false;
     bool mStencil = false;
     bool mColorMasked = false;
+    bool mFrontFace = false;
+    unsigned mClipDistances = 0; ///< bit i: GL_CLIP_DISTANCE0 + i enabled here
     std::vector<BlockBinding> mBoundBlocks;
 };
 

@@ -49,8 +49,6 @@ public:
     static Program build(const std::vector<ShaderStage>& stages,
                          const std::vector<std::pair<std::string, std::string>>& defines = {},
                          const std::vector<std::string>& feedbackVaryings = {});
-    // TRANSITIONAL: removed once every pass resolves its uniforms through location().
-    GLint uniform(const char* name) const { return glGetUniformLocation(id(), name); }
 
     /// The active uniform `name` (not in a block), checked against what the linker kept: a missing or
     /// misspelt name throws gis::Error naming the program's files, where the program is built, so a

@@ -287,13 +287,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     ReflectionInputs rin;
     rin.width = state.width;
     rin.height = state.height;
-    rin.gPosition = &mResources.get("gbuffer.position");
-    rin.gNormal = &mResources.get("gbuffer.normal");
-    rin.gAlbedo = &mResources.get("gbuffer.albedo");
-    rin.gSpecular = &mResources.get("gbuffer.specular");
-    rin.direct = &mResources.get("direct");
+    rin.resources = &mResources;
     rin.indirect = indirect;
-    rin.shadowMap = &mResources.get(FrameResources::light(0, "shadow"));
     rin.frame = &u;
     rin.scene = mScene.get();
     rin.sceneGpu = mSceneGpu.get();

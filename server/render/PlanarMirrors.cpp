@@ -6,8 +6,7 @@
 #include <string>
 #include <vector>
 
-#include <glm/gtc/type_ptr.hpp>
-
+#include "gl/Pass.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
@@ -66,11 +65,44 @@ struct Level {
     gl::Framebuffer stencilFbo; // depth-stencil only
 };
 
+/// The uniforms and samplers of shaders/render/mirror_region.glsl in one program.
+struct RegionSlots {
+    gl::UniformLocation level, chain;
+    gl::TextureUnit idEye, id1, id2;
+    static RegionSlots of(const gl::Program& p) {
+        return {p.location("uLevel"), p.location("uChain"), p.textureUnit("gMirrorIdEye"),
+                p.textureUnit("gMirrorId1"), p.textureUnit("gMirrorId2")};
+    }
+};
+
 } // namespace
 
 struct PlanarMirrors::Impl {
-    gl::Program stencil, forward, indirect, blur, apply;
-    MaterialSlots forwardMaterials;
+    /// shaders/render/mirror_stencil.frag: marks one view's pixels.
+    struct StencilPass {
+        gl::Program program;
+        RegionSlots region;
+    } stencil;
+    ForwardProgram forward;
+    /// shaders/render/mirror_indirect.frag: the eye's indirect light at reflected points it also sees.
+    struct IndirectPass {
+        gl::Program program;
+        gl::TextureUnit indirect, position, viewPosition;
+    } indirect;
+    /// shaders/render/mirror_blur.frag: one direction of a view's glossy blur.
+    struct BlurPass {
+        gl::Program program;
+        RegionSlots region;
+        gl::TextureUnit source, mirrorPosition, reflectPosition;
+        gl::UniformLocation direction, roughness, viewProjChain, maxSigmaPx;
+    } blur;
+    /// shaders/render/mirror_apply.frag: Fresnel x a view's radiance, added into its parent.
+    struct ApplyPass {
+        gl::Program program;
+        RegionSlots region;
+        gl::TextureUnit reflected, mirrorPosition;
+        gl::UniformLocation parentEye, mirrorNormal, f0;
+    } apply;
     gl::VertexArray emptyVao;
     gl::Query anySamples;
     int width = 0, height = 0;
@@ -111,23 +143,50 @@ struct PlanarMirrors::Impl {
         }
     }
 
-    void setRegion(const gl::Program& p, const View& v) const {
-        glUniform1i(p.uniform("uLevel"), v.level);
-        glUniform3i(p.uniform("uChain"), v.chain.x, v.chain.y, v.chain.z);
+    /// Selects view `v`'s pixels in a program reading mirror_region.glsl: its chain, and the mirror
+    /// ids of the eye and of the levels above it.
+    void setRegion(gl::Pass& pass, const RegionSlots& r, const View& v, const gl::Texture& eyeIds) const {
+        pass.set(r.level, v.level).set(r.chain, v.chain).texture(r.idEye, eyeIds);
+        if (v.level >= 2) pass.texture(r.id1, levels[0].mirrorId);
+        if (v.level >= 3) pass.texture(r.id2, levels[1].mirrorId);
     }
 };
 
 PlanarMirrors::PlanarMirrors() : mImpl(std::make_unique<Impl>()) {
+    Impl& s = *mImpl;
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
-    mImpl->stencil = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_stencil.frag"}});
-    mImpl->forward = gl::Program::build(
-        {{GL_VERTEX_SHADER, "render/forward.vert"}, {GL_FRAGMENT_SHADER, "render/forward.frag"}});
-    mImpl->forwardMaterials = MaterialSlots::of(mImpl->forward);
-    mImpl->indirect = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_indirect.frag"}});
-    mImpl->blur = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_blur.frag"}});
-    mImpl->apply = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_apply.frag"}});
-    mImpl->emptyVao = gl::VertexArray::create();
-    mImpl->anySamples = gl::Query::create(GL_ANY_SAMPLES_PASSED);
+    s.stencil.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_stencil.frag"}});
+    s.stencil.region = RegionSlots::of(s.stencil.program);
+    s.forward = ForwardProgram::build();
+
+    Impl::IndirectPass& i = s.indirect;
+    i.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_indirect.frag"}});
+    i.indirect = i.program.textureUnit("gIndirect");
+    i.position = i.program.textureUnit("gPosition");
+    i.viewPosition = i.program.textureUnit("gViewPos");
+
+    Impl::BlurPass& b = s.blur;
+    b.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_blur.frag"}});
+    b.region = RegionSlots::of(b.program);
+    b.source = b.program.textureUnit("gSource");
+    b.mirrorPosition = b.program.textureUnit("gMirrorPos");
+    b.reflectPosition = b.program.textureUnit("gReflectPos");
+    b.direction = b.program.location("uDirection");
+    b.roughness = b.program.location("uRoughness");
+    b.viewProjChain = b.program.location("uViewProjChain");
+    b.maxSigmaPx = b.program.location("uMaxSigmaPx");
+
+    Impl::ApplyPass& a = s.apply;
+    a.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/mirror_apply.frag"}});
+    a.region = RegionSlots::of(a.program);
+    a.reflected = a.program.textureUnit("gReflected");
+    a.mirrorPosition = a.program.textureUnit("gMirrorPos");
+    a.parentEye = a.program.location("uParentEye");
+    a.mirrorNormal = a.program.location("uMirrorNormal");
+    a.f0 = a.program.location("uF0");
+
+    s.emptyVao = gl::VertexArray::create();
+    s.anySamples = gl::Query::create(GL_ANY_SAMPLES_PASSED);
     gl::checkErrors("planar mirrors setup");
 }
 
@@ -137,8 +196,11 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
                             gl::PassTimer& timer, Counters& counters) {
     counters["mirror_views"] = 0;
     const int depth = std::clamp(static_cast<int>(fp.getInt("mirror_depth")), 0, kMaxMirrorDepth);
-    if (depth == 0 || !in.mirrors || in.mirrors->empty() || !in.frame || !in.sceneGpu || !in.gNormal ||
-        !in.gPosition || in.width <= 0 || in.height <= 0)
+    const gl::Texture* gPosition = in.find("gbuffer.position");
+    const gl::Texture* gNormal = in.find("gbuffer.normal");
+    const gl::Texture* shadowMap = in.find(FrameResources::light(0, "shadow"));
+    if (depth == 0 || !in.mirrors || in.mirrors->empty() || !in.frame || !in.sceneGpu || !gNormal ||
+        !gPosition || in.width <= 0 || in.height <= 0)
         return;
     const std::vector<MirrorPlane>& mirrors = *in.mirrors;
     const int mirrorCount = std::min(static_cast<int>(mirrors.size()), kMaxMirrors);
@@ -163,17 +225,7 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
         reflections[static_cast<size_t>(i)] = mirrorReflection(m.point, normals[static_cast<size_t>(i)]);
     }
 
-    const float zero[4] = {0, 0, 0, 0};
-    const float one = 1.0f;
-    const GLint zeroStencil = 0;
-    glViewport(0, 0, in.width, in.height);
-    glDisable(GL_SCISSOR_TEST);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glBindVertexArray(s.emptyVao.id());
-    glBindTextureUnit(1, in.gNormal->id());
-
+    const int w = in.width, h = in.height;
     // Breadth first: level k's views, their stencil marks and renders, need level k-1's mirror ids.
     std::vector<View> views;
     std::vector<int> previous{-1}; // the eye
@@ -208,102 +260,74 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
         if (candidates.empty()) break;
 
         // 1. Stencil: each candidate's pixels get its stencil value; empty views are dropped.
-        timer.begin("mirror_stencil" + suffix);
-        glDepthMask(GL_TRUE); // clears obey the write masks
-        glStencilMask(0xFF);
-        for (int i = 0; i < 3; ++i) glClearNamedFramebufferfv(L.renderFbo.id(), GL_COLOR, i, zero);
-        glClearNamedFramebufferfi(L.renderFbo.id(), GL_DEPTH_STENCIL, 0, one, zeroStencil);
-        glBindFramebuffer(GL_FRAMEBUFFER, L.stencilFbo.id());
-        glDisable(GL_DEPTH_TEST);
-        glEnable(GL_STENCIL_TEST);
-        glStencilMask(0xFF);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-        glUseProgram(s.stencil.id());
-        if (level >= 2) glBindTextureUnit(2, s.levels[0].mirrorId.id());
-        if (level >= 3) glBindTextureUnit(3, s.levels[1].mirrorId.id());
         std::vector<View> visible;
-        for (View& v : candidates) {
-            if (static_cast<int>(views.size() + visible.size()) >= kMaxMirrorViews) break;
-            glStencilFunc(GL_ALWAYS, v.stencil, 0xFF);
-            s.setRegion(s.stencil, v);
-            glBeginQuery(GL_ANY_SAMPLES_PASSED, s.anySamples.id());
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-            glEndQuery(GL_ANY_SAMPLES_PASSED);
-            GLuint any = 0;
-            glGetQueryObjectuiv(s.anySamples.id(), GL_QUERY_RESULT, &any);
-            if (any) visible.push_back(v);
+        {
+            const Impl::StencilPass& st = s.stencil;
+            gl::Pass pass(timer, "mirror_stencil" + suffix);
+            pass.target(L.renderFbo, w, h).clearColor(3).clearDepthStencil(1.0f, 0);
+            pass.target(L.stencilFbo, w, h).stencilTest(true).use(st.program);
+            for (View& v : candidates) {
+                if (static_cast<int>(views.size() + visible.size()) >= kMaxMirrorViews) break;
+                pass.stencilFunc(GL_ALWAYS, v.stencil);
+                s.setRegion(pass, st.region, v, *gNormal);
+                if (pass.drawFullscreenAnySamples(s.emptyVao, s.anySamples)) visible.push_back(v);
+            }
         }
-        timer.end();
         if (visible.empty()) break;
 
         // 2. Render the scene mirrored about each view's chain into its pixels (stencil equal), with
         //    its own depth test and the mirror's front half-space as the clip plane.
-        timer.begin("mirror_render" + suffix);
-        glBindFramebuffer(GL_FRAMEBUFFER, L.renderFbo.id());
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glDepthMask(GL_TRUE);
-        glStencilMask(0x00);
-        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-        glEnable(GL_CLIP_DISTANCE0);
-        glUseProgram(s.forward.id());
-        if (in.shadowMap) glBindTextureUnit(4, in.shadowMap->id());
-        const GLint viewProjLoc = s.forward.uniform("uViewProj");
-        const GLint clipLoc = s.forward.uniform("uClipPlane");
-        const GLint eyeLoc = s.forward.uniform("uEye");
+        gl::Pass render(timer, "mirror_render" + suffix);
         previous.clear();
-        for (View& v : visible) {
-            const glm::mat4 vp = viewProj * v.reflect;
-            const glm::vec3 n = normals[static_cast<size_t>(v.mirror)];
-            const float d = -glm::dot(n, mirrors[static_cast<size_t>(v.mirror)].point) - clipOffset;
-            // A reflection flips the winding; culling is off in this renderer, but keep GL's notion
-            // of front faces right for anything that enables it.
-            const bool odd = (v.level % 2) == 1;
-            glFrontFace(odd ? GL_CW : GL_CCW);
-            glStencilFunc(GL_EQUAL, v.stencil, 0xFF);
-            glUniformMatrix4fv(viewProjLoc, 1, GL_FALSE, glm::value_ptr(vp));
-            glUniform4f(clipLoc, n.x, n.y, n.z, d);
-            glUniform3f(eyeLoc, v.eye.x, v.eye.y, v.eye.z);
-            in.sceneGpu->draw(s.forward, &s.forwardMaterials);
-            previous.push_back(static_cast<int>(views.size()));
-            views.push_back(v);
+        {
+            const ForwardProgram& fw = s.forward;
+            gl::Pass sub("mirror_views");
+            sub.target(L.renderFbo, w, h)
+                .depthTest(GL_LESS)
+                .stencilTest(false)
+                .clipDistance(0)
+                .use(fw.program)
+                .texture(fw.shadowMap, shadowMap);
+            for (View& v : visible) {
+                const glm::vec3 n = normals[static_cast<size_t>(v.mirror)];
+                const float d = -glm::dot(n, mirrors[static_cast<size_t>(v.mirror)].point) - clipOffset;
+                // A reflection flips the winding; culling is off in this renderer, but keep GL's notion
+                // of front faces right for anything that enables it.
+                const bool odd = (v.level % 2) == 1;
+                sub.frontFace(odd ? GL_CW : GL_CCW)
+                    .stencilFunc(GL_EQUAL, v.stencil)
+                    .set(fw.viewProj, viewProj * v.reflect)
+                    .set(fw.clipPlane, glm::vec4(n, d))
+                    .set(fw.eye, v.eye);
+                in.sceneGpu->draw(fw.program, &fw.materials);
+                previous.push_back(static_cast<int>(views.size()));
+                views.push_back(v);
+            }
         }
-        glFrontFace(GL_CCW);
-        glDisable(GL_CLIP_DISTANCE0);
-        glDisable(GL_STENCIL_TEST);
-        glDisable(GL_DEPTH_TEST);
         // Indirect light where the reflected points are also seen by the eye.
         if (in.indirect) {
-            glBindFramebuffer(GL_FRAMEBUFFER, L.colorFbo.id());
-            glEnable(GL_BLEND);
-            glBlendFunc(GL_ONE, GL_ONE);
-            glUseProgram(s.indirect.id());
-            glBindTextureUnit(5, in.indirect->id());
-            glBindTextureUnit(6, in.gPosition->id());
-            glBindTextureUnit(7, L.position.id());
-            glBindVertexArray(s.emptyVao.id());
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-            glDisable(GL_BLEND);
+            const Impl::IndirectPass& ip = s.indirect;
+            gl::Pass sub("mirror_indirect");
+            sub.target(L.colorFbo, w, h)
+                .blendAdd()
+                .use(ip.program)
+                .texture(ip.indirect, *in.indirect)
+                .texture(ip.position, *gPosition)
+                .texture(ip.viewPosition, L.position);
+            sub.drawFullscreen(s.emptyVao);
         }
-        glBindVertexArray(s.emptyVao.id());
-        timer.end();
         levelsUsed = level;
     }
-    glStencilMask(0xFF);
     counters["mirror_views"] = static_cast<double>(views.size());
     if (views.empty()) return;
 
     // 3. From the deepest level up: blur (optional) each view's radiance, then add Fresnel x radiance
     //    into its parent (the target at level 1).
-    timer.begin("mirror_apply");
-    glBindVertexArray(s.emptyVao.id());
-    glBindTextureUnit(1, in.gNormal->id());
-    if (levelsUsed >= 2) glBindTextureUnit(2, s.levels[0].mirrorId.id());
-    if (levelsUsed >= 3) glBindTextureUnit(3, s.levels[1].mirrorId.id());
+    gl::Pass pass(timer, "mirror_apply");
     for (int level = levelsUsed; level >= 1; --level) {
         Level& L = s.levels[static_cast<size_t>(level - 1)];
         const gl::Texture& parentPos =
-            level == 1 ? *in.gPosition : s.levels[static_cast<size_t>(level - 2)].position;
+            level == 1 ? *gPosition : s.levels[static_cast<size_t>(level - 2)].position;
         for (const View& v : views) {
             if (v.level != level) continue;
             const MirrorPlane& m = mirrors[static_cast<size_t>(v.mirror)];
@@ -316,43 +340,35 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
             const float maxSigma =
                 std::min(kMaxBlurSigmaPx, 2.0f * std::tan(lobe) * 0.5f * static_cast<float>(in.height) * p11);
             if (blurOn && maxSigma >= kMinBlurSigmaPx) {
-                glDisable(GL_BLEND);
-                glUseProgram(s.blur.id());
-                s.setRegion(s.blur, v);
-                glUniform1f(s.blur.uniform("uRoughness"), m.roughness);
-                glUniform1f(s.blur.uniform("uMaxSigmaPx"), maxSigma);
-                const glm::mat4 vp = viewProj * v.reflect;
-                glUniformMatrix4fv(s.blur.uniform("uViewProjChain"), 1, GL_FALSE, glm::value_ptr(vp));
-                glBindTextureUnit(6, parentPos.id());
-                glBindTextureUnit(7, L.position.id());
-                glBindFramebuffer(GL_FRAMEBUFFER, s.blurFbo.id());
-                glUniform2i(s.blur.uniform("uDirection"), 1, 0);
-                glBindTextureUnit(5, L.radiance.id());
-                glDrawArrays(GL_TRIANGLES, 0, 3);
-                glBindFramebuffer(GL_FRAMEBUFFER, L.colorFbo.id());
-                glUniform2i(s.blur.uniform("uDirection"), 0, 1);
-                glBindTextureUnit(5, s.blurTemp.id());
-                glDrawArrays(GL_TRIANGLES, 0, 3);
+                // Horizontal into the blur target, then vertical back into the view's radiance.
+                const Impl::BlurPass& b = s.blur;
+                gl::Pass sub("mirror_blur");
+                sub.use(b.program)
+                    .set(b.roughness, m.roughness)
+                    .set(b.maxSigmaPx, maxSigma)
+                    .set(b.viewProjChain, viewProj * v.reflect)
+                    .texture(b.mirrorPosition, parentPos)
+                    .texture(b.reflectPosition, L.position);
+                s.setRegion(sub, b.region, v, *gNormal);
+                sub.target(s.blurFbo, w, h).set(b.direction, glm::ivec2(1, 0)).texture(b.source, L.radiance);
+                sub.drawFullscreen(s.emptyVao);
+                sub.target(L.colorFbo, w, h).set(b.direction, glm::ivec2(0, 1)).texture(b.source, s.blurTemp);
+                sub.drawFullscreen(s.emptyVao);
             }
-            glBindFramebuffer(GL_FRAMEBUFFER, level == 1
-                                                  ? target.id()
-                                                  : s.levels[static_cast<size_t>(level - 2)].colorFbo.id());
-            glEnable(GL_BLEND);
-            glBlendFunc(GL_ONE, GL_ONE);
-            glUseProgram(s.apply.id());
-            s.setRegion(s.apply, v);
-            glUniform3f(s.apply.uniform("uParentEye"), parentEye.x, parentEye.y, parentEye.z);
-            const glm::vec3 n = normals[static_cast<size_t>(v.mirror)];
-            glUniform3f(s.apply.uniform("uMirrorNormal"), n.x, n.y, n.z);
-            glUniform3f(s.apply.uniform("uF0"), m.f0.r, m.f0.g, m.f0.b);
-            glBindTextureUnit(5, L.radiance.id());
-            glBindTextureUnit(6, parentPos.id());
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-            glDisable(GL_BLEND);
+            const Impl::ApplyPass& a = s.apply;
+            gl::Pass sub("mirror_add");
+            sub.target(level == 1 ? target : s.levels[static_cast<size_t>(level - 2)].colorFbo, w, h)
+                .blendAdd()
+                .use(a.program)
+                .set(a.parentEye, parentEye)
+                .set(a.mirrorNormal, normals[static_cast<size_t>(v.mirror)])
+                .set(a.f0, m.f0)
+                .texture(a.reflected, L.radiance)
+                .texture(a.mirrorPosition, parentPos);
+            s.setRegion(sub, a.region, v, *gNormal);
+            sub.drawFullscreen(s.emptyVao);
         }
     }
-    timer.end();
-    glDisable(GL_BLEND);
 }
 
 } // namespace gis

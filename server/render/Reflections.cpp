@@ -18,6 +18,23 @@ std::string count(int n, const char* what) {
 
 } // namespace
 
+const gl::Texture& ReflectionInputs::get(const std::string& name) const {
+    GIS_ASSERT(resources != nullptr);
+    return resources->get(name);
+}
+
+ForwardProgram ForwardProgram::build() {
+    ForwardProgram f;
+    f.program = gl::Program::build(
+        {{GL_VERTEX_SHADER, "render/forward.vert"}, {GL_FRAGMENT_SHADER, "render/forward.frag"}});
+    f.viewProj = f.program.location("uViewProj");
+    f.clipPlane = f.program.location("uClipPlane");
+    f.eye = f.program.location("uEye");
+    f.shadowMap = f.program.textureUnit("gShadowMap");
+    f.materials = MaterialSlots::of(f.program);
+    return f;
+}
+
 Reflections::Reflections() = default;
 Reflections::~Reflections() = default;
 

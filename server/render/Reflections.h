@@ -21,6 +21,7 @@
 
 #include "core/Param.h"
 #include "gi/Technique.h"
+#include "gl/FrameResources.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "render/SceneGpu.h"
@@ -41,17 +42,17 @@ struct EnvObject {
 };
 inline constexpr int kMaxLocalProbes = 3;
 
-/// What the reflection passes read. Textures are the renderer's; the frame block is bound at
-/// GIS_UBO_FRAME and `frame` is its CPU copy.
+/// What the reflection passes read. Textures are the renderer's, read from the frame's resource
+/// table by name (gl/FrameResources.h): gbuffer.position (RGBA32F, w = 1 covered), gbuffer.normal
+/// (RGBA16F, w = reflector id: mirror index + 1, local probe -(k + 1), 0 none), gbuffer.specular
+/// (RGBA8 rgb F0, a roughness) and light[0].shadow (the spotlight's shadow map, for
+/// shaders/render/lighting.glsl). The frame block is bound at GIS_UBO_FRAME and `frame` is its CPU
+/// copy.
 struct ReflectionInputs {
     int width = 0, height = 0;
-    const gl::Texture* gPosition = nullptr; ///< RGBA32F, w = 1 covered
-    const gl::Texture* gNormal = nullptr;   ///< RGBA16F, w = mirror index + 1 (0: not a mirror)
-    const gl::Texture* gAlbedo = nullptr;   ///< RGBA8 diffuse albedo
-    const gl::Texture* gSpecular = nullptr; ///< RGBA8 rgb F0, a roughness
-    const gl::Texture* direct = nullptr;    ///< RGBA32F direct radiance + emission (eye view)
-    const gl::Texture* indirect = nullptr;  ///< the technique's indirect radiance (eye view), may be null
-    const gl::Texture* shadowMap = nullptr; ///< bind at unit 4 for shaders/render/lighting.glsl
+    /// Everything the frame produced before the reflections, by name.
+    const FrameResources* resources = nullptr;
+    const gl::Texture* indirect = nullptr; ///< the technique's indirect radiance (eye view), may be null
     const shader::FrameUniforms* frame = nullptr;
     const Scene* scene = nullptr;
     const SceneGpu* sceneGpu = nullptr;
@@ -63,6 +64,24 @@ struct ReflectionInputs {
     /// True when the planar-mirror pass shades the mirror pixels (gNormal.w > 0); otherwise the
     /// environment probe shades them too (mirror_depth=0, effect_mirrors=off).
     bool mirrorPass = false;
+
+    /// The resource `name`, or nullptr when the frame did not produce it.
+    const gl::Texture* find(const std::string& name) const {
+        return resources ? resources->find(name) : nullptr;
+    }
+    /// The resource `name`; asserts that the frame produced it.
+    const gl::Texture& get(const std::string& name) const;
+};
+
+/// The program the reflection passes render the scene with from viewpoints other than the eye
+/// (shaders/render/forward.*: environment-probe faces, mirrored views), with its uniforms, shadow-map
+/// unit and material slots resolved where it is built.
+struct ForwardProgram {
+    gl::Program program;
+    gl::UniformLocation viewProj, clipPlane, eye;
+    gl::TextureUnit shadowMap;
+    MaterialSlots materials;
+    static ForwardProgram build(); ///< compiles: may throw gis::Error
 };
 
 class EnvProbe;
