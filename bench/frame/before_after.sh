@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Per-pass times of two gi-bench builds side by side on this machine: runs `gi-bench passes` with
-# each binary in turn, ROUNDS times (before, after, before, after, ...), so both see the same load,
+# each binary in turn, ROUNDS times in ABBA order (before, after, after, before, ...: whichever runs
+# second in a pair is a few per cent slower on a shared 2-core machine), so both see the same load,
 # and prints each pass's median over all frames of all rounds, before and after, with the ratio.
 #
 #   bench/frame/before_after.sh OLD/gi-bench NEW/gi-bench [ROUNDS] [SCENE] [SIZE]
@@ -15,14 +16,19 @@ scene=${4:-builtin:cornell}
 size=${5:-256x256}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-configs=(--config none --config rsm_gather --config ssbc --config multires_splat --config multires_gather
-         --config isr --config hier_isr --config second_order)
+# CONFIGS="none rsm_gather" narrows the set (default: every technique at its defaults).
+configs=()
+for c in ${CONFIGS:-none rsm_gather ssbc multires_splat multires_gather isr hier_isr second_order}; do
+    configs+=(--config "$c")
+done
 for ((r = 0; r < rounds; ++r)); do
-    for side in before after; do
+    order="before after"
+    ((r % 2 == 1)) && order="after before"
+    for side in $order; do
         bin=$before
         [[ $side == after ]] && bin=$after
         "$bin" passes --scene "$scene" --size "$size" --frames 5 "${configs[@]}" --json "$work/$side.$r.json" \
-            > /dev/null
+            > /dev/null 2>&1
     done
 done
 python3 - "$work" "$rounds" "$scene" "$size" <<'PY'

@@ -295,9 +295,6 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     rin.envMaxRoughness = nonDiffuse.glossy ? fp.getFloat("glossy_split") : 1.01f;
     const gl::Texture* reflection = mReflections.execute(nonDiffuse, rin, fp, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
-    glDisable(GL_BLEND);
-    glDisable(GL_STENCIL_TEST);
-    glDisable(GL_DEPTH_TEST);
     if (reflection)
         mResources.publish("reflection", "reflections", *reflection);
     else

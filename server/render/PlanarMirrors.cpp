@@ -114,9 +114,7 @@ struct PlanarMirrors::Impl {
         if (w != width || h != height) {
             levels.clear();
             blurTemp = gl::Texture::create2D(GL_RGBA32F, w, h);
-            blurFbo = gl::Framebuffer::create();
-            blurFbo.attachColor(0, blurTemp);
-            blurFbo.finish(1, "mirror blur");
+            blurFbo = gl::Framebuffer::of("mirror blur", {&blurTemp});
             width = w;
             height = h;
         }
@@ -127,18 +125,10 @@ struct PlanarMirrors::Impl {
             l.mirrorId = gl::Texture::create2D(GL_R16F, w, h);
             l.depthStencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, w, h);
             const std::string label = "mirror level " + std::to_string(levels.size() + 1);
-            l.renderFbo = gl::Framebuffer::create();
-            l.renderFbo.attachColor(0, l.radiance);
-            l.renderFbo.attachColor(1, l.position);
-            l.renderFbo.attachColor(2, l.mirrorId);
-            l.renderFbo.attachDepthStencil(l.depthStencil);
-            l.renderFbo.finish(3, label);
-            l.colorFbo = gl::Framebuffer::create();
-            l.colorFbo.attachColor(0, l.radiance);
-            l.colorFbo.finish(1, label + " colour");
-            l.stencilFbo = gl::Framebuffer::create();
-            l.stencilFbo.attachDepthStencil(l.depthStencil);
-            l.stencilFbo.finish(0, label + " stencil");
+            l.renderFbo =
+                gl::Framebuffer::of(label, {&l.radiance, &l.position, &l.mirrorId}, &l.depthStencil);
+            l.colorFbo = gl::Framebuffer::of(label + " colour", {&l.radiance});
+            l.stencilFbo = gl::Framebuffer::of(label + " stencil", {}, &l.depthStencil);
             levels.push_back(std::move(l));
         }
     }

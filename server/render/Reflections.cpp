@@ -155,9 +155,7 @@ const gl::Texture* Reflections::execute(const Decision& d, ReflectionInputs in, 
     if (!d.env && !d.mirrors) return nullptr;
     if (in.width != mWidth || in.height != mHeight) {
         mOutput = gl::Texture::create2D(GL_RGBA32F, in.width, in.height);
-        mOutputFbo = gl::Framebuffer::create();
-        mOutputFbo.attachColor(0, mOutput);
-        mOutputFbo.finish(1, "reflections");
+        mOutputFbo = gl::Framebuffer::of("reflections", {&mOutput});
         mWidth = in.width;
         mHeight = in.height;
     }
