@@ -5,6 +5,7 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "gi/Catalog.h"
+#include "frame/DefaultLighting.h"
 #include "frame/FrameParams.h"
 
 namespace gis {
@@ -14,13 +15,16 @@ FrameState makeFrameState(const Scene& scene, const std::string& technique) {
     if (!scene.cameras.empty()) s.camera = scene.cameras.front();
     auto spot = std::find_if(scene.lights.begin(), scene.lights.end(),
                              [](const Light& l) { return l.type == LightType::Spot; });
+    DefaultLighting fallback;
     if (spot != scene.lights.end()) {
         s.light = *spot;
-    } else {
-        s.lightEnabled = false;
-        if (!scene.lights.empty())
-            logWarn("render: scene '" + scene.name +
-                    "' has no spot light; point and directional lights are not rendered yet");
+        s.lightSource = "scene";
+        s.lightNote = "the scene's spot light '" + spot->name + "'";
+    } else if (needsDefaultLighting(scene, s.camera, fallback)) {
+        s.light = fallback.key;
+        s.lightSource = "default";
+        s.lightNote = fallback.reason;
+        if (!scene.lights.empty()) logWarn("render: scene '" + scene.name + "': " + fallback.reason);
     }
     s.frameParams = ParamSet(frameParamTable());
     setTechnique(s, technique);

@@ -15,6 +15,11 @@ struct FrameState {
     Camera camera;
     Light light; ///< the spotlight the pipeline renders (from the scene, or as the client moved it)
     bool lightEnabled = true;
+    /// Where `light` came from: "scene" (the file's first spot light) or "default" (frame/
+    /// DefaultLighting.h: the file has no light the renderer shows), with a sentence saying which or
+    /// why; reported in the stats as `lighting`.
+    std::string lightSource = "scene";
+    std::string lightNote;
     int width = 512;
     int height = 512;
     std::string technique = "rsm_gather";
@@ -29,9 +34,9 @@ struct FrameState {
 
 namespace gis {
 
-/// The scene's first camera and first spot light (a scene without a spot light renders emission
-/// only), default frame parameters and the technique's default parameters. Throws InputError for
-/// an unknown technique.
+/// The scene's first camera and first spot light (a scene without one gets the default key light of
+/// frame/DefaultLighting.h, with lightSource "default"), default frame parameters and the technique's default
+/// parameters. Throws InputError for an unknown technique.
 FrameState makeFrameState(const Scene& scene, const std::string& technique);
 /// Switches technique, resetting its parameters to that technique's defaults.
 void setTechnique(FrameState& state, const std::string& technique, const std::string& where = "technique");

@@ -330,6 +330,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
                  {"params", std::move(params)}};
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
+    out.stats["lighting"] = {{"source", state.lightSource}, {"note", state.lightNote}};
     return out;
 }
 
