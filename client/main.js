@@ -469,6 +469,7 @@ function recordDraw(frame, decodeMs, frameBytes) {
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
     sceneGui.showPlan(stats?.plan, stats?.nondiffuse);
+    noteDefaultLighting(stats?.lighting);
     statsGui.showDetails(stats);
     accuracyGui.frameDrawn();
     gizmo.render();
@@ -552,6 +553,20 @@ function showMessage(text, kind = 'error') {
     // Older messages go first so that a burst of errors cannot fill the view.
     while (ui.messages.children.length > 4) ui.messages.firstChild.remove();
     setTimeout(() => item.remove(), MESSAGE_HIDE_MS);
+}
+
+let lastLightingNote = null;
+
+/** Says once per scene when the server lights it with its default key light, and why (stats.lighting). */
+function noteDefaultLighting(lighting) {
+    if (lighting?.source !== 'default' || !lighting.note) {
+        lastLightingNote = null;
+        return;
+    }
+    const key = `${state.scene}:${lighting.note}`;
+    if (key === lastLightingNote) return;
+    lastLightingNote = key;
+    showMessage(`Default lighting: ${lighting.note}. Ctrl-drag moves it, like any light.`, 'info');
 }
 
 function block(tag, className, text) {

@@ -15,9 +15,10 @@ struct FrameState {
     Camera camera;
     Light light; ///< the spotlight the pipeline renders (from the scene, or as the client moved it)
     bool lightEnabled = true;
-    /// Where `light` came from: "scene" (the file's first spot light) or "default" (frame/
-    /// DefaultLighting.h: the file has no light the renderer shows), with a sentence saying which or
-    /// why; reported in the stats as `lighting`.
+    /// Where `light` came from: "scene" (the file's first spot light), "default" (frame/
+    /// DefaultLighting.h: the file has no light the renderer shows) or "request" (an API render
+    /// request's light), with a sentence saying which or why; reported in the stats as `lighting`.
+    /// A client moving the light keeps the source: it is still that light, edited.
     std::string lightSource = "scene";
     std::string lightNote;
     int width = 512;

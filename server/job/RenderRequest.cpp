@@ -193,7 +193,11 @@ FrameState makeJobFrameState(const Scene& scene, const RenderJob& job) {
     FrameState state = makeFrameState(scene, job.technique);
     applyJobParams(state, job);
     if (job.camera) applyCameraJson(state, *job.camera, "/camera");
-    if (job.light) applyLightJson(state, *job.light, "/light");
+    if (job.light) {
+        applyLightJson(state, *job.light, "/light");
+        state.lightSource = "request";
+        state.lightNote = "the request's light";
+    }
     state.width = job.width;
     state.height = job.height;
     return state;

@@ -435,6 +435,8 @@ void Session::workerMain() {
                     mDesired.camera = fresh.camera;
                     mDesired.light = fresh.light;
                     mDesired.lightEnabled = fresh.lightEnabled;
+                    mDesired.lightSource = fresh.lightSource;
+                    mDesired.lightNote = fresh.lightNote;
                     mScene = next;
                     mSceneName = sceneRequest;
                     stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};

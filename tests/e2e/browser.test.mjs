@@ -232,6 +232,10 @@ test('a .glb dropped on the view is uploaded with progress and shown', async () 
     await until('the uploaded scene renders', () => window.giClient.lastStats?.scene === 'upload:box.glb');
     assert.match(await page.locator('.upload-text').textContent(), /uploaded box\.glb/);
     assert.equal(await control('scene', 'select').inputValue(), 'upload:box.glb');
+    // The file has no lights: the server lights it with its default key light and the client says so.
+    assert.equal((await page.evaluate(() => window.giClient.lastStats.lighting)).source, 'default');
+    await until('the default lighting is explained', () => [...document.querySelectorAll('.message')]
+        .some((m) => m.textContent.startsWith('Default lighting: the scene has no lights')));
     await control('scene', 'select').selectOption('builtin:cornell');
     await until('back on the Cornell box', () => window.giClient.lastStats?.scene === 'builtin:cornell');
 });

@@ -385,7 +385,7 @@ export function isJpeg(bytes) {
 
 /**
  * A small binary glTF (.glb) for upload tests: a floor and a box, positions and normals, one
- * material; the server adds its framing camera and default spotlight.
+ * material, no light and no camera: the server adds its framing camera and default key light.
  */
 export function makeGlb() {
     const positions = [];
