@@ -502,6 +502,10 @@ int run(int argc, char** argv) {
                     " ms";
         gis::logInfo(line);
     }
+    if (state.lightSource == "default") {
+        gis::logWarn("gi-render: default lighting: " + state.lightNote +
+                     " (--request with a \"light\" places your own)");
+    }
     return 0;
 }
 
