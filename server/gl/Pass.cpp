@@ -114,14 +114,6 @@ Pass& Pass::blend(GLenum srcRgb, GLenum dstRgb, GLenum srcAlpha, GLenum dstAlpha
     return *this;
 }
 
-Pass& Pass::stencil(GLenum func, int ref, GLenum stencilFail, GLenum depthFail, GLenum pass) {
-    glEnable(GL_STENCIL_TEST);
-    glStencilFunc(func, ref, 0xFF);
-    glStencilOp(stencilFail, depthFail, pass);
-    mStencil = true;
-    return *this;
-}
-
 Pass& Pass::noColorWrites() {
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     mColorMasked = true;

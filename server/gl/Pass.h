@@ -50,9 +50,6 @@ public:
     Pass& blendAdd();
     /// Blending with separate colour and alpha factors.
     Pass& blend(GLenum srcRgb, GLenum dstRgb, GLenum srcAlpha, GLenum dstAlpha);
-    /// Stencil test `func` against `ref` (mask 0xFF) with the operations for stencil fail, depth fail
-    /// and pass.
-    Pass& stencil(GLenum func, int ref, GLenum stencilFail, GLenum depthFail, GLenum pass);
     /// Writes no colour (a stencil- or depth-only draw) until the pass ends.
     Pass& noColorWrites();
     /// Makes this pass's earlier writes to a texture visible to its later reads (glTextureBarrier).

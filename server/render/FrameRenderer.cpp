@@ -288,7 +288,6 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     rin.width = state.width;
     rin.height = state.height;
     rin.resources = &mResources;
-    rin.indirect = indirect;
     rin.frame = &u;
     rin.scene = mScene.get();
     rin.sceneGpu = mSceneGpu.get();

@@ -295,13 +295,13 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
             }
         }
         // Indirect light where the reflected points are also seen by the eye.
-        if (in.indirect) {
+        if (const gl::Texture* indirect = in.find("indirect")) {
             const Impl::IndirectPass& ip = s.indirect;
             gl::Pass sub("mirror_indirect");
             sub.target(L.colorFbo, w, h)
                 .blendAdd()
                 .use(ip.program)
-                .texture(ip.indirect, *in.indirect)
+                .texture(ip.indirect, *indirect)
                 .texture(ip.position, *gPosition)
                 .texture(ip.viewPosition, L.position);
             sub.drawFullscreen(s.emptyVao);

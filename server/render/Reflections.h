@@ -45,14 +45,14 @@ inline constexpr int kMaxLocalProbes = 3;
 /// What the reflection passes read. Textures are the renderer's, read from the frame's resource
 /// table by name (gl/FrameResources.h): gbuffer.position (RGBA32F, w = 1 covered), gbuffer.normal
 /// (RGBA16F, w = reflector id: mirror index + 1, local probe -(k + 1), 0 none), gbuffer.specular
-/// (RGBA8 rgb F0, a roughness) and light[0].shadow (the spotlight's shadow map, for
-/// shaders/render/lighting.glsl). The frame block is bound at GIS_UBO_FRAME and `frame` is its CPU
+/// (RGBA8 rgb F0, a roughness), light[0].shadow (the spotlight's shadow map, for
+/// shaders/render/lighting.glsl) and, when the technique made one, indirect (its eye-view indirect
+/// radiance, for the mirrors' reprojection). The frame block is bound at GIS_UBO_FRAME and `frame` is its CPU
 /// copy.
 struct ReflectionInputs {
     int width = 0, height = 0;
     /// Everything the frame produced before the reflections, by name.
     const FrameResources* resources = nullptr;
-    const gl::Texture* indirect = nullptr; ///< the technique's indirect radiance (eye view), may be null
     const shader::FrameUniforms* frame = nullptr;
     const Scene* scene = nullptr;
     const SceneGpu* sceneGpu = nullptr;

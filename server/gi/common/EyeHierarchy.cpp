@@ -148,7 +148,7 @@ void EyeHierarchy::beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& 
                                          const FrameInputs& in, bool stencil) const {
     pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight);
     bindInputs(pass, handles, in);
-    if (stencil) pass.stencil(GL_EQUAL, 1, GL_KEEP, GL_KEEP, GL_KEEP);
+    if (stencil) pass.stencilTest(false).stencilFunc(GL_EQUAL, 1);
     pass.blend(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
 }
 
@@ -206,7 +206,7 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     mCounts.upload(0, sizeof zeroCounts, zeroCounts);
     pass.use(mReceivers.program).buffer(mReceivers.counts, mCounts).texture(mReceivers.flags, mFlags);
     bindInputs(pass, mReceivers.inputs, in);
-    pass.noColorWrites().stencil(GL_ALWAYS, 1, GL_KEEP, GL_KEEP, GL_REPLACE).drawFullscreen(mEmptyVao);
+    pass.noColorWrites().stencilTest(true).stencilFunc(GL_ALWAYS, 1).drawFullscreen(mEmptyVao);
 }
 
 void EyeHierarchy::countReceivers(Counters& counters, int coveredPixels) {

@@ -340,14 +340,14 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
                 .texture(d.normal, normal)
                 .texture(d.lowPosition, mLowPosition)
                 .texture(d.lowNormal, mLowNormal);
-            pass.stencil(GL_ALWAYS, 1, GL_KEEP, GL_KEEP, GL_REPLACE);
+            pass.stencilTest(true).stencilFunc(GL_ALWAYS, 1);
             glBeginQuery(GL_SAMPLES_PASSED, mFlaggedQuery.id());
             pass.drawFullscreen(mEmptyVao);
             glEndQuery(GL_SAMPLES_PASSED);
         }
         gl::Pass pass(timer, "fixup_gather");
         pass.target(mFixupFbo, in.width, in.height).clearColor(1);
-        pass.stencil(GL_EQUAL, 1, GL_KEEP, GL_KEEP, GL_KEEP);
+        pass.stencilTest(false).stencilFunc(GL_EQUAL, 1);
         gather(pass, position, normal, params, slots, counters);
     }
 
