@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <glm/gtc/constants.hpp>
+#include <glm/glm.hpp>
+
+#include "scene/Geometry.h"
 
 namespace gis {
 namespace {
@@ -16,26 +18,20 @@ constexpr float kMaxOuterDeg = 80.0f;
 constexpr float kInnerFraction = 0.8f;
 constexpr float kCentreLux = 1.6f;
 
-glm::vec3 normalizedOr(const glm::vec3& v, const glm::vec3& fallback) {
-    const float len = glm::length(v);
-    return len > 1e-20f && std::isfinite(len) ? v / len : fallback;
-}
-
 } // namespace
 
 Light defaultKeyLight(const Bounds& bounds, const Camera& camera) {
     const glm::vec3 centre = bounds.center();
     const float radius = std::max(bounds.radius(), 1e-3f);
-    const glm::vec3 toCamera = normalizedOr(camera.position - centre, glm::vec3(0.0f, 0.0f, 1.0f));
     // An orthonormal camera frame: f towards the camera, u its up, r its right (it looks along -f).
-    const glm::vec3 f = toCamera;
+    const glm::vec3 f = safeNormalize(camera.position - centre, glm::vec3(0.0f, 0.0f, 1.0f));
     const glm::vec3 anyUp = std::abs(f.y) < 0.99f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
     glm::vec3 u = camera.up - glm::dot(camera.up, f) * f;
-    u = normalizedOr(u, normalizedOr(anyUp - glm::dot(anyUp, f) * f, glm::vec3(0.0f, 1.0f, 0.0f)));
+    u = safeNormalize(u, safeNormalize(anyUp - glm::dot(anyUp, f) * f, glm::vec3(0.0f, 1.0f, 0.0f)));
     const glm::vec3 r = glm::cross(-f, u);
     const float yaw = glm::radians(kRightDeg), pitch = glm::radians(kUpDeg);
     const glm::vec3 horizontal = std::cos(yaw) * f + std::sin(yaw) * r;
-    const glm::vec3 dir = normalizedOr(std::cos(pitch) * horizontal + std::sin(pitch) * u, f);
+    const glm::vec3 dir = safeNormalize(std::cos(pitch) * horizontal + std::sin(pitch) * u, f);
 
     const float distance = kDistanceRadii * radius;
     Light l;
@@ -51,21 +47,22 @@ Light defaultKeyLight(const Bounds& bounds, const Camera& camera) {
     return l;
 }
 
-bool needsDefaultLighting(const Scene& scene, const Camera& camera, DefaultLighting& out) {
-    const bool hasSpot = std::any_of(scene.lights.begin(), scene.lights.end(),
-                                     [](const Light& l) { return l.type == LightType::Spot; });
-    if (hasSpot) return false;
+DefaultLighting defaultLighting(const Scene& scene, const Camera& camera) {
+    DefaultLighting out;
     out.key = defaultKeyLight(scene.bounds, camera);
     if (scene.lights.empty()) {
         out.reason = "the scene has no lights: showing a default key light over the camera's shoulder";
     } else {
         int point = 0, directional = 0;
-        for (const Light& l : scene.lights) (l.type == LightType::Point ? point : directional)++;
+        for (const Light& l : scene.lights) {
+            if (l.type == LightType::Point) ++point;
+            if (l.type == LightType::Directional) ++directional;
+        }
         out.reason =
             "the scene's lights (" + std::to_string(point) + " point, " + std::to_string(directional) +
             " directional) are not rendered yet: showing a default key light over the camera's shoulder";
     }
-    return true;
+    return out;
 }
 
 } // namespace gis

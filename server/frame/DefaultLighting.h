@@ -27,8 +27,7 @@ struct DefaultLighting {
 /// at the centre or a degenerate box fall back to looking down -z with radius 1e-3 at least).
 Light defaultKeyLight(const Bounds& bounds, const Camera& camera);
 
-/// The scene's first spot light when it has one (nullopt-like: returns false); otherwise fills
-/// `out` with the default rig and the reason, naming the lights it could not show.
-bool needsDefaultLighting(const Scene& scene, const Camera& camera, DefaultLighting& out);
+/// The rig for a scene without a spot light, and the reason, naming the lights it cannot show.
+DefaultLighting defaultLighting(const Scene& scene, const Camera& camera);
 
 } // namespace gis

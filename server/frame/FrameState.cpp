@@ -15,12 +15,12 @@ FrameState makeFrameState(const Scene& scene, const std::string& technique) {
     if (!scene.cameras.empty()) s.camera = scene.cameras.front();
     auto spot = std::find_if(scene.lights.begin(), scene.lights.end(),
                              [](const Light& l) { return l.type == LightType::Spot; });
-    DefaultLighting fallback;
     if (spot != scene.lights.end()) {
         s.light = *spot;
         s.lightSource = "scene";
         s.lightNote = "the scene's spot light '" + spot->name + "'";
-    } else if (needsDefaultLighting(scene, s.camera, fallback)) {
+    } else {
+        const DefaultLighting fallback = defaultLighting(scene, s.camera);
         s.light = fallback.key;
         s.lightSource = "default";
         s.lightNote = fallback.reason;

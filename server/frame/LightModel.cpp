@@ -5,17 +5,14 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/Geometry.h"
+
 namespace gis {
 namespace {
 
 // Spot cones wider than this get a light frustum of this half-angle: tan() grows without bound
 // towards 90 degrees. Radians (85 degrees).
 constexpr float kMaxLightHalfFov = 1.4835299f;
-
-glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
-    const float len2 = glm::dot(v, v);
-    return len2 > 1e-24f && std::isfinite(len2) ? v / std::sqrt(len2) : fallback;
-}
 
 glm::vec3 upFor(glm::vec3 forward, glm::vec3 preferred) {
     glm::vec3 up = safeNormalize(preferred, {0, 1, 0});

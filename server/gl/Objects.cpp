@@ -19,50 +19,43 @@ void Buffer::upload(GLintptr offset, GLsizeiptr bytes, const void* data) {
     glNamedBufferSubData(id(), offset, bytes, data);
 }
 
-Texture Texture::create2DArray(GLenum internalFormat, int width, int height, int layers) {
-    GIS_ASSERT(width > 0 && height > 0 && layers > 0);
+Texture Texture::allocate(GLenum target, GLenum internalFormat, int width, int height, int levels,
+                          int layers) {
     GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
-    glTextureStorage3D(id, 1, internalFormat, width, height, layers);
+    glCreateTextures(target, 1, &id);
+    if (target == GL_TEXTURE_2D_ARRAY)
+        glTextureStorage3D(id, levels, internalFormat, width, height, layers);
+    else
+        glTextureStorage2D(id, levels, internalFormat, width, height);
     Texture t(id);
     t.mWidth = width;
     t.mHeight = height;
-    t.mLevels = 1;
+    t.mLevels = levels;
     t.mFormat = internalFormat;
-    t.setFilter(GL_NEAREST, GL_NEAREST);
     t.setWrap(GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+Texture Texture::create2DArray(GLenum internalFormat, int width, int height, int layers) {
+    GIS_ASSERT(width > 0 && height > 0 && layers > 0);
+    Texture t = allocate(GL_TEXTURE_2D_ARRAY, internalFormat, width, height, 1, layers);
+    t.setFilter(GL_NEAREST, GL_NEAREST);
     return t;
 }
 
 Texture Texture::create2D(GLenum internalFormat, int width, int height, int levels) {
     GIS_ASSERT(width > 0 && height > 0 && levels > 0);
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_2D, 1, &id);
-    glTextureStorage2D(id, levels, internalFormat, width, height);
-    Texture t(id);
-    t.mWidth = width;
-    t.mHeight = height;
-    t.mLevels = levels;
-    t.mFormat = internalFormat;
+    Texture t = allocate(GL_TEXTURE_2D, internalFormat, width, height, levels, 1);
     t.setFilter(GL_NEAREST, GL_NEAREST);
-    t.setWrap(GL_CLAMP_TO_EDGE);
     return t;
 }
 
 Texture Texture::createCube(GLenum internalFormat, int size, int levels) {
     GIS_ASSERT(size > 0 && levels > 0);
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_CUBE_MAP, 1, &id);
-    glTextureStorage2D(id, levels, internalFormat, size, size);
-    Texture t(id);
-    t.mWidth = size;
-    t.mHeight = size;
-    t.mLevels = levels;
-    t.mFormat = internalFormat;
+    Texture t = allocate(GL_TEXTURE_CUBE_MAP, internalFormat, size, size, levels, 1);
     t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
-    t.setWrap(GL_CLAMP_TO_EDGE);
-    glTextureParameteri(id, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(id, GL_TEXTURE_MAX_LEVEL, levels - 1);
+    glTextureParameteri(t.id(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t.id(), GL_TEXTURE_MAX_LEVEL, levels - 1);
     return t;
 }
 

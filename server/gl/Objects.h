@@ -98,6 +98,9 @@ public:
 
 private:
     using Object::Object;
+    /// Immutable storage of `target` (2D, 2D array or cube) with clamp-to-edge wrapping.
+    static Texture allocate(GLenum target, GLenum internalFormat, int width, int height, int levels,
+                            int layers);
     int mWidth = 0, mHeight = 0, mLevels = 0;
     GLenum mFormat = 0;
 };

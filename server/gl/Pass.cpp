@@ -189,17 +189,25 @@ Pass& Pass::imageLayered(ImageUnit unit, const Texture& texture, GLenum access, 
     return *this;
 }
 
+void Pass::rememberBlock(BlockBinding block) {
+    // A loop rebinding one block (ping-pong lists) unbinds it once at the end.
+    const bool known = std::any_of(mBoundBlocks.begin(), mBoundBlocks.end(), [&](const BlockBinding& b) {
+        return b.target == block.target && b.index == block.index;
+    });
+    if (!known) mBoundBlocks.push_back(block);
+}
+
 Pass& Pass::buffer(BlockBinding block, const Buffer& buffer) {
     if (block.index == kNoUnit) return *this;
     glBindBufferBase(block.target, block.index, buffer.id());
-    mBoundBlocks.push_back(block);
+    rememberBlock(block);
     return *this;
 }
 
 Pass& Pass::buffer(BlockBinding block, const Buffer& buffer, GLintptr offset, GLsizeiptr bytes) {
     if (block.index == kNoUnit) return *this;
     glBindBufferRange(block.target, block.index, buffer.id(), offset, bytes);
-    mBoundBlocks.push_back(block);
+    rememberBlock(block);
     return *this;
 }
 

@@ -101,6 +101,8 @@ public:
     Pass& barrier(GLbitfield bits);
 
 private:
+    void rememberBlock(BlockBinding block);
+
     PassTimer* mTimer;
     std::string mName;
     GLuint mFbo = 0;

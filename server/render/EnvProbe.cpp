@@ -77,6 +77,8 @@ glm::mat4 EnvProbe::faceViewProj(int face, const glm::vec3& probe, float zNear, 
 EnvProbe::EnvProbe() : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
     m.forward = ForwardProgram::build();
+    // Filtered cube lookups across face edges, for every later frame (nothing turns it off).
+    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
 
     Impl::PrefilterPass& f = m.prefilter;
     f.program = gl::Program::build({{GL_COMPUTE_SHADER, "render/env_prefilter.comp"}});
@@ -185,7 +187,6 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     // near plane at 1e-3 of it (at least 0.1 mm) keeps 32-bit float depth well resolved.
     const float extent = std::max(glm::length(bounds.max - bounds.min), 1e-3f);
     const float zNear = std::max(1e-3f * extent, 1e-4f), zFar = 1.01f * extent + zNear;
-    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
 
     for (size_t p = 0; p < probes.size(); ++p) {
         const glm::vec3 probe = probes[p].position;

@@ -19,7 +19,7 @@
 //      first texel centre (n.v = 1/64) above that, so no NaN at grazing angles. Opaque surfaces only:
 //      no transmitted or total-internal-reflection term. With env_parallax=box the reflected ray is
 //      intersected with the scene bounds and the cube read towards the hit point from the probe.
-// The cube map is sampled with GL_TEXTURE_CUBE_MAP_SEAMLESS (enabled by execute()).
+// The cube map is sampled with GL_TEXTURE_CUBE_MAP_SEAMLESS (enabled when the probe is created).
 // Parameters (frame table): env_size (8-512 texels per face), env_samples (1-256), env_parallax,
 // specular_lobe. Timer passes env_render, env_prefilter, env_apply; counters env_size, env_samples,
 // env_levels.
