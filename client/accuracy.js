@@ -6,6 +6,7 @@
 // The server's answer has the metrics (stats.compare), the rendered image and the reference, both
 // tone-mapped PNGs (PROTOCOL.md, HTTP API).
 
+import { requestLight } from './lights.js';
 import { validateJson } from './protocol.js';
 
 /** The reference modes of render_request.json, cheapest first. */
@@ -27,9 +28,11 @@ export function canCompare(scene) {
 /**
  * The POST /api/render body for the frame on screen: its scene, technique and parameters
  * (stats.params of the drawn frame, so presets and the effect plan's choices are the same), the
- * camera and light, at compareSize(); PNG so that the difference view sees no codec artefacts.
+ * camera and the session's `lights` (all of them, with types and ids: they replace the scene's, so
+ * added and removed lights count too), at compareSize(); PNG so that the difference view sees no
+ * codec artefacts. `light` (one light, edits the scene's first) is for servers without a light list.
  */
-export function buildCompareRequest({ scene, technique, params, camera, light, frameSize, maxSide, mode, spp }) {
+export function buildCompareRequest({ scene, technique, params, camera, lights, light, frameSize, maxSide, mode, spp }) {
     const request = {
         scene,
         technique,
@@ -40,7 +43,8 @@ export function buildCompareRequest({ scene, technique, params, camera, light, f
         compare: { mode, spp },
     };
     if (camera) request.camera = { ...camera };
-    if (light) request.light = { ...light };
+    if (Array.isArray(lights)) request.lights = lights.map(requestLight);
+    else if (light) request.light = { ...light };
     return request;
 }
 

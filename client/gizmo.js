@@ -1,8 +1,10 @@
-// The spotlight gizmo: an SVG layer over the frame with the light's position (drag: move it
-// parallel to the image) and an aim handle at the end of its beam (drag: point the beam there).
-// Drawn from the client's own camera, so it follows a drag at once, before the frame does.
+// The light gizmo: an SVG layer over the frame for the selected light, with a disc at its position
+// (drag: move it parallel to the image) and an aim handle at the end of its beam (drag: point the
+// beam there). A point light has only the disc, a directional light only the aim handle (its beam
+// starts at the light's position field, or the orbit target). Drawn from the client's own camera,
+// so it follows a drag at once, before the frame does.
 
-import { containRect, dragToWorld, gizmoHandles, moveLight, aimAt } from './light.js';
+import { aimAt, containRect, dragToWorld, gizmoHandles, gizmoKinds, gizmoLabels, moveLight } from './light.js';
 
 const SVG = 'http://www.w3.org/2000/svg';
 
@@ -18,7 +20,7 @@ function cssColor(rgb) {
 }
 
 /**
- * `svg` covers the viewport. Options: getCamera() (protocol camera), getLight() (protocol light),
+ * `svg` covers the viewport. Options: getCamera() (protocol camera), getLight() (the selected protocol light),
  * getFrameSize() ([w, h] of the frame shown), onMove(position), onAim(direction), onDragEnd().
  */
 export class LightGizmo {
@@ -28,13 +30,13 @@ export class LightGizmo {
         this.visible = true;
         this.enabled = true;
         this.line = svgElement('line', { class: 'gizmo-beam' });
+        // Where a directional light's beam starts, which has no handle of its own.
+        this.anchor = svgElement('circle', { class: 'gizmo-anchor', r: 3 });
         this.origin = svgElement('circle', { class: 'gizmo-handle gizmo-origin', r: 9 });
         this.tip = svgElement('circle', { class: 'gizmo-handle gizmo-tip', r: 6 });
         this.origin.append(svgElement('title'));
-        this.origin.firstChild.textContent = 'spotlight: drag to move it';
         this.tip.append(svgElement('title'));
-        this.tip.firstChild.textContent = 'spotlight aim: drag to point the beam';
-        svg.append(this.line, this.origin, this.tip);
+        svg.append(this.line, this.anchor, this.origin, this.tip);
         this.bindDrag(this.origin, 'move');
         this.bindDrag(this.tip, 'aim');
     }
@@ -53,11 +55,17 @@ export class LightGizmo {
     render() {
         const camera = this.options.getCamera();
         const light = this.options.getLight();
-        const show = this.visible && this.enabled && camera && light?.position && light?.direction;
+        const kinds = gizmoKinds(light);
+        const show = this.visible && this.enabled && camera && light
+            && (!kinds.move || light.position) && (!kinds.aim || light.direction);
         this.svg.classList.toggle('hidden', !show);
         if (!show) return;
+        this.svg.dataset.lightType = light.type ?? 'spot';
+        const labels = gizmoLabels(light);
+        this.origin.firstChild.textContent = labels.move;
+        this.tip.firstChild.textContent = labels.aim;
         const rect = this.rect();
-        const { origin, tip } = gizmoHandles(camera, rect.width / Math.max(1, rect.height), light);
+        const { anchorPoint, origin, tip } = gizmoHandles(camera, rect.width / Math.max(1, rect.height), light);
         const place = (el, p) => {
             el.style.display = p ? '' : 'none';
             if (!p) return null;
@@ -66,7 +74,9 @@ export class LightGizmo {
             el.setAttribute('cy', y);
             return [x, y];
         };
-        const a = place(this.origin, origin);
+        const originAt = place(this.origin, origin);
+        const anchorAt = place(this.anchor, kinds.move ? null : anchorPoint);
+        const a = originAt ?? anchorAt;
         const b = place(this.tip, tip);
         this.line.style.display = a && b ? '' : 'none';
         if (a && b) {
@@ -77,6 +87,7 @@ export class LightGizmo {
         }
         const color = cssColor(light.color);
         this.origin.style.fill = light.enabled === false ? 'transparent' : color;
+        this.anchor.style.fill = color;
         this.line.style.stroke = color;
     }
 
@@ -90,7 +101,7 @@ export class LightGizmo {
             const light = this.options.getLight();
             const rect = this.rect();
             const handles = gizmoHandles(camera, rect.width / Math.max(1, rect.height), light);
-            start = { x: e.clientX, y: e.clientY, camera, rect, position: [...light.position], handles };
+            start = { x: e.clientX, y: e.clientY, camera, rect, position: [...handles.anchor], handles };
             handle.classList.add('dragging');
         });
         handle.addEventListener('pointermove', (e) => {

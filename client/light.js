@@ -1,6 +1,6 @@
-// The spotlight seen from the eye camera: projecting it into the view for the gizmo, and turning
-// pixel drags into new light positions and directions. Pure math on protocol cameras
-// ({position, target, up?, fov_deg}) and lights ({position, direction, ...}).
+// A light seen from the eye camera: projecting it into the view for the gizmo, and turning pixel
+// drags into new light positions and directions. Pure math on protocol cameras
+// ({position, target, up?, fov_deg}) and lights ({type, position, direction, ...}).
 
 import { add, clamp, cross, dot, length, normalize, roundVec, scale, sub } from './vec.js';
 
@@ -59,13 +59,15 @@ export function moveLight(position, camera, dx, dy, viewHeight) {
  * A light direction turned by a drag of (dx, dy) pixels (Ctrl-drag): the end of the beam (the
  * gizmo's aim handle) follows the cursor in the plane parallel to the image, so dragging right
  * turns the beam to the right as seen from the camera, whichever way it points (no poles).
- * `light` needs position and direction; the result is a unit vector rounded for the message.
+ * `light` needs a direction (and a position, else the orbit target anchors it); the result is a
+ * unit vector rounded for the message.
  */
 export function aimLight(light, camera, dx, dy, viewHeight) {
-    const tip = add(light.position, scale(normalize(light.direction), aimHandleLength(camera, light.position)));
+    const anchor = gizmoAnchor(light, camera);
+    const tip = add(anchor, scale(normalize(light.direction), aimHandleLength(camera, anchor)));
     let depth = dot(sub(tip, camera.position), viewBasis(camera).forward);
     if (depth <= NEAR) depth = length(sub(camera.target, camera.position));
-    return aimAt(light.position, add(tip, dragToWorld(camera, depth, dx, dy, viewHeight)));
+    return aimAt(anchor, add(tip, dragToWorld(camera, depth, dx, dy, viewHeight)));
 }
 
 /** A unit direction whose rounded components stay within the light schema's [-1, 1] and not all zero. */
@@ -86,12 +88,47 @@ export function aimHandleLength(camera, position) {
     return 0.25 * Math.max(0.05, length(sub(position, camera.position)));
 }
 
-/** The gizmo's two handles in normalised device coordinates (null where behind the eye). */
+/**
+ * Which gizmo handles a light has: a point light shines every way, so it only moves; a directional
+ * light is everywhere at once, so it only turns; a spot does both. A light without a type is
+ * protocol 1's spotlight.
+ */
+export function gizmoKinds(light) {
+    const type = light?.type ?? 'spot';
+    return { move: type !== 'directional', aim: type !== 'point' };
+}
+
+/** The handles' tooltips, by light type. */
+export function gizmoLabels(light) {
+    switch (light?.type ?? 'spot') {
+    case 'point': return { move: 'point light: drag to move it', aim: '' };
+    case 'directional': return { move: '', aim: 'directional light: drag to turn the direction it shines in' };
+    default: return { move: 'spotlight: drag to move it', aim: 'spotlight aim: drag to point the beam' };
+    }
+}
+
+/**
+ * Where the gizmo sits: the light's position. A directional light's position means nothing to the
+ * renderer; the server fills it with a point in the scene, and without one the orbit target keeps
+ * the aim handle in view.
+ */
+export function gizmoAnchor(light, camera) {
+    if (Array.isArray(light?.position) && light.position.length === 3) return light.position;
+    return camera.target;
+}
+
+/** The gizmo's handles in normalised device coordinates (null where behind the eye or not shown). */
 export function gizmoHandles(camera, aspect, light) {
-    const tipWorld = add(light.position, scale(normalize(light.direction), aimHandleLength(camera, light.position)));
+    const kinds = gizmoKinds(light);
+    const anchor = gizmoAnchor(light, camera);
+    const tipWorld = kinds.aim && light.direction
+        ? add(anchor, scale(normalize(light.direction), aimHandleLength(camera, anchor)))
+        : null;
     return {
-        origin: projectPoint(camera, aspect, light.position),
-        tip: projectPoint(camera, aspect, tipWorld),
+        anchor,
+        anchorPoint: projectPoint(camera, aspect, anchor),
+        origin: kinds.move ? projectPoint(camera, aspect, anchor) : null,
+        tip: tipWorld ? projectPoint(camera, aspect, tipWorld) : null,
         tipWorld,
     };
 }

@@ -1,15 +1,20 @@
 // App wiring: connection and session role, frame display, the sidebar sections, the stats overlay,
-// the light gizmo and the accuracy view. The pure pieces live in their own modules (protocol,
-// camera, light, params, stats, accuracy, messages, upload); this file talks to the DOM.
+// the lights panel and gizmo, and the accuracy view. The pure pieces live in their own modules
+// (protocol, camera, light, lights, params, stats, accuracy, messages, upload); this file talks to
+// the DOM.
 
 import {
-    ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, lightMsg, paramsMsg, parseFrameHeader, parseServerMessage,
-    pingMsg, qualityMsg, resizeMsg, sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
-    viewportFor,
+    ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, lightAddMsg, lightMsg, lightRemoveMsg, paramsMsg,
+    parseFrameHeader, parseServerMessage, pingMsg, qualityMsg, resizeMsg, sceneMsg, snapshotMsg, techniqueMsg,
+    validateClientMessage, validateParamValues, viewportFor,
 } from './protocol.js';
 import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from './schemas.js';
 import { DRAG_TOOLS, MAX_FOV_DEG, MIN_FOV_DEG, OrbitCamera, attachViewControls } from './camera.js';
-import { aimLight, moveLight } from './light.js';
+import { aimLight, gizmoKinds, moveLight } from './light.js';
+import {
+    LIGHT_TYPES, applyLightChanges, intensityUnit, lightLabel, lightStatuses, lightType, lightingLines, lightsOfState,
+    newLightFor, pickSelection,
+} from './lights.js';
 import { StreamConnection, pageOptions, shareLink, streamUrl } from './connection.js';
 import { ParamPanel, addBlock, describe, makeSection } from './controls.js';
 import { presetChanges, schemaDefaults } from './params.js';
@@ -105,8 +110,17 @@ const state = {
     scenes: [],
     uploads: [], // upload:NAME scenes of this session
     params: {}, // the session's own parameter values (what the panel shows)
-    light: null, // the session's spotlight as this client knows it
-    lightHome: null,
+    lights: [], // the session's lights as this client knows them (state.lights, or protocol 1's one light)
+    lightList: false, // the server lists its lights with ids (protocol 2): only then can they be added and removed
+    selectedLightId: null, // the light the Light section and the gizmo edit
+    /** The selected light: what code written for the single light of protocol 1 reads. */
+    get light() {
+        return selectedLight();
+    },
+    lightHomes: new Map(), // id ('' without ids) -> the light as the scene defined it, for "Reset light"
+    lightOps: [], // 'add' / 'remove' sent, oldest first, whose state answer has not arrived
+    serverScene: null, // the scene of the last full state from the server
+    lighting: null, // state.lighting {source, note}, until a frame's stats.lighting says more
     statsByFrame: new Map(), // frame -> {stats, arrivedAt}
     lastDrawn: null, // {frame, width, height, stats}
     framesDrawn: 0,
@@ -146,6 +160,8 @@ const hook = {
     states: [], // the last connection states, oldest first
     get params() { return { ...state.params }; },
     get light() { return state.light ? structuredClone(state.light) : null; },
+    get lights() { return structuredClone(state.lights); },
+    get selectedLightId() { return state.selectedLightId; },
     get camera() { return camera.toCamera(); },
     get compare() { return state.compare?.result ?? null; },
     get rttMs() { return state.rttMs; },
@@ -189,18 +205,18 @@ function sendResize(force = false) {
 
 // Pointer moves and slider drags arrive faster than frames: coalesce them into one message of each
 // kind per animation frame.
-const outbox = { camera: false, light: null, params: null, frame: 0 };
+// Light changes are kept per light (key: its id, '' for protocol 1's unnamed one), so switching
+// the selected light mid-drag cannot send one light's changes to another.
+const outbox = { camera: false, lights: new Map(), params: null, frame: 0 };
 function flushOutbox() {
     outbox.frame = 0;
     if (outbox.camera) {
         outbox.camera = false;
         steer(cameraMsg(camera.toCamera()));
     }
-    if (outbox.light) {
-        const changes = outbox.light;
-        outbox.light = null;
-        steer(lightMsg(changes));
-    }
+    const lightChanges = [...outbox.lights];
+    outbox.lights.clear();
+    for (const [key, changes] of lightChanges) steer(lightMsg(changes, key === '' ? null : key));
     if (outbox.params) {
         const values = outbox.params;
         outbox.params = null;
@@ -219,13 +235,43 @@ function scheduleCamera() {
     cameraGui.update();
 }
 
-function changeLight(changes) {
-    if (state.viewer || !state.light) return;
-    Object.assign(state.light, structuredClone(changes));
-    outbox.light = { ...(outbox.light ?? {}), ...changes };
+function selectedLight() {
+    return state.lights.find((l) => (l.id ?? null) === state.selectedLightId) ?? state.lights[0] ?? null;
+}
+
+/** Changes light `id` (default: the selected one) here at once and queues them for the server. */
+function changeLight(changes, id = state.selectedLightId) {
+    if (state.viewer) return;
+    let index = state.lights.findIndex((l) => (l.id ?? null) === id);
+    if (index < 0 && id === null && state.lights.length > 0) index = 0;
+    if (index < 0) return;
+    state.lights[index] = applyLightChanges(state.lights[index], changes);
+    const key = state.lights[index].id ?? '';
+    outbox.lights.set(key, { ...(outbox.lights.get(key) ?? {}), ...structuredClone(changes) });
     scheduleFlush();
     gizmo.render();
     lightGui.update();
+}
+
+function selectLight(id) {
+    state.selectedLightId = id;
+    lightGui.update();
+    gizmo.render();
+}
+
+/** light_add for a light of `type` placed from the current view; the server's state answer selects it. */
+function addLight(type) {
+    if (state.viewer || !state.lightList) return;
+    // Queued edits go first, so the server's answer already contains them.
+    flushOutbox();
+    if (steer(lightAddMsg(newLightFor(type, camera.toCamera(), state.light)))) state.lightOps.push('add');
+}
+
+function removeSelectedLight() {
+    const id = state.light?.id;
+    if (state.viewer || !state.lightList || !id) return;
+    flushOutbox();
+    if (steer(lightRemoveMsg(id))) state.lightOps.push('remove');
 }
 
 function queueParams(values) {
@@ -287,7 +333,7 @@ function handleText(text) {
         // Stats whose frame never arrives (a reconnect in between) must not pile up.
         for (const frame of state.statsByFrame.keys()) if (frame < msg.frame - 8) state.statsByFrame.delete(frame);
         break;
-    case 'state': applyState(msg.state ?? {}, { fromServer: true }); break;
+    case 'state': applyServerState(msg.state ?? {}); break;
     case 'error': handleError(msg); break;
     case 'shutdown':
         // The server drains before it stops: this session will not survive it, so the reconnect
@@ -313,6 +359,10 @@ function handleError(msg) {
     } else if (FATAL_ERRORS.has(msg.code)) {
         if (msg.code === 'session_ended' || msg.code === 'idle_timeout') sessionStorage.removeItem(RESUME_KEY);
         connection.stopReconnecting();
+    } else if (msg.request === 'light_add' || msg.request === 'light_remove') {
+        // Refused: no state answer will come for it.
+        const index = state.lightOps.indexOf(msg.request === 'light_add' ? 'add' : 'remove');
+        if (index >= 0) state.lightOps.splice(index, 1);
     } else if (msg.code === 'invalid_param' || msg.code === 'limit_exceeded') {
         // The server kept its values: show them again (the next stats carry what it renders).
         paramPanel.update(state.params, { force: true });
@@ -324,6 +374,7 @@ function handleWelcome(msg) {
     hook.welcomes += 1;
     hook.resumed = msg.resumed === true;
     state.welcome = msg;
+    state.lightOps = [];
     setRole(msg.role === 'viewer');
     if (msg.resume_token) sessionStorage.setItem(RESUME_KEY, msg.resume_token);
     if (!msg.resumed) state.uploads = [];
@@ -343,21 +394,54 @@ function handleWelcome(msg) {
  */
 function applyState(s, { resumed = false, fresh = false } = {}) {
     if (s.scene !== undefined) state.scene = s.scene;
+    state.serverScene = state.scene;
     sceneGui.setScenes();
     if (s.camera) {
         if (resumed) camera.set(s.camera);
         else camera.setHome(s.camera);
         cameraGui.update();
     }
-    if (s.light) {
-        state.light = structuredClone(s.light);
-        if (!resumed || !state.lightHome) state.lightHome = structuredClone(s.light);
-        lightGui.update();
+    const lights = lightsOfState(s);
+    if (lights) {
+        showLights(lights, s, {});
+        if (!resumed || state.lightHomes.size === 0) {
+            state.lightHomes = new Map(lights.map((l) => [l.id ?? '', structuredClone(l)]));
+        }
     }
     if (s.params) state.params = { ...s.params };
     if (s.technique !== undefined || fresh) showTechnique(s.technique ?? state.technique);
     else paramPanel.update(state.params);
     sceneGui.update();
+    gizmo.render();
+}
+
+/**
+ * A state message from the server. The answer to this client's light_add or light_remove changes
+ * only the lights: applying the rest would make the camera it carries the new home (and may undo
+ * camera moves sent since), so only the lights are taken from it.
+ */
+function applyServerState(s) {
+    const sameScene = s.scene === undefined || s.scene === state.serverScene;
+    if (state.lightOps.length > 0 && sameScene && Array.isArray(s.lights)) {
+        const op = state.lightOps.shift();
+        showLights(lightsOfState(s), s, { expectAdded: op === 'add' });
+        return;
+    }
+    applyState(s);
+}
+
+/** Shows the light list of a state; edits still in the outbox are newer than it and stay applied. */
+function showLights(lights, s, { expectAdded = false }) {
+    const previousIds = state.lights.map((l) => l.id ?? null);
+    state.lights = lights.map((l) => {
+        const pending = outbox.lights.get(l.id ?? '');
+        return pending ? applyLightChanges(l, pending) : l;
+    });
+    state.lightList = Array.isArray(s.lights);
+    if (s.lighting) state.lighting = s.lighting;
+    state.selectedLightId = pickSelection(previousIds, state.lights, state.selectedLightId, { expectAdded });
+    lightGui.update();
+    lightGui.showLighting(state.lastDrawn?.stats?.lighting ?? state.lighting);
     gizmo.render();
 }
 
@@ -470,6 +554,7 @@ function recordDraw(frame, decodeMs, frameBytes) {
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
     sceneGui.showPlan(stats?.plan, stats?.nondiffuse);
     noteDefaultLighting(stats?.lighting);
+    lightGui.showLighting(stats?.lighting ?? state.lighting);
     statsGui.showDetails(stats);
     accuracyGui.frameDrawn();
     gizmo.render();
@@ -737,39 +822,104 @@ function showTechnique(name) {
 const lightGui = (() => {
     const gui = makeSection(ui.sections, 'Light', { id: 'light' });
     const model = {
+        addType: 'point',
+        add: () => addLight(model.addType),
+        remove: () => removeSelectedLight(),
         enabled: true, intensity: 1, color: [1, 1, 1], cone_deg: 45, gizmo: settings.gizmo,
         reset: () => {
-            if (state.lightHome) changeLight(structuredClone(state.lightHome));
+            const light = state.light;
+            const home = light ? state.lightHomes.get(light.id ?? '') : null;
+            if (home) changeLight(structuredClone(home), light.id ?? null);
         },
     };
-    const enabledCtl = describe(gui.add(model, 'enabled').name('on'), 'light-enabled', 'the spotlight on or off');
+    const list = addBlock(gui, block('ul', 'light-list block'));
+    list.dataset.block = 'lights';
+    const addTypeCtl = describe(gui.add(model, 'addType', [...LIGHT_TYPES]).name('new light'), 'light-add-type',
+        'the type of light "Add light" adds: a spot, a point light (shines every way) or a directional light '
+        + '(parallel rays, like the sun)');
+    const addCtl = describe(gui.add(model, 'add').name('Add light'), 'light-add',
+        'adds a light of the type above, placed from the current view: a point light above the orbit target, '
+        + 'a directional light shining along the view and somewhat down, a spot aimed at the target');
+    const removeCtl = describe(gui.add(model, 'remove').name('Remove selected light'), 'light-remove',
+        'removes the selected light from this session');
+    const folder = gui.addFolder('selected light');
+    folder.domElement.dataset.folder = 'selected-light';
+    const enabledCtl = describe(folder.add(model, 'enabled').name('on'), 'light-enabled', 'the selected light on or off');
     enabledCtl.onChange((v) => changeLight({ enabled: v }));
     let intensityMax = 100;
-    const intensityCtl = describe(gui.add(model, 'intensity', 0, intensityMax, 0.1).name('intensity (cd)'),
-        'light-intensity', 'luminous intensity of the spotlight in candela');
+    const intensityCtl = describe(folder.add(model, 'intensity', 0, intensityMax, 0.1).name('intensity (cd)'),
+        'light-intensity', 'luminous intensity in candela; for a directional light, illuminance in lux');
     intensityCtl.onChange((v) => changeLight({ intensity: v }));
-    const colorCtl = describe(gui.addColor(model, 'color', 1).name('colour'), 'light-color', 'the light\'s colour (linear RGB)');
+    const colorCtl = describe(folder.addColor(model, 'color', 1).name('colour'), 'light-color',
+        'the light\'s colour (linear RGB)');
     colorCtl.onChange((v) => changeLight({ color: v.map((c) => Math.round(c * 1e4) / 1e4) }));
-    const coneCtl = describe(gui.add(model, 'cone_deg', 1, 85, 0.5).name('cone (deg)'), 'light-cone',
+    const coneCtl = describe(folder.add(model, 'cone_deg', 1, 85, 0.5).name('cone (deg)'), 'light-cone',
         'outer half-angle of the spot cone, 1 to 85 degrees');
     coneCtl.onChange((v) => changeLight({ cone_deg: v }));
+    const resetCtl = describe(folder.add(model, 'reset').name('Reset light'), 'light-reset',
+        'back to the light as the scene defined it (lights added here have none)');
     describe(gui.add(model, 'gizmo').name('show gizmo'), 'light-gizmo',
-        'handles in the view: drag the disc to move the light, the small dot to aim it')
+        'handles in the view for the selected light: drag the disc to move it, the small dot to aim it')
         .onChange((on) => {
             settings.gizmo = on;
             saveSettings();
             gizmo.visible = on;
             gizmo.render();
         });
-    describe(gui.add(model, 'reset').name('Reset light'), 'light-reset', 'back to the scene\'s own spotlight');
+    const status = addBlock(gui, block('div', 'lighting-status block'));
+    status.dataset.block = 'lighting';
     addBlock(gui, block('p', 'hint block',
-        'Drag the gizmo in the view, or Ctrl-drag to aim and Ctrl+Shift-drag to move the light '
-        + '(touch: pick "aim light" or "move light" as the drag tool under Camera).'));
+        'Click a light to edit it. Drag the gizmo in the view, or Ctrl-drag to aim and Ctrl+Shift-drag to move '
+        + 'the selected light (touch: pick "aim light" or "move light" as the drag tool under Camera). A point '
+        + 'light only moves, a directional light only turns.'));
+    let listKey = '';
+    let statusKey = '';
+    let rows = new Map(); // light id ('' without ids) -> its row in the list
+
+    function renderList() {
+        const selected = state.light;
+        const key = JSON.stringify([state.lights.map((l) => [l.id, l.name, l.type, l.enabled]), selected?.id ?? null]);
+        if (key === listKey) return;
+        listKey = key;
+        statusKey = '';
+        rows = new Map();
+        list.replaceChildren(...state.lights.map((light) => {
+            const id = light.id ?? null;
+            const li = block('li', 'light-row');
+            li.dataset.lightId = id ?? '';
+            li.classList.toggle('selected', light === selected);
+            const pick = li.appendChild(block('button', 'light-select'));
+            pick.type = 'button';
+            pick.title = 'edit this light';
+            pick.setAttribute('aria-pressed', String(light === selected));
+            pick.append(block('span', 'light-name', lightLabel(light)), block('span', 'light-type', lightType(light)));
+            pick.addEventListener('click', () => selectLight(id));
+            const toggle = li.appendChild(Object.assign(document.createElement('input'), {
+                type: 'checkbox', className: 'light-toggle', checked: light.enabled !== false,
+            }));
+            toggle.setAttribute('aria-label', `${lightLabel(light)} on`);
+            toggle.title = 'on or off';
+            toggle.addEventListener('change', () => changeLight({ enabled: toggle.checked }, id));
+            const reason = li.appendChild(block('div', 'light-reason'));
+            reason.hidden = true;
+            rows.set(id ?? '', { li, reason });
+            return li;
+        }));
+        if (state.lights.length === 0) list.append(block('li', 'hint', 'No lights: add one below.'));
+    }
+
     return {
         gui,
         update() {
+            renderList();
+            addTypeCtl.show(state.lightList);
+            addCtl.show(state.lightList);
+            removeCtl.show(state.lightList);
             const l = state.light;
+            removeCtl.disable(!l?.id);
+            folder.show(Boolean(l));
             if (!l) return;
+            folder.title(`${lightLabel(l)} (${lightType(l)})`);
             model.enabled = l.enabled !== false;
             // The server's floats (60.000003814697266) shown as the numbers they stand for.
             const round = (v, digits) => Math.round(v * 10 ** digits) / 10 ** digits;
@@ -778,9 +928,31 @@ const lightGui = (() => {
                 intensityMax = Math.ceil(model.intensity * 4);
                 intensityCtl.max(intensityMax);
             }
+            intensityCtl.name(`intensity (${intensityUnit(l)})`);
             model.color = [...(l.color ?? [1, 1, 1])];
             model.cone_deg = round(l.cone_deg ?? model.cone_deg, 2);
+            coneCtl.show(lightType(l) === 'spot');
+            resetCtl.disable(!state.lightHomes.has(l.id ?? ''));
             for (const c of [enabledCtl, intensityCtl, colorCtl, coneCtl]) c.updateDisplay();
+        },
+        /**
+         * What the frame on screen says about the lights (stats.lighting): the server's note, its
+         * warning, and per light whether it was rendered or why not.
+         */
+        showLighting(lighting) {
+            renderList();
+            const key = JSON.stringify([lighting ?? null, listKey]);
+            if (key === statusKey) return;
+            statusKey = key;
+            for (const st of lightStatuses(state.lights, lighting)) {
+                const row = rows.get(st.id ?? '');
+                if (!row) continue;
+                row.li.classList.toggle('rendered', st.rendered === true);
+                row.li.classList.toggle('skipped', st.rendered === false);
+                row.reason.hidden = st.rendered !== false;
+                row.reason.textContent = st.rendered === false ? `not rendered: ${st.reason}` : '';
+            }
+            status.replaceChildren(...lightingLines(lighting).map((line) => block('p', line.kind, line.text)));
         },
     };
 })();
@@ -1026,14 +1198,17 @@ function requestSnapshot() {
 /** The compare request for the frame on screen, or null when there is none to measure. */
 function currentCompareRequest() {
     const drawn = state.lastDrawn;
-    if (!drawn?.stats || !state.light) return null;
+    if (!drawn?.stats) return null;
     const m = accuracyGui.model;
     return buildCompareRequest({
         scene: state.scene,
         technique: drawn.stats.technique ?? state.technique,
         params: drawn.stats.params ?? state.params,
         camera: camera.toCamera(),
-        light: state.light,
+        // Every light, so the reference sees what the stream renders; a protocol-1 server only
+        // knows its one light.
+        lights: state.lightList ? state.lights : undefined,
+        light: state.lightList ? undefined : state.light ?? undefined,
         frameSize: [drawn.width, drawn.height],
         maxSide: m.maxSide,
         mode: m.mode,
@@ -1236,13 +1411,18 @@ const gizmo = new LightGizmo(ui.gizmo, {
 });
 gizmo.visible = settings.gizmo;
 
+/** Ctrl-drag (aim) and Ctrl+Shift-drag (move) of the selected light, as far as its type has them. */
 function onLightDrag(gesture, dx, dy) {
-    if (!state.light) return;
+    const light = state.light;
+    if (!light) return;
+    const kinds = gizmoKinds(light);
     const cam = camera.toCamera();
     if (gesture === 'light-move') {
-        changeLight({ position: moveLight(state.light.position, cam, dx, dy, ui.canvas.clientHeight) });
-    } else {
-        changeLight({ direction: aimLight(state.light, cam, dx, dy, ui.canvas.clientHeight) });
+        if (kinds.move && light.position) {
+            changeLight({ position: moveLight(light.position, cam, dx, dy, ui.canvas.clientHeight) });
+        }
+    } else if (kinds.aim && light.direction) {
+        changeLight({ direction: aimLight(light, cam, dx, dy, ui.canvas.clientHeight) });
     }
 }
 

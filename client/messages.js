@@ -8,6 +8,7 @@ const EXPLANATIONS = {
     invalid_param: 'The server refused a parameter value.',
     unknown_technique: 'The server does not offer that technique.',
     unknown_scene: 'The server does not offer that scene.',
+    unknown_light: 'The session has no light with that id (it may have been removed): pick one in the Light section.',
     limit_exceeded: 'That is over the server\'s limits.',
     message_too_large: 'A message was over the server\'s size limit.',
     binary_not_accepted: 'The server accepts no binary messages.',

@@ -1,13 +1,14 @@
-// Wire protocol v1 (protocol/PROTOCOL.md): message builders, the binary frame header and the
+// Wire protocol v2 (protocol/PROTOCOL.md): message builders, the binary frame header and the
 // JSON-Schema subset validator. Pure functions without DOM access so node's test runner can load
 // this module as it is.
 
-export const PROTOCOL_VERSION = 1;
+export const PROTOCOL_VERSION = 2;
 export const SUBPROTOCOL = 'gi-stream';
 export const CLIENT_NAME = 'gi-web/0.2';
 
 export const CLIENT_MESSAGE_TYPES = Object.freeze([
-    'hello', 'camera', 'light', 'technique', 'params', 'resize', 'scene', 'quality', 'snapshot', 'ack', 'ping',
+    'hello', 'camera', 'light', 'light_add', 'light_remove', 'technique', 'params', 'resize', 'scene', 'quality',
+    'snapshot', 'ack', 'ping',
 ]);
 
 // The bounds of the resize/hello schemas; the server scales the product size x dpr down to its
@@ -39,8 +40,28 @@ export function cameraMsg({ position, target, up, fov_deg: fovDeg }) {
     return msg;
 }
 
-export function lightMsg(changes) {
-    return { type: 'light', ...changes };
+/**
+ * Changes to one light: the light `id` (else the `id` among the changes) in protocol 2's nested
+ * form, where `type` may change the light's type. Without an id the fields go flat, protocol 1's
+ * form, which edits the first light; a light type cannot be given there, since `type` is the
+ * message's own.
+ */
+export function lightMsg(changes, id = changes.id) {
+    const fields = structuredClone(changes);
+    delete fields.id;
+    if (id !== undefined && id !== null) return { type: 'light', id, light: fields };
+    delete fields.type;
+    return { type: 'light', ...fields };
+}
+
+/** Adds a light (protocol 2); the server assigns its id and answers with a state message. */
+export function lightAddMsg(light) {
+    return light === undefined ? { type: 'light_add' } : { type: 'light_add', light: structuredClone(light) };
+}
+
+/** Removes the light `id` (protocol 2); the server answers with a state message. */
+export function lightRemoveMsg(id) {
+    return { type: 'light_remove', id };
 }
 
 export function techniqueMsg(name) {

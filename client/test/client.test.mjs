@@ -1,5 +1,5 @@
 // Unit tests of the client's pure modules: camera modes and keys, the light gizmo's math, the
-// parameter controls, stats and latency, the accuracy request, error texts, upload names, and
+// light list (selection, new lights, what a frame rendered), the parameter controls, stats and latency, the accuracy request, error texts, upload names, and
 // that the vendored libraries the import map names are in place. Run: node --test client/test/
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -9,8 +9,13 @@ import { fileURLToPath } from 'node:url';
 
 import { DRAG_TOOLS, OrbitCamera, gestureFor, keyMotion } from '../camera.js';
 import {
-    aimAt, aimLight, containRect, dragToWorld, gizmoHandles, moveLight, projectPoint, safeDirection, viewBasis,
+    aimAt, aimLight, containRect, dragToWorld, gizmoAnchor, gizmoHandles, gizmoKinds, gizmoLabels, moveLight, projectPoint,
+    safeDirection, viewBasis,
 } from '../light.js';
+import {
+    LIGHT_TYPES, applyLightChanges, intensityUnit, lightLabel, lightStatuses, lightType, lightingLines, lightsOfState,
+    newLightFor, pickSelection, requestLight,
+} from '../lights.js';
 import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
 import { LatencyTracker, PassHistory, RateCounter, formatBytes, networkMs, passMs, stackSeries } from '../stats.js';
 import {
@@ -18,7 +23,7 @@ import {
 } from '../accuracy.js';
 import { describeError, describeHttpError } from '../messages.js';
 import { uploadName } from '../upload.js';
-import { cameraMsg, lightMsg, validateClientMessage, validateParamValues } from '../protocol.js';
+import { cameraMsg, lightAddMsg, lightMsg, validateClientMessage, validateParamValues } from '../protocol.js';
 import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from '../schemas.js';
 import { dot, length, normalize } from '../vec.js';
 import { VENDOR_FILES, checkVendor } from '../tools/vendor.mjs';
@@ -147,6 +152,119 @@ test('gizmo handles and the contained frame rectangle', () => {
     assert.deepEqual(containRect(300, 200, 0, 0), { left: 0, top: 0, width: 300, height: 200 });
 });
 
+test('the gizmo has the handles the light type has, labelled by type', () => {
+    assert.deepEqual(gizmoKinds({ type: 'spot' }), { move: true, aim: true });
+    assert.deepEqual(gizmoKinds({}), { move: true, aim: true }, 'protocol 1\'s light is a spot');
+    assert.deepEqual(gizmoKinds({ type: 'point' }), { move: true, aim: false });
+    assert.deepEqual(gizmoKinds({ type: 'directional' }), { move: false, aim: true });
+    assert.equal(gizmoLabels({ type: 'point' }).move, 'point light: drag to move it');
+    assert.match(gizmoLabels({ type: 'directional' }).aim, /^directional light: drag/);
+    assert.match(gizmoLabels({ type: 'spot' }).aim, /^spotlight aim/);
+    const point = gizmoHandles(HOME, 1, { type: 'point', position: [0, 1.5, 0], direction: [0, -1, 0] });
+    assert.ok(point.origin && point.tip === null, 'a point light has no aim handle');
+    const sun = { type: 'directional', direction: [0, -1, 0] };
+    assert.deepEqual(gizmoAnchor(sun, HOME), HOME.target, 'without a position the orbit target anchors it');
+    const sunHandles = gizmoHandles(HOME, 1, sun);
+    assert.ok(sunHandles.origin === null && sunHandles.tip, 'a directional light only has the aim handle');
+    assert.ok(sunHandles.anchorPoint.y > sunHandles.tip.y, 'shining down: the handle is below the anchor');
+    assert.deepEqual(gizmoAnchor({ ...sun, position: [1, 2, 3] }, HOME), [1, 2, 3], 'the server\'s position anchors it');
+    const turned = aimLight(sun, HOME, 50, 0, 400);
+    assert.ok(turned[0] > 0.1, `aiming a directional light without a position works (${turned})`);
+});
+
+// ---- lights -------------------------------------------------------------------------------------
+
+const KEY = { id: 'light0', name: 'key', type: 'spot', position: [0, 1.95, 0], direction: [0, -1, 0], intensity: 6,
+    color: [1, 1, 1], range: 0, cone_deg: 60, inner_cone_deg: 48, enabled: true };
+
+test('a state\'s lights: protocol 2\'s list or protocol 1\'s one light', () => {
+    assert.deepEqual(lightsOfState({ lights: [KEY], light: KEY }), [KEY]);
+    assert.notEqual(lightsOfState({ lights: [KEY] })[0], KEY, 'a copy');
+    const v1 = { position: [0, 1, 0], direction: [0, -1, 0], intensity: 6, color: [1, 1, 1], cone_deg: 60, enabled: true };
+    assert.deepEqual(lightsOfState({ light: v1 }), [v1]);
+    assert.deepEqual(lightsOfState({ lights: [], light: null }), []);
+    assert.equal(lightsOfState({ camera: HOME }), null, 'a state without lights leaves them alone');
+    assert.equal(lightType(v1), 'spot');
+    assert.equal(lightType({ type: 'point' }), 'point');
+    assert.equal(lightLabel(KEY), 'key');
+    assert.equal(lightLabel({ id: 'light3', name: '' }), 'light3');
+    assert.equal(intensityUnit({ type: 'directional' }), 'lux');
+    assert.equal(intensityUnit(KEY), 'cd');
+    assert.deepEqual([...LIGHT_TYPES], ['spot', 'point', 'directional']);
+});
+
+test('the selection follows an added light, keeps a light still there, else takes the first', () => {
+    const a = { id: 'light0' };
+    const b = { id: 'light1' };
+    const c = { id: 'light2' };
+    assert.equal(pickSelection(['light0', 'light1'], [a, b, c], 'light0', { expectAdded: true }), 'light2');
+    assert.equal(pickSelection(['light0', 'light1'], [a, b, c], 'light0'), 'light0', 'a list from elsewhere keeps it');
+    assert.equal(pickSelection(['light0', 'light1'], [a], 'light1'), 'light0', 'the removed light\'s first neighbour');
+    assert.equal(pickSelection(['light0'], [], 'light0'), null);
+    assert.equal(pickSelection([], [{}], null), null, 'protocol 1\'s unnamed light');
+    assert.equal(pickSelection(['light0'], [a], 'light0', { expectAdded: true }), 'light0', 'nothing new: kept');
+});
+
+test('local light edits follow the server\'s cone rule', () => {
+    const narrower = applyLightChanges(KEY, { cone_deg: 30 });
+    assert.equal(narrower.cone_deg, 30);
+    assert.ok(Math.abs(narrower.inner_cone_deg - 24) < 1e-9, 'the inner cone keeps its proportion');
+    assert.equal(applyLightChanges(KEY, { cone_deg: 30, inner_cone_deg: 10 }).inner_cone_deg, 10);
+    assert.deepEqual(applyLightChanges(KEY, { position: [1, 1, 1] }).position, [1, 1, 1]);
+    assert.deepEqual(KEY.position, [0, 1.95, 0], 'the light given is left as it was');
+});
+
+test('new lights are placed from the view and light the target about as the selected light does', () => {
+    const at = (light) => light.intensity / Math.hypot(...light.position.map((v, i) => v - HOME.target[i])) ** 2;
+    const key = 6 / 0.95 ** 2;
+    const point = newLightFor('point', HOME, KEY);
+    assert.equal(point.type, 'point');
+    assert.ok(point.position[1] > HOME.target[1] && point.position[1] < HOME.target[1] + 1, `above the target (${point.position})`);
+    assert.ok(Math.abs(at(point) - key) / key < 0.01, 'the same illuminance at the target');
+    const sun = newLightFor('directional', HOME, KEY);
+    assert.ok(sun.direction[2] < -0.8 && sun.direction[1] < -0.2 && Math.abs(sun.direction[0]) < 1e-9,
+        `shines along the view, somewhat down (${sun.direction})`);
+    const sunHandles = gizmoHandles(HOME, 1, sun);
+    assert.ok(Math.hypot(sunHandles.tip.x - sunHandles.anchorPoint.x, sunHandles.tip.y - sunHandles.anchorPoint.y) > 0.05,
+        'its aim handle is apart from its anchor');
+    assert.ok(Math.abs(sun.intensity - key) / key < 0.01, 'lux at the target');
+    const spot = newLightFor('spot', HOME, KEY);
+    const aim = normalize(spot.position.map((v, i) => HOME.target[i] - v));
+    assertClose(spot.direction, aim, 1e-4, 'the spot aims at the target');
+    assert.ok(spot.position[2] > HOME.target[2] && spot.position[2] < HOME.position[2], 'between target and eye');
+    assert.ok(newLightFor('point', HOME, null).intensity > 0, 'without a light to match there is still light');
+    for (const type of LIGHT_TYPES) {
+        for (const reference of [KEY, null, { type: 'directional', direction: [0, -1, 0], intensity: 3 }]) {
+            const msg = lightAddMsg(newLightFor(type, HOME, reference));
+            assert.equal(validateClientMessage(msg, CLIENT_SCHEMAS), null, JSON.stringify(msg));
+        }
+    }
+});
+
+test('what a frame says about each light: rendered, or skipped and why', () => {
+    const lights = [KEY, { id: 'light1', name: 'fill', type: 'point' }, { id: 'light2', name: 'sun', type: 'directional' }];
+    const lighting = {
+        source: 'scene', note: 'the scene\'s 3 lights',
+        rendered: [{ id: 'light0', name: 'key', type: 'spot', views: 1 }],
+        skipped: ["light 'fill' (light1): disabled", "light 'sun' (light2): over max_lights (1): raise it to render this light"],
+        views: 1, shadow_side: 1024, rsm_side: 256,
+    };
+    assert.deepEqual(lightStatuses(lights, lighting), [
+        { id: 'light0', rendered: true, reason: null, views: 1 },
+        { id: 'light1', rendered: false, reason: 'disabled', views: 0 },
+        { id: 'light2', rendered: false, reason: 'over max_lights (1): raise it to render this light', views: 0 },
+    ]);
+    assert.deepEqual(lightStatuses(lights, null).map((s) => s.rendered), [null, null, null], 'no stats: unknown');
+    assert.deepEqual(lightStatuses([...lights, { id: 'light3', type: 'point' }], lighting)[3],
+        { id: 'light3', rendered: null, reason: null, views: null }, 'a frame from before the light was added');
+    const lines = lightingLines({ ...lighting, warning: 'none of the lights is rendered' });
+    assert.deepEqual(lines.map((l) => l.kind), ['note', 'warning', 'skipped', 'skipped']);
+    assert.equal(lines[0].text, 'Lights from the scene: the scene\'s 3 lights');
+    assert.match(lines[2].text, /^not rendered: light 'fill' \(light1\): disabled$/);
+    assert.match(lightingLines({ source: 'default', note: 'the scene has no lights' })[0].text, /^Default lighting: /);
+    assert.deepEqual(lightingLines(null), []);
+});
+
 // ---- parameters ---------------------------------------------------------------------------------
 
 const VPL_GRID = { type: 'integer', minimum: 1, maximum: 256, default: 16, description: 'VPLs on a grid',
@@ -241,11 +359,15 @@ test('the accuracy request is the view on screen, small, and valid for POST /api
     assert.deepEqual(compareSize([480, 400], 128), [128, 107]);
     assert.deepEqual(compareSize([100, 60], 256), [100, 60], 'never larger than the frame');
     assert.deepEqual(compareSize([2000, 20], 128), [128, 16], 'each side at least 16');
+    const fill = { id: 'light1', name: 'added light1', type: 'point', position: [0.5, 1.5, 0.2], direction: [0, -1, 0],
+        intensity: 3, color: [1, 0.8, 0.6], range: 4, cone_deg: 45, inner_cone_deg: 36, enabled: false };
     const request = buildCompareRequest({
         scene: 'builtin:cornell', technique: 'rsm_gather', params: { vpl_grid: 4, exposure: 0 }, camera: HOME,
-        light: { position: [0, 1.95, 0], direction: [0, -1, 0], intensity: 6, color: [1, 1, 1], cone_deg: 60, enabled: true },
-        frameSize: [480, 400], maxSide: 128, mode: 'one-bounce-unoccluded', spp: 8,
+        lights: [KEY, fill], frameSize: [480, 400], maxSide: 128, mode: 'one-bounce-unoccluded', spp: 8,
     });
+    assert.deepEqual(request.lights, [KEY, fill], 'every light, with its type and id');
+    assert.equal('light' in request, false, 'lights replace the scene\'s; light would only edit one of them');
+    assert.notEqual(request.lights[0], KEY, 'a copy');
     assert.equal(request.response, 'json');
     assert.deepEqual(request.compare, { mode: 'one-bounce-unoccluded', spp: 8 });
     assert.deepEqual(request.size, [128, 107]);
@@ -255,6 +377,20 @@ test('the accuracy request is the view on screen, small, and valid for POST /api
     assert.equal(viewKey({ ...request, size: [64, 64], compare: { mode: 'path', spp: 1 } }), viewKey(request),
         'the view key ignores size and reference settings');
     assert.notEqual(viewKey({ ...request, params: { vpl_grid: 5 } }), viewKey(request));
+    assert.notEqual(viewKey({ ...request, lights: [KEY] }), viewKey(request), 'a removed light is another view');
+    // A protocol-1 light has no type; a local copy may hold fields the request has no room for.
+    const v1 = { position: [0, 1.95, 0], direction: [0, -1, 0], intensity: 6, color: [1, 1, 1], cone_deg: 60, enabled: true };
+    assert.deepEqual(requestLight({ ...v1, extra: 1 }), { ...v1, type: 'spot' });
+    assert.equal('inner_cone_deg' in requestLight({ ...KEY, inner_cone_deg: 70 }), false,
+        'an inner cone wider than the outer one is left to the server');
+    const noLights = buildCompareRequest({ scene: 'builtin:cornell', technique: 'none', camera: HOME, lights: [], frameSize: [64, 64],
+        maxSide: 64, mode: 'direct', spp: 1 });
+    assert.deepEqual(noLights.lights, [], 'no lights is a view too');
+    assert.equal(validateCompareRequest(noLights, RENDER_REQUEST_SCHEMA), null);
+    const single = buildCompareRequest({ scene: 'builtin:cornell', technique: 'none', camera: HOME, light: v1, frameSize: [64, 64],
+        maxSide: 64, mode: 'direct', spp: 1 });
+    assert.deepEqual(single.light, v1, 'a server without a light list gets its one light');
+    assert.equal(validateCompareRequest(single, RENDER_REQUEST_SCHEMA), null);
     assert.ok(canCompare('builtin:cornell'));
     assert.ok(!canCompare('upload:x.glb'), 'uploads are not reachable through the HTTP API');
 });

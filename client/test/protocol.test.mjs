@@ -6,8 +6,8 @@ import { readFileSync } from 'node:fs';
 import path from 'node:path';
 
 import {
-    ackMsg, buildFrameHeader, cameraMsg, CLIENT_MESSAGE_TYPES, CODEC_MIME, CODECS, helloMsg, lightMsg,
-    paramsMsg, parseFrameHeader, parseServerMessage, pingMsg, PROTOCOL_VERSION, qualityMsg, resizeMsg,
+    ackMsg, buildFrameHeader, cameraMsg, CLIENT_MESSAGE_TYPES, CODEC_MIME, CODECS, helloMsg, lightAddMsg, lightMsg,
+    lightRemoveMsg, paramsMsg, parseFrameHeader, parseServerMessage, pingMsg, PROTOCOL_VERSION, qualityMsg, resizeMsg,
     sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateJson, validateParamValues, viewportFor,
 } from '../protocol.js';
 import { OrbitCamera, cameraBasis, orbitFromPosition, positionFromOrbit } from '../camera.js';
@@ -114,7 +114,12 @@ const BUILT = {
     ],
     camera: [cameraMsg({ position: [0, 1, 3.9], target: [0, 1, 0], up: [0, 1, 0], fov_deg: 40 }),
         cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] })],
-    light: [lightMsg({ intensity: 8, enabled: false }), lightMsg({ direction: [0, -1, 0], cone_deg: 30 })],
+    light: [lightMsg({ intensity: 8, enabled: false }), lightMsg({ direction: [0, -1, 0], cone_deg: 30 }),
+        lightMsg({ type: 'point', position: [0.5, 1.5, 0.2], intensity: 3, color: [1, 0.8, 0.6], range: 4 }, 'light1'),
+        lightMsg({ id: 'light0', name: 'key', type: 'spot', cone_deg: 40, inner_cone_deg: 30, enabled: true })],
+    light_add: [lightAddMsg(), lightAddMsg({ type: 'directional', direction: [0.3, -0.9, 0.2], intensity: 2 }),
+        lightAddMsg({ type: 'point', position: [0, 1.5, 0], intensity: 3, color: [1, 1, 1], range: 0 })],
+    light_remove: [lightRemoveMsg('light1')],
     technique: [techniqueMsg('none')],
     params: [paramsMsg({ vpl_grid: 8, effects: 'auto', exposure: 0.5 })],
     resize: [resizeMsg(256, 256), resizeMsg(640, 480, 1.5)],
@@ -136,12 +141,12 @@ test('every builder produces messages that validate against their schema', () =>
 });
 
 test('builders send only the fields given', () => {
-    assert.equal(PROTOCOL_VERSION, 1);
-    assert.deepEqual(helloMsg(), { type: 'hello', protocol: 1 });
-    assert.deepEqual(helloMsg({ view: 'v-1', token: undefined, resume: undefined }), { type: 'hello', protocol: 1, view: 'v-1' });
+    assert.equal(PROTOCOL_VERSION, 2);
+    assert.deepEqual(helloMsg(), { type: 'hello', protocol: 2 });
+    assert.deepEqual(helloMsg({ view: 'v-1', token: undefined, resume: undefined }), { type: 'hello', protocol: 2, view: 'v-1' });
     const fields = { client: 'c', token: 't', resume: 'r', view: 'v', codecs: ['webp'], quality: 90,
         max_in_flight: 3, adaptive: false, size: [320, 200], dpr: 1.25 };
-    assert.deepEqual(helloMsg(fields), { type: 'hello', protocol: 1, ...fields });
+    assert.deepEqual(helloMsg(fields), { type: 'hello', protocol: 2, ...fields });
     assert.deepEqual(helloMsg({ adaptive: false }).adaptive, false, 'false is a value, not a missing field');
     assert.equal('unknown' in helloMsg({ unknown: 1 }), false, 'fields outside the schema are not copied');
     assert.deepEqual(resizeMsg(640, 480), { type: 'resize', size: [640, 480] });
@@ -150,6 +155,27 @@ test('builders send only the fields given', () => {
     assert.deepEqual(snapshotMsg(), { type: 'snapshot' });
     assert.deepEqual(snapshotMsg('webp'), { type: 'snapshot', codec: 'webp' });
     assert.equal('up' in cameraMsg({ position: [1, 2, 3], target: [0, 0, 0] }), false);
+});
+
+test('light messages: nested with an id (protocol 2), flat without (protocol 1)', () => {
+    assert.deepEqual(lightMsg({ intensity: 3 }), { type: 'light', intensity: 3 });
+    assert.deepEqual(lightMsg({ intensity: 3, type: 'point' }), { type: 'light', intensity: 3 },
+        'the flat form has no room for a light type');
+    assert.deepEqual(lightMsg({ type: 'point', intensity: 3 }, 'light2'),
+        { type: 'light', id: 'light2', light: { type: 'point', intensity: 3 } });
+    assert.deepEqual(lightMsg({ id: 'light4', enabled: false }), { type: 'light', id: 'light4', light: { enabled: false } },
+        'the light\'s own id names it');
+    assert.deepEqual(lightMsg({ id: 'light4', enabled: false }, 'light5').id, 'light5', 'the id argument wins');
+    const changes = { position: [1, 2, 3] };
+    lightMsg(changes, 'light1').light.position[0] = 9;
+    assert.deepEqual(changes.position, [1, 2, 3], 'the message holds a copy');
+    assert.deepEqual(lightAddMsg(), { type: 'light_add' });
+    assert.deepEqual(lightAddMsg({ type: 'point' }), { type: 'light_add', light: { type: 'point' } });
+    assert.deepEqual(lightRemoveMsg('light3'), { type: 'light_remove', id: 'light3' });
+    const check = (msg) => validateClientMessage(msg, schemas);
+    assert.equal(check(lightMsg({ type: 'area' }, 'light1')).where, '/light/type');
+    assert.equal(check(lightAddMsg({ type: 'spot', range: -1 })).where, '/light/range');
+    assert.equal(check(lightRemoveMsg('')).where, '/id');
 });
 
 test('invalid builder input is caught by the schema before sending', () => {

@@ -25,6 +25,7 @@
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
 #include "frame/Presets.h"
+#include "frame/StateJson.h"
 #include "job/RenderRequest.h"
 #include "scene/SceneLoader.h"
 
@@ -45,6 +46,10 @@ Renders a scene with a global-illumination technique and writes the image and pe
                         WebP at the same --quality)
   --quality N           JPEG and lossy WebP quality, 1..100 (default 90, as the API)
   --stats FILE          write the stats JSON (per-pass ms, counts, params); '-' for stdout
+  --lights FILE         replace the scene's lights with a JSON array of lights (or {"lights": [...]}),
+                        each {"type": "spot"|"point"|"directional", "position", "direction",
+                        "intensity" (cd; lux for directional), "color", "range", "cone_deg",
+                        "inner_cone_deg", "enabled"}: the request's "lights" (protocol/PROTOCOL.md)
   --request FILE        render a POST /api/render request (JSON; '-' for stdin) exactly as the server
                         does: --out gets the encoded bytes, --stats the stats; scene, technique,
                         preset, parameters, size, camera, light, format and compare come from the file
@@ -97,6 +102,7 @@ struct Options {
     std::string out, stats;
     int quality = gis::kDefaultImageQuality;
     std::string request;
+    std::string lights;                  ///< --lights FILE
     std::vector<std::string> sceneFlags; ///< flags --request takes from its file instead
     int frames = 1;
     std::string gl;
@@ -285,8 +291,9 @@ int run(int argc, char** argv) {
     };
     // Flags whose settings a --request file carries (or that do not apply to one frame of it).
     static const std::vector<std::string> kRequestConflicts = {
-        "--scene",   "--technique", "--preset", "--param",       "--size", "--quality",   "--frames",
-        "--explain", "--reference", "--spp",    "--time-budget", "--seed", "--max-depth", "--compare"};
+        "--scene",       "--technique", "--preset",    "--param",     "--size",
+        "--quality",     "--frames",    "--explain",   "--reference", "--spp",
+        "--time-budget", "--seed",      "--max-depth", "--compare",   "--lights"};
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         if (std::find(kRequestConflicts.begin(), kRequestConflicts.end(), a) != kRequestConflicts.end())
@@ -329,6 +336,8 @@ int run(int argc, char** argv) {
             o.quality = parseInt("--quality", value(i), 1, 100);
         else if (a == "--request")
             o.request = value(i);
+        else if (a == "--lights")
+            o.lights = value(i);
         else if (a == "--frames")
             o.frames = parseInt("--frames", value(i), 1, 10000);
         else if (a == "--gl")
@@ -418,6 +427,13 @@ int run(int argc, char** argv) {
             gis::setParamFromString(typed, k, v, "--param " + k);
             job.params[k] = gis::paramsJson(typed)[k]; // the value as the parameter's type
         }
+        if (!o.lights.empty()) {
+            const nlohmann::json file = readRequest(o.lights);
+            const nlohmann::json& list = file.is_object() && file.contains("lights") ? file["lights"] : file;
+            gis::FrameState probe = typed;
+            gis::setLightsJson(probe, list, "--lights " + o.lights); // names the file and the field
+            job.lights = list;
+        }
         state = gis::makeJobFrameState(*scene, job);
     } catch (const gis::InputError& e) {
         throw UsageError{e.what()};
@@ -469,9 +485,11 @@ int run(int argc, char** argv) {
     }
     if (o.listResources) {
         std::printf("%-28s %-12s %-18s %s\n", "resource", "producer", "format", "size");
-        for (const gis::FrameResource& r : renderer.resources().list())
-            std::printf("%-28s %-12s %-18s %dx%d\n", r.name.c_str(), r.producer.c_str(), r.format.c_str(),
-                        r.width, r.height);
+        for (const gis::FrameResource& r : renderer.resources().list()) {
+            const std::string layers = r.layers > 1 ? " x " + std::to_string(r.layers) + " layers" : "";
+            std::printf("%-28s %-12s %-18s %dx%d%s\n", r.name.c_str(), r.producer.c_str(), r.format.c_str(),
+                        r.width, r.height, layers.c_str());
+        }
     }
     nlohmann::json summary = gis::medianStats(stats);
     summary["scene"] = o.scene;
@@ -503,8 +521,7 @@ int run(int argc, char** argv) {
         gis::logInfo(line);
     }
     if (state.lightSource == "default") {
-        gis::logWarn("gi-render: default lighting: " + state.lightNote +
-                     " (--request with a \"light\" places your own)");
+        gis::logWarn("gi-render: default lighting: " + state.lightNote + " (--lights FILE places your own)");
     }
     return 0;
 }

@@ -40,10 +40,6 @@ glm::vec3 facing(const glm::vec3& n, const glm::vec3& towards) {
     return glm::dot(n, towards) < 0.0f ? -n : n;
 }
 
-bool finiteVec(const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
 double sumSq(const glm::dvec3& v) {
     return glm::dot(v, v);
 }
@@ -228,22 +224,10 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
 
     const RayScene rays(scene);
     const float eps = rays.epsilon();
-    const Light& light = state.light;
-    const bool lightOn = state.lightEnabled && light.intensity > 0.0f && std::isfinite(light.intensity) &&
-                         finiteVec(light.position) && light.type != LightType::Directional;
-    const glm::vec3 axis =
-        glm::length(light.direction) > 0.0f ? glm::normalize(light.direction) : glm::vec3(0.0f, -1.0f, 0.0f);
-    const glm::vec3 power =
-        lightOn ? light.intensity * glm::max(light.color, glm::vec3(0.0f)) : glm::vec3(0.0f);
-    const bool spot = light.type == LightType::Spot;
-    const float cosOuter = spot ? std::cos(light.outerConeAngle) : -1.0f;
-    const float cosInner = spot ? std::cos(light.innerConeAngle) : -1.0f;
-    auto spotFactor = [&](const glm::vec3& dirFromLight) {
-        if (!spot) return 1.0f;
-        const float t = std::clamp(
-            (glm::dot(axis, dirFromLight) - cosOuter) / std::max(cosInner - cosOuter, 1e-4f), 0.0f, 1.0f);
-        return t * t; // shaders/common.glsl spotFactor()
-    };
+    // The lights exactly as the renderer shows them (frame/LightModel.h): the enabled ones that reach
+    // the scene, at most max_lights.
+    const LightSetModel lightSet = makeLightSet(state, scene.bounds);
+    const bool lightOn = lightSet.any();
     // Point-kernel singularity: receivers next to a VPL would dominate a few-hundred-sample estimate,
     // so distances are floored at 2% of the scene radius (a G bound far above any clamp_b in use).
     const float minDist = std::max(0.02f * scene.bounds.radius(), 1e-4f);
@@ -276,9 +260,11 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         }
     plan.receivers = static_cast<int>(receivers.size());
 
-    // 2. Light paths: stratified directions over the spot cone (uniform in solid angle), each hit a
-    //    VPL carrying flux rho * I c f(dir) * (cone solid angle / N), oriented towards the light (the
-    //    RSM's rule).
+    // 2. Light paths, the samples split across lights by the flux each sends into the scene: per light,
+    //    stratified directions over a spot's cone or a point light's sphere (uniform in solid angle),
+    //    or stratified origins over a directional light's orthographic square (uniform in area). Each
+    //    hit is a VPL carrying flux rho x (irradiance on a surface facing the light) x (the sample's
+    //    share of the measure: solid angle x d^2, or area), oriented towards the light (the RSM's rule).
     struct Vpl {
         Point at;
         glm::vec3 flux{0.0f};
@@ -286,31 +272,58 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     std::vector<Vpl> vpls;
     std::vector<Material> vplMaterial;
     if (lightOn) {
+        const float radius = std::max(scene.bounds.radius(), 1e-6f);
+        double totalFlux = 0.0;
+        for (const LightModel& l : lightSet.lights) totalFlux += std::max(l.sceneFlux(radius), 0.0);
         const int n = std::max(options.vplSamples, 1);
-        const int side = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(n))));
-        const float coneSolidAngle = 2.0f * kPi * (1.0f - cosOuter);
-        const float perSample = coneSolidAngle / static_cast<float>(side * side);
-        glm::vec3 t, b;
-        reference::basisAround(axis, t, b);
-        for (int j = 0; j < side; ++j)
-            for (int i = 0; i < side; ++i) {
-                Rng rng(options.seed + 1, static_cast<std::uint64_t>(j * side + i), 1);
-                const float cosTheta =
-                    1.0f - (1.0f - cosOuter) * (static_cast<float>(j) + rng.uniform()) / side;
-                const float phi = 2.0f * kPi * (static_cast<float>(i) + rng.uniform()) / side;
-                const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
-                const glm::vec3 dir = cosTheta * axis + sinTheta * (std::cos(phi) * t + std::sin(phi) * b);
-                SurfaceHit hit;
-                ++plan.rays;
-                if (!rays.intersect(light.position, dir, 0.0f, std::numeric_limits<float>::infinity(), hit))
-                    continue;
-                const glm::vec3 flux = hit.albedo * power * spotFactor(dir) * perSample;
-                Vpl v{{hit.position, facing(hit.shadingNormal, -dir), facing(hit.geometricNormal, -dir),
-                       hit.albedo},
-                      flux};
-                vpls.push_back(v);
-                vplMaterial.push_back(materialOf(scene, hit.mesh));
-            }
+        for (size_t li = 0; li < lightSet.lights.size(); ++li) {
+            const LightModel& light = lightSet.lights[li];
+            const double share = totalFlux > 0.0 ? std::max(light.sceneFlux(radius), 0.0) / totalFlux
+                                                 : 1.0 / static_cast<double>(lightSet.lights.size());
+            const int samples = static_cast<int>(std::lround(n * share));
+            if (samples <= 0) continue;
+            const int side = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(samples))));
+            const bool directional = light.type == LightType::Directional;
+            const float cosOuter = light.type == LightType::Spot ? light.cosOuter : -1.0f;
+            const LightViewModel& view = lightSet.views[static_cast<size_t>(light.firstView)];
+            const float perSample =
+                directional
+                    ? (2.0f * view.halfWidth) * (2.0f * view.halfWidth) / static_cast<float>(side * side)
+                    : 2.0f * kPi * (1.0f - cosOuter) / static_cast<float>(side * side);
+            glm::vec3 t, b;
+            reference::basisAround(light.axis, t, b);
+            const glm::mat4 invView = glm::inverse(view.viewProj); // orthographic: NDC to world
+            for (int j = 0; j < side; ++j)
+                for (int i = 0; i < side; ++i) {
+                    Rng rng(options.seed + 1 + li, static_cast<std::uint64_t>(j * side + i), 1);
+                    glm::vec3 origin = light.position, dir = light.axis;
+                    if (directional) {
+                        const float u = 2.0f * (static_cast<float>(i) + rng.uniform()) / side - 1.0f;
+                        const float v = 2.0f * (static_cast<float>(j) + rng.uniform()) / side - 1.0f;
+                        origin = glm::vec3(invView * glm::vec4(u, v, -1.0f, 1.0f)); // on the near plane
+                    } else {
+                        const float cosTheta =
+                            1.0f - (1.0f - cosOuter) * (static_cast<float>(j) + rng.uniform()) / side;
+                        const float phi = 2.0f * kPi * (static_cast<float>(i) + rng.uniform()) / side;
+                        const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
+                        dir = cosTheta * light.axis + sinTheta * (std::cos(phi) * t + std::sin(phi) * b);
+                    }
+                    SurfaceHit hit;
+                    ++plan.rays;
+                    if (!rays.intersect(origin, dir, 0.0f, std::numeric_limits<float>::infinity(), hit))
+                        continue;
+                    glm::vec3 toLight, irradiance;
+                    float dist = 0.0f;
+                    if (!light.incidence(hit.position, toLight, dist, irradiance)) continue;
+                    const float measure = directional ? perSample : perSample * dist * dist;
+                    const glm::vec3 flux = hit.albedo * irradiance * measure;
+                    Vpl vpl{{hit.position, facing(hit.shadingNormal, -dir), facing(hit.geometricNormal, -dir),
+                             hit.albedo},
+                            flux};
+                    vpls.push_back(vpl);
+                    vplMaterial.push_back(materialOf(scene, hit.mesh));
+                }
+        }
     }
     plan.vpls = static_cast<int>(vpls.size());
 
@@ -325,23 +338,23 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     for (size_t r = 0; r < receivers.size(); ++r) {
         const Point& x = receivers[r];
         glm::dvec3 direct(emission[r]);
-        if (lightOn) {
-            const glm::vec3 d = light.position - x.p;
-            const float dist = glm::length(d);
-            if (dist > 1e-6f) {
-                const glm::vec3 l = d / dist;
-                const float cosX = glm::dot(x.n, l);
-                const float s = spotFactor(-l);
-                if (cosX > 0.0f && s > 0.0f) {
-                    const glm::vec3 origin = x.p + facing(x.ng, l) * eps;
-                    ++plan.rays;
-                    if (!rays.occluded(origin, l, 0.0f, glm::length(light.position - origin) - eps)) {
-                        direct += glm::dvec3(x.albedo * kInvPi * power * (s * cosX / (dist * dist)));
-                        ++lit;
-                    }
-                }
+        bool litHere = false;
+        for (const LightModel& light : lightSet.lights) {
+            glm::vec3 l, irradiance;
+            float dist = 0.0f;
+            if (!light.incidence(x.p, l, dist, irradiance)) continue;
+            const float cosX = glm::dot(x.n, l);
+            if (!(cosX > 0.0f) || !(glm::dot(irradiance, irradiance) > 0.0f)) continue;
+            const glm::vec3 origin = x.p + facing(x.ng, l) * eps;
+            ++plan.rays;
+            const float tfar = std::isfinite(dist) ? glm::length(light.position - origin) - eps
+                                                   : std::numeric_limits<float>::infinity();
+            if (!rays.occluded(origin, l, 0.0f, tfar)) {
+                direct += glm::dvec3(x.albedo * kInvPi * irradiance * cosX);
+                litHere = true;
             }
         }
+        if (litHere) ++lit;
         glm::dvec3 unoccluded(0.0), occluded(0.0), removed(0.0);
         for (const Vpl& v : vpls) {
             const glm::vec3 d = v.at.p - x.p;
@@ -401,7 +414,8 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         d.threshold = 0.0;
         d.costMs = pixels * kDirectNsPerPixel * 1e-6;
         if (!lightOn)
-            d.reason = "the light is off or has no intensity";
+            d.reason = lightSet.skipped.empty() ? "there is no light"
+                                                : "no light is rendered: " + lightSet.skipped.front();
         else if (receivers.empty())
             d.reason = "no surface is in view";
         else
@@ -561,8 +575,9 @@ void applyEffectPlan(FrameState& state, const EffectPlan& plan) {
     for (const EffectDecision& d : plan.decisions) {
         if (!d.applied) continue;
         if (d.effect == "direct") {
-            // Forcing it on cannot light a scene without a spotlight; it only keeps the light as it is.
-            if (!d.enabled) state.lightEnabled = false;
+            // Forcing it on cannot light a scene without lights; it only keeps the lights as they are.
+            if (!d.enabled)
+                for (FrameLight& l : state.lights) l.enabled = false;
         } else if (d.effect == "indirect") {
             if (!d.enabled && state.technique != "none") {
                 setTechnique(state, "none", "effect_indirect");

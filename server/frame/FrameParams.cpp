@@ -1,5 +1,7 @@
 #include "frame/FrameParams.h"
 
+#include "frame/LightModel.h"
+
 namespace gis {
 
 const ParamTable& frameParamTable() {
@@ -24,7 +26,16 @@ const ParamTable& frameParamTable() {
          .min = 128,
          .max = 4096,
          .unit = "texels",
-         .help = "side of the spotlight's shadow map",
+         .help = "side of each light view's shadow map (halved while the views would exceed four full maps "
+                 "and 16 of 1024^2)",
+         .source = "eng"},
+        {.name = "max_lights",
+         .type = ParamType::Int,
+         .defaultValue = kDefaultMaxLights,
+         .min = 1,
+         .max = kMaxLights,
+         .unit = "lights",
+         .help = "most lights rendered (in the scene's order; the rest are listed as skipped)",
          .source = "eng"},
         {.name = "pcf_radius",
          .type = ParamType::Int,
@@ -40,7 +51,8 @@ const ParamTable& frameParamTable() {
          .min = 16,
          .max = 1024,
          .unit = "texels",
-         .help = "side of the reflective shadow map (VPL candidates)",
+         .help = "side of each light view's reflective shadow map (VPL candidates; halved while the views "
+                 "would exceed four full maps and 16 of 256^2)",
          .source = "001 §4 (256^2)"},
         {.name = "rsm_solid_angle",
          .type = ParamType::Enum,

@@ -13,22 +13,46 @@ namespace gis {
 FrameState makeFrameState(const Scene& scene, const std::string& technique) {
     FrameState s;
     if (!scene.cameras.empty()) s.camera = scene.cameras.front();
-    auto spot = std::find_if(scene.lights.begin(), scene.lights.end(),
-                             [](const Light& l) { return l.type == LightType::Spot; });
-    if (spot != scene.lights.end()) {
-        s.light = *spot;
+    if (!scene.lights.empty()) {
+        setLights(s, scene.lights);
         s.lightSource = "scene";
-        s.lightNote = "the scene's spot light '" + spot->name + "'";
+        s.lightNote = scene.lights.size() == 1
+                          ? "the scene's light '" + scene.lights.front().name + "'"
+                          : "the scene's " + std::to_string(scene.lights.size()) + " lights";
     } else {
         const DefaultLighting fallback = defaultLighting(scene, s.camera);
-        s.light = fallback.key;
+        setLights(s, {fallback.key, fallback.fill});
         s.lightSource = "default";
         s.lightNote = fallback.reason;
-        if (!scene.lights.empty()) logWarn("render: scene '" + scene.name + "': " + fallback.reason);
     }
     s.frameParams = ParamSet(frameParamTable());
     setTechnique(s, technique);
     return s;
+}
+
+std::string nextLightId(const FrameState& state) {
+    long next = 0;
+    for (const FrameLight& l : state.lights) {
+        if (l.id.rfind("light", 0) != 0 || l.id.size() == 5) continue;
+        const std::string digits = l.id.substr(5);
+        if (digits.size() > 6 ||
+            !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+            continue;
+        next = std::max(next, std::stol(digits) + 1);
+    }
+    return "light" + std::to_string(next);
+}
+
+FrameLight* findLight(FrameState& state, const std::string& id) {
+    for (FrameLight& l : state.lights)
+        if (l.id == id) return &l;
+    return nullptr;
+}
+
+void setLights(FrameState& state, const std::vector<Light>& lights) {
+    state.lights.clear();
+    for (const Light& l : lights)
+        state.lights.push_back({"light" + std::to_string(state.lights.size()), l, true});
 }
 
 void setTechnique(FrameState& state, const std::string& technique, const std::string& where) {

@@ -11,14 +11,23 @@
 
 namespace gis {
 
+/// One light of a frame: a scene light (or a default or added one) as the client or request left it.
+struct FrameLight {
+    std::string id; ///< stable while the state lives: "light0", "light1", ... (nextLightId())
+    Light light;
+    bool enabled = true;
+};
+
 struct FrameState {
     Camera camera;
-    Light light; ///< the spotlight the pipeline renders (from the scene, or as the client moved it)
-    bool lightEnabled = true;
-    /// Where `light` came from: "scene" (the file's first spot light), "default" (frame/
-    /// DefaultLighting.h: the file has no light the renderer shows) or "request" (an API render
-    /// request's light), with a sentence saying which or why; reported in the stats as `lighting`.
-    /// A client moving the light keeps the source: it is still that light, edited.
+    /// Every light the frame may render, in order: the file's lights (all KHR_lights_punctual types),
+    /// the default rig, a request's list, or the client's edits. The renderer shows at most
+    /// max_lights of the enabled ones (frame/LightModel.h).
+    std::vector<FrameLight> lights;
+    /// Where `lights` came from: "scene" (the file's lights), "default" (frame/DefaultLighting.h: the
+    /// file has no light) or "request" (an API render request's lights), with a sentence saying
+    /// which or why; reported in the stats as `lighting`. A client editing, adding or removing lights
+    /// keeps the source: they are still those lights, edited.
     std::string lightSource = "scene";
     std::string lightNote;
     int width = 512;
@@ -35,10 +44,16 @@ struct FrameState {
 
 namespace gis {
 
-/// The scene's first camera and first spot light (a scene without one gets the default key light of
-/// frame/DefaultLighting.h, with lightSource "default"), default frame parameters and the technique's default
-/// parameters. Throws InputError for an unknown technique.
+/// The scene's first camera and all its lights (a scene without any gets the default rig of
+/// frame/DefaultLighting.h, with lightSource "default"), default frame parameters and the technique's
+/// default parameters. Throws InputError for an unknown technique.
 FrameState makeFrameState(const Scene& scene, const std::string& technique);
+/// A light id not used by `state`'s lights ("lightN", N one past the largest in use).
+std::string nextLightId(const FrameState& state);
+/// The light with this id, or nullptr.
+FrameLight* findLight(FrameState& state, const std::string& id);
+/// Replaces the lights with `lights`, numbered light0, light1, ...
+void setLights(FrameState& state, const std::vector<Light>& lights);
 /// Switches technique, resetting its parameters to that technique's defaults.
 void setTechnique(FrameState& state, const std::string& technique, const std::string& where = "technique");
 /// Sets one parameter by name, in the frame table or the technique's table. Throws InputError.

@@ -12,7 +12,7 @@ const gl::Texture& FrameInputs::get(const std::string& name) const {
 bool FrameInputs::complete() const {
     for (const char* name : {"gbuffer.position", "gbuffer.normal", "gbuffer.albedo", "direct"})
         if (!find(name)) return false;
-    return find(FrameResources::light(0, "rsm.position")) != nullptr;
+    return find("lights.rsm.position") != nullptr;
 }
 
 } // namespace gis

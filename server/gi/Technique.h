@@ -24,7 +24,8 @@ namespace gis {
 
 namespace shader {
 struct FrameUniforms;
-}
+struct LightUniforms;
+} // namespace shader
 
 /// The frame pipeline's products a technique may read. Textures are owned by the renderer and read
 /// from the frame's resource table by name (gl/FrameResources.h, docs/architecture.md):
@@ -32,16 +33,23 @@ struct FrameUniforms;
 ///   gbuffer.normal    RGBA16F unit normal facing the camera
 ///   gbuffer.albedo    RGBA8 linear diffuse albedo rho_d (scene/Brdf.h)
 ///   gbuffer.specular  RGBA8: rgb F0, a perceptual roughness (F0 = 0: no lobe)
-///   light[i].rsm.position  RGBA32F, w = 1 where a surface was hit
-///   light[i].rsm.normal    RGBA16F, facing the light
-///   light[i].rsm.flux      RGBA32F diffusely reflected flux per texel
-///   light[i].rsm.specular  RGBA8: rgb F0, a roughness of the texel's surface
+/// and, one layer per light view (2D arrays, lightViews layers; shared/FrameData.h LightView):
+///   lights.rsm.position  RGBA32F, w = 1 where a surface was hit
+///   lights.rsm.normal    RGBA16F, facing the light
+///   lights.rsm.flux      RGBA32F: rgb diffusely reflected flux per texel, a its area perpendicular
+///                        to the light (m^2; the VPL disk area of 001 Eq. 3)
+///   lights.rsm.specular  RGBA8: rgb F0, a roughness of the texel's surface
+///   lights.shadow        DEPTH32F shadow maps
 ///   direct            RGBA32F shadowed direct radiance plus emission
 struct FrameInputs {
     int width = 0, height = 0;
     /// Everything the frame produced before the technique, by name.
     const FrameResources* resources = nullptr;
-    int rsmSize = 0; ///< texels per side of each light's RSM
+    int rsmSize = 0;    ///< texels per side of each light view's RSM layer
+    int lightViews = 0; ///< RSM layers that hold a light view (0: no light is on)
+    /// Reflected flux luminance of each view's RSM (the VPL budget's split); empty for one view.
+    std::vector<double> viewFlux;
+    const shader::LightUniforms* lights = nullptr; ///< CPU copy of the bound gLights block
     /// Glossy VPL transport (effect_glossy): when true, a technique whose glossyTransport() is true
     /// adds the specular lobe (lobe: frame shadingInfo.x) at receivers whose roughness is at least
     /// glossyMinRoughness; smoother receivers get theirs from the reflection passes.
@@ -60,11 +68,7 @@ struct FrameInputs {
     }
     /// The resource `name`; asserts that the frame produced it.
     const gl::Texture& get(const std::string& name) const;
-    /// The resource NAME of light `index`: light[index].NAME.
-    const gl::Texture& light(int index, const std::string& name) const {
-        return get(FrameResources::light(index, name));
-    }
-    /// Whether the G-buffer, light 0's RSM and the direct light are all published.
+    /// Whether the G-buffer, the lights' RSMs and the direct light are all published.
     bool complete() const;
 };
 

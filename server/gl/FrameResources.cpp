@@ -29,8 +29,13 @@ std::string formatName(GLenum f) {
 
 void FrameResources::publish(const std::string& name, const std::string& producer,
                              const gl::Texture& texture) {
-    FrameResource r{
-        name, producer, &texture, formatName(texture.format()), texture.width(), texture.height()};
+    FrameResource r{name,
+                    producer,
+                    &texture,
+                    formatName(texture.format()),
+                    texture.width(),
+                    texture.height(),
+                    texture.layers()};
     auto it = std::find_if(mResources.begin(), mResources.end(),
                            [&](const FrameResource& x) { return x.name == name; });
     if (it == mResources.end())
@@ -53,10 +58,6 @@ const gl::Texture& FrameResources::get(const std::string& name) const {
 
 void FrameResources::withdraw(const std::string& name) {
     std::erase_if(mResources, [&](const FrameResource& r) { return r.name == name; });
-}
-
-std::string FrameResources::light(int index, const std::string& name) {
-    return "light[" + std::to_string(index) + "]." + name;
 }
 
 } // namespace gis

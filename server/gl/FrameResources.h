@@ -1,5 +1,5 @@
 // The named products of one frame (DESIGN.md §3): each stage publishes the textures it writes under
-// a name (`gbuffer.normal`, `light[0].rsm.flux`, `direct`, ...) with its format, size and producer,
+// a name (`gbuffer.normal`, `lights.rsm.flux`, `direct`, ...) with its format, size and producer,
 // and later stages, tests and the stability harness read them by name. Names carry the light index
 // so that every light's shadow map and RSM is one more loop iteration, not a copy. Textures stay
 // owned by the stage that made them; the table only points at them for the frame.
@@ -13,11 +13,12 @@
 namespace gis {
 
 struct FrameResource {
-    std::string name;     ///< "gbuffer.position", "light[0].shadow", ...
+    std::string name;     ///< "gbuffer.position", "lights.shadow", ...
     std::string producer; ///< the stage that wrote it: "gbuffer", "rsm", "technique", ...
     const gl::Texture* texture = nullptr;
     std::string format; ///< "RGBA32F", "DEPTH32F", ...
     int width = 0, height = 0;
+    int layers = 1; ///< array layers (one per light view for the lights.* resources)
 };
 
 class FrameResources {
@@ -31,9 +32,6 @@ public:
     /// Drops `name` (a stage that did not run this frame).
     void withdraw(const std::string& name);
     const std::vector<FrameResource>& list() const { return mResources; }
-
-    /// "light[i].NAME", the key of light i's resource NAME.
-    static std::string light(int index, const std::string& name);
 
 private:
     std::vector<FrameResource> mResources;

@@ -31,6 +31,7 @@ Texture Texture::allocate(GLenum target, GLenum internalFormat, int width, int h
     t.mWidth = width;
     t.mHeight = height;
     t.mLevels = levels;
+    t.mLayers = target == GL_TEXTURE_2D_ARRAY ? layers : target == GL_TEXTURE_CUBE_MAP ? 6 : 1;
     t.mFormat = internalFormat;
     t.setWrap(GL_CLAMP_TO_EDGE);
     return t;
@@ -94,6 +95,16 @@ Framebuffer Framebuffer::of(const std::string& label, std::initializer_list<cons
     return fbo;
 }
 
+Framebuffer Framebuffer::ofLayer(const std::string& label, std::initializer_list<const Texture*> colors,
+                                 const Texture* depth, int layer) {
+    Framebuffer fbo = create();
+    int index = 0;
+    for (const Texture* t : colors) fbo.attachColorLayer(index++, *t, layer);
+    if (depth) fbo.attachDepthLayer(*depth, layer);
+    fbo.finish(index, label + " (layer " + std::to_string(layer) + ")");
+    return fbo;
+}
+
 void Framebuffer::attachColor(int index, const Texture& texture, int level) {
     glNamedFramebufferTexture(id(), GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index), texture.id(), level);
 }
@@ -109,6 +120,10 @@ void Framebuffer::attachDepthStencil(const Texture& texture, int level) {
 void Framebuffer::attachColorLayer(int index, const Texture& texture, int layer, int level) {
     glNamedFramebufferTextureLayer(id(), GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index), texture.id(),
                                    level, layer);
+}
+
+void Framebuffer::attachDepthLayer(const Texture& texture, int layer, int level) {
+    glNamedFramebufferTextureLayer(id(), GL_DEPTH_ATTACHMENT, texture.id(), level, layer);
 }
 
 bool Framebuffer::tryFinish(int colorCount) {

@@ -90,6 +90,7 @@ public:
     int height() const { return mHeight; }
     GLenum format() const { return mFormat; }
     int levels() const { return mLevels; }
+    int layers() const { return mLayers; } ///< array layers (6 for a cube map, 1 for a 2D texture)
     /// Nearest or linear filtering and clamp-to-edge wrapping.
     void setFilter(GLenum minFilter, GLenum magFilter);
     void setWrap(GLenum wrap);
@@ -101,7 +102,7 @@ private:
     /// Immutable storage of `target` (2D, 2D array or cube) with clamp-to-edge wrapping.
     static Texture allocate(GLenum target, GLenum internalFormat, int width, int height, int levels,
                             int layers);
-    int mWidth = 0, mHeight = 0, mLevels = 0;
+    int mWidth = 0, mHeight = 0, mLevels = 0, mLayers = 0;
     GLenum mFormat = 0;
 };
 
@@ -113,12 +114,17 @@ public:
     /// attached as depth and stencil) and the draw buffers selected; throws gis::Error naming `label`.
     static Framebuffer of(const std::string& label, std::initializer_list<const Texture*> colors,
                           const Texture* depth = nullptr);
+    /// of() for layer `layer` of array textures: that layer of every colour texture and of `depth`.
+    static Framebuffer ofLayer(const std::string& label, std::initializer_list<const Texture*> colors,
+                               const Texture* depth, int layer);
     void attachColor(int index, const Texture& texture, int level = 0);
     void attachDepth(const Texture& texture, int level = 0);
     void attachDepthStencil(const Texture& texture, int level = 0); ///< GL_DEPTH24_STENCIL8 texture
     /// Attaches one layer of an array texture, or one face (layer 0..5: +X, -X, +Y, -Y, +Z, -Z) of a
     /// cube map, as colour attachment `index`.
     void attachColorLayer(int index, const Texture& texture, int layer, int level = 0);
+    /// Attaches one layer of a depth array texture as the depth attachment.
+    void attachDepthLayer(const Texture& texture, int layer, int level = 0);
     /// Selects the draw buffers 0..count-1 and checks completeness; throws gis::Error naming `label`.
     void finish(int colorCount, const std::string& label);
     /// finish() for targets (re)allocated on the per-frame path, which never throws: returns whether

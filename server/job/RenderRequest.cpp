@@ -32,7 +32,7 @@ std::span<const EmbeddedFile> httpSchemas(); // protocol/http/*.json, gis_embed_
 namespace {
 
 constexpr const char* kKnownFields =
-    "scene, technique, preset, params, size, format, quality, camera, light, compare";
+    "scene, technique, preset, params, size, format, quality, camera, light, lights, compare";
 
 /// How to fix a schema violation at `pointer`, by the request field it is in.
 std::string hintFor(const std::string& pointer, const std::string& message, const RenderLimits& limits) {
@@ -54,8 +54,16 @@ std::string hintFor(const std::string& pointer, const std::string& message, cons
         return "camera is {\"position\": [x, y, z], \"target\": [x, y, z]} in metres, optionally with \"up\" "
                "and \"fov_deg\" (1..170)";
     if (field == "light")
-        return "light has any of position [x, y, z], direction [x, y, z] (components in [-1, 1]), intensity "
-               "(>= 0), color [r, g, b] in [0, 1], cone_deg (1..85), enabled";
+        return "light edits the scene's first light (or the one named by \"id\") with any of type (spot, "
+               "point, "
+               "directional), position [x, y, z], direction [x, y, z] (components in [-1, 1]), intensity (>= "
+               "0; cd, "
+               "lux for directional), color [r, g, b] in [0, 1], range (>= 0 m), cone_deg (1..85), "
+               "inner_cone_deg, "
+               "enabled";
+    if (field == "lights")
+        return "lights replaces the scene's lights: an array of lights, each with a type (spot, point, "
+               "directional) and the fields of light";
     if (field == "compare")
         return "compare is {\"mode\": \"direct\" | \"one-bounce-unoccluded\" | \"one-bounce\" | \"path\", "
                "\"spp\": samples per pixel, \"time_budget_s\": seconds}";
@@ -91,6 +99,14 @@ ReferenceOptions referenceOptions(const RenderCompare& compare) {
     return options;
 }
 #endif
+
+// A request's "light": edits the light named by its "id", or the first one.
+void editRequestLight(FrameState& state, const nlohmann::json& light) {
+    std::string id;
+    if (light.is_object())
+        if (auto i = light.find("id"); i != light.end() && i->is_string()) id = i->get<std::string>();
+    editLightJson(state, id, light, "/light", true);
+}
 
 } // namespace
 
@@ -152,8 +168,19 @@ RenderJob parseRenderRequest(const nlohmann::json& request, const RenderLimits& 
         applyCameraJson(probe, *c, "/camera");
         job.camera = *c;
     }
+    if (auto l = request.find("lights"); l != request.end()) {
+        setLightsJson(probe, *l, "/lights");
+        job.lights = *l;
+    }
     if (auto l = request.find("light"); l != request.end()) {
-        applyLightJson(probe, *l, "/light");
+        // The scene's light ids are known only once it is loaded (makeJobFrameState checks them).
+        if (!request.contains("lights")) {
+            std::string id = "light0";
+            if (l->is_object())
+                if (auto i = l->find("id"); i != l->end() && i->is_string()) id = i->get<std::string>();
+            probe.lights = {{id, Light{}, true}};
+        }
+        editRequestLight(probe, *l);
         job.light = *l;
     }
 
@@ -193,10 +220,15 @@ FrameState makeJobFrameState(const Scene& scene, const RenderJob& job) {
     FrameState state = makeFrameState(scene, job.technique);
     applyJobParams(state, job);
     if (job.camera) applyCameraJson(state, *job.camera, "/camera");
-    if (job.light) {
-        applyLightJson(state, *job.light, "/light");
+    if (job.lights) {
+        setLightsJson(state, *job.lights, "/lights");
         state.lightSource = "request";
-        state.lightNote = "the request's light";
+        state.lightNote = "the request's " + std::to_string(state.lights.size()) + " lights";
+    }
+    if (job.light) {
+        editRequestLight(state, *job.light);
+        state.lightSource = "request";
+        if (!job.lights) state.lightNote = "the scene's lights with the request's light";
     }
     state.width = job.width;
     state.height = job.height;

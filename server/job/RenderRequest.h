@@ -43,7 +43,7 @@ struct RenderCompare {
 
 /// Everything a one-shot render depends on besides the scene's contents. Parameters, camera and
 /// light are kept as the request's JSON (already validated) and applied on top of the scene's own
-/// state by makeJobFrameState, in that order: technique defaults, preset, params, camera, light.
+/// state by makeJobFrameState, in that order: technique defaults, preset, params, camera, lights, light.
 struct RenderJob {
     std::string scene; ///< handed to the caller's scene resolver
     std::string technique = "rsm_gather";
@@ -52,7 +52,8 @@ struct RenderJob {
     int width = 512;
     int height = 512;
     std::optional<nlohmann::json> camera; ///< applyCameraJson object; absent = the scene's camera
-    std::optional<nlohmann::json> light;  ///< applyLightJson object; absent = the scene's spotlight
+    std::optional<nlohmann::json> lights; ///< setLightsJson array; absent = the scene's lights
+    std::optional<nlohmann::json> light;  ///< editLightJson object (first light or "id"); absent = as is
     ImageCodec codec = ImageCodec::Png;
     int quality = kDefaultImageQuality; ///< jpeg and webp
     std::optional<RenderCompare> compare;

@@ -1017,11 +1017,12 @@ struct WsServer::Impl {
                       1001);
             return;
         }
-        if (hello["protocol"].get<int>() != kProtocolVersion) {
+        if (const int asked = hello["protocol"].get<int>();
+            asked < kOldestProtocolVersion || asked > kProtocolVersion) {
             closeWith(c,
                       {"protocol_mismatch",
-                       "this server speaks protocol " + std::to_string(kProtocolVersion) + ", the client " +
-                           std::to_string(hello["protocol"].get<int>()),
+                       "this server speaks protocols " + std::to_string(kOldestProtocolVersion) + " to " +
+                           std::to_string(kProtocolVersion) + ", the client " + std::to_string(asked),
                        "/protocol", "hello"},
                       1002);
             return;

@@ -10,6 +10,7 @@
 
 #include "core/Error.h"
 #include "core/Log.h"
+#include "frame/LightModel.h"
 #include "reference/ContentHash.h"
 #include "reference/ReferenceRenderer.h"
 
@@ -20,7 +21,7 @@ namespace reference {
 // cache files stop matching.
 // 2: non-diffuse materials (scene/Brdf.h: metallic, roughness, specular) and the frame parameters
 // specular_lobe and effect_specular.
-constexpr const char* kKeyVersion = "gis-reference-2";
+constexpr const char* kKeyVersion = "gis-reference-3"; // 3: every light, range windows
 
 std::string sceneDigest(const Scene& scene) {
     Hasher h;
@@ -68,16 +69,21 @@ std::string requestKey(const std::string& digest, const FrameState& state, const
     h.value(c.yfovRadians);
     h.value(c.znear);
     h.value(c.zfar);
-    const Light& l = state.light;
-    h.value(static_cast<int>(l.type));
-    h.value(l.position);
-    h.value(l.direction);
-    h.value(l.color);
-    h.value(l.intensity);
-    h.value(l.innerConeAngle);
-    h.value(l.outerConeAngle);
-    h.value(l.range);
-    h.value(state.lightEnabled);
+    h.value(static_cast<int>(state.lights.size()));
+    for (const FrameLight& fl : state.lights) {
+        const Light& l = fl.light;
+        h.value(static_cast<int>(l.type));
+        h.value(l.position);
+        h.value(l.direction);
+        h.value(l.color);
+        h.value(l.intensity);
+        h.value(l.innerConeAngle);
+        h.value(l.outerConeAngle);
+        h.value(l.range);
+        h.value(fl.enabled);
+    }
+    // Which of them are rendered.
+    h.value(state.frameParams.has("max_lights") ? state.frameParams.getInt("max_lights") : kDefaultMaxLights);
     h.value(state.width);
     h.value(state.height);
     // The frame parameters the reflection model reads (ReferenceRenderer.cpp ShadingModel); a state

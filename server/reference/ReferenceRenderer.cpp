@@ -97,51 +97,67 @@ struct ShadingModel {
     }
 };
 
+// Lights a reference sample evaluates exactly, one by one; a set larger than this is sampled at
+// path vertices: one light chosen with probability proportional to its power into the scene
+// (LightModel::sceneFlux), weighted by 1 / that probability (unbiased). Primary vertices always sum
+// every light, so a direct-mode render stays exact.
+constexpr size_t kExactLights = 4;
+
 class Integrator {
 public:
-    Integrator(const RayScene& rays, const LightModel& light, const ShadingModel& shading, Mode mode,
-               int maxDepth, float causticMinRoughness)
-        : mRays(rays), mLight(light), mShading(shading), mMode(mode), mMaxDepth(maxDepth),
+    Integrator(const RayScene& rays, const LightSetModel& lights, float sceneRadius,
+               const ShadingModel& shading, Mode mode, int maxDepth, float causticMinRoughness)
+        : mRays(rays), mLights(lights), mShading(shading), mMode(mode), mMaxDepth(maxDepth),
           mEps(rays.epsilon()),
           // alpha of that roughness; 0 keeps every caustic (alpha >= kMinAlpha > 0 is never below it)
-          mCausticMinAlpha(causticMinRoughness > 0.0f ? brdf::alphaFrom(causticMinRoughness) : 0.0f) {}
-
-    /// Unit direction from p towards the light and the distance (infinite for directional); false when
-    /// the direction is undefined (p at the light's position: digest S.4 case 1, contributes 0).
-    bool toLight(const glm::vec3& p, glm::vec3& l, float& dist) const {
-        if (mLight.type == LightType::Directional) {
-            l = -mLight.axis;
-            dist = std::numeric_limits<float>::infinity();
-            return true;
+          mCausticMinAlpha(causticMinRoughness > 0.0f ? brdf::alphaFrom(causticMinRoughness) : 0.0f) {
+        double total = 0.0;
+        for (const LightModel& l : lights.lights) {
+            total += std::max(l.sceneFlux(sceneRadius), 0.0);
+            mCdf.push_back(total);
         }
-        const glm::vec3 d = mLight.position - p;
-        const float d2 = glm::dot(d, d);
-        if (!(d2 > 1e-12f) || !std::isfinite(d2)) return false; // same threshold as direct.frag
-        dist = std::sqrt(d2);
-        l = d / dist;
-        return true;
+        if (!(total > 0.0)) // no measurable power: uniform selection
+            for (size_t i = 0; i < mCdf.size(); ++i) mCdf[i] = static_cast<double>(i + 1);
+        const double last = mCdf.empty() ? 1.0 : mCdf.back();
+        for (double& c : mCdf) c /= last;
     }
 
-    /// E_d at p for the side of unit normal n: I c f max(0, n.l) / d^2 times a hard shadow ray. `lOut`
-    /// receives the unit direction to the light when given.
-    glm::vec3 directIrradiance(const glm::vec3& p, const glm::vec3& n, const glm::vec3& ngRaw,
-                               glm::vec3* lOut = nullptr) const {
-        if (!mLight.on) return glm::vec3(0.0f);
-        glm::vec3 l;
+    bool anyLight() const { return !mLights.lights.empty(); }
+
+    /// E_d of light `light` at p for the side of unit normal n: its irradiance on a surface facing it
+    /// (LightModel::incidence: I c f window / d^2, or E c) times max(0, n.l) and a hard shadow ray.
+    /// `lOut` receives the unit direction to the light. Zero where the direction is undefined (p at
+    /// the light's position: digest S.4 case 1).
+    glm::vec3 directIrradiance(const LightModel& light, const glm::vec3& p, const glm::vec3& n,
+                               const glm::vec3& ngRaw, glm::vec3* lOut = nullptr) const {
+        glm::vec3 l, irradiance;
         float dist = 0.0f;
-        if (!toLight(p, l, dist)) return glm::vec3(0.0f);
+        if (!light.incidence(p, l, dist, irradiance)) return glm::vec3(0.0f);
         if (lOut) *lOut = l;
         const float cosTheta = glm::dot(n, l);
         if (!(cosTheta > 0.0f)) return glm::vec3(0.0f);
-        const float falloff = mLight.type == LightType::Directional ? 1.0f : 1.0f / (dist * dist);
-        const float scale = mLight.spotFactor(-l) * cosTheta * falloff;
-        if (!(scale > 0.0f)) return glm::vec3(0.0f);
+        const glm::vec3 e = irradiance * cosTheta;
+        if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) return glm::vec3(0.0f);
         // Leave from the light's side of the geometric surface so the ray cannot re-hit its own triangle.
         const glm::vec3 origin = p + facing(ngRaw, l) * mEps;
         float tfar = std::numeric_limits<float>::infinity();
-        if (std::isfinite(dist)) tfar = glm::length(mLight.position - origin) - mEps;
+        if (std::isfinite(dist)) tfar = glm::length(light.position - origin) - mEps;
         if (tfar > mEps && mRays.occluded(origin, l, 0.0f, tfar)) return glm::vec3(0.0f);
-        return mLight.power() * scale;
+        return e;
+    }
+
+    /// Calls `each(light, weight)` for the lights a vertex evaluates: all of them (weight 1) when
+    /// `rng` is null or the set is small, else one chosen by power with weight 1 / its probability.
+    template <class F> void forLights(Rng* rng, F&& each) const {
+        if (!rng || mLights.lights.size() <= kExactLights) {
+            for (const LightModel& l : mLights.lights) each(l, 1.0f);
+            return;
+        }
+        const double u = rng->uniform();
+        size_t i = static_cast<size_t>(std::lower_bound(mCdf.begin(), mCdf.end(), u) - mCdf.begin());
+        i = std::min(i, mCdf.size() - 1);
+        const double pmf = mCdf[i] - (i > 0 ? mCdf[i - 1] : 0.0);
+        if (pmf > 0.0) each(mLights.lights[i], static_cast<float>(1.0 / pmf));
     }
 
     /// True when vertex v reflects through a specular lobe (its material has one and effect_specular is
@@ -155,13 +171,18 @@ public:
     /// at the receiver. With causticMinRoughness > 0, v's specular lobe is left out when it is smoother
     /// than that roughness AND narrower than reachedAlpha: a sharp lobe found by sampling a wider one
     /// (a caustic, or a glossy-to-sharper-glossy path) is what a path tracer finds only by chance.
-    glm::vec3 reflectedDirect(const Vertex& v, float reachedAlpha = 0.0f) const {
-        glm::vec3 l(0.0f);
-        const glm::vec3 e = directIrradiance(v.hit.position, v.n, v.hit.geometricNormal, &l);
-        glm::vec3 radiance = v.hit.albedo * kInvPi * e;
+    glm::vec3 reflectedDirect(const Vertex& v, float reachedAlpha = 0.0f, Rng* rng = nullptr) const {
+        glm::vec3 radiance(0.0f);
         const bool caustic = v.hit.surface.alpha < std::min(mCausticMinAlpha, reachedAlpha);
-        if (specularAt(v) && !caustic && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f))
-            radiance += brdf::specular(v.hit.surface, mShading.lobe, v.n, l, v.wo) * e;
+        const bool specular = specularAt(v) && !caustic;
+        forLights(rng, [&](const LightModel& light, float weight) {
+            glm::vec3 l(0.0f);
+            const glm::vec3 e =
+                weight * directIrradiance(light, v.hit.position, v.n, v.hit.geometricNormal, &l);
+            if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) return;
+            radiance += v.hit.albedo * kInvPi * e;
+            if (specular) radiance += brdf::specular(v.hit.surface, mShading.lobe, v.n, l, v.wo) * e;
+        });
         return radiance;
     }
 
@@ -236,7 +257,7 @@ private:
         if (!mRays.intersect(x.hit.position + x.ng * mEps, w, 0.0f, std::numeric_limits<float>::infinity(),
                              hit))
             return glm::vec3(0.0f);
-        return weight * reflectedDirect(orient(hit, -w), lobeAlpha);
+        return weight * reflectedDirect(orient(hit, -w), lobeAlpha, &rng);
     }
 
     // L_1 without visibility between x and y. Changing the area integral to directions at x turns
@@ -251,18 +272,21 @@ private:
     // specular lobe and without the VPLs' own glossy lobes.
     glm::vec3 oneBounceUnoccluded(const Vertex& x, Rng& rng, std::vector<RawHit>& hits) const {
         glm::vec3 w, weight;
-        if (!sampleBounce(x, rng, w, weight) || !mLight.on) return glm::vec3(0.0f);
+        if (!sampleBounce(x, rng, w, weight) || !anyLight()) return glm::vec3(0.0f);
         const glm::vec3 origin = x.hit.position + x.ng * mEps;
         mRays.intersectAll(origin, w, 0.0f, std::numeric_limits<float>::infinity(), hits);
         glm::vec3 sum(0.0f);
         for (const RawHit& raw : hits) {
             const SurfaceHit y = mRays.resolve(raw, origin, w);
-            glm::vec3 l;
-            float dist = 0.0f;
-            if (!toLight(y.position, l, dist)) continue;
-            const glm::vec3 nLight = facing(y.shadingNormal, l); // the RSM's light-facing normal
-            if (!(glm::dot(nLight, -w) > 0.0f)) continue;        // x behind y's lit side
-            sum += y.albedo * kInvPi * directIrradiance(y.position, nLight, y.geometricNormal);
+            forLights(&rng, [&](const LightModel& light, float lightWeight) {
+                glm::vec3 l, irradiance;
+                float dist = 0.0f;
+                if (!light.incidence(y.position, l, dist, irradiance)) return;
+                const glm::vec3 nLight = facing(y.shadingNormal, l); // the RSM's light-facing normal
+                if (!(glm::dot(nLight, -w) > 0.0f)) return;          // x behind y's lit side
+                sum += lightWeight * y.albedo * kInvPi *
+                       directIrradiance(light, y.position, nLight, y.geometricNormal);
+            });
         }
         return weight * sum;
     }
@@ -295,13 +319,14 @@ private:
                                  std::numeric_limits<float>::infinity(), hit))
                 break;
             v = orient(hit, -w);
-            radiance += throughput * (v.hit.emission + reflectedDirect(v, reachedAlpha));
+            radiance += throughput * (v.hit.emission + reflectedDirect(v, reachedAlpha, &rng));
         }
         return radiance;
     }
 
     const RayScene& mRays;
-    const LightModel& mLight;
+    const LightSetModel& mLights;
+    std::vector<double> mCdf; ///< cumulative selection probabilities, by power
     const ShadingModel& mShading;
     Mode mMode;
     int mMaxDepth;
@@ -357,10 +382,11 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
     // planes, so the reference sees exactly the GL frustum, clipping included. Double precision keeps
     // the inverse accurate for large far/near ratios.
     const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(cameraViewProj(state.camera, w, h)));
-    // The light exactly as the GL pipeline sees it (frame/LightModel.h).
-    const LightModel light = makeLightModel(state, mBounds);
+    // The lights exactly as the GL pipeline sees them (frame/LightModel.h).
+    const LightSetModel lights = makeLightSet(state, mBounds);
     const ShadingModel shading(state);
-    const Integrator integrator(*mRays, light, shading, mode, options.maxDepth, options.causticMinRoughness);
+    const Integrator integrator(*mRays, lights, std::max(mBounds.radius(), 1e-6f), shading, mode,
+                                options.maxDepth, options.causticMinRoughness);
 
     // A pixel-centre direct render has no random decision: one sample is the exact answer.
     const int target = (mode == Mode::Direct && !options.jitter) ? 1 : options.spp;

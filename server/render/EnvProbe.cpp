@@ -142,7 +142,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     const gl::Texture* gPosition = in.find("gbuffer.position");
     const gl::Texture* gNormal = in.find("gbuffer.normal");
     const gl::Texture* gSpecular = in.find("gbuffer.specular");
-    const gl::Texture* shadowMap = in.find(FrameResources::light(0, "shadow"));
+    const gl::Texture* shadowMap = in.find("lights.shadow");
     if (!in.scene || !in.sceneGpu || !gPosition || !gNormal || !gSpecular || in.width <= 0 || in.height <= 0)
         return;
     const int size = std::clamp(fp.getInt("env_size"), 8, 512);

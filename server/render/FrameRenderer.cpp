@@ -55,11 +55,52 @@ std::vector<float> readRgba32f(const gl::Framebuffer& fbo, int attachment, int w
 
 } // namespace
 
-void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u) {
-    u.lightViewProj = light.viewProj;
-    u.lightPos = glm::vec4(light.position, light.intensity);
-    u.lightDir = glm::vec4(light.axis, light.cosOuter);
-    u.lightColor = glm::vec4(light.color, light.cosInner);
+nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set) {
+    nlohmann::json rendered = nlohmann::json::array();
+    for (const LightModel& l : set.lights) {
+        const char* type = l.type == LightType::Spot    ? "spot"
+                           : l.type == LightType::Point ? "point"
+                                                        : "directional";
+        rendered.push_back({{"id", l.id}, {"name", l.name}, {"type", type}, {"views", l.viewCount}});
+    }
+    nlohmann::json out = {{"source", state.lightSource},     {"note", state.lightNote},
+                          {"rendered", std::move(rendered)}, {"skipped", set.skipped},
+                          {"views", set.views.size()},       {"shadow_side", set.shadowSide},
+                          {"rsm_side", set.rsmSide}};
+    if (set.lights.empty())
+        out["warning"] = state.lights.empty()
+                             ? "there are no lights: the view shows emission only"
+                             : "none of the lights is rendered (see skipped): the view shows "
+                               "emission only";
+    return out;
+}
+
+static_assert(kMaxLights == GIS_MAX_LIGHTS, "max_lights' maximum is the light block's capacity");
+
+void writeLightUniforms(const LightSetModel& set, shader::LightUniforms& u) {
+    const int lights = std::min(static_cast<int>(set.lights.size()), GIS_MAX_LIGHTS);
+    const int views = std::min(static_cast<int>(set.views.size()), GIS_MAX_LIGHT_VIEWS);
+    for (int i = 0; i < lights; ++i) {
+        const LightModel& l = set.lights[static_cast<size_t>(i)];
+        shader::GpuLight& g = u.lights[i];
+        const float type = l.type == LightType::Spot    ? GIS_LIGHT_SPOT
+                           : l.type == LightType::Point ? GIS_LIGHT_POINT
+                                                        : GIS_LIGHT_DIRECTIONAL;
+        g.position = glm::vec4(l.position, l.intensity);
+        g.direction = glm::vec4(l.axis, l.cosOuter);
+        g.color = glm::vec4(l.color, l.cosInner);
+        g.info = glm::vec4(type, l.range, static_cast<float>(l.firstView), static_cast<float>(l.viewCount));
+    }
+    for (int v = 0; v < views; ++v) {
+        const LightViewModel& m = set.views[static_cast<size_t>(v)];
+        shader::LightView& g = u.views[v];
+        g.viewProj = m.viewProj;
+        g.eye = glm::vec4(m.eye, static_cast<float>(m.light));
+        g.info = glm::vec4(m.orthographic ? 1.0f : 0.0f, m.orthographic ? m.halfWidth : m.tanHalfFov,
+                           static_cast<float>(m.face), 0.0f);
+        g.axis = glm::vec4(m.axis, 0.0f);
+    }
+    u.counts = glm::ivec4(lights, views, 0, 0);
 }
 
 FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
@@ -92,7 +133,14 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     mCompositePass.reflection = c.textureUnit("gReflection");
     mCompositePass.hasIndirect = c.location("uHasIndirect");
     mCompositePass.hasReflection = c.location("uHasReflection");
+    mFluxPass.program = gl::Program::build({{GL_COMPUTE_SHADER, "render/rsm_flux.comp"}});
+    mFluxPass.rsmSize = mFluxPass.program.location("uRsmSize");
+    mFluxPass.position = mFluxPass.program.textureUnit("gRsmPosition");
+    mFluxPass.flux = mFluxPass.program.textureUnit("gRsmFlux");
+    mFluxPass.sums = mFluxPass.program.storageBlock("ViewFlux");
+    mFluxSums = gl::Buffer::create(GIS_MAX_LIGHT_VIEWS * sizeof(float));
     mFrameUbo = gl::Buffer::create(sizeof(shader::FrameUniforms));
+    mLightUbo = gl::Buffer::create(sizeof(shader::LightUniforms));
     mEmptyVao = gl::VertexArray::create();
     gl::checkErrors("renderer setup");
 }
@@ -105,24 +153,33 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
     mScene = std::move(scene);
 }
 
-void FrameRenderer::ensureTargets(int width, int height, int rsmSize, int shadowSize) {
-    if (shadowSize != mShadowSize) {
-        mShadowDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, shadowSize, shadowSize);
+void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadowSide, int views) {
+    // At least one layer, so that the shadow and RSM resources exist (and read as empty) with no light.
+    const int layers = std::max(views, 1);
+    if (shadowSide != mShadowSize || layers != mShadowLayers) {
+        mShadowDepth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, shadowSide, shadowSide, layers);
         mShadowDepth.setFilter(GL_LINEAR, GL_LINEAR); // hardware 2x2 PCF with the compare mode
         glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
         glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-        mShadowFbo = gl::Framebuffer::of("shadow map", {}, &mShadowDepth);
-        mShadowSize = shadowSize;
+        mShadowFbos.clear();
+        for (int v = 0; v < layers; ++v)
+            mShadowFbos.push_back(gl::Framebuffer::ofLayer("shadow map", {}, &mShadowDepth, v));
+        mShadowSize = shadowSide;
+        mShadowLayers = layers;
     }
-    if (rsmSize != mRsmSize) {
-        mRsmPosition = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
-        mRsmNormal = gl::Texture::create2D(GL_RGBA16F, rsmSize, rsmSize);
-        mRsmFlux = gl::Texture::create2D(GL_RGBA32F, rsmSize, rsmSize);
-        mRsmSpecular = gl::Texture::create2D(GL_RGBA8, rsmSize, rsmSize);
-        mRsmDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, rsmSize, rsmSize);
-        mRsmFbo = gl::Framebuffer::of("reflective shadow map",
-                                      {&mRsmPosition, &mRsmNormal, &mRsmFlux, &mRsmSpecular}, &mRsmDepth);
-        mRsmSize = rsmSize;
+    if (rsmSide != mRsmSize || layers != mRsmLayers) {
+        mRsmPosition = gl::Texture::create2DArray(GL_RGBA32F, rsmSide, rsmSide, layers);
+        mRsmNormal = gl::Texture::create2DArray(GL_RGBA16F, rsmSide, rsmSide, layers);
+        mRsmFlux = gl::Texture::create2DArray(GL_RGBA32F, rsmSide, rsmSide, layers);
+        mRsmSpecular = gl::Texture::create2DArray(GL_RGBA8, rsmSide, rsmSide, layers);
+        mRsmDepth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, rsmSide, rsmSide, layers);
+        mRsmFbos.clear();
+        for (int v = 0; v < layers; ++v)
+            mRsmFbos.push_back(gl::Framebuffer::ofLayer(
+                "reflective shadow map", {&mRsmPosition, &mRsmNormal, &mRsmFlux, &mRsmSpecular}, &mRsmDepth,
+                v));
+        mRsmSize = rsmSide;
+        mRsmLayers = layers;
     }
     if (width != mWidth || height != mHeight) {
         mGPosition = gl::Texture::create2D(GL_RGBA32F, width, height);
@@ -156,33 +213,65 @@ void FrameRenderer::ensureTechnique(const std::string& name, int width, int heig
     }
 }
 
-void FrameRenderer::renderShadowMap(int light) {
-    // Depth only, with a slope-scaled offset against acne.
+void FrameRenderer::renderShadowMaps(int views) {
+    // Depth only, with a slope-scaled offset against acne; layers without a view are cleared (lit).
     gl::Pass pass(mTimer, "shadow_map");
-    pass.target(mShadowFbo, mShadowSize, mShadowSize)
-        .depthTest(GL_LESS)
-        .clearDepth()
-        .polygonOffset(2.0f, 4.0f);
-    pass.use(mShadowPass.program).set(mShadowPass.view, 1);
-    mSceneGpu->draw(mShadowPass.program, nullptr);
-    mResources.publish(FrameResources::light(light, "shadow"), "shadow_map", mShadowDepth);
+    for (int v = 0; v < mShadowLayers; ++v) {
+        gl::Pass layer("shadow_map view");
+        layer.target(mShadowFbos[static_cast<size_t>(v)], mShadowSize, mShadowSize)
+            .depthTest(GL_LESS)
+            .clearDepth();
+        if (v >= views) continue;
+        layer.polygonOffset(2.0f, 4.0f);
+        layer.use(mShadowPass.program).set(mShadowPass.view, v);
+        mSceneGpu->draw(mShadowPass.program, nullptr);
+    }
+    mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
 }
 
-void FrameRenderer::renderRsm(int light, int rsmSize) {
+void FrameRenderer::renderRsms(int views) {
     gl::Pass pass(mTimer, "rsm");
-    pass.target(mRsmFbo, rsmSize, rsmSize).depthTest(GL_LESS).clearColor(4).clearDepth();
-    pass.use(mRsmPass.program).set(mRsmPass.view, 1);
-    mSceneGpu->draw(mRsmPass.program, &mRsmPass.materials);
-    mResources.publish(FrameResources::light(light, "rsm.position"), "rsm", mRsmPosition);
-    mResources.publish(FrameResources::light(light, "rsm.normal"), "rsm", mRsmNormal);
-    mResources.publish(FrameResources::light(light, "rsm.flux"), "rsm", mRsmFlux);
-    mResources.publish(FrameResources::light(light, "rsm.specular"), "rsm", mRsmSpecular);
+    for (int v = 0; v < mRsmLayers; ++v) {
+        gl::Pass layer("rsm view");
+        layer.target(mRsmFbos[static_cast<size_t>(v)], mRsmSize, mRsmSize)
+            .depthTest(GL_LESS)
+            .clearColor(4)
+            .clearDepth();
+        if (v >= views) continue;
+        layer.use(mRsmPass.program).set(mRsmPass.view, v);
+        mSceneGpu->draw(mRsmPass.program, &mRsmPass.materials);
+    }
+    mResources.publish("lights.rsm.position", "rsm", mRsmPosition);
+    mResources.publish("lights.rsm.normal", "rsm", mRsmNormal);
+    mResources.publish("lights.rsm.flux", "rsm", mRsmFlux);
+    mResources.publish("lights.rsm.specular", "rsm", mRsmSpecular);
+}
+
+std::vector<double> FrameRenderer::measureViewFlux(int views) {
+    if (views <= 1) return {};
+    {
+        gl::Pass pass(mTimer, "rsm_flux");
+        pass.use(mFluxPass.program).set(mFluxPass.rsmSize, mRsmSize);
+        pass.texture(mFluxPass.position, mRsmPosition).texture(mFluxPass.flux, mRsmFlux);
+        pass.buffer(mFluxPass.sums, mFluxSums);
+        pass.dispatch(views).barrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    }
+    // A small synchronous read (views floats): the split must be known before the technique's
+    // extraction is dispatched, and using the previous frame's would make a single render depend on
+    // the frame before it.
+    std::vector<float> sums(static_cast<size_t>(views), 0.0f);
+    glGetNamedBufferSubData(mFluxSums.id(), 0, static_cast<GLsizeiptr>(sums.size() * sizeof(float)),
+                            sums.data());
+    std::vector<double> out(sums.begin(), sums.end());
+    for (double& f : out)
+        if (!std::isfinite(f) || f < 0.0) f = 0.0;
+    return out;
 }
 
 void FrameRenderer::renderGBuffer(int width, int height) {
     gl::Pass pass(mTimer, "gbuffer");
     pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
-    pass.use(mGBufferPass.program).set(mGBufferPass.view, 0);
+    pass.use(mGBufferPass.program).set(mGBufferPass.view, -1);
     mSceneGpu->draw(mGBufferPass.program, &mGBufferPass.materials);
     mResources.publish("gbuffer.position", "gbuffer", mGPosition);
     mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
@@ -202,7 +291,7 @@ void FrameRenderer::renderDirect() {
         .texture(d.normal, mResources.get("gbuffer.normal"))
         .texture(d.albedo, mResources.get("gbuffer.albedo"))
         .texture(d.emissive, mResources.get("gbuffer.emissive"))
-        .texture(d.shadow, mResources.get(FrameResources::light(0, "shadow")))
+        .texture(d.shadow, mResources.get("lights.shadow"))
         .texture(d.specular, mResources.get("gbuffer.specular"));
     pass.drawFullscreen(mEmptyVao);
     mResources.publish("direct", "direct", mDirect);
@@ -228,35 +317,42 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     GIS_ASSERT(state.width > 0 && state.height > 0);
     Stopwatch frameClock;
     const ParamSet& fp = state.frameParams;
-    const int rsmSize = fp.getInt("rsm_size");
-    ensureTargets(state.width, state.height, rsmSize, fp.getInt("shadow_map_size"));
+    const LightSetModel lightSet = makeLightSet(state, mScene->bounds);
+    const int views = static_cast<int>(lightSet.views.size());
+    ensureTargets(state.width, state.height, lightSet.rsmSide, lightSet.shadowSide, views);
     ensureTechnique(state.technique, state.width, state.height);
     const Reflections::Decision nonDiffuse =
         mReflections.decide(*mScene, *mSceneGpu, fp, mTechnique->glossyTransport(state.techniqueParams));
 
-    // Frame uniforms.
+    // Frame and light uniforms.
     shader::FrameUniforms u{};
-    const LightModel light = makeLightModel(state, mScene->bounds);
-    const float tanHalf = light.tanHalfFov;
+    auto lights = std::make_unique<shader::LightUniforms>();
+    writeLightUniforms(lightSet, *lights);
+    float widestTan = 0.0f;
+    for (const LightViewModel& v : lightSet.views)
+        if (!v.orthographic) widestTan = std::max(widestTan, v.tanHalfFov);
     u.viewProj = cameraViewProj(state.camera, state.width, state.height);
     u.cameraPos = glm::vec4(state.camera.position, 0.0f);
-    const bool lightOn = light.on;
-    writeLightUniforms(light, u);
+    const bool lightOn = lightSet.any();
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
-    u.rsmInfo = glm::vec4(rsmSize, tanHalf, mShadowSize, fp.getInt("pcf_radius"));
+    u.rsmInfo = glm::vec4(lightSet.rsmSide, widestTan > 0.0f ? widestTan : 1.0f, lightSet.shadowSide,
+                          fp.getInt("pcf_radius"));
     u.toneInfo =
         glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
                   lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
     u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f,
                               fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);
+    mLightUbo.upload(0, sizeof *lights, lights.get());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
 
     mTimer.beginFrame();
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
-    renderShadowMap(0);
-    renderRsm(0, rsmSize);
+    renderShadowMaps(views);
+    renderRsms(views);
+    const std::vector<double> viewFlux = measureViewFlux(views);
     renderGBuffer(state.width, state.height);
     renderDirect();
 
@@ -266,7 +362,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.width = state.width;
     in.height = state.height;
     in.resources = &mResources;
-    in.rsmSize = rsmSize;
+    in.rsmSize = lightSet.rsmSide;
+    in.lightViews = views;
+    in.viewFlux = viewFlux;
+    in.lights = lights.get();
     in.glossy = nonDiffuse.glossy;
     in.glossyMinRoughness = fp.getFloat("glossy_split");
     in.lightEnabled = lightOn;
@@ -277,6 +376,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     const gl::Texture* indirect = mTechnique->indirect();
     if (indirect)
         mResources.publish("indirect", "technique", *indirect);
@@ -294,6 +394,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     rin.envMaxRoughness = nonDiffuse.glossy ? fp.getFloat("glossy_split") : 1.01f;
     const gl::Texture* reflection = mReflections.execute(nonDiffuse, rin, fp, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     if (reflection)
         mResources.publish("reflection", "reflections", *reflection);
     else
@@ -329,7 +430,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
                  {"params", std::move(params)}};
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
-    out.stats["lighting"] = {{"source", state.lightSource}, {"note", state.lightNote}};
+    out.stats["lighting"] = lightingStats(state, lightSet);
     return out;
 }
 

@@ -1,5 +1,6 @@
-// The frame pipeline (DESIGN.md §3): shadow map and RSM from the spotlight, eye G-buffer, direct
-// light, the technique's indirect passes, composite with tone mapping, read-back.
+// The frame pipeline (DESIGN.md §3): a shadow map and an RSM per light view (frame/LightModel.h),
+// eye G-buffer, direct light from every light, the technique's indirect passes, composite with tone
+// mapping, read-back.
 //
 // Threading: one FrameRenderer per GL context, used on the thread where that context is current.
 // Errors: construction, setScene() and the first render() after a technique or size change may
@@ -26,9 +27,14 @@
 
 namespace gis {
 
-/// The light's part of the frame uniforms (gFrame in shaders/shared): its frustum, position and
-/// intensity, axis and outer cone, colour and inner cone, which spotFactor() and the light passes read.
-void writeLightUniforms(const LightModel& light, shader::FrameUniforms& u);
+/// The light block (gLights in shaders/shared/FrameData.h) of a light set: every light's position and
+/// intensity, axis and outer cone, colour and inner cone, type, range and views, and every view's
+/// projection, which lightIncidence(), the shadow lookups and the light passes read.
+void writeLightUniforms(const LightSetModel& set, shader::LightUniforms& u);
+
+/// The stats' `lighting` object: where the lights came from, which are rendered (id, name, type,
+/// views), which are skipped and why, the view sizes, and a warning when no light is rendered.
+nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set);
 
 struct FrameOutput {
     int width = 0;
@@ -57,11 +63,13 @@ public:
     const FrameResources& resources() const { return mResources; }
 
 private:
-    void ensureTargets(int width, int height, int rsmSize, int shadowSize);
+    void ensureTargets(int width, int height, int rsmSide, int shadowSide, int views);
     void ensureTechnique(const std::string& name, int width, int height);
     // The frame's stages, in order; each publishes what it writes in mResources.
-    void renderShadowMap(int light);
-    void renderRsm(int light, int rsmSize);
+    void renderShadowMaps(int views);
+    void renderRsms(int views);
+    /// Reflected flux luminance of every view's RSM (pass "rsm_flux", read back); empty for one view.
+    std::vector<double> measureViewFlux(int views);
     void renderGBuffer(int width, int height);
     void renderDirect();
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
@@ -87,14 +95,21 @@ private:
         gl::TextureUnit direct, indirect, reflection;
         gl::UniformLocation hasIndirect, hasReflection;
     } mCompositePass;
-    gl::Buffer mFrameUbo;
+    struct FluxPass {
+        gl::Program program;
+        gl::UniformLocation rsmSize;
+        gl::TextureUnit position, flux;
+        gl::BlockBinding sums;
+    } mFluxPass;
+    gl::Buffer mFrameUbo, mLightUbo, mFluxSums;
     gl::VertexArray mEmptyVao;
 
-    int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0;
+    int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0, mShadowLayers = 0, mRsmLayers = 0;
+    // One layer per light view; one framebuffer per layer.
     gl::Texture mShadowDepth;
-    gl::Framebuffer mShadowFbo;
+    std::vector<gl::Framebuffer> mShadowFbos;
     gl::Texture mRsmPosition, mRsmNormal, mRsmFlux, mRsmSpecular, mRsmDepth;
-    gl::Framebuffer mRsmFbo;
+    std::vector<gl::Framebuffer> mRsmFbos;
     gl::Texture mGPosition, mGNormal, mGAlbedo, mGEmissive, mGSpecular, mGDepth;
     gl::Framebuffer mGBufferFbo;
     gl::Texture mDirect;

@@ -188,7 +188,7 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
     const int depth = std::clamp(static_cast<int>(fp.getInt("mirror_depth")), 0, kMaxMirrorDepth);
     const gl::Texture* gPosition = in.find("gbuffer.position");
     const gl::Texture* gNormal = in.find("gbuffer.normal");
-    const gl::Texture* shadowMap = in.find(FrameResources::light(0, "shadow"));
+    const gl::Texture* shadowMap = in.find("lights.shadow");
     if (depth == 0 || !in.mirrors || in.mirrors->empty() || !in.frame || !in.sceneGpu || !gNormal ||
         !gPosition || in.width <= 0 || in.height <= 0)
         return;

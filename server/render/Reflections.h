@@ -45,9 +45,10 @@ inline constexpr int kMaxLocalProbes = 3;
 /// What the reflection passes read. Textures are the renderer's, read from the frame's resource
 /// table by name (gl/FrameResources.h): gbuffer.position (RGBA32F, w = 1 covered), gbuffer.normal
 /// (RGBA16F, w = reflector id: mirror index + 1, local probe -(k + 1), 0 none), gbuffer.specular
-/// (RGBA8 rgb F0, a roughness), light[0].shadow (the spotlight's shadow map, for
+/// (RGBA8 rgb F0, a roughness), lights.shadow (the light views' shadow maps, for
 /// shaders/render/lighting.glsl) and, when the technique made one, indirect (its eye-view indirect
-/// radiance, for the mirrors' reprojection). The frame block is bound at GIS_UBO_FRAME and `frame` is its CPU
+/// radiance, for the mirrors' reprojection). The frame and light blocks are bound at GIS_UBO_FRAME and
+/// GIS_UBO_LIGHTS; `frame` is the frame block's CPU
 /// copy.
 struct ReflectionInputs {
     int width = 0, height = 0;

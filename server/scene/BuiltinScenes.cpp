@@ -218,6 +218,92 @@ Scene makeGallery() {
     return scene;
 }
 
+/// The Cornell room with its boxes lit by one point light under the ceiling instead of the spot: the
+/// light reaches the ceiling and all walls directly (every cube face of its shadow map and RSM
+/// matters). 2 cd at 0.45 m below the ceiling gives the floor's centre about 0.8 lux, half the
+/// spot's, so the default exposure suits it.
+Scene makeCornellPoint() {
+    Scene scene = makeCornell(CornellContents::Boxes);
+    scene.lights.clear();
+    scene.lights.push_back(Light{.name = "ceiling_bulb",
+                                 .type = LightType::Point,
+                                 .position = {0.1f, 1.55f, 0.35f},
+                                 .color = glm::vec3(1.0f),
+                                 .intensity = 2.0f});
+    return scene;
+}
+
+/// A closed grey room (2 x 2 x 2 m) with a 0.6 x 0.6 m skylight, lit by a directional sun through
+/// it: the sun lights a patch of the floor and the lower back wall, and most of what the camera sees
+/// is lit only indirectly (the "room lit mostly indirectly"). A red and a blue box stand in it.
+/// 20 lux of sun: about 7 W enter, so the indirectly lit walls get some 0.5 lux.
+Scene makeSunRoom() {
+    Scene scene;
+    const int white = addMaterial(scene, "white", kWhite);
+    const int red = addMaterial(scene, "red", kRed);
+    const int blue = addMaterial(scene, "blue", {0.08f, 0.15f, 0.55f});
+    const glm::vec3 x(2, 0, 0), y(0, 2, 0), z(0, 0, 2);
+    scene.meshes.push_back(makeGrid("floor", white, {-1, 0, -1}, z, x));
+    scene.meshes.push_back(makeGrid("back_wall", white, {-1, 0, -1}, x, y));
+    scene.meshes.push_back(makeGrid("front_wall", white, {1, 0, 1}, -x, y));
+    scene.meshes.push_back(makeGrid("left_wall", white, {-1, 0, -1}, y, z));
+    scene.meshes.push_back(makeGrid("right_wall", white, {1, 0, -1}, z, y));
+    // The ceiling, facing down, around a skylight spanning x, z in [-0.3, 0.3] x [-0.3, 0.3]:
+    // four strips.
+    const float h = 0.3f;
+    auto ceiling = [&](const std::string& name, float x0, float x1, float z0, float z1) {
+        scene.meshes.push_back(makeGrid(name, white, {x0, 2, z0}, {x1 - x0, 0, 0}, {0, 0, z1 - z0}));
+    };
+    ceiling("ceiling_back", -1, 1, -1, -h);
+    ceiling("ceiling_front", -1, 1, h, 1);
+    ceiling("ceiling_left", -1, -h, -h, h);
+    ceiling("ceiling_right", h, 1, -h, h);
+    scene.meshes.push_back(
+        makeBox("red_box", red, {-0.45f, 0.3f, -0.35f}, {0.5f, 0.6f, 0.5f}, glm::radians(20.0f)));
+    scene.meshes.push_back(
+        makeBox("blue_box", blue, {0.5f, 0.2f, 0.2f}, {0.35f, 0.4f, 0.35f}, glm::radians(-15.0f)));
+    scene.lights.push_back(Light{.name = "sun",
+                                 .type = LightType::Directional,
+                                 .position = {0.5f, 3.0f, 0.6f},
+                                 .direction = glm::normalize(glm::vec3(-0.25f, -1.0f, -0.3f)),
+                                 .color = {1.0f, 0.95f, 0.85f},
+                                 .intensity = 20.0f});
+    // Inside the room, by the front wall, looking at the sunlit patch.
+    scene.cameras.push_back(Camera{.name = "default",
+                                   .position = {0.55f, 1.3f, 0.92f},
+                                   .target = {-0.2f, 0.5f, -0.5f},
+                                   .up = glm::vec3(0.0f, 1.0f, 0.0f),
+                                   .yfovRadians = glm::radians(70.0f),
+                                   .znear = 0.02f,
+                                   .zfar = 10.0f});
+    return scene;
+}
+
+/// The empty Cornell room lit by three coloured lights: a warm spot from a corner, a blue point light
+/// near the floor and a faint green directional light through the open front. Each light alone
+/// lights a different part, so superposition and the VPL budget's split are visible.
+Scene makeCornellColored() {
+    Scene scene = makeCornell(CornellContents::Boxes);
+    scene.lights.clear();
+    Light warm = makeSpot("warm_spot", {0.8f, 1.85f, 0.8f}, {-0.6f, -1.0f, -0.7f}, 25.0f, 40.0f);
+    warm.color = {1.0f, 0.6f, 0.3f};
+    warm.intensity = 4.0f;
+    scene.lights.push_back(warm);
+    scene.lights.push_back(Light{.name = "blue_bulb",
+                                 .type = LightType::Point,
+                                 .position = {-0.6f, 0.35f, 0.6f},
+                                 .color = {0.3f, 0.5f, 1.0f},
+                                 .intensity = 0.6f,
+                                 .range = 3.0f});
+    scene.lights.push_back(Light{.name = "green_fill",
+                                 .type = LightType::Directional,
+                                 .position = {0.0f, 1.0f, 3.0f},
+                                 .direction = glm::normalize(glm::vec3(0.2f, -0.3f, -1.0f)),
+                                 .color = {0.4f, 1.0f, 0.5f},
+                                 .intensity = 0.25f});
+    return scene;
+}
+
 Scene makeCrease() {
     Scene scene;
     const int grey = addMaterial(scene, "grey", kGrey);
@@ -231,7 +317,8 @@ Scene makeCrease() {
 } // namespace
 
 std::vector<std::string> builtinSceneNames() {
-    return {"cornell", "cornell-empty", "cornell-dense", "crease", "cornell-black", "gallery"};
+    return {"cornell", "cornell-empty", "cornell-dense", "crease",         "cornell-black",
+            "gallery", "cornell-point", "sun-room",      "cornell-colored"};
 }
 
 Scene makeBuiltinScene(const std::string& name) {
@@ -248,6 +335,12 @@ Scene makeBuiltinScene(const std::string& name) {
         scene = makeCrease();
     else if (name == "gallery")
         scene = makeGallery();
+    else if (name == "cornell-point")
+        scene = makeCornellPoint();
+    else if (name == "sun-room")
+        scene = makeSunRoom();
+    else if (name == "cornell-colored")
+        scene = makeCornellColored();
     else {
         std::string known;
         for (const auto& n : builtinSceneNames()) known += (known.empty() ? "" : ", ") + n;

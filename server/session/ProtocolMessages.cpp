@@ -30,9 +30,9 @@ const nlohmann::json* schemaFor(const std::string& type) {
 } // namespace
 
 const std::vector<std::string>& clientMessageTypes() {
-    static const std::vector<std::string> types = {"hello",    "camera", "light", "technique",
-                                                   "params",   "resize", "scene", "quality",
-                                                   "snapshot", "ack",    "ping"};
+    static const std::vector<std::string> types = {
+        "hello",  "camera", "light",   "light_add", "light_remove", "technique", "params",
+        "resize", "scene",  "quality", "snapshot",  "ack",          "ping"};
     return types;
 }
 

@@ -14,7 +14,10 @@
 
 namespace gis {
 
-constexpr int kProtocolVersion = 1;
+constexpr int kProtocolVersion = 2;
+/// The oldest protocol a client may speak: protocol 1 has one light (flat `light` messages, the
+/// state's `light`), which protocol 2 still accepts and reports (protocol/PROTOCOL.md).
+constexpr int kOldestProtocolVersion = 1;
 constexpr std::size_t kFrameHeaderSize = 16;
 
 /// A request the server rejects; becomes an `error` message, the session survives.

@@ -54,9 +54,16 @@ std::string effectPlanKey(const Scene& scene, const FrameState& s) {
         {"params", s.techniqueParams.toJson()},
         {"frame", s.frameParams.toJson()},
         {"camera", {q(s.camera.position, step), q(dir(s.camera.target - s.camera.position), 0.1f)}},
-        {"light",
-         {q(s.light.position, step), q(dir(s.light.direction), 0.1f), s.lightEnabled, s.light.intensity,
-          s.light.outerConeAngle}}}
+        {"lights",
+         [&] {
+             nlohmann::json lights = nlohmann::json::array();
+             for (const FrameLight& l : s.lights)
+                 lights.push_back({l.id, static_cast<int>(l.light.type), q(l.light.position, step),
+                                   q(dir(l.light.direction), 0.1f), l.enabled, l.light.intensity,
+                                   l.light.color.r, l.light.color.g, l.light.color.b, l.light.range,
+                                   l.light.outerConeAngle});
+             return lights;
+         }()}}
         .dump();
 }
 } // namespace
@@ -103,7 +110,9 @@ nlohmann::json Session::stateJsonLocked() const {
             {"params", paramsJson(mDesired)},
             {"size", {mDesired.width, mDesired.height}},
             {"camera", cameraJson(mDesired.camera)},
-            {"light", lightJson(mDesired)}};
+            {"light", lightJson(mDesired)},
+            {"lights", lightsJson(mDesired)},
+            {"lighting", {{"source", mDesired.lightSource}, {"note", mDesired.lightNote}}}};
 }
 
 nlohmann::json Session::stateJson() const {
@@ -248,11 +257,29 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
         return;
     }
     std::unique_lock lock(mMutex);
+    bool lightsChanged = false; // light_add and light_remove answer with the new state (its ids)
     try {
         if (type == "camera") {
             applyCameraJson(mDesired, msg, "");
         } else if (type == "light") {
-            applyLightJson(mDesired, msg, "");
+            try {
+                applyLightJson(mDesired, msg, "");
+            } catch (const InputError& e) {
+                if (e.reason().rfind("no light '", 0) == 0)
+                    throw ProtocolError{"unknown_light", e.reason() + "; add one with a light_add message",
+                                        e.where(), type};
+                throw;
+            }
+        } else if (type == "light_add") {
+            addLightJson(mDesired, msg.value("light", nlohmann::json::object()), "/light");
+            lightsChanged = true;
+        } else if (type == "light_remove") {
+            try {
+                removeLight(mDesired, msg["id"].get<std::string>(), "/id");
+            } catch (const InputError& e) {
+                throw ProtocolError{"unknown_light", e.reason(), e.where(), type};
+            }
+            lightsChanged = true;
         } else if (type == "technique") {
             FrameState next = mDesired;
             try {
@@ -311,8 +338,11 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
         throw ProtocolError{"invalid_message", e.reason(), e.where(), type};
     }
     markInput();
+    nlohmann::json stateMsg;
+    if (lightsChanged) stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
     lock.unlock();
     mCv.notify_all();
+    if (lightsChanged) broadcastText(stateMsg);
 }
 
 void Session::fail(const std::string& reason) {
@@ -433,8 +463,7 @@ void Session::workerMain() {
                     std::lock_guard lock(mMutex);
                     FrameState fresh = makeFrameState(*next, mDesired.technique);
                     mDesired.camera = fresh.camera;
-                    mDesired.light = fresh.light;
-                    mDesired.lightEnabled = fresh.lightEnabled;
+                    mDesired.lights = fresh.lights;
                     mDesired.lightSource = fresh.lightSource;
                     mDesired.lightNote = fresh.lightNote;
                     mScene = next;

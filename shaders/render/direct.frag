@@ -1,5 +1,5 @@
 #version 450 core
-// Direct light from the spotlight with a PCF-filtered shadow map, plus emission: the diffuse lobe
+// Direct light from every light, each with a PCF-filtered shadow map, plus emission: the diffuse lobe
 // rho_d / pi and, where the surface has one, the specular lobe of render/brdf.glsl.
 #include "common.glsl"
 #include "render/brdf.glsl"
@@ -27,6 +27,6 @@ void main() {
     vec3 toEye = gFrame.cameraPos.xyz - pos.xyz;
     float e2 = dot(toEye, toEye);
     vec3 v = e2 > 1e-20 ? toEye * inversesqrt(e2) : n;
-    vec3 radiance = emissive + spotReflected(pos.xyz, n, albedo, spec, v, gFrame.shadingInfo.z > 0.5);
+    vec3 radiance = emissive + lightsReflected(pos.xyz, n, albedo, spec, v, gFrame.shadingInfo.z > 0.5);
     outRadiance = vec4(max(sanitize(radiance), vec3(0.0)), 1.0);
 }

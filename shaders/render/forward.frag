@@ -1,5 +1,5 @@
 #version 450 core
-// Forward shading for views other than the eye camera: emission plus the shadowed spotlight (diffuse
+// Forward shading for views other than the eye camera: emission plus the shadowed lights (diffuse
 // and specular lobes of render/brdf.glsl) as seen from uEye. No indirect light: a reflection shows
 // the directly lit scene (docs/nondiffuse.md, limits). Output is linear radiance, sanitised.
 #include "common.glsl"
@@ -24,7 +24,7 @@ void main() {
     vec3 base = materialBaseColor(vTexcoord);
     vec4 spec = vec4(materialF0(base), clamp(uMetalRoughSpec.y, 0.0, 1.0));
     vec3 radiance = max(sanitize(uEmissive), vec3(0.0)) +
-                    spotReflected(vWorldPos, n, materialAlbedo(vTexcoord), spec, v, gFrame.shadingInfo.z > 0.5);
+                    lightsReflected(vWorldPos, n, materialAlbedo(vTexcoord), spec, v, gFrame.shadingInfo.z > 0.5);
     outRadiance = vec4(max(sanitize(radiance), vec3(0.0)), 1.0);
     outPosition = vec4(vWorldPos, 1.0);
     outMirror = vec4(float(uMirrorId), 0.0, 0.0, 1.0);

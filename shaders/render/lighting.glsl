@@ -1,49 +1,73 @@
-// Spotlight shading shared by the deferred direct pass (direct.frag) and forward renders of the scene
-// from other viewpoints (environment probe faces, mirrored views: forward.frag). Binds the shadow
-// map at unit 4.
+// Punctual-light shading shared by the deferred direct pass (direct.frag) and forward renders of the
+// scene from other viewpoints (environment probe faces, mirrored views: forward.frag): every light of
+// the frame (spot, point, directional), each with its shadow map. Binds the light-view shadow maps
+// (one layer per light view, shared/FrameData.h) at unit 4.
 #ifndef GIS_LIGHTING_GLSL
 #define GIS_LIGHTING_GLSL
 #include "render/brdf.glsl"
 
-layout(binding = 4) uniform sampler2DShadow gShadowMap;
+layout(binding = 4) uniform sampler2DArrayShadow gShadowMap;
 
-float shadowVisibility(vec3 worldPos, vec3 n, vec3 l) {
-    // Normal offset of about one shadow texel at this distance hides acne on lit surfaces.
-    float dist = length(gFrame.lightPos.xyz - worldPos);
-    float texelWorld = 2.0 * gFrame.rsmInfo.y * dist / gFrame.rsmInfo.z;
+// The view of light i that sees direction `fromLight`: its only view, or for a point light the cube
+// face of the direction's major axis (+X, -X, +Y, -Y, +Z, -Z).
+int shadowViewOf(int i, vec3 fromLight) {
+    int first = int(gLights.lights[i].info.z + 0.5);
+    if (lightType(i) != GIS_LIGHT_POINT) return first;
+    vec3 a = abs(fromLight);
+    if (a.x >= a.y && a.x >= a.z) return first + (fromLight.x >= 0.0 ? 0 : 1);
+    if (a.y >= a.z) return first + (fromLight.y >= 0.0 ? 2 : 3);
+    return first + (fromLight.z >= 0.0 ? 4 : 5);
+}
+
+// Fraction of light i reaching p (PCF over (2r + 1)^2 taps). `l` is the unit direction to the light.
+float shadowVisibility(int i, vec3 worldPos, vec3 n, vec3 l) {
+    int v = shadowViewOf(i, -l);
+    LightView view = gLights.views[v];
+    bool ortho = view.info.x > 0.5;
+    // Normal offset of about one shadow texel at this distance hides acne on lit surfaces: the texel's
+    // world size is 2 t d / N for a perspective view, 2 w / N for an orthographic one (w its half-width).
+    float texelWorld = ortho ? 2.0 * view.info.y / gFrame.rsmInfo.z
+                             : 2.0 * view.info.y * length(view.eye.xyz - worldPos) / gFrame.rsmInfo.z;
     float cosTheta = clamp(dot(n, l), 0.0, 1.0);
     vec3 p = worldPos + n * texelWorld * (1.0 + 1.5 * (1.0 - cosTheta));
-    vec4 clip = gFrame.lightViewProj * vec4(p, 1.0);
+    vec4 clip = view.viewProj * vec4(p, 1.0);
     if (clip.w <= 1e-6) return 0.0;
     vec3 ndc = clip.xyz / clip.w;
     vec3 uvz = ndc * 0.5 + 0.5;
+    // A cube face's neighbour starts at its edge: rounding there must not read as shadow.
+    if (lightType(i) == GIS_LIGHT_POINT) uvz.xy = clamp(uvz.xy, vec2(0.0), vec2(1.0));
     if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(1.0)))) return 0.0;
+    // Past the far plane of an orthographic view (nothing there casts a shadow): lit.
+    uvz.z = min(uvz.z, 1.0);
     int r = int(gFrame.rsmInfo.w);
     float texel = 1.0 / gFrame.rsmInfo.z;
     float sum = 0.0;
     float count = 0.0;
     for (int y = -r; y <= r; ++y)
         for (int x = -r; x <= r; ++x) {
-            sum += texture(gShadowMap, vec3(uvz.xy + vec2(x, y) * texel, uvz.z));
+            sum += texture(gShadowMap, vec4(uvz.xy + vec2(x, y) * texel, float(v), uvz.z));
             count += 1.0;
         }
     return sum / count;
 }
 
-// Reflected spotlight radiance towards `toViewer` (unit) at a surface point: diffuse rho_d / pi plus
-// the specular lobe when `withSpecular`, shadowed. Exactly 0 at the light's position (S.4 case 1).
-vec3 spotReflected(vec3 p, vec3 n, vec3 albedo, vec4 spec, vec3 toViewer, bool withSpecular) {
+// Reflected radiance of every light towards `toViewer` (unit) at a surface point: diffuse rho_d / pi
+// plus the specular lobe when `withSpecular`, shadowed. A light at p itself adds 0 (S.4 case 1).
+vec3 lightsReflected(vec3 p, vec3 n, vec3 albedo, vec4 spec, vec3 toViewer, bool withSpecular) {
     if (!(gFrame.toneInfo.z > 0.5)) return vec3(0.0);
-    vec3 toLight = gFrame.lightPos.xyz - p;
-    float d2 = dot(toLight, toLight);
-    if (!(d2 > 1e-12)) return vec3(0.0);
-    vec3 l = toLight * inversesqrt(d2);
-    float cosTheta = max(dot(n, l), 0.0);
-    float e = gFrame.lightPos.w * spotFactor(-l) * cosTheta / d2;
-    if (!(e > 0.0)) return vec3(0.0);
-    vec3 f = albedo * kInvPi;
-    if (withSpecular) f += brdfSpecular(spec.rgb, spec.a, int(gFrame.shadingInfo.x), n, l, toViewer);
-    return f * gFrame.lightColor.rgb * e * shadowVisibility(p, n, l);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < lightCount(); ++i) {
+        vec3 l, irradiance;
+        float dist;
+        if (!lightIncidence(i, p, l, dist, irradiance)) continue;
+        float cosTheta = max(dot(n, l), 0.0);
+        vec3 e = irradiance * cosTheta;
+        if (!(max(e.r, max(e.g, e.b)) > 0.0)) continue;
+        vec3 f = albedo * kInvPi;
+        if (withSpecular) f += brdfSpecular(spec.rgb, spec.a, int(gFrame.shadingInfo.x), n, l, toViewer);
+        sum += f * e * shadowVisibility(i, p, n, l);
+    }
+    return sum;
 }
 
 #endif

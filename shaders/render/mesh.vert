@@ -5,7 +5,7 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inTexcoord;
 
-// 0: eye camera, 1: spotlight (shadow map and RSM)
+// -1: eye camera; v >= 0: light view v (shadow map and RSM layer v)
 uniform int uView;
 
 out vec3 vWorldPos;
@@ -16,5 +16,5 @@ void main() {
     vWorldPos = inPosition;
     vNormal = inNormal;
     vTexcoord = inTexcoord;
-    gl_Position = (uView == 0 ? gFrame.viewProj : gFrame.lightViewProj) * vec4(inPosition, 1.0);
+    gl_Position = (uView < 0 ? gFrame.viewProj : gLights.views[uView].viewProj) * vec4(inPosition, 1.0);
 }

@@ -11,7 +11,8 @@
 
 #define GIS_UBO_LIGHT_TREE 4
 #define GIS_SSBO_LIGHT_NODES 2
-#define GIS_MAX_LIGHT_LEVELS 12 // rsm_size <= 1024 gives at most 11 levels
+#define GIS_MAX_LIGHT_LEVELS                                                                                 \
+    13 // a mosaic of light views at most 2.5 x 1024 texels wide gives at most 13 levels
 
 // One node: the clustered light patch over the RSM texels under it. The first three members have
 // the layout of Vpl (shared/FrameData.h), so a selected node becomes a VPL by copying them.
@@ -24,8 +25,9 @@ struct LightNode {
 };
 
 struct LightTreeUniforms {
-    ivec4 level[GIS_MAX_LIGHT_LEVELS]; // x: first node index; y: nodes per side; z: texels per node side (2^l)
-    ivec4 info;                        // x: level count; y: RSM size R; z: total node count; w: unused
+    ivec4
+        level[GIS_MAX_LIGHT_LEVELS]; // x: first node index; y: nodes per side; z: texels per node side (2^l)
+    ivec4 info;                      // x: level count; y: RSM size R; z: total node count; w: unused
 };
 
 #endif

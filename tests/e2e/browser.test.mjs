@@ -1,6 +1,6 @@
 // Browser tests of the web client: headless Chromium (Debian's, driven by playwright-core) against a
-// real gi-server. The page connects and draws frames; the technique, a parameter, the light, the
-// accuracy view, an upload, a snapshot and a view-only link work through the UI; the stats overlay
+// real gi-server. The page connects and draws frames; the technique, a parameter, the light, adding
+// and removing a light, the accuracy view, an upload, a snapshot and a view-only link work through the UI; the stats overlay
 // shows per-pass times; the phone layout has a drawer; the page reconnects after the server
 // restarts. Screenshots of the page are saved as test artifacts (the path is printed).
 // Run: GI_SERVER=build/dev/bin/gi-server node --test tests/e2e/browser.test.mjs
@@ -216,6 +216,46 @@ test('the accuracy view measures the view against the CPU reference', async (t) 
     assert.match(await page.locator('#layer-label').textContent(), /\|API render − reference\|/);
     await control('compare-view', 'select').selectOption({ label: 'live stream' });
     assert.ok(!(await page.locator('#compare-view').isVisible()), 'back to the stream');
+});
+
+test('a point light added in the Light panel is rendered, and removing it takes it out again', async () => {
+    const before = await until('a frame that lists its rendered lights', () => {
+        const l = window.giClient.lastStats?.lighting;
+        return Array.isArray(l?.rendered) && { rendered: l.rendered.length, lights: window.giClient.lights.length };
+    });
+    assert.equal(await page.locator('[data-block="lights"] li.light-row').count(), before.lights, 'a row per light');
+    await control('light-add-type', 'select').selectOption('point');
+    await control('light-add', 'button').click();
+    const added = await until('a frame that renders one more light', (n) => {
+        const l = window.giClient.lastStats?.lighting;
+        const light = window.giClient.light;
+        return l?.rendered?.length === n + 1 && light?.type === 'point' && l.rendered.some((r) => r.id === light.id)
+            && { id: light.id, views: l.rendered.find((r) => r.id === light.id).views };
+    }, before.rendered);
+    assert.equal(added.views, 6, 'a point light renders a cube of shadow views');
+    const row = page.locator(`[data-block="lights"] li[data-light-id="${added.id}"]`);
+    assert.ok(await row.isVisible(), 'the new light is listed');
+    assert.match(await row.getAttribute('class'), /selected/, 'and selected');
+    assert.equal(await page.locator('#gizmo').getAttribute('data-light-type'), 'point');
+    assert.ok(await page.locator('.gizmo-origin').isVisible(), 'a point light has the move handle');
+    assert.ok(!(await page.locator('.gizmo-tip').isVisible()), 'and no aim handle');
+    assert.equal(await page.locator('.gizmo-origin title').textContent(), 'point light: drag to move it');
+    // Switched off, it is skipped, and the panel says why.
+    await row.locator('.light-toggle').uncheck();
+    await until('a frame that skips the disabled light', (id) => window.giClient.lastStats?.lighting?.skipped
+        ?.some((s) => s.includes(`(${id}): disabled`)), added.id);
+    await until('the panel shows the skipped light', () => [...document.querySelectorAll('[data-block="lighting"] .skipped')]
+        .some((p) => /disabled/.test(p.textContent)));
+    assert.match(await row.locator('.light-reason').textContent(), /not rendered: disabled/);
+    await control('light-remove', 'button').click();
+    await until('a frame without the removed light', ([n, id, count]) => {
+        const l = window.giClient.lastStats?.lighting;
+        return l?.rendered?.length === n && !l.skipped.some((s) => s.includes(`(${id})`))
+            && window.giClient.lights.length === count;
+    }, [before.rendered, added.id, before.lights]);
+    assert.equal(await row.count(), 0, 'the row is gone');
+    assert.notEqual(await page.evaluate(() => window.giClient.selectedLightId), added.id);
+    assert.ok(await page.locator('.gizmo-tip').isVisible(), 'the spotlight is selected again, with its aim handle');
 });
 
 test('a .glb dropped on the view is uploaded with progress and shown', async () => {

@@ -95,7 +95,7 @@ function assertClose(actual, expected, what) {
 // Opening handshake and authentication
 
 check('hello with another protocol version is refused with protocol_mismatch, then closed', async () => {
-    for (const protocol of [0, 2]) {
+    for (const protocol of [0, 3]) {
         const client = await connect(servers.main);
         const error = await client.expectError({ type: 'hello', protocol }, 'protocol_mismatch', `hello protocol ${protocol}`);
         assert.ok(error.message.length > 0);
@@ -211,6 +211,23 @@ check('every client message type has its effect', async (t) => {
         await client.expectError({ type: 'scene', name: 'builtin:no-such-scene' }, 'unknown_scene');
         client.send({ type: 'scene', name: 'builtin:cornell' });
         await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'builtin:cornell', 'state after scene back', 15000);
+    });
+
+    await t.test('light_add and light_remove change the light list; light edits one light by id', async () => {
+        client.send({ type: 'light_add', light: { type: 'point', position: [0.3, 1.2, 0.4], intensity: 1.5, color: [0.4, 0.6, 1] } });
+        const added = await client.inbox.next((m) => m.type === 'state' && m.state?.lights?.length === 2, 'state after light_add', 15000);
+        const point = added.state.lights[1];
+        assert.equal(point.type, 'point');
+        assert.equal(added.state.light.id, added.state.lights[0].id, 'protocol 1 light is the first light');
+        last = await client.frame('a frame with two lights', (s) => s.lighting?.rendered?.length === 2);
+        assert.equal(last.stats.lighting.rendered[1].views, 6, 'a point light has six cube-face views');
+        await frameAfter({ type: 'light', id: point.id, light: { enabled: false } }, 'the point light off',
+            (s) => s.lighting?.rendered?.length === 1 && s.lighting.skipped.length === 1);
+        assert.match(last.stats.lighting.skipped[0], /disabled/);
+        await client.expectError({ type: 'light', id: 'light-none', light: { intensity: 1 } }, 'unknown_light');
+        await client.expectError({ type: 'light_remove', id: 'light-none' }, 'unknown_light');
+        client.send({ type: 'light_remove', id: point.id });
+        await client.inbox.next((m) => m.type === 'state' && m.state?.lights?.length === 1, 'state after light_remove', 15000);
     });
 
     await t.test('quality turns adaptive quality on and off', async () => {

@@ -57,7 +57,7 @@ test('gi-server streams frames over the gi-stream WebSocket', async (t) => {
         // adaptive false: every frame is exactly the requested state (no scaled interactive frames).
         client = await Client.open(server, { codecs: ['jpeg'], adaptive: false });
         welcome = client.welcome;
-        assert.equal(welcome.protocol, 1, 'welcome.protocol is 1');
+        assert.equal(welcome.protocol, 2, 'welcome.protocol is 2');
         assert.equal(welcome.role, 'controller', 'a new session makes this client its controller');
         assert.equal(welcome.resumed, false, 'a new session is not resumed');
         assert.equal(welcome.codec, 'jpeg', 'the codec asked for in hello');

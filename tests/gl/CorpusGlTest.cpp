@@ -1,6 +1,6 @@
 // Files made by another tool (Blender's glTF exporter, tests/data/corpus/generate.py) render lit and
-// finite through the whole pipeline: none of them has a light the renderer shows, so each gets the
-// default key light (frame/DefaultLighting.h) and says so in the stats.
+// finite through the whole pipeline: those without lights get the default rig (frame/DefaultLighting.h)
+// and say so in the stats; point_lamps.glb is lit by its own two point lamps and sun.
 #include <string>
 
 #include <gtest/gtest.h>
@@ -14,7 +14,9 @@ namespace {
 
 struct CorpusFile {
     const char* name;
+    const char* source;
     const char* noteContains;
+    int rendered; ///< lights rendered
 };
 
 // Mean linear radiance over the RGB channels of covered and uncovered pixels alike.
@@ -27,11 +29,11 @@ double meanRadiance(const FrameOutput& f) {
 
 } // namespace
 
-TEST(Corpus, BlenderExportsRenderLitWithTheDefaultKeyLight) {
-    const CorpusFile files[] = {{"suzanne", "no lights"},
-                                {"textured_box", "no lights"},
-                                {"millimetres", "no lights"},
-                                {"point_lamps", "2 point, 1 directional"}};
+TEST(Corpus, BlenderExportsRenderLit) {
+    const CorpusFile files[] = {{"suzanne", "default", "no lights", 2},
+                                {"textured_box", "default", "no lights", 2},
+                                {"millimetres", "default", "no lights", 2},
+                                {"point_lamps", "scene", "3 lights", 3}};
     for (const CorpusFile& file : files) {
         for (const char* technique : {"none", "rsm_gather"}) {
             SCOPED_TRACE(std::string(file.name) + " / " + technique);
@@ -39,11 +41,15 @@ TEST(Corpus, BlenderExportsRenderLitWithTheDefaultKeyLight) {
             const FrameOutput f = renderScene(path, technique, 64, 64);
             EXPECT_EQ(gis::test::badValues(f), 0u);
             ASSERT_TRUE(f.stats.contains("lighting"));
-            EXPECT_EQ(f.stats["lighting"]["source"], "default");
-            EXPECT_NE(f.stats["lighting"]["note"].get<std::string>().find(file.noteContains),
-                      std::string::npos)
-                << f.stats["lighting"].dump();
-            // Black before the default light: the direct light alone must now show the model.
+            const nlohmann::json& lighting = f.stats["lighting"];
+            EXPECT_EQ(lighting["source"], file.source);
+            EXPECT_NE(lighting["note"].get<std::string>().find(file.noteContains), std::string::npos)
+                << lighting.dump();
+            EXPECT_EQ(lighting["rendered"].size(), static_cast<size_t>(file.rendered)) << lighting.dump();
+            EXPECT_TRUE(lighting["skipped"].empty()) << "no unexplained light: " << lighting.dump();
+            EXPECT_FALSE(lighting.contains("warning")) << lighting.dump();
+            // Black before the default light (and before point and sun lamps rendered): the direct
+            // light alone must now show the model.
             EXPECT_GT(meanRadiance(f), 1e-3) << "the frame is black";
         }
     }

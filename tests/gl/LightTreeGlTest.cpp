@@ -58,9 +58,9 @@ struct RsmTotals {
 RsmTotals rsmTotals(const FrameInputs& in) {
     const size_t n = static_cast<size_t>(in.rsmSize) * static_cast<size_t>(in.rsmSize);
     std::vector<float> pos(n * 4), flux(n * 4);
-    glGetTextureImage(in.find(FrameResources::light(0, "rsm.position"))->id(), 0, GL_RGBA, GL_FLOAT,
+    glGetTextureImage(in.find("lights.rsm.position")->id(), 0, GL_RGBA, GL_FLOAT,
                       static_cast<GLsizei>(pos.size() * 4), pos.data());
-    glGetTextureImage(in.find(FrameResources::light(0, "rsm.flux"))->id(), 0, GL_RGBA, GL_FLOAT,
+    glGetTextureImage(in.find("lights.rsm.flux")->id(), 0, GL_RGBA, GL_FLOAT,
                       static_cast<GLsizei>(flux.size() * 4), flux.data());
     RsmTotals t;
     for (size_t i = 0; i < n; ++i) {
@@ -78,7 +78,7 @@ void expectFluxNear(glm::dvec3 actual, glm::dvec3 expected, double rel, const st
 
 float tanHalfFov(const Frame& f) {
     float t = 1.0f;
-    lightViewProj(f.state.light, f.scene->bounds, &t);
+    lightViewProj(f.state.lights.at(0).light, f.scene->bounds, &t);
     return t;
 }
 
@@ -339,7 +339,7 @@ TEST(LightTree, LightOffGivesNoIndirect) {
         FrameState state = makeFrameState(scene, technique);
         state.width = 32;
         state.height = 32;
-        state.lightEnabled = false;
+        state.lights.at(0).enabled = false;
         applyParams(state, {{"rsm_size", 16}}, "test");
         const FrameOutput on = renderer.render(state, true);
         FrameState none = state;

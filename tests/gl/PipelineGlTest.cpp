@@ -42,19 +42,15 @@ TEST(Context, CreatesOpenGL45Core) {
 
 TEST(Context, SharedStructLayoutMatchesGlsl) {
     test::sharedContext();
-    gl::Program p = gl::Program::build({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
-                                        {GL_FRAGMENT_SHADER, "render/direct.frag"}});
+    gl::Program p = gl::Program::build(
+        {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
     struct Member {
         const char* name;
         size_t offset;
     };
     const Member members[] = {
         {"gFrame.viewProj", offsetof(shader::FrameUniforms, viewProj)},
-        {"gFrame.lightViewProj", offsetof(shader::FrameUniforms, lightViewProj)},
         {"gFrame.cameraPos", offsetof(shader::FrameUniforms, cameraPos)},
-        {"gFrame.lightPos", offsetof(shader::FrameUniforms, lightPos)},
-        {"gFrame.lightDir", offsetof(shader::FrameUniforms, lightDir)},
-        {"gFrame.lightColor", offsetof(shader::FrameUniforms, lightColor)},
         {"gFrame.viewport", offsetof(shader::FrameUniforms, viewport)},
         {"gFrame.rsmInfo", offsetof(shader::FrameUniforms, rsmInfo)},
         {"gFrame.toneInfo", offsetof(shader::FrameUniforms, toneInfo)},
@@ -73,6 +69,31 @@ TEST(Context, SharedStructLayoutMatchesGlsl) {
     GLint size = 0;
     glGetActiveUniformBlockiv(p.id(), block, GL_UNIFORM_BLOCK_DATA_SIZE, &size);
     EXPECT_EQ(static_cast<size_t>(size), sizeof(shader::FrameUniforms));
+    // The light block: its members' offsets and its size as the C++ side lays them out.
+    const Member lightMembers[] = {
+        {"gLights.lights[0].position", offsetof(shader::LightUniforms, lights)},
+        {"gLights.lights[0].info",
+         offsetof(shader::LightUniforms, lights) + offsetof(shader::GpuLight, info)},
+        {"gLights.views[0].viewProj", offsetof(shader::LightUniforms, views)},
+        {"gLights.views[0].info", offsetof(shader::LightUniforms, views) + offsetof(shader::LightView, info)},
+        {"gLights.counts", offsetof(shader::LightUniforms, counts)},
+    };
+    int found = 0;
+    for (const auto& m : lightMembers) {
+        GLuint index = GL_INVALID_INDEX;
+        const char* names[] = {m.name};
+        glGetUniformIndices(p.id(), 1, names, &index);
+        if (index == GL_INVALID_INDEX) continue;
+        ++found;
+        GLint offset = -1;
+        glGetActiveUniformsiv(p.id(), 1, &index, GL_UNIFORM_OFFSET, &offset);
+        EXPECT_EQ(static_cast<size_t>(offset), m.offset) << m.name;
+    }
+    EXPECT_GT(found, 0) << "the direct pass reads the light block";
+    GLuint lights = glGetUniformBlockIndex(p.id(), "LightBlock");
+    ASSERT_NE(lights, GL_INVALID_INDEX);
+    glGetActiveUniformBlockiv(p.id(), lights, GL_UNIFORM_BLOCK_DATA_SIZE, &size);
+    EXPECT_EQ(static_cast<size_t>(size), sizeof(shader::LightUniforms));
 }
 
 TEST(Shaders, CompileErrorsNameFileAndLine) {
@@ -81,7 +102,8 @@ TEST(Shaders, CompileErrorsNameFileAndLine) {
     std::filesystem::create_directories(dir / "x");
     {
         std::FILE* f = std::fopen((dir / "x/main.frag").c_str(), "w");
-        std::fputs("#version 450 core\n#include \"x/inc.glsl\"\nout vec4 c;\nvoid main() { c = vec4(f()); }\n", f);
+        std::fputs(
+            "#version 450 core\n#include \"x/inc.glsl\"\nout vec4 c;\nvoid main() { c = vec4(f()); }\n", f);
         std::fclose(f);
         f = std::fopen((dir / "x/inc.glsl").c_str(), "w");
         std::fputs("float f() {\n  return 1.0;\n  this is not glsl;\n}\n", f);
@@ -107,8 +129,8 @@ TEST(Pipeline, DirectOnlyMatchesGolden) {
     }
     int w = 0, h = 0;
     std::vector<std::uint8_t> expected;
-    ASSERT_TRUE(test::readPng(golden, w, h, expected)) << "missing golden " << golden
-                                                       << " (regenerate with GIS_UPDATE_GOLDENS=1)";
+    ASSERT_TRUE(test::readPng(golden, w, h, expected))
+        << "missing golden " << golden << " (regenerate with GIS_UPDATE_GOLDENS=1)";
     ASSERT_EQ(w, f.width);
     ASSERT_EQ(h, f.height);
     // Tolerance: llvmpipe versions and EGL/OSMesa may differ in the last bit of rasterisation and
@@ -143,10 +165,12 @@ TEST(Pipeline, RsmGatherAddsRedBleedingNearTheRedWall) {
     const float redDirect = windowMean(direct, p, 0), redGi = windowMean(gi, p, 0);
     const float greenDirect = windowMean(direct, p, 1), greenGi = windowMean(gi, p, 1);
     EXPECT_GT(redGi, redDirect * 1.05f) << "indirect light should add red at pixel " << p.x << "," << p.y;
-    EXPECT_GT(redGi - redDirect, greenGi - greenDirect) << "the added light should be redder than it is green";
+    EXPECT_GT(redGi - redDirect, greenGi - greenDirect)
+        << "the added light should be redder than it is green";
     // And the mirror image next to the green wall gets greener.
     glm::ivec2 q = test::projectToPixel(scene, {0.85f, 0.0f, 0.55f}, s, s);
-    EXPECT_GT(windowMean(gi, q, 1) - windowMean(direct, q, 1), windowMean(gi, q, 0) - windowMean(direct, q, 0));
+    EXPECT_GT(windowMean(gi, q, 1) - windowMean(direct, q, 1),
+              windowMean(gi, q, 0) - windowMean(direct, q, 0));
 }
 
 TEST(Pipeline, NoNanInfOrNegativeRadiance) {

@@ -66,10 +66,11 @@ TEST(RenderRequestGl, PngHoldsTheDirectRendersPixels) {
     state.camera.position = {0.3f, 1.1f, 3.6f};
     state.camera.target = {0.0f, 0.9f, 0.0f};
     state.camera.yfovRadians = 45.0f * 0.017453292519943295f;
-    const float ratio = state.light.innerConeAngle / state.light.outerConeAngle;
-    state.light.intensity = 5.0f;
-    state.light.outerConeAngle = 50.0f * 0.017453292519943295f;
-    state.light.innerConeAngle = std::clamp(ratio, 0.0f, 0.99f) * state.light.outerConeAngle;
+    const float ratio = state.lights.at(0).light.innerConeAngle / state.lights.at(0).light.outerConeAngle;
+    state.lights.at(0).light.intensity = 5.0f;
+    state.lights.at(0).light.outerConeAngle = 50.0f * 0.017453292519943295f;
+    state.lights.at(0).light.innerConeAngle =
+        std::clamp(ratio, 0.0f, 0.99f) * state.lights.at(0).light.outerConeAngle;
     gis::FrameRenderer& renderer = gis::test::sharedRenderer();
     const gis::FrameOutput direct = renderer.render(state);
 

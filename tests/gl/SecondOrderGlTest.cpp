@@ -44,7 +44,6 @@ double count(const FrameOutput& f, const char* name) {
 
 // sqrt(mean((a - b)^2)) / sqrt(mean(b^2)) over RGB, pixels where either image is non-black.
 
-
 SecondOrder* technique() {
     return dynamic_cast<SecondOrder*>(test::sharedRenderer().technique());
 }
@@ -133,13 +132,13 @@ TEST(SecondOrder, PositiveLightsCarryTheRsmFluxWhateverTheirCount) {
     // Flux is normalised to the RSM total, so 64 and 256 lights carry the same total (digest S.4
     // case 7), and so does a narrow cone's handful.
     auto positiveFlux = [](int n, float coneDegrees) {
-        FrameOutput f = renderState("builtin:cornell", 64, 64, {{"positive_count", n}, {"negative_count", 0}},
-                                    [&](FrameState& s) {
-                                        if (coneDegrees > 0) {
-                                            s.light.outerConeAngle = glm::radians(coneDegrees);
-                                            s.light.innerConeAngle = glm::radians(coneDegrees * 0.5f);
-                                        }
-                                    });
+        FrameOutput f = renderState(
+            "builtin:cornell", 64, 64, {{"positive_count", n}, {"negative_count", 0}}, [&](FrameState& s) {
+                if (coneDegrees > 0) {
+                    s.lights.at(0).light.outerConeAngle = glm::radians(coneDegrees);
+                    s.lights.at(0).light.innerConeAngle = glm::radians(coneDegrees * 0.5f);
+                }
+            });
         int positives = 0;
         std::vector<shader::Vpl> vpls = technique()->readVpls(&positives);
         EXPECT_EQ(positives, static_cast<int>(count(f, "positive_count")));
@@ -171,8 +170,8 @@ TEST(SecondOrder, PositiveLightsCarryTheRsmFluxWhateverTheirCount) {
 TEST(SecondOrder, NarrowConeRendersFewerLightsGracefully) {
     const auto start = std::chrono::steady_clock::now();
     FrameOutput f = renderState("builtin:cornell", 64, 48, {}, [](FrameState& s) {
-        s.light.outerConeAngle = glm::radians(0.5f);
-        s.light.innerConeAngle = glm::radians(0.25f);
+        s.lights.at(0).light.outerConeAngle = glm::radians(0.5f);
+        s.lights.at(0).light.innerConeAngle = glm::radians(0.25f);
     });
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_EQ(count(f, "cone_capped"), 1.0);
@@ -239,10 +238,10 @@ TEST(SecondOrder, NegativeLightsLeaveTheEmptyBoxAlone) {
 
 TEST(SecondOrder, NoNanInfOrNegativeRadiance) {
     const std::function<void(FrameState&)> narrow = [](FrameState& s) {
-        s.light.outerConeAngle = glm::radians(0.5f);
-        s.light.innerConeAngle = glm::radians(0.25f);
+        s.lights.at(0).light.outerConeAngle = glm::radians(0.5f);
+        s.lights.at(0).light.innerConeAngle = glm::radians(0.25f);
     };
-    const std::function<void(FrameState&)> off = [](FrameState& s) { s.lightEnabled = false; };
+    const std::function<void(FrameState&)> off = [](FrameState& s) { s.lights.at(0).enabled = false; };
     struct Config {
         const char* name;
         nlohmann::json params;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 #include "StabilityLab.h"
 #include "StabilityScenes.h"
@@ -19,18 +20,33 @@ namespace sc = gis::stability::scenes;
 
 namespace {
 
+// A copy of a 2D texture or of a 2D array (the light views' RSM layers), of the same kind.
 gl::Texture copyOf(GLuint source) {
-    GLint format = 0, w = 0, h = 0;
+    GLint format = 0, w = 0, h = 0, layers = 0, target = 0;
     glGetTextureLevelParameteriv(source, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
     glGetTextureLevelParameteriv(source, 0, GL_TEXTURE_WIDTH, &w);
     glGetTextureLevelParameteriv(source, 0, GL_TEXTURE_HEIGHT, &h);
+    glGetTextureLevelParameteriv(source, 0, GL_TEXTURE_DEPTH, &layers);
+    glGetTextureParameteriv(source, GL_TEXTURE_TARGET, &target);
+    if (target == GL_TEXTURE_2D_ARRAY) {
+        gl::Texture t = gl::Texture::create2DArray(static_cast<GLenum>(format), w, h, layers);
+        glCopyImageSubData(source, GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, t.id(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
+                           w, h, layers);
+        return t;
+    }
     gl::Texture t = gl::Texture::create2D(static_cast<GLenum>(format), w, h);
     glCopyImageSubData(source, GL_TEXTURE_2D, 0, 0, 0, 0, t.id(), GL_TEXTURE_2D, 0, 0, 0, 0, w, h, 1);
     return t;
 }
 
+// One texel of a 2D texture, or of layer 0 of an array.
 void poke(const gl::Texture& t, int x, int y, const float rgba[4]) {
-    glTextureSubImage2D(t.id(), 0, x, y, 1, 1, GL_RGBA, GL_FLOAT, rgba);
+    GLint target = 0;
+    glGetTextureParameteriv(t.id(), GL_TEXTURE_TARGET, &target);
+    if (target == GL_TEXTURE_2D_ARRAY)
+        glTextureSubImage3D(t.id(), 0, x, y, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, rgba);
+    else
+        glTextureSubImage2D(t.id(), 0, x, y, 1, 1, GL_RGBA, GL_FLOAT, rgba);
 }
 
 struct Injection {
@@ -78,9 +94,9 @@ Result runInjected(const std::string& technique, const RenderSpec& spec, const F
     resources.publish("gbuffer.position", "test", gPos);
     resources.publish("gbuffer.normal", "test", gNrm);
     resources.publish("gbuffer.albedo", "test", gAlb);
-    resources.publish(FrameResources::light(0, "rsm.position"), "test", rPos);
-    resources.publish(FrameResources::light(0, "rsm.normal"), "test", rNrm);
-    resources.publish(FrameResources::light(0, "rsm.flux"), "test", rFlux);
+    resources.publish("lights.rsm.position", "test", rPos);
+    resources.publish("lights.rsm.normal", "test", rNrm);
+    resources.publish("lights.rsm.flux", "test", rFlux);
     resources.publish("direct", "test", direct);
     FrameInputs in;
     in.width = w;
@@ -88,6 +104,13 @@ Result runInjected(const std::string& technique, const RenderSpec& spec, const F
     in.resources = &resources;
     in.rsmSize = rsm;
     in.lightEnabled = true;
+    in.lightViews = 1;
+    // The light block too: the scene's one spot light has one view.
+    GLint lightUbo = 0;
+    glGetIntegeri_v(GL_UNIFORM_BUFFER_BINDING, GIS_UBO_LIGHTS, &lightUbo);
+    auto lightBlock = std::make_unique<shader::LightUniforms>();
+    glGetNamedBufferSubData(static_cast<GLuint>(lightUbo), 0, sizeof *lightBlock, lightBlock.get());
+    in.lights = lightBlock.get();
     in.frame = &u;
     in.drawGeometry = [](const gl::Program&, int) {};
     in.sceneExtent = glm::length(spec.scene->bounds.max - spec.scene->bounds.min);

@@ -175,9 +175,9 @@ FrameTextures frameTextures(const FrameRenderer& renderer) {
     t.gPosition = id("gbuffer.position");
     t.gNormal = id("gbuffer.normal");
     t.gAlbedo = id("gbuffer.albedo");
-    t.rsmPosition = id(FrameResources::light(0, "rsm.position"));
-    t.rsmNormal = id(FrameResources::light(0, "rsm.normal"));
-    t.rsmFlux = id(FrameResources::light(0, "rsm.flux"));
+    t.rsmPosition = id("lights.rsm.position");
+    t.rsmNormal = id("lights.rsm.normal");
+    t.rsmFlux = id("lights.rsm.flux");
     t.direct = id("direct");
     return t;
 }
@@ -306,7 +306,7 @@ Frame renderRaw(const RenderSpec& spec) {
     state.width = spec.width;
     state.height = spec.height;
     if (spec.camera) state.camera = *spec.camera;
-    if (spec.light) state.light = *spec.light;
+    if (spec.light) state.lights = {{"light0", *spec.light, true}};
     nlohmann::json params = fastFrameParams();
     for (const auto& [k, v] : spec.params.items()) {
         if (state.frameParams.has(k) || state.techniqueParams.has(k))

@@ -30,6 +30,8 @@ LightTree::LightTree() {
     gl::Program p = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/light_tree_build.comp"}});
     mBuild = {{},
               p.location("uLevel"),
+              p.location("uTiles"),
+              p.location("uViewSide"),
               p.textureUnit("uRsmPosition"),
               p.textureUnit("uRsmNormal"),
               p.textureUnit("uRsmFlux")};
@@ -57,22 +59,30 @@ void LightTree::bind() const {
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHT_TREE, mUbo.id());
 }
 
+int lightTreeTiles(int views) {
+    int tiles = 1;
+    while (tiles * tiles < views) ++tiles;
+    return tiles;
+}
+
 void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
     mLastInputs = in;
     mValid = false;
-    if (in.rsmSize <= 0 || !in.find(FrameResources::light(0, "rsm.position"))) return;
-    ensureLayout(in.rsmSize);
+    if (in.rsmSize <= 0 || !in.find("lights.rsm.position")) return;
+    const int tiles = lightTreeTiles(std::max(in.lightViews, 1));
+    ensureLayout(tiles * in.rsmSize);
+    mTiles = tiles;
     counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
     counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);
-    if (!in.lightEnabled) return;
+    if (!in.lightEnabled || in.lightViews <= 0) return;
 
     {
         gl::Pass pass(timer, "light_tree");
-        pass.use(mBuild.program);
+        pass.use(mBuild.program).set(mBuild.tiles, tiles).set(mBuild.viewSide, in.rsmSize);
         bind();
-        pass.texture(mBuild.position, in.light(0, "rsm.position"))
-            .texture(mBuild.normal, in.light(0, "rsm.normal"))
-            .texture(mBuild.flux, in.light(0, "rsm.flux"));
+        pass.texture(mBuild.position, in.get("lights.rsm.position"))
+            .texture(mBuild.normal, in.get("lights.rsm.normal"))
+            .texture(mBuild.flux, in.get("lights.rsm.flux"));
         // Level 1's dispatch writes level 0 too (light_tree_build.comp); then one dispatch per level.
         for (size_t l = 1; l < mLevels.size(); ++l) {
             if (l > 1) pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT); // level l - 1 is complete

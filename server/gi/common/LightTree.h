@@ -8,6 +8,10 @@
 // a uniform block with the level offsets: a traversal reads any node with one index computation, and
 // a level is contiguous for the per-level build and selection passes.
 //
+// Several light views: level 0 is a mosaic of the views' RSM layers, lightTreeTiles(views) per row
+// (empty tiles past the last view), so one tree spans every light's texels and isr's and hier_isr's
+// cuts choose among all lights' patches at once.
+//
 // Build: one compute dispatch per level from level 1 up (level 1's also writes level 0 from the RSM
 // textures), each node reducing its 2x2 children; about 4/3 R^2 nodes of 80 bytes (7 MB at
 // R = 1024). Compute writes the SSBO directly; the fragment + glTextureBarrier route that suits the
@@ -33,6 +37,8 @@ struct LightLevel {
 /// Levels of the tree over an R x R RSM: level 0 is R x R, level l is ceil(R / 2^l) per side, the
 /// last one 1 x 1. Pure, so tests can check it without GL.
 std::vector<LightLevel> lightTreeLayout(int rsmSize);
+/// Tiles per row of level 0's mosaic of `views` light views: ceil(sqrt(views)).
+int lightTreeTiles(int views);
 /// The finest level whose side does not exceed `resolution` (patches per side): the level a
 /// "16^2 light patches" style parameter names. Clamps to the tree (R when resolution >= R).
 int lightLevelForResolution(const std::vector<LightLevel>& levels, int resolution);
@@ -45,7 +51,10 @@ public:
     void build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters);
     bool valid() const { return mValid; }
     const std::vector<LightLevel>& levels() const { return mLevels; }
+    /// Side of level 0 (texels): tiles() x the RSM side of one view.
     int rsmSize() const { return mRsmSize; }
+    /// Views per mosaic row of level 0 (view v at tile (v % tiles, v / tiles)).
+    int tiles() const { return mTiles; }
     const gl::Buffer& nodes() const { return mNodes; }
     /// Binds the nodes at GIS_SSBO_LIGHT_NODES and the level table at GIS_UBO_LIGHT_TREE.
     void bind() const;
@@ -60,12 +69,13 @@ private:
 
     struct BuildProgram {
         gl::Program program;
-        gl::UniformLocation level;
+        gl::UniformLocation level, tiles, viewSide;
         gl::TextureUnit position, normal, flux;
     } mBuild;
     gl::Buffer mNodes, mUbo;
     std::vector<LightLevel> mLevels;
-    int mRsmSize = 0;
+    int mRsmSize = 0; ///< side of level 0: the mosaic of every view's RSM
+    int mTiles = 1;
     bool mValid = false;
     FrameInputs mLastInputs;
 };

@@ -1,6 +1,7 @@
 #include "gi/common/VplGrid.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "gi/common/BiasCompensation.h"
 #include "gl/ShaderShared.h"
@@ -36,6 +37,8 @@ VplGrid::VplGrid() {
     mExtract = {{},
                 p.location("uGrid"),
                 p.location("uRsmSize"),
+                p.location("uView"),
+                p.location("uOffset"),
                 p.textureUnit("gRsmPosition"),
                 p.textureUnit("gRsmNormal"),
                 p.textureUnit("gRsmFlux"),
@@ -45,9 +48,37 @@ VplGrid::VplGrid() {
     mExtract.program = std::move(p);
 }
 
+std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int views, int rsmSide) {
+    std::vector<int> sides(static_cast<size_t>(std::max(views, 0)), 0);
+    if (views <= 0 || grid <= 0) return sides;
+    const int maxSide = std::max(rsmSide, 1);
+    if (views == 1) {
+        sides[0] = std::clamp(grid, 1, maxSide);
+        return sides;
+    }
+    double total = 0.0;
+    for (int v = 0; v < views; ++v) {
+        const double f = v < static_cast<int>(viewFlux.size()) ? viewFlux[static_cast<size_t>(v)] : 0.0;
+        if (std::isfinite(f) && f > 0.0) total += f;
+    }
+    const double budget = double(grid) * double(grid);
+    for (int v = 0; v < views; ++v) {
+        const double f = v < static_cast<int>(viewFlux.size()) ? viewFlux[static_cast<size_t>(v)] : 0.0;
+        // No flux anywhere (every light sees only empty space): an even split, so the set is not empty
+        // on account of the measurement alone.
+        const double share = total > 0.0 ? (std::isfinite(f) && f > 0.0 ? f / total : 0.0) : 1.0 / views;
+        if (!(share > 0.0)) continue;
+        const int side = static_cast<int>(std::lround(std::sqrt(budget * share)));
+        sides[static_cast<size_t>(v)] = std::clamp(side, 1, maxSide);
+    }
+    return sides;
+}
+
 int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Counters& counters) {
-    grid = std::clamp(grid, 1, std::max(in.rsmSize, 1));
-    mCount = in.lightEnabled ? grid * grid : 0;
+    const int views = in.lightEnabled ? in.lightViews : 0;
+    const std::vector<int> sides = splitVplGrid(grid, in.viewFlux, views, in.rsmSize);
+    mCount = 0;
+    for (int side : sides) mCount += side * side;
     counters["vpl_count"] = mCount;
     const GLsizeiptr bytes = static_cast<GLsizeiptr>(std::max(mCount, 1)) * sizeof(shader::Vpl);
     if (mVpls.size() < bytes) mVpls = gl::Buffer::create(bytes);
@@ -57,13 +88,21 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
 
     const ExtractProgram& e = mExtract;
     gl::Pass pass(timer, "vpl_extract");
-    pass.use(e.program).set(e.grid, grid).set(e.rsmSize, in.rsmSize);
-    pass.texture(e.position, in.light(0, "rsm.position"))
-        .texture(e.normal, in.light(0, "rsm.normal"))
-        .texture(e.flux, in.light(0, "rsm.flux"))
-        .texture(e.specular, in.find(FrameResources::light(0, "rsm.specular")));
+    pass.use(e.program).set(e.rsmSize, in.rsmSize);
+    pass.texture(e.position, in.get("lights.rsm.position"))
+        .texture(e.normal, in.get("lights.rsm.normal"))
+        .texture(e.flux, in.get("lights.rsm.flux"))
+        .texture(e.specular, in.find("lights.rsm.specular"));
     pass.buffer(e.vpls, mVpls).buffer(e.glossy, mGlossy);
-    pass.dispatch((mCount + 63) / 64).barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    int offset = 0;
+    for (int v = 0; v < views; ++v) {
+        const int side = sides[static_cast<size_t>(v)];
+        if (side <= 0) continue;
+        pass.set(e.grid, side).set(e.view, v).set(e.offset, offset);
+        pass.dispatch((side * side + 63) / 64);
+        offset += side * side;
+    }
+    pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     return mCount;
 }
 

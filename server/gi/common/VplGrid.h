@@ -52,6 +52,13 @@ struct VplTransportHandles {
              const gl::Buffer* glossyData) const;
 };
 
+/// The VPL grid side of each of `views` light views: one VPL set of about `grid`^2 VPLs split in
+/// proportion to each view's reflected flux `viewFlux` (measured from its RSM), so a dim light does not
+/// take VPLs from a bright one: side_v = round(sqrt(grid^2 x share_v)), at least 1 for a view with
+/// flux, 0 for one without, at most `rsmSide`. One view gets min(grid, rsmSide); views that all
+/// measure no flux share evenly. Pure (unit-tested).
+std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int views, int rsmSide);
+
 /// Binds the first `count` VPLs of `vpls` batch by batch (GIS_MAX_VPLS_PER_BATCH each) at
 /// GIS_UBO_VPLS and calls `draw(batchCount)` for each batch. Returns the number of batches.
 int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(int batchCount)>& draw);
@@ -59,8 +66,9 @@ int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(
 class VplGrid {
 public:
     VplGrid();
-    /// Extracts min(vpl_grid, rsm_size)^2 VPLs from the RSM (none when the light is off); records
-    /// the pass "vpl_extract" and the counter "vpl_count". Returns the VPL count.
+    /// Extracts about `grid`^2 VPLs from the light views' RSMs, split across views by
+    /// splitVplGrid() (none when no light is on), in view order in one buffer; records the pass
+    /// "vpl_extract" and the counter "vpl_count". Returns the VPL count.
     int extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Counters& counters);
     const gl::Buffer& buffer() const { return mVpls; }
     /// The VPLs' glossy data (shader::VplGlossy), indexed like buffer().
@@ -73,7 +81,7 @@ public:
 private:
     struct ExtractProgram {
         gl::Program program;
-        gl::UniformLocation grid, rsmSize;
+        gl::UniformLocation grid, rsmSize, view, offset;
         gl::TextureUnit position, normal, flux, specular;
         gl::BlockBinding vpls, glossy;
     } mExtract;

@@ -5,6 +5,7 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 
+#include "core/Error.h"
 #include "gi/common/VplGrid.h"
 #include "gi/second_order/Limits.h"
 #include "gl/ShaderShared.h"
@@ -39,9 +40,11 @@ SecondOrder::SecondOrder() {
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
     PlacePositiveProgram& pp = mPlacePositive;
     pp.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/second_order/place_positive.comp"}});
+    pp.first = pp.program.location("uFirst");
     pp.count = pp.program.location("uCount");
+    pp.light = pp.program.location("uLight");
     pp.rsmSize = pp.program.location("uRsmSize");
-    pp.sampleSolidAngle = pp.program.location("uSampleSolidAngle");
+    pp.sampleMeasure = pp.program.location("uSampleMeasure");
     pp.position = pp.program.textureUnit("gRsmPosition");
     pp.normal = pp.program.textureUnit("gRsmNormal");
     pp.flux = pp.program.textureUnit("gRsmFlux");
@@ -141,47 +144,152 @@ const halton::ConeSamples& SecondOrder::cone(ConeCache& cache, double cosHalfAng
     return cache.samples;
 }
 
-int SecondOrder::placePositive(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
-    const shader::FrameUniforms& f = *in.frame;
-    const int requested = std::clamp(mPositiveSlots, 0, kMaxPositive);
-    const double cosOuter = std::clamp(static_cast<double>(f.lightDir.w), -1.0, 1.0);
-    const halton::ConeSamples& samples = cone(mLightCone, cosOuter, requested);
-    counters["halton_draws"] = samples.draws;
-    counters["cone_capped"] = samples.capped ? 1 : 0;
-    const int count = static_cast<int>(samples.directions.size());
-    counters["positive_count"] = count;
-    if (count == 0) return 0;
-
-    // The cone's axis is the spot direction, so the accepted set turns with the light: lights move
-    // smoothly under rotation instead of popping in and out at the cone's edge.
-    const halton::Frame frame = halton::frameAround(glm::vec3(f.lightDir));
-    const glm::vec3 origin(f.lightPos);
-    std::vector<glm::vec4> uv(static_cast<size_t>(count), glm::vec4(0.0f));
-    for (int i = 0; i < count; ++i) {
-        const glm::vec3 d = frame.toWorld(samples.directions[static_cast<size_t>(i)]);
-        const glm::vec4 clip = f.lightViewProj * glm::vec4(origin + d, 1.0f);
-        if (!(clip.w > 1e-6f)) continue; // behind the light: no image point
-        const glm::vec2 ndc = glm::vec2(clip) / clip.w;
-        if (!(std::abs(ndc.x) <= 1.0f && std::abs(ndc.y) <= 1.0f)) continue; // outside the RSM frustum
-        uv[static_cast<size_t>(i)] = glm::vec4(ndc * 0.5f + 0.5f, 1.0f, 0.0f);
+std::vector<int> splitPositiveSlots(int slots, const std::vector<double>& lightFlux) {
+    std::vector<int> counts(lightFlux.size(), 0);
+    if (slots <= 0 || lightFlux.empty()) return counts;
+    if (lightFlux.size() == 1) {
+        counts[0] = slots;
+        return counts;
     }
+    double total = 0.0;
+    for (double f : lightFlux)
+        if (std::isfinite(f) && f > 0.0) total += f;
+    // Largest remainders: the counts sum to `slots` exactly; a light with flux gets at least one
+    // slot while there are slots to give.
+    std::vector<double> remainder(lightFlux.size(), 0.0);
+    int given = 0;
+    for (size_t i = 0; i < lightFlux.size(); ++i) {
+        const double f = std::isfinite(lightFlux[i]) && lightFlux[i] > 0.0 ? lightFlux[i] : 0.0;
+        const double share = total > 0.0 ? f / total : 1.0 / double(lightFlux.size());
+        const double exact = share * slots;
+        counts[i] = static_cast<int>(std::floor(exact));
+        remainder[i] = exact - counts[i];
+        if (counts[i] == 0 && share > 0.0) remainder[i] += 1.0; // first in line for a leftover slot
+        given += counts[i];
+    }
+    while (given < slots) {
+        const size_t best =
+            static_cast<size_t>(std::max_element(remainder.begin(), remainder.end()) - remainder.begin());
+        ++counts[best];
+        remainder[best] = -1.0;
+        ++given;
+    }
+    return counts;
+}
+
+int SecondOrder::placePositive(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
+    GIS_ASSERT(in.lights != nullptr);
+    const shader::LightUniforms& lights = *in.lights;
+    const int lightCount = lights.counts.x;
+    const int requested = std::clamp(mPositiveSlots, 0, kMaxPositive);
+    // Each light's share of the slots follows its reflected flux (the sum over its views).
+    std::vector<double> lightFlux(static_cast<size_t>(lightCount), 1.0);
+    if (!in.viewFlux.empty()) {
+        for (int i = 0; i < lightCount; ++i) {
+            double sum = 0.0;
+            const int first = static_cast<int>(lights.lights[i].info.z),
+                      views = static_cast<int>(lights.lights[i].info.w);
+            for (int v = first; v < first + views && v < static_cast<int>(in.viewFlux.size()); ++v)
+                sum += in.viewFlux[static_cast<size_t>(v)];
+            lightFlux[static_cast<size_t>(i)] = sum;
+        }
+    }
+    const std::vector<int> perLight = splitPositiveSlots(requested, lightFlux);
+    if (mLightCones.size() < perLight.size()) mLightCones.resize(perLight.size());
+
+    std::vector<glm::vec4> uv;
+    struct Range {
+        int first, count, light;
+        float measure;
+    };
+    std::vector<Range> ranges;
+    double draws = 0;
+    bool capped = false;
+    constexpr double kPi = 3.14159265358979323846;
+    for (int i = 0; i < lightCount; ++i) {
+        const int n = perLight[static_cast<size_t>(i)];
+        if (n <= 0) continue;
+        const shader::GpuLight& light = lights.lights[i];
+        const int type = static_cast<int>(light.info.x + 0.5f);
+        const int firstView = static_cast<int>(light.info.z + 0.5f);
+        const int first = static_cast<int>(uv.size());
+        float measure = 0.0f;
+        if (type == GIS_LIGHT_DIRECTIONAL) {
+            // The lit square of the orthographic view: 2D Halton points (bases 2, 3), each standing for
+            // an equal share of its area.
+            const shader::LightView& view = lights.views[firstView];
+            for (int k = 0; k < n; ++k) {
+                const auto index = static_cast<std::uint32_t>(k + 1);
+                uv.emplace_back(halton::radicalInverse(index, 2), halton::radicalInverse(index, 3), 1.0f,
+                                static_cast<float>(firstView));
+            }
+            const double side = 2.0 * view.info.y;
+            measure = static_cast<float>(side * side / n);
+        } else {
+            // The spot's cone around its axis, or the whole sphere of a point light (its cube face
+            // by the direction's major axis). The cone's axis is the spot direction, so the accepted
+            // set turns with the light: lights move smoothly under rotation instead of popping in and
+            // out at the cone's edge.
+            const bool point = type == GIS_LIGHT_POINT;
+            const double cosOuter =
+                point ? -1.0 : std::clamp(static_cast<double>(light.direction.w), -1.0, 1.0);
+            const halton::ConeSamples& samples = cone(mLightCones[static_cast<size_t>(i)], cosOuter, n);
+            draws += samples.draws;
+            capped = capped || samples.capped;
+            const halton::Frame frame = halton::frameAround(glm::vec3(light.direction));
+            const glm::vec3 origin(light.position);
+            const int count = static_cast<int>(samples.directions.size());
+            for (int k = 0; k < count; ++k) {
+                const glm::vec3 d = frame.toWorld(samples.directions[static_cast<size_t>(k)]);
+                int view = firstView;
+                if (point) {
+                    const glm::vec3 a = glm::abs(d);
+                    const int face = (a.x >= a.y && a.x >= a.z) ? (d.x >= 0.0f ? 0 : 1)
+                                     : (a.y >= a.z)             ? (d.y >= 0.0f ? 2 : 3)
+                                                                : (d.z >= 0.0f ? 4 : 5);
+                    view += face;
+                }
+                glm::vec4 sample(0.0f, 0.0f, 0.0f, static_cast<float>(view));
+                const glm::vec4 clip = lights.views[view].viewProj * glm::vec4(origin + d, 1.0f);
+                if (clip.w > 1e-6f) { // behind the light: no image point
+                    glm::vec2 ndc = glm::vec2(clip) / clip.w;
+                    if (point) ndc = glm::clamp(ndc, glm::vec2(-1.0f), glm::vec2(1.0f)); // face seams
+                    if (std::abs(ndc.x) <= 1.0f && std::abs(ndc.y) <= 1.0f) // inside the RSM frustum
+                        sample = glm::vec4(ndc * 0.5f + 0.5f, 1.0f, static_cast<float>(view));
+                }
+                uv.push_back(sample);
+            }
+            if (count > 0) measure = static_cast<float>(2.0 * kPi * (1.0 - cosOuter) / count);
+        }
+        const int count = static_cast<int>(uv.size()) - first;
+        if (count > 0) ranges.push_back({first, count, i, measure});
+    }
+    counters["halton_draws"] = draws;
+    counters["cone_capped"] = capped ? 1 : 0;
+    const int total = static_cast<int>(uv.size());
+    counters["positive_count"] = total;
+    if (total == 0) return 0;
     mSamples.upload(0, static_cast<GLsizeiptr>(uv.size() * sizeof(glm::vec4)), uv.data());
 
     {
         gl::Pass pass(timer, "vpl_place");
         const PlacePositiveProgram& p = mPlacePositive;
-        const double coneSolidAngle = 2.0 * 3.14159265358979323846 * (1.0 - cosOuter);
-        pass.use(p.program)
-            .set(p.count, count)
-            .set(p.rsmSize, in.rsmSize)
-            .set(p.sampleSolidAngle, static_cast<float>(coneSolidAngle / count));
-        pass.texture(p.position, in.light(0, "rsm.position"))
-            .texture(p.normal, in.light(0, "rsm.normal"))
-            .texture(p.flux, in.light(0, "rsm.flux"));
+        pass.use(p.program).set(p.rsmSize, in.rsmSize);
+        pass.texture(p.position, in.get("lights.rsm.position"))
+            .texture(p.normal, in.get("lights.rsm.normal"))
+            .texture(p.flux, in.get("lights.rsm.flux"));
         pass.buffer(p.vpls, mVpls).buffer(p.samples, mSamples).buffer(p.stats, mStats);
-        pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+        for (const Range& r : ranges) {
+            pass.set(p.first, r.first)
+                .set(p.count, r.count)
+                .set(p.light, r.light)
+                .set(p.sampleMeasure, r.measure);
+            // Each dispatch adds to the counts the previous one wrote.
+            pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
     }
-    return count;
+    return total;
 }
 
 int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, int positiveCount,
@@ -288,8 +396,8 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
     mPositiveSlots = in.lightEnabled ? params.getInt("positive_count") : 0;
     mNegativeSlots = std::clamp(params.getInt("negative_count"), 0, kMaxNegative);
     if (!in.frame || !in.find("gbuffer.position") || !in.find("gbuffer.normal") ||
-        !in.find("gbuffer.albedo") || !in.find(FrameResources::light(0, "rsm.position")) || in.rsmSize <= 0 ||
-        in.width <= 0 || in.height <= 0)
+        !in.find("gbuffer.albedo") || !in.find("lights.rsm.position") || in.rsmSize <= 0 ||
+        in.lightViews <= 0 || !in.lights || in.width <= 0 || in.height <= 0)
         mPositiveSlots = 0;
     if (mPositiveSlots <= 0) {
         mPositiveSlots = mNegativeSlots = 0;

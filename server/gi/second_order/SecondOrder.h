@@ -6,10 +6,13 @@
 // (VPL set B, receivers R1, kernel K1 + K4, reconstruction U2, correction C1).
 //
 // Pipeline:
-//   1. CPU: the first positive_count Halton (2, 3) sphere points inside the spot cone (Halton.h; in
-//      the light's frame, cached per cone and count), projected into the RSM image
-//   2. vpl_place: one compute workgroup looks the points up in the RSM (invalid texels give empty
-//      lights) and scales their flux so the set carries the RSM's total reflected flux
+//   1. CPU: positive_count split across the lights by their RSMs' reflected flux
+//      (splitPositiveSlots); per light, the first Halton (2, 3) points of its type (Halton.h): sphere
+//      points inside a spot's cone (in the light's frame, cached per cone and count), the whole
+//      sphere of a point light (each on the cube face of its major axis), 2D points over the lit
+//      square of a directional light's orthographic view; projected into the RSM layer
+//   2. vpl_place: one compute workgroup per light looks its points up in the RSM (invalid texels
+//      give empty lights) and scales their flux so the set carries that light's reflected flux
 //   3. negative_place: Halton points in the camera's frustum pick candidate pixels; at each, the
 //      back-side irradiance from the positive lights (K4) and its luminance-weighted mean direction
 //      form S_neg; the first negative_count back-lit candidates become lights of negative flux
@@ -59,6 +62,10 @@ namespace shader {
 struct Vpl;
 }
 
+/// `slots` positive lights split across lights in proportion to `lightFlux` (largest remainders:
+/// the counts sum to `slots`; each light with flux gets one while slots last). Pure.
+std::vector<int> splitPositiveSlots(int slots, const std::vector<double>& lightFlux);
+
 class SecondOrder final : public Technique {
 public:
     SecondOrder();
@@ -85,10 +92,11 @@ private:
     void gather(gl::Pass& pass, const gl::Texture& position, const gl::Texture& normal,
                 const ParamSet& params, int slots, Counters& counters);
 
-    ConeCache mLightCone, mCameraCone;
+    std::vector<ConeCache> mLightCones; ///< one per light
+    ConeCache mCameraCone;
     struct PlacePositiveProgram {
         gl::Program program;
-        gl::UniformLocation count, rsmSize, sampleSolidAngle;
+        gl::UniformLocation first, count, light, rsmSize, sampleMeasure;
         gl::TextureUnit position, normal, flux;
         gl::BlockBinding vpls, samples, stats;
     } mPlacePositive;

@@ -7,6 +7,9 @@
 //                             (texel-count weighted) mean where the node reflects no light
 //   light distance, normal:   min and max (Eq. 8's max depth; isr's discontinuity test)
 // Empty texels (position.w < 0.5) contribute nothing and never define a position.
+// Several light views: level 0 is a mosaic of the views' RSM layers, uTiles per row, each uViewSide
+// texels square (view v at tile (v % uTiles, v / uTiles)); tiles past the last view are empty. One
+// tree thus spans every light's texels, and its upper levels cluster texels across views.
 // The level-1 dispatch also writes level 0 (its children, from the RSM): one pass fewer over the
 // largest level (llvmpipe, R = 256: 3.3 ms against 4.7 ms for separate passes; 16 x 16 tiles
 // reducing four levels in shared memory took 17 ms, their barriers being costly there).
@@ -16,11 +19,13 @@
 
 layout(local_size_x = 64) in;
 
-layout(binding = 0) uniform sampler2D uRsmPosition;
-layout(binding = 1) uniform sampler2D uRsmNormal;
-layout(binding = 2) uniform sampler2D uRsmFlux;
+layout(binding = 0) uniform sampler2DArray uRsmPosition;
+layout(binding = 1) uniform sampler2DArray uRsmNormal;
+layout(binding = 2) uniform sampler2DArray uRsmFlux;
 
-uniform int uLevel; // >= 1; level 1 also writes level 0, straight from the RSM
+uniform int uLevel;    // >= 1; level 1 also writes level 0, straight from the RSM
+uniform int uTiles;    // views per mosaic row
+uniform int uViewSide; // RSM texels per view side
 
 LightNode emptyNode() {
     LightNode n;
@@ -34,21 +39,23 @@ LightNode emptyNode() {
 
 bool finite3(vec3 v) { return !(isBad(v.x) || isBad(v.y) || isBad(v.z)); }
 
-LightNode fromTexel(ivec2 t) {
+LightNode fromTexel(ivec2 q) {
+    ivec2 tile = q / max(uViewSide, 1);
+    int view = tile.y * uTiles + tile.x;
+    if (view >= lightViewCount()) return emptyNode();
+    ivec3 t = ivec3(q - tile * uViewSide, view);
     vec4 p = texelFetch(uRsmPosition, t, 0);
     if (!(p.w >= 0.5) || !finite3(p.xyz)) return emptyNode();
-    vec3 v = p.xyz - gFrame.lightPos.xyz;
-    float d2 = dot(v, v);
-    float d = sqrt(max(d2, 0.0));
+    float d = lightViewDistance(view, p.xyz);
     // The RSM writes unit normals (fp16-quantised); level 0 keeps them as stored so a full
     // traversal reproduces the per-texel gather exactly. A broken one falls back to facing the light.
     vec3 n = texelFetch(uRsmNormal, t, 0).xyz;
-    if (!finite3(n) || !(dot(n, n) > 1e-12)) n = d > 0.0 ? -v / d : vec3(0.0, 1.0, 0.0);
+    if (!finite3(n) || !(dot(n, n) > 1e-12)) n = directionToLight(lightOfView(view), p.xyz);
     LightNode node;
     node.position = vec4(p.xyz, 1.0);
-    float area = rsmTexelSolidAngle(vec2(t) + 0.5) * d2;
-    node.normal = vec4(n, isBad(area) ? 0.0 : max(area, 0.0));
-    node.flux = vec4(max(sanitize(texelFetch(uRsmFlux, t, 0).rgb), vec3(0.0)), 1.0);
+    vec4 f = texelFetch(uRsmFlux, t, 0);
+    node.normal = vec4(n, isBad(f.a) ? 0.0 : max(f.a, 0.0));
+    node.flux = vec4(max(sanitize(f.rgb), vec3(0.0)), 1.0);
     node.lo = vec4(n, d);
     node.hi = vec4(n, d);
     return node;

@@ -34,14 +34,15 @@ void vplGlossyAccumulate(Vpl v, VplGlossy g, vec3 e, float visibility, float min
     vec3 wi = toVpl * inversesqrt(d2);
     vec3 total = e;
     if (g.incident.a > 0.5 && glossyLobe(g.specular)) {
-        vec3 toLight = gFrame.lightPos.xyz - v.position.xyz;
-        float l2 = dot(toLight, toLight);
-        if (l2 > 1e-20) {
+        int light = int(g.incident.a - 0.5); // incident.a is 1 + the light's index
+        vec3 l, irradiance;
+        float dist;
+        if (lightIncidence(light, v.position.xyz, l, dist, irradiance)) {
             Vpl incoming = v;
             incoming.flux.rgb = g.incident.rgb;
             vec3 eIn = vplIrradianceSelected(p, n, incoming, minDistance) * visibility;
             vec3 fs = brdfSpecular(g.specular.rgb, g.specular.a, int(gFrame.shadingInfo.x), v.normal.xyz,
-                                   toLight * inversesqrt(l2), -wi);
+                                   l, -wi);
             vec3 es = max(sanitize(kPi * fs * eIn), vec3(0.0));
             eExtra += es;
             total += es;

@@ -65,7 +65,7 @@ TEST(EffectPlan, CompensationFollowsTheClamp) {
 
 TEST(EffectPlan, LightPointingAwayTurnsEverythingOff) {
     const Planned away = plan("crease", nlohmann::json::object(), [](FrameState& s) {
-        s.light.direction = {0.0f, 1.0f, 0.0f};
+        s.lights.at(0).light.direction = {0.0f, 1.0f, 0.0f};
     });
     for (const char* e : {"direct", "indirect", "occlusion", "compensation"})
         EXPECT_FALSE(decision(away.plan, e).enabled) << e << ": " << decision(away.plan, e).reason;

@@ -75,24 +75,24 @@ TEST(DefaultLighting, FrameStateUsesTheScenesSpotAndOtherwiseSaysWhy) {
     FrameState none = makeFrameState(scene, "none");
     EXPECT_EQ(none.lightSource, "default");
     EXPECT_NE(none.lightNote.find("no lights"), std::string::npos) << none.lightNote;
-    EXPECT_TRUE(none.lightEnabled);
-    EXPECT_TRUE(makeLightModel(none, scene.bounds).on) << "the default light is a valid, lit spot";
+    ASSERT_EQ(none.lights.size(), 2u) << "a key and a fill";
+    EXPECT_TRUE(none.lights.at(0).enabled);
+    EXPECT_TRUE(makeLightModel(none.lights.at(0), scene.bounds).on) << "the default key is a valid, lit spot";
+    EXPECT_EQ(none.lights.at(1).light.type, LightType::Directional);
+    EXPECT_TRUE(makeLightModel(none.lights.at(1), scene.bounds).on) << "the fill is a lit directional light";
+    EXPECT_LT(none.lights.at(1).light.intensity, 0.5f * 1.6f) << "the fill is dim next to the key's 1.6 lux";
 
+    // A file's own lights are used as given, whatever their types.
     Light point;
     point.type = LightType::Point;
     Light sun;
     sun.type = LightType::Directional;
     scene.lights = {point, point, sun};
-    FrameState unsupported = makeFrameState(scene, "none");
-    EXPECT_EQ(unsupported.lightSource, "default");
-    EXPECT_NE(unsupported.lightNote.find("2 point, 1 directional"), std::string::npos)
-        << unsupported.lightNote;
-
-    Light spot;
-    spot.name = "desk";
-    spot.position = {0.0f, 3.0f, 0.0f};
-    scene.lights.push_back(spot);
     FrameState own = makeFrameState(scene, "none");
     EXPECT_EQ(own.lightSource, "scene");
-    EXPECT_EQ(own.light.name, "desk");
+    ASSERT_EQ(own.lights.size(), 3u);
+    EXPECT_EQ(own.lights.at(2).light.type, LightType::Directional);
+    EXPECT_EQ(own.lights.at(0).id, "light0");
+    EXPECT_EQ(own.lights.at(2).id, "light2");
+    EXPECT_NE(own.lightNote.find("3 lights"), std::string::npos) << own.lightNote;
 }

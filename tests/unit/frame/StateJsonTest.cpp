@@ -96,33 +96,34 @@ TEST(StateJson, CameraErrorsNameTheField) {
 
 TEST(StateJson, LightChangesOnlyTheGivenFields) {
     gis::FrameState s = cornellState();
-    const gis::Light before = s.light;
+    const gis::Light before = s.lights.at(0).light;
     gis::applyLightJson(s, {{"intensity", 3.5}, {"direction", {0, -0.5, 0}}}, "/light");
-    EXPECT_EQ(s.light.intensity, 3.5f);
-    expectVec(s.light.direction, {0, -1, 0}); // normalised
-    expectVec(s.light.position, before.position);
-    expectVec(s.light.color, before.color);
-    EXPECT_EQ(s.light.outerConeAngle, before.outerConeAngle);
-    EXPECT_TRUE(s.lightEnabled);
+    EXPECT_EQ(s.lights.at(0).light.intensity, 3.5f);
+    expectVec(s.lights.at(0).light.direction, {0, -1, 0}); // normalised
+    expectVec(s.lights.at(0).light.position, before.position);
+    expectVec(s.lights.at(0).light.color, before.color);
+    EXPECT_EQ(s.lights.at(0).light.outerConeAngle, before.outerConeAngle);
+    EXPECT_TRUE(s.lights.at(0).enabled);
     gis::applyLightJson(s, {{"enabled", false}, {"color", {1, 0.5, 0.25}}, {"position", {0, 1.5, 0}}},
                         "/light");
-    EXPECT_FALSE(s.lightEnabled);
-    expectVec(s.light.color, {1, 0.5f, 0.25f});
-    expectVec(s.light.position, {0, 1.5f, 0});
+    EXPECT_FALSE(s.lights.at(0).enabled);
+    expectVec(s.lights.at(0).light.color, {1, 0.5f, 0.25f});
+    expectVec(s.lights.at(0).light.position, {0, 1.5f, 0});
 }
 
 TEST(StateJson, ConeKeepsTheInnerOuterRatio) {
     gis::FrameState s = cornellState();
-    ASSERT_GT(s.light.outerConeAngle, 0.0f);
-    const float ratio = s.light.innerConeAngle / s.light.outerConeAngle;
+    ASSERT_GT(s.lights.at(0).light.outerConeAngle, 0.0f);
+    const float ratio = s.lights.at(0).light.innerConeAngle / s.lights.at(0).light.outerConeAngle;
     gis::applyLightJson(s, {{"cone_deg", 30}}, "/light");
-    EXPECT_NEAR(s.light.outerConeAngle, 30 * kDegToRad, 1e-6f);
-    EXPECT_NEAR(s.light.innerConeAngle / s.light.outerConeAngle, std::min(ratio, 0.99f), 1e-5f);
+    EXPECT_NEAR(s.lights.at(0).light.outerConeAngle, 30 * kDegToRad, 1e-6f);
+    EXPECT_NEAR(s.lights.at(0).light.innerConeAngle / s.lights.at(0).light.outerConeAngle,
+                std::min(ratio, 0.99f), 1e-5f);
 }
 
 TEST(StateJson, LightErrorsNameTheFieldAndChangeNothing) {
     gis::FrameState s = cornellState();
-    const gis::Light before = s.light;
+    const gis::Light before = s.lights.at(0).light;
     std::string message;
     EXPECT_EQ(whereOf(
                   [&] {
@@ -139,8 +140,8 @@ TEST(StateJson, LightErrorsNameTheFieldAndChangeNothing) {
                   gis::applyLightJson(s, {{"enabled", false}, {"intensity", "bright"}}, "");
               }),
               "/intensity");
-    EXPECT_EQ(s.light.intensity, before.intensity);
-    EXPECT_TRUE(s.lightEnabled);
+    EXPECT_EQ(s.lights.at(0).light.intensity, before.intensity);
+    EXPECT_TRUE(s.lights.at(0).enabled);
 }
 
 TEST(StateJson, JsonRoundTrips) {
@@ -163,11 +164,11 @@ TEST(StateJson, JsonRoundTrips) {
     expectVec(t.camera.target, s.camera.target);
     expectVec(t.camera.up, s.camera.up);
     EXPECT_NEAR(t.camera.yfovRadians, s.camera.yfovRadians, 1e-6f);
-    expectVec(t.light.position, s.light.position);
-    expectVec(t.light.direction, s.light.direction);
-    EXPECT_EQ(t.light.intensity, s.light.intensity);
-    EXPECT_NEAR(t.light.outerConeAngle, s.light.outerConeAngle, 1e-6f);
-    EXPECT_FALSE(t.lightEnabled);
+    expectVec(t.lights.at(0).light.position, s.lights.at(0).light.position);
+    expectVec(t.lights.at(0).light.direction, s.lights.at(0).light.direction);
+    EXPECT_EQ(t.lights.at(0).light.intensity, s.lights.at(0).light.intensity);
+    EXPECT_NEAR(t.lights.at(0).light.outerConeAngle, s.lights.at(0).light.outerConeAngle, 1e-6f);
+    EXPECT_FALSE(t.lights.at(0).enabled);
 }
 
 } // namespace

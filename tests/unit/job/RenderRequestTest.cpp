@@ -212,13 +212,13 @@ TEST(RenderRequest, JobFrameStateLayersTheRequestOnTheScene) {
     EXPECT_EQ(state.frameParams.getFloat("exposure"), 1.0);
     EXPECT_EQ(state.camera.position, glm::vec3(0.5f, 1, 3));
     EXPECT_EQ(state.camera.up, plain.camera.up); // not in the request: the scene's
-    EXPECT_EQ(state.light.intensity, 2.0f);
-    EXPECT_EQ(state.light.position, plain.light.position);
+    EXPECT_EQ(state.lights.at(0).light.intensity, 2.0f);
+    EXPECT_EQ(state.lights.at(0).light.position, plain.lights.at(0).light.position);
 
     // Without camera and light the scene's own are used.
     const gis::FrameState bare = gis::makeJobFrameState(scene, gis::parseRenderRequest(withScene({})));
     EXPECT_EQ(bare.camera.position, plain.camera.position);
-    EXPECT_EQ(bare.light.intensity, plain.light.intensity);
+    EXPECT_EQ(bare.lights.at(0).light.intensity, plain.lights.at(0).light.intensity);
     EXPECT_EQ(gis::paramsJson(bare), gis::paramsJson(plain));
 }
 

@@ -1,6 +1,9 @@
 // Reference renderer against closed-form answers: a Lambertian plane under a point or spot light, a
 // closed sphere lit from its centre (one bounce, and all bounces as a geometric series).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <gtest/gtest.h>
@@ -104,6 +107,152 @@ TEST(ReferenceAnalytic, PlaneUnderSpotLightUsesGltfConeFalloff) {
     EXPECT_GT(inside, 5);
     EXPECT_GT(penumbra, 5);
     EXPECT_GT(outside, 5);
+}
+
+// Pixels of the plane y = 0 seen by `cam` (away from its edges) with their points.
+template <class F> int forPlanePixels(const Camera& cam, int w, int h, F&& each) {
+    int n = 0;
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px) {
+            glm::dvec3 o, d;
+            pixelRay(cam, w, h, px, py, o, d);
+            if (d.y >= -1e-3) continue;
+            const glm::dvec3 p = o + d * (-o.y / d.y);
+            if (std::abs(p.x) > 4.9 || std::abs(p.z) > 4.9) continue;
+            each(static_cast<size_t>(py) * w + px, p);
+            ++n;
+        }
+    return n;
+}
+
+TEST(ReferenceAnalytic, PlaneUnderDirectionalLightIsUniformLuxTimesCosine) {
+    const float rho = 0.4f;
+    const Scene scene = makePlaneScene(rho);
+    const Camera cam = lookAt({0.5f, 2.5f, 3.0f}, {0.0f, 0.0f, 0.0f});
+    Light sun;
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.5f));
+    sun.intensity = 3.0f; // lux
+    sun.color = {1.0f, 0.8f, 0.6f};
+    const int w = 20, h = 20;
+    ReferenceRenderer renderer(scene);
+    const ReferenceImage img = renderer.render(frameFor(cam, sun, w, h), {.mode = "direct", .spp = 1});
+    // E = E_perp cos(theta), theta the angle between the normal (+y) and the direction to the sun.
+    const double cosTheta = -double(sun.direction.y);
+    const int n = forPlanePixels(cam, w, h, [&](size_t i, const glm::dvec3&) {
+        for (int c = 0; c < 3; ++c) {
+            const double expected = rho / M_PI * sun.intensity * sun.color[c] * cosTheta;
+            EXPECT_NEAR(img.rgb[i * 3 + static_cast<size_t>(c)], expected, 1e-5 * expected);
+        }
+    });
+    EXPECT_GT(n, w * h / 3);
+}
+
+TEST(ReferenceAnalytic, RangeWindowFollowsTheSpecsFalloff) {
+    const float rho = 0.5f;
+    const Scene scene = makePlaneScene(rho);
+    const Camera cam = lookAt({0.0f, 4.0f, 2.5f}, {0.0f, 0.0f, 0.0f});
+    Light light = pointLight({0.2f, 0.8f, 0.1f}, 3.0f);
+    light.range = 2.0f;
+    const int w = 24, h = 24;
+    ReferenceRenderer renderer(scene);
+    const ReferenceImage img = renderer.render(frameFor(cam, light, w, h), {.mode = "direct", .spp = 1});
+    int zero = 0, windowed = 0;
+    forPlanePixels(cam, w, h, [&](size_t i, const glm::dvec3& p) {
+        const double d = glm::length(p - glm::dvec3(light.position));
+        const double r = d / light.range;
+        const double window = std::pow(std::clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
+        const double expected = planeRadiance(p, rho, light, window).x;
+        EXPECT_NEAR(img.rgb[i * 3], expected, 1e-4 * expected + 1e-9) << "distance " << d;
+        (window == 0.0 ? zero : windowed)++;
+    });
+    EXPECT_GT(zero, 10) << "points beyond the range are unlit";
+    EXPECT_GT(windowed, 10);
+}
+
+TEST(ReferenceAnalytic, TwoLightsEqualTheSumOfEachAlone) {
+    // Direct and one bounce (the plane and a wall facing it), with a spot and a point light.
+    Scene scene = makePlaneScene(0.6f);
+    Mesh wall;
+    wall.name = "wall";
+    wall.positions = {{-2, 0, -1}, {2, 0, -1}, {2, 3, -1}, {-2, 3, -1}};
+    wall.normals.assign(4, glm::vec3(0, 0, 1));
+    wall.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    wall.indices = {0, 1, 2, 0, 2, 3};
+    scene.materials.push_back(diffuse({0.8f, 0.3f, 0.2f}, "red"));
+    wall.material = 1;
+    scene.meshes.push_back(wall);
+    finalizeScene(scene, "plane and wall");
+    const Camera cam = lookAt({0.3f, 1.5f, 3.0f}, {0.0f, 0.5f, -0.5f});
+    Light a = pointLight({-0.6f, 1.2f, 0.4f}, 2.0f, {1.0f, 0.9f, 0.7f});
+    Light b = pointLight({0.7f, 0.9f, -0.3f}, 1.5f, {0.4f, 0.6f, 1.0f});
+    b.type = LightType::Spot;
+    b.direction = glm::normalize(glm::vec3(-0.2f, -1.0f, -0.4f));
+    b.innerConeAngle = 0.4f;
+    b.outerConeAngle = 0.8f;
+    const int w = 16, h = 16;
+    ReferenceRenderer renderer(scene);
+    for (const char* mode : {"direct", "one-bounce"}) {
+        const ReferenceOptions options{.mode = mode, .spp = std::string(mode) == "direct" ? 1 : 256};
+        FrameState both = frameFor(cam, a, w, h);
+        both.lights.push_back({"light1", b, true});
+        const ReferenceImage ab = renderer.render(both, options);
+        const ReferenceImage ia = renderer.render(frameFor(cam, a, w, h), options);
+        const ReferenceImage ib = renderer.render(frameFor(cam, b, w, h), options);
+        double diff = 0, norm = 0;
+        for (size_t i = 0; i < ab.rgb.size(); ++i) {
+            const double sum = double(ia.rgb[i]) + double(ib.rgb[i]);
+            diff += (ab.rgb[i] - sum) * (ab.rgb[i] - sum);
+            norm += sum * sum;
+        }
+        const double rel = std::sqrt(diff / std::max(norm, 1e-30));
+        std::printf("superposition (%s): relative RMS difference %.2e\n", mode, rel);
+        // Both modes sum up to four lights exactly at every vertex, and the bounce directions do not
+        // depend on the lights: what remains is float rounding (measured: 1e-8).
+        EXPECT_LT(rel, 1e-5) << mode;
+    }
+}
+
+TEST(ReferenceAnalytic, ManyLightsAreSampledByPowerWithoutBias) {
+    // Eight point lights (more than the exact-sum limit): a path vertex picks one by power. The one-bounce
+    // image converges to the sum of the lights' one-bounce images.
+    Scene scene = makePlaneScene(0.7f);
+    Mesh wall;
+    wall.name = "wall";
+    wall.positions = {{-3, 0, -1}, {3, 0, -1}, {3, 3, -1}, {-3, 3, -1}};
+    wall.normals.assign(4, glm::vec3(0, 0, 1));
+    wall.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    wall.indices = {0, 1, 2, 0, 2, 3};
+    wall.material = 0;
+    scene.meshes.push_back(wall);
+    finalizeScene(scene, "plane and wall");
+    const Camera cam = lookAt({0.0f, 1.2f, 3.0f}, {0.0f, 0.6f, -0.5f});
+    const int w = 12, h = 12;
+    ReferenceRenderer renderer(scene);
+    FrameState many = frameFor(cam, pointLight({-1.5f, 1.0f, 0.0f}, 0.5f), w, h);
+    for (int i = 1; i < 8; ++i)
+        many.lights.push_back(
+            {"light" + std::to_string(i),
+             pointLight({-1.5f + 0.4f * float(i), 0.5f + 0.15f * float(i), 0.3f}, 0.5f + 0.4f * float(i)),
+             true});
+    const ReferenceOptions options{.mode = "one-bounce", .spp = 512};
+    const ReferenceImage sampled = renderer.render(many, options);
+    std::vector<double> sum(sampled.rgb.size(), 0.0);
+    for (const FrameLight& l : many.lights) {
+        const ReferenceImage one = renderer.render(frameFor(cam, l.light, w, h), options);
+        for (size_t i = 0; i < sum.size(); ++i) sum[i] += one.rgb[i];
+    }
+    double diff = 0, norm = 0, meanSampled = 0, meanSum = 0;
+    for (size_t i = 0; i < sum.size(); ++i) {
+        diff += (sampled.rgb[i] - sum[i]) * (sampled.rgb[i] - sum[i]);
+        norm += sum[i] * sum[i];
+        meanSampled += sampled.rgb[i];
+        meanSum += sum[i];
+    }
+    std::printf("8 lights sampled by power: relative RMS difference %.3f, mean ratio %.4f\n",
+                std::sqrt(diff / norm), meanSampled / meanSum);
+    EXPECT_NEAR(meanSampled / meanSum, 1.0, 0.02) << "no bias in the mean";
+    EXPECT_LT(std::sqrt(diff / norm), 0.15);
 }
 
 TEST(ReferenceAnalytic, OccluderCastsHardShadow) {

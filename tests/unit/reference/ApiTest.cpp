@@ -95,14 +95,14 @@ TEST(ReferenceApi, HardCasesStayFiniteAndNonNegative) {
     for (const glm::vec3 lightPos :
          {glm::vec3(0, 0, 0), glm::vec3(-1, 0, -1), glm::vec3(0, 0.3f, 0), glm::vec3(0.0f, 1.5f, 1.5f)}) {
         FrameState state = smallState(scene);
-        state.light.position = lightPos;
+        state.lights.at(0).light.position = lightPos;
         for (const std::string& mode : referenceModes()) {
             const ReferenceImage img = renderer.render(state, {.mode = mode, .spp = 4, .jitter = true});
             EXPECT_TRUE(allFiniteNonNegative(img.rgb)) << mode;
         }
     }
     FrameState nanLight = smallState(scene);
-    nanLight.light.color = glm::vec3(NAN, 1.0f, INFINITY);
+    nanLight.lights.at(0).light.color = glm::vec3(NAN, 1.0f, INFINITY);
     const ReferenceImage img = renderer.render(nanLight, {.mode = "path", .spp = 4});
     EXPECT_TRUE(allFiniteNonNegative(img.rgb));
 }
@@ -111,7 +111,7 @@ TEST(ReferenceApi, LightOffLeavesEmissionOnlyAndBackgroundIsZero) {
     Scene scene = smallScene();
     scene.materials[0].emissive = glm::vec3(0.25f, 0.5f, 1.0f);
     FrameState state = smallState(scene);
-    state.lightEnabled = false;
+    state.lights.at(0).enabled = false;
     ReferenceRenderer renderer(scene);
     state.camera = lookAt({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, 30.0f); // looks straight down at the quad
     const ReferenceImage img = renderer.render(state, {.mode = "one-bounce", .spp = 2});

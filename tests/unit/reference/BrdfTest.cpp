@@ -150,7 +150,7 @@ TEST(ReferenceBrdf, WhiteFurnaceGgxMetalMatchesItsDirectionalAlbedo) {
         finalizeScene(scene, "furnace");
         const Camera cam = lookAt({0.0f, 1.0f, 1.0f}, {0.0f, 0.0f, 0.0f}, 4.0f); // 45 degrees off the normal
         FrameState state = frameFor(cam, pointLight({0.0f, 1.0f, 0.0f}, 1.0f), 16, 16);
-        state.lightEnabled = false;
+        state.lights.at(0).enabled = false;
         ReferenceRenderer renderer(scene);
         const ReferenceImage img = renderer.render(state, {.mode = "path", .spp = 256, .maxDepth = 2});
         ASSERT_TRUE(allFiniteNonNegative(img.rgb));
@@ -179,7 +179,7 @@ TEST(ReferenceBrdf, MirrorReflectsAnEmitterTimesF0) {
     finalizeScene(scene, "mirror");
     const Camera cam = lookAt({0.0f, 1.0f, std::tan(glm::radians(30.0f))}, {0.0f, 0.0f, 0.0f}, 10.0f);
     FrameState state = frameFor(cam, pointLight({0.0f, 1.5f, 0.0f}, 1.0f), 8, 8);
-    state.lightEnabled = false;
+    state.lights.at(0).enabled = false;
     ReferenceRenderer renderer(scene);
     const ReferenceImage img = renderer.render(state, {.mode = "path", .spp = 64, .maxDepth = 2});
     ASSERT_TRUE(allFiniteNonNegative(img.rgb));

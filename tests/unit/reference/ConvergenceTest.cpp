@@ -102,7 +102,7 @@ TEST(ReferenceCacheKey, FollowsEveryInputButNotThreads) {
     moved.camera.position.x += 0.01f;
     EXPECT_NE(key, referenceCacheKey(scene, moved, o));
     FrameState lit = state;
-    lit.light.intensity *= 2.0f;
+    lit.lights.at(0).light.intensity *= 2.0f;
     EXPECT_NE(key, referenceCacheKey(scene, lit, o));
     FrameState bigger = state;
     bigger.width = 64;

@@ -82,12 +82,11 @@ inline Light pointLight(glm::vec3 position, float intensity, glm::vec3 colour = 
     return l;
 }
 
-/// A FrameState built by hand: the reference reads only camera, light, lightEnabled and the size.
+/// A FrameState built by hand: the reference reads only camera, lights and the size.
 inline FrameState frameFor(const Camera& camera, const Light& light, int w, int h) {
     FrameState s;
     s.camera = camera;
-    s.light = light;
-    s.lightEnabled = true;
+    s.lights = {{"light0", light, true}};
     s.width = w;
     s.height = h;
     return s;

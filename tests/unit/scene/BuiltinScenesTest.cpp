@@ -23,8 +23,28 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
 }
 
 TEST(BuiltinScenes, NamesList) {
-    EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{"cornell", "cornell-empty", "cornell-dense",
-                                                             "crease", "cornell-black", "gallery"}));
+    EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{
+                                       "cornell", "cornell-empty", "cornell-dense", "crease", "cornell-black",
+                                       "gallery", "cornell-point", "sun-room", "cornell-colored"}));
+}
+
+TEST(BuiltinScenes, LightScenesHaveTheirLightTypes) {
+    const Scene point = makeBuiltinScene("cornell-point");
+    ASSERT_EQ(point.lights.size(), 1u);
+    EXPECT_EQ(point.lights[0].type, LightType::Point);
+    const Scene sun = makeBuiltinScene("sun-room");
+    ASSERT_EQ(sun.lights.size(), 1u);
+    EXPECT_EQ(sun.lights[0].type, LightType::Directional);
+    // The room is closed but for the skylight: a ray from the camera's position towards the sun leaves
+    // only through it, so the camera's position is inside the bounds.
+    EXPECT_TRUE(glm::all(glm::greaterThan(sun.cameras[0].position, sun.bounds.min)));
+    EXPECT_TRUE(glm::all(glm::lessThan(sun.cameras[0].position, sun.bounds.max)));
+    const Scene colored = makeBuiltinScene("cornell-colored");
+    ASSERT_EQ(colored.lights.size(), 3u);
+    EXPECT_EQ(colored.lights[0].type, LightType::Spot);
+    EXPECT_EQ(colored.lights[1].type, LightType::Point);
+    EXPECT_EQ(colored.lights[2].type, LightType::Directional);
+    for (const Light& l : colored.lights) EXPECT_NE(l.color, glm::vec3(1.0f)) << l.name << " is coloured";
 }
 
 TEST(BuiltinScenes, GalleryHasEachNonDiffuseMaterial) {
@@ -63,7 +83,7 @@ TEST(BuiltinScenes, EachBuildsAndValidates) {
         EXPECT_EQ(s.name, "builtin:" + name);
         EXPECT_NO_THROW(validateScene(s, s.name));
         EXPECT_GT(s.triangleCount(), 0u);
-        EXPECT_EQ(s.lights.size(), 1u);
+        EXPECT_GE(s.lights.size(), 1u);
         ASSERT_EQ(s.cameras.size(), 1u);
         EXPECT_EQ(s.cameras[0].name, "default");
         for (const Mesh& m : s.meshes) {
