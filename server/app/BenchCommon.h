@@ -65,6 +65,8 @@ Measurement measure(FrameRenderer& renderer, const FrameState& state, int frames
 double sumPassMs(const nlohmann::json& stats);
 
 int sweep(const std::vector<std::string>& args);
+int lights(const std::vector<std::string>& args);
+int pointShadows(const std::vector<std::string>& args);
 int report(const std::vector<std::string>& args);
 
 } // namespace gis::bench

@@ -40,6 +40,8 @@ constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
        gi-bench passes [options]
        gi-bench sweep [options]     (gi-bench sweep --help)
        gi-bench report [options]    (gi-bench report --help)
+       gi-bench lights [options]
+       gi-bench point-shadows [options]
 
 compare  prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
          size; pixels black in the reference are left out) as JSON.
@@ -73,6 +75,22 @@ passes   renders every configuration --frames times, interleaved (frame k of eac
 
 sweep    runs each technique over its parameter grid and appends time and error per point to CSV
          and JSON Lines; see gi-bench sweep --help.
+lights   frame time against light count: for each technique, N spot lights on a ring under the
+         ceiling sharing the first light's power (N = 1, 2, 4, 8, 16), at the technique's default
+         (total) VPL budget; frames of every N interleaved; prints the median frame time, the ratio
+         of each N to one light and the per-light passes (shadow_map, rsm, rsm_flux) at the largest N.
+  --scene, --size, --config, --frames, --gl, --timing, --json as for passes (default 512x512,
+                          every technique, 3 frames)
+  --counts N,N,...        light counts (default 1,2,4,8,16)
+
+point-shadows  a point light's shadow map as a cube (the renderer's six faces) and as a dual
+         paraboloid with the same texel count: render time (median of --repeats, glFinish) and the
+         share of surface points whose visibility disagrees with a ray (docs/lights.md).
+  --scene NAME            a scene with a point light (default builtin:cornell-point)
+  --side N                cube face side (default 512; the paraboloids get sqrt(3) N)
+  --samples N             surface points (default 20000)
+  --repeats N             timed renders of each (default 15)
+
 report   writes docs/accuracy.md, its plots and presets/presets.json from a sweep; see
          gi-bench report --help.
 )";
@@ -362,8 +380,10 @@ int run(int argc, char** argv) {
     if (command == "passes") return passes(args);
     if (command == "sweep") return sweep(args);
     if (command == "report") return report(args);
+    if (command == "lights") return lights(args);
+    if (command == "point-shadows") return pointShadows(args);
     throw UsageError{"unknown command '" + command +
-                     "': use compare, table, passes, sweep or report (see --help)"};
+                     "': use compare, table, passes, sweep, report, lights or point-shadows (see --help)"};
 }
 
 } // namespace

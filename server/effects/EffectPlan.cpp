@@ -228,6 +228,8 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     // the scene, at most max_lights.
     const LightSetModel lightSet = makeLightSet(state, scene.bounds);
     const bool lightOn = lightSet.any();
+    for (const LightModel& l : lightSet.lights) plan.lightsRendered.push_back(l.id);
+    plan.lightsSkipped = lightSet.skipped;
     // Point-kernel singularity: receivers next to a VPL would dominate a few-hundred-sample estimate,
     // so distances are floored at 2% of the scene radius (a G bound far above any clamp_b in use).
     const float minDist = std::max(0.02f * scene.bounds.radius(), 1e-4f);
@@ -619,9 +621,13 @@ nlohmann::json toJson(const EffectPlan& plan) {
                              {"value", d.value},
                              {"threshold", d.threshold},
                              {"cost_ms", d.costMs}});
-    return {{"mode", plan.mode},           {"decisions", std::move(decisions)},
-            {"receivers", plan.receivers}, {"vpls", plan.vpls},
-            {"rays", plan.rays},           {"analysis_ms", plan.analysisMs}};
+    return {{"mode", plan.mode},
+            {"decisions", std::move(decisions)},
+            {"receivers", plan.receivers},
+            {"vpls", plan.vpls},
+            {"rays", plan.rays},
+            {"analysis_ms", plan.analysisMs},
+            {"lights", {{"rendered", plan.lightsRendered}, {"skipped", plan.lightsSkipped}}}};
 }
 
 std::string describe(const EffectPlan& plan) {
@@ -638,6 +644,10 @@ std::string describe(const EffectPlan& plan) {
                       d.threshold, d.costMs);
         out += line + d.reason + "\n";
     }
+    out += "  lights rendered: " + std::to_string(plan.lightsRendered.size());
+    for (const std::string& id : plan.lightsRendered) out += " " + id;
+    out += "\n";
+    for (const std::string& s : plan.lightsSkipped) out += "  skipped " + s + "\n";
     return out;
 }
 

@@ -65,6 +65,9 @@ struct EffectPlan {
     int vpls = 0;       ///< light samples that hit a surface
     long long rays = 0; ///< rays traced
     double analysisMs = 0.0;
+    /// The lights the frame renders (id) and those it skips with the reason (LightSetModel::skipped):
+    /// a skipped light's shadow-map and RSM passes do not run.
+    std::vector<std::string> lightsRendered, lightsSkipped;
 
     const EffectDecision* find(std::string_view effect) const;
     /// The decision for `effect`; true when it is unknown.

@@ -30,6 +30,9 @@ struct TechniqueInfo {
     bool eyeHierarchy = false;
     bool vplVisibility = false;
     bool biasCompensation = false;
+    /// Whether execute() reads the lights' RSMs (lights.rsm.*): the renderer skips the RSM passes,
+    /// one per light view, for a technique that does not.
+    bool readsRsm = true;
 };
 
 /// Every technique, in the registry's stable order.

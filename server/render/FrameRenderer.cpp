@@ -351,8 +351,16 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     renderShadowMaps(views);
-    renderRsms(views);
-    const std::vector<double> viewFlux = measureViewFlux(views);
+    // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
+    std::vector<double> viewFlux;
+    if (findTechniqueInfo(state.technique).readsRsm) {
+        renderRsms(views);
+        viewFlux = measureViewFlux(views);
+    } else {
+        for (const char* name :
+             {"lights.rsm.position", "lights.rsm.normal", "lights.rsm.flux", "lights.rsm.specular"})
+            mResources.withdraw(name);
+    }
     renderGBuffer(state.width, state.height);
     renderDirect();
 

@@ -698,6 +698,14 @@ private:
         light.innerConeAngle = static_cast<float>(src.spot.innerConeAngle);
         light.outerConeAngle = static_cast<float>(src.spot.outerConeAngle);
         light.position = glm::vec3(world[3]);
+        // Spot and directional lights point along their node's -Z axis; a node transform that collapses
+        // it (a zero scale) or is not finite leaves them no direction, which no fallback should invent.
+        const glm::vec3 axis = glm::mat3(world) * glm::vec3(0.0f, 0.0f, -1.0f);
+        const float axisLength = glm::length(axis);
+        if (light.type != LightType::Point && !(axisLength > 1e-12f && std::isfinite(axisLength)))
+            fail("light '" + light.name + "' (node " + std::to_string(nodeIndex) +
+                 "): direction is zero or not finite: its node's transform collapses the -Z axis it points "
+                 "along (a zero scale?); give the node a non-zero scale");
         light.direction = forwardOf(world);
         mScene.lights.push_back(light);
     }

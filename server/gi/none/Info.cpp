@@ -5,6 +5,7 @@ namespace gis {
 
 TechniqueInfo noIndirectInfo() {
     TechniqueInfo info{"none", "direct light only (no indirect illumination)", "baseline", ParamTable{}};
+    info.readsRsm = false;
     return info;
 }
 

@@ -172,3 +172,64 @@ TEST(StateJson, JsonRoundTrips) {
 }
 
 } // namespace
+
+TEST(StateJson, LightsByIdAddRemoveAndReplace) {
+    gis::FrameState s = cornellState();
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].id, "light0");
+    // Protocol 2: nested fields, the light's own type among them.
+    const std::string id =
+        gis::addLightJson(s, {{"type", "point"}, {"position", {0.1, 1.2, 0.3}}, {"intensity", 2}}, "/light");
+    EXPECT_EQ(id, "light1");
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_EQ(s.lights[1].light.type, gis::LightType::Point);
+    gis::applyLightJson(
+        s, {{"type", "light"}, {"id", "light1"}, {"light", {{"type", "directional"}, {"intensity", 0.5}}}},
+        "");
+    EXPECT_EQ(s.lights[1].light.type, gis::LightType::Directional);
+    EXPECT_EQ(s.lights[1].light.intensity, 0.5f);
+    // Protocol 1's flat message edits the first light and never reads its "type" as the light's.
+    gis::applyLightJson(s, {{"type", "light"}, {"intensity", 7}}, "");
+    EXPECT_EQ(s.lights[0].light.intensity, 7.0f);
+    EXPECT_EQ(s.lights[0].light.type, gis::LightType::Spot);
+    // Errors name the id or the field and change nothing.
+    std::string message;
+    EXPECT_EQ(whereOf(
+                  [&] {
+                      gis::applyLightJson(s, {{"id", "light9"}, {"light", {{"intensity", 1}}}}, "");
+                  },
+                  &message),
+              "/id");
+    EXPECT_NE(message.find("light0, light1"), std::string::npos) << message;
+    EXPECT_EQ(whereOf([&] {
+                  gis::applyLightJson(s, {{"id", "light1"}, {"light", {{"direction", {0, 0, 0}}}}}, "");
+              }),
+              "/light/direction");
+    EXPECT_EQ(whereOf([&] { gis::applyLightJson(s, {{"light", {{"type", "area"}}}}, ""); }), "/light/type");
+    EXPECT_EQ(whereOf([&] { gis::addLightJson(s, {{"range", -1}}, "/light"); }), "/light/range");
+    EXPECT_EQ(whereOf([&] { gis::addLightJson(s, {{"id", "light0"}}, "/light"); }), "/light/id");
+    EXPECT_EQ(whereOf([&] { gis::removeLight(s, "nope", "/id"); }), "/id");
+    EXPECT_EQ(whereOf([&] {
+                  gis::addLightJson(s, {{"cone_deg", 30}, {"inner_cone_deg", 40}}, "/light");
+              }),
+              "/light/inner_cone_deg");
+    EXPECT_EQ(s.lights.size(), 2u);
+    gis::removeLight(s, "light0", "/id");
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(gis::nextLightId(s), "light2") << "ids are not reused";
+    // Replace all, all or nothing.
+    EXPECT_EQ(whereOf([&] {
+                  gis::setLightsJson(s, {{{"type", "spot"}}, {{"intensity", 1}}}, "/lights");
+              }),
+              "/lights/1");
+    EXPECT_EQ(s.lights.size(), 1u);
+    gis::setLightsJson(s, {{{"type", "spot"}}, {{"type", "point"}, {"range", 2}}, {{"type", "directional"}}},
+                       "/lights");
+    ASSERT_EQ(s.lights.size(), 3u);
+    EXPECT_EQ(s.lights[1].light.range, 2.0f);
+    const nlohmann::json all = gis::lightsJson(s);
+    ASSERT_EQ(all.size(), 3u);
+    EXPECT_EQ(all[2]["type"], "directional");
+    EXPECT_EQ(all[0]["id"], "light0");
+    EXPECT_EQ(gis::lightJson(s)["id"], "light0") << "protocol 1's light is the first";
+}

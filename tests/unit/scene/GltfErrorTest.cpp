@@ -199,6 +199,28 @@ TEST(GltfErrors, BadSpotConeFromFile) {
     expectInputError(b.writeGltf(dir, "cone.gltf"), {"light 'wide'", "cone"});
 }
 
+TEST(GltfErrors, ZeroLengthLightDirectionFromFileNamesTheLight) {
+    for (const char* type : {"spot", "directional"}) {
+        TempDir dir;
+        GltfBuilder b;
+        const int tri = b.addTriangleNode();
+        nlohmann::json light = {{"name", "flat"}, {"type", type}};
+        if (std::string(type) == "spot") light["spot"] = {{"outerConeAngle", 0.7}};
+        b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {light};
+        b.setScene({tri, b.addNode({{"scale", {0.0, 0.0, 0.0}},
+                                    {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+        expectInputError(b.writeGltf(dir, "flat.gltf"), {"light 'flat'", "direction"});
+    }
+    // A point light has no direction: a zero scale is harmless.
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"name", "bulb"}, {"type", "point"}}};
+    b.setScene({tri, b.addNode({{"scale", {0.0, 0.0, 0.0}},
+                                {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+    EXPECT_EQ(loadScene(b.writeGltf(dir, "bulb.gltf")).lights.size(), 1u);
+}
+
 // Corrupting bytes of a valid file anywhere must give a scene or an InputError, nothing else.
 TEST(GltfErrors, CorruptedAndTruncatedGlbNeverEscapeAsOtherErrors) {
     TempDir dir;
