@@ -3,6 +3,7 @@
 // of issue [lights] (a light on or inside a surface, a directional light parallel to a wall, zero
 // intensity, range 0, 64 lights).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -96,53 +97,73 @@ TEST(Lights, EveryTechniqueSuperposesTwoLights) {
 }
 
 // Each light type against the reference's one-bounce-unoccluded mode, indirect only (each side's
-// total minus its own direct term), with rsm_gather at one VPL per RSM texel and no distance clamp:
-// the comparison ReferenceGl.RsmGatherApproachesOneBounceUnoccluded makes for the spot, for a point
-// light (cornell-point), a directional sun through a skylight (sun-room) and three coloured lights of
-// all types (cornell-colored). Measured at 40x40 with a 1024-spp reference (indirect relative RMSE,
-// mean indirect GL/reference): cornell-point 0.114, 0.996; sun-room 0.160, 0.982; cornell-colored
-// 0.166, 0.986 (the spot in ReferenceGl: 0.132 at 64^2 VPLs). The bounds add headroom. The sun-room's
-// reference is the noisiest (its light enters through 9% of the ceiling).
-TEST(Lights, EachTypeApproachesTheReference) {
+// total minus its own direct term), for every technique at its defaults (rsm_size 64): a point light
+// (cornell-point), a directional sun through a skylight (sun-room, lit mostly indirectly) and three
+// coloured lights of all types (cornell-colored). rsm_gather also runs at one VPL per RSM texel with
+// no distance clamp, the comparison ReferenceGl.RsmGatherApproachesOneBounceUnoccluded makes for the
+// spot. The figures are printed; the bounds (kBounds) are the measured values on llvmpipe with
+// headroom. What remains at the defaults is each technique's own approximation (the distance clamp,
+// VPL count, hierarchy, negative lights' occlusion, which the unoccluded reference does not have)
+// plus the reference's noise; the sun-room's reference is the noisiest (its light enters through 9%
+// of the ceiling).
+TEST(Lights, EachTypeApproachesTheReferenceWithEveryTechnique) {
     const int w = 40, h = 40;
-    struct Case {
-        const char* scene;
-        int spp;
-        double boundIndirect;
+    // technique -> {cornell-point, sun-room, cornell-colored}
+    // Measured (cornell-point, sun-room, cornell-colored): rsm_gather 64^2 exact 0.114, 0.160, 0.166;
+    // rsm_gather 0.192, 0.549, 0.241; ssbc 0.164, 0.356, 0.186; multires_splat 0.188, 0.548, 0.239;
+    // multires_gather 0.165, 0.345, 0.218; isr 0.127, 0.167, 0.192; hier_isr 0.116, 0.294, 0.166;
+    // second_order 0.194, 0.599, 0.247. Bounds: 1.3 x measured. In the sun-room most of the RSM is the
+    // roof's sunlit outside, whose VPLs face away from the room: 256 VPLs leave few for the skylight's
+    // patch (the exact row's 4096 do), hence its large default-budget errors.
+    const std::map<std::string, std::array<double, 3>> kBounds = {
+        {"rsm_gather (64^2, min_distance 0)", {0.15, 0.21, 0.22}},
+        {"rsm_gather", {0.25, 0.72, 0.32}},
+        {"ssbc", {0.22, 0.47, 0.25}},
+        {"multires_splat", {0.25, 0.72, 0.32}},
+        {"multires_gather", {0.22, 0.45, 0.29}},
+        {"isr", {0.17, 0.22, 0.25}},
+        {"hier_isr", {0.16, 0.39, 0.22}},
+        {"second_order", {0.26, 0.78, 0.33}},
     };
-    for (const Case& k : {Case{"builtin:cornell-point", 1024, 0.20}, Case{"builtin:sun-room", 1024, 0.35},
-                          Case{"builtin:cornell-colored", 1024, 0.25}}) {
-        SCOPED_TRACE(k.scene);
-        const Scene scene = loadScene(k.scene);
+    const char* scenes[] = {"builtin:cornell-point", "builtin:sun-room", "builtin:cornell-colored"};
+    for (int k = 0; k < 3; ++k) {
+        SCOPED_TRACE(scenes[k]);
+        const Scene scene = loadScene(scenes[k]);
         FrameState state = makeFrameState(scene, "rsm_gather");
         state.width = w;
         state.height = h;
         ReferenceRenderer reference(scene);
         const ReferenceImage ref =
-            reference.render(state, {.mode = "one-bounce-unoccluded", .spp = k.spp, .seed = 5});
+            reference.render(state, {.mode = "one-bounce-unoccluded", .spp = 1024, .seed = 5});
         const ReferenceImage refDirect = reference.render(state, {.mode = "direct", .spp = 1});
-        const nlohmann::json params = {{"rsm_size", 64}, {"vpl_grid", 64}, {"min_distance", 0.0}};
-        const FrameOutput gl = test::renderScene(k.scene, "rsm_gather", w, h, params);
-        const FrameOutput glDirect = test::renderScene(k.scene, "none", w, h, {{"rsm_size", 64}});
-        std::vector<float> glIndirect(ref.rgb.size()), refIndirect(ref.rgb.size());
-        double glSum = 0, refSum = 0;
-        for (size_t i = 0; i < static_cast<size_t>(w * h); ++i)
-            for (size_t c = 0; c < 3; ++c) {
-                glIndirect[i * 3 + c] = gl.linear[i * 4 + c] - glDirect.linear[i * 4 + c];
-                refIndirect[i * 3 + c] = ref.rgb[i * 3 + c] - refDirect.rgb[i * 3 + c];
-                glSum += glIndirect[i * 3 + c];
-                refSum += refIndirect[i * 3 + c];
+        const FrameOutput glDirect = test::renderScene(scenes[k], "none", w, h, {{"rsm_size", 64}});
+        for (const auto& [label, bounds] : kBounds) {
+            const bool exact = label.find("min_distance 0") != std::string::npos;
+            const std::string technique = label.substr(0, label.find(' '));
+            nlohmann::json params = {{"rsm_size", 64}};
+            if (exact) params = {{"rsm_size", 64}, {"vpl_grid", 64}, {"min_distance", 0.0}};
+            const FrameOutput gl = test::renderScene(scenes[k], technique, w, h, params);
+            std::vector<float> glIndirect(ref.rgb.size()), refIndirect(ref.rgb.size());
+            double glSum = 0, refSum = 0;
+            for (size_t i = 0; i < static_cast<size_t>(w * h); ++i)
+                for (size_t c = 0; c < 3; ++c) {
+                    glIndirect[i * 3 + c] = gl.linear[i * 4 + c] - glDirect.linear[i * 4 + c];
+                    refIndirect[i * 3 + c] = ref.rgb[i * 3 + c] - refDirect.rgb[i * 3 + c];
+                    glSum += glIndirect[i * 3 + c];
+                    refSum += refIndirect[i * 3 + c];
+                }
+            const double indirect =
+                test::relativeRmseOf(glIndirect, 3, refIndirect, 3, refIndirect.size() / 3);
+            std::printf("%-24s %-36s indirect relative RMSE %.4f, mean indirect GL/reference %.3f (reference "
+                        "%d spp)\n",
+                        scenes[k], label.c_str(), indirect, refSum > 0 ? glSum / refSum : 0.0, ref.spp);
+            EXPECT_GT(refSum, 0.0) << "the reference sees indirect light";
+            EXPECT_EQ(test::badValues(gl), 0u) << label;
+            EXPECT_LT(indirect, bounds[static_cast<size_t>(k)]) << label;
+            if (exact) {
+                EXPECT_NEAR(glSum / refSum, 1.0, 0.15) << "energy of the bounce";
             }
-        const double indirect = test::relativeRmseOf(glIndirect, 3, refIndirect, 3, refIndirect.size() / 3);
-        const double direct =
-            test::relativeRmseOf(glDirect.linear, 4, refDirect.rgb, 3, refDirect.rgb.size() / 3);
-        std::printf(
-            "%s %dx%d: rsm_gather (64^2 VPLs in all, min_distance 0) vs one-bounce-unoccluded "
-            "(%d spp): indirect relative RMSE %.4f, direct term %.4f, mean indirect GL/reference %.4f\n",
-            k.scene, w, h, ref.spp, indirect, direct, refSum > 0 ? glSum / refSum : 0.0);
-        EXPECT_GT(refSum, 0.0) << "the reference sees indirect light";
-        EXPECT_NEAR(glSum / refSum, 1.0, 0.15) << "energy of the bounce";
-        EXPECT_LT(indirect, k.boundIndirect);
+        }
     }
 }
 
