@@ -23,7 +23,7 @@ FrameRenderer& sharedRenderer() {
 }
 
 FrameOutput renderScene(const std::string& sceneName, const std::string& technique, int w, int h,
-                        const nlohmann::json& params) {
+                        const nlohmann::json& params, const std::function<void(FrameState&)>& edit) {
     sharedContext();
     static std::map<std::string, std::shared_ptr<Scene>> scenes;
     auto& scene = scenes[sceneName];
@@ -33,8 +33,25 @@ FrameOutput renderScene(const std::string& sceneName, const std::string& techniq
     FrameState state = makeFrameState(*scene, technique);
     state.width = w;
     state.height = h;
-    applyParams(state, params, "test");
+    if (!params.is_null()) applyParams(state, params, "test"); // {} arrives as null
+    if (edit) edit(state);
     return renderer->render(state, true);
+}
+
+IndirectPair indirectOnly(const FrameOutput& gl, const FrameOutput& glDirect, const std::vector<float>& ref,
+                          const std::vector<float>& refDirect) {
+    IndirectPair out;
+    const size_t pixels = ref.size() / 3;
+    out.gl.resize(ref.size());
+    out.reference.resize(ref.size());
+    for (size_t i = 0; i < pixels; ++i)
+        for (size_t c = 0; c < 3; ++c) {
+            out.gl[i * 3 + c] = gl.linear[i * 4 + c] - glDirect.linear[i * 4 + c];
+            out.reference[i * 3 + c] = ref[i * 3 + c] - refDirect[i * 3 + c];
+            out.glSum += out.gl[i * 3 + c];
+            out.refSum += out.reference[i * 3 + c];
+        }
+    return out;
 }
 
 glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h) {

@@ -2,6 +2,7 @@
 // (CTest runs the same binary once per backend).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,9 +20,20 @@ gl::Context& sharedContext();
 /// The renderer renderScene() uses (tests inspect its technique after a frame).
 FrameRenderer& sharedRenderer();
 
-/// Renders `scene` with `technique` and optional parameter overrides at w x h, with the linear frame.
+/// Renders `scene` with `technique` and optional parameter overrides at w x h, with the linear frame;
+/// `edit` may change the frame state (lights, camera) last.
 FrameOutput renderScene(const std::string& scene, const std::string& technique, int w, int h,
-                        const nlohmann::json& params = nlohmann::json::object());
+                        const nlohmann::json& params = nlohmann::json::object(),
+                        const std::function<void(FrameState&)>& edit = {});
+
+/// Each side's indirect light (its total minus its own direct term), GL frames (RGBA) against
+/// reference images (RGB), as interleaved RGB; `glSum` and `refSum` receive their sums.
+struct IndirectPair {
+    std::vector<float> gl, reference;
+    double glSum = 0, refSum = 0;
+};
+IndirectPair indirectOnly(const FrameOutput& gl, const FrameOutput& glDirect, const std::vector<float>& ref,
+                          const std::vector<float>& refDirect);
 
 /// Pixel (x, y), top-left origin, where world point p lands in the scene's default camera.
 glm::ivec2 projectToPixel(const Scene& scene, glm::vec3 p, int w, int h);

@@ -69,7 +69,8 @@ TEST(ReferenceGl, RsmGatherApproachesOneBounceUnoccluded) {
 
         const int covered = coveredPixels(gl.linear, 4, ref.rgb);
         const double total = test::relativeRmseOf(gl.linear, 4, ref.rgb, 3, ref.rgb.size() / 3);
-        const double direct = test::relativeRmseOf(glDirect.linear, 4, refDirect.rgb, 3, refDirect.rgb.size() / 3);
+        const double direct =
+            test::relativeRmseOf(glDirect.linear, 4, refDirect.rgb, 3, refDirect.rgb.size() / 3);
         // Indirect alone (each side's total minus its own direct term): the light-transport comparison.
         std::vector<float> glIndirect(ref.rgb.size()), refIndirect(ref.rgb.size());
         double glSum = 0, refSum = 0;

@@ -21,21 +21,10 @@ namespace {
 
 const double kPi = 3.14159265358979323846;
 
-// Like test::renderScene, with a hook that edits the frame state (light, cone) before rendering.
+// test::renderScene with second_order.
 FrameOutput renderState(const std::string& sceneName, int w, int h, const nlohmann::json& params,
                         const std::function<void(FrameState&)>& edit = {}) {
-    test::sharedContext();
-    static std::map<std::string, std::shared_ptr<Scene>> scenes;
-    auto& scene = scenes[sceneName];
-    if (!scene) scene = std::make_shared<Scene>(loadScene(sceneName));
-    FrameRenderer& renderer = test::sharedRenderer();
-    if (renderer.scene() != scene.get()) renderer.setScene(scene);
-    FrameState state = makeFrameState(*scene, "second_order");
-    state.width = w;
-    state.height = h;
-    if (!params.is_null()) applyParams(state, params, "test"); // {} arrives as null
-    if (edit) edit(state);
-    return renderer.render(state, true);
+    return test::renderScene(sceneName, "second_order", w, h, params, edit);
 }
 
 double count(const FrameOutput& f, const char* name) {

@@ -109,6 +109,19 @@ TEST(ReferenceAnalytic, PlaneUnderSpotLightUsesGltfConeFalloff) {
     EXPECT_GT(outside, 5);
 }
 
+// A wall in the plane z = z0 facing +z, spanning x in [-halfWidth, halfWidth] and y in [0, height].
+Mesh makeWallZ(float z0, float halfWidth, float height, int material) {
+    Mesh wall;
+    wall.name = "wall";
+    wall.positions = {
+        {-halfWidth, 0, z0}, {halfWidth, 0, z0}, {halfWidth, height, z0}, {-halfWidth, height, z0}};
+    wall.normals.assign(4, glm::vec3(0, 0, 1));
+    wall.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    wall.indices = {0, 1, 2, 0, 2, 3};
+    wall.material = material;
+    return wall;
+}
+
 // Pixels of the plane y = 0 seen by `cam` (away from its edges) with their points.
 template <class F> int forPlanePixels(const Camera& cam, int w, int h, F&& each) {
     int n = 0;
@@ -173,15 +186,8 @@ TEST(ReferenceAnalytic, RangeWindowFollowsTheSpecsFalloff) {
 TEST(ReferenceAnalytic, TwoLightsEqualTheSumOfEachAlone) {
     // Direct and one bounce (the plane and a wall facing it), with a spot and a point light.
     Scene scene = makePlaneScene(0.6f);
-    Mesh wall;
-    wall.name = "wall";
-    wall.positions = {{-2, 0, -1}, {2, 0, -1}, {2, 3, -1}, {-2, 3, -1}};
-    wall.normals.assign(4, glm::vec3(0, 0, 1));
-    wall.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    wall.indices = {0, 1, 2, 0, 2, 3};
     scene.materials.push_back(diffuse({0.8f, 0.3f, 0.2f}, "red"));
-    wall.material = 1;
-    scene.meshes.push_back(wall);
+    scene.meshes.push_back(makeWallZ(-1.0f, 2.0f, 3.0f, 1));
     finalizeScene(scene, "plane and wall");
     const Camera cam = lookAt({0.3f, 1.5f, 3.0f}, {0.0f, 0.5f, -0.5f});
     Light a = pointLight({-0.6f, 1.2f, 0.4f}, 2.0f, {1.0f, 0.9f, 0.7f});
@@ -217,14 +223,7 @@ TEST(ReferenceAnalytic, ManyLightsAreSampledByPowerWithoutBias) {
     // Eight point lights (more than the exact-sum limit): a path vertex picks one by power. The one-bounce
     // image converges to the sum of the lights' one-bounce images.
     Scene scene = makePlaneScene(0.7f);
-    Mesh wall;
-    wall.name = "wall";
-    wall.positions = {{-3, 0, -1}, {3, 0, -1}, {3, 3, -1}, {-3, 3, -1}};
-    wall.normals.assign(4, glm::vec3(0, 0, 1));
-    wall.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    wall.indices = {0, 1, 2, 0, 2, 3};
-    wall.material = 0;
-    scene.meshes.push_back(wall);
+    scene.meshes.push_back(makeWallZ(-1.0f, 3.0f, 3.0f, 0));
     finalizeScene(scene, "plane and wall");
     const Camera cam = lookAt({0.0f, 1.2f, 3.0f}, {0.0f, 0.6f, -0.5f});
     const int w = 12, h = 12;
