@@ -67,6 +67,7 @@ int lightTreeTiles(int views) {
 
 void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
     mLastInputs = in;
+    mLastInputs.lights = nullptr; // the renderer's per-frame copy: gone after the frame
     mValid = false;
     if (in.rsmSize <= 0 || !in.find("lights.rsm.position")) return;
     const int tiles = lightTreeTiles(std::max(in.lightViews, 1));
