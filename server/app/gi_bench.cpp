@@ -54,7 +54,7 @@ table    renders each technique configuration with GL (median frame time over --
   --config SPEC           technique[:name=value,...], repeatable (default: none, rsm_gather)
   --reference MODE        reference mode, repeatable (default: one-bounce-unoccluded, one-bounce)
   --spp N                 reference samples per pixel (default 1024)
-  --caustic-min-roughness R  leave out of the reference the spotlight's reflection off specular
+  --caustic-min-roughness R  leave out of the reference the lights' reflection off specular
                           lobes smoother than R reaching a rougher surface (caustics the GL
                           pipeline does not render; biased; default 0 = unbiased; see
                           docs/nondiffuse.md)

@@ -72,7 +72,7 @@ Ground truth and error (CPU reference renderer, Embree):
   --time-budget S       stop the reference after S seconds (reports the spp reached)
   --seed N              reference random seed (default 1)
   --max-depth N         path mode: vertices per path, 1..64 (default 8)
-  --caustic-min-roughness R  leave out the spotlight's reflection off specular lobes smoother than R
+  --caustic-min-roughness R  leave out the lights' reflection off specular lobes smoother than R
                         that reaches a rougher surface (caustics the GL pipeline does not render;
                         biased, default 0 = unbiased; docs/nondiffuse.md)
   --cache-dir DIR       reuse references rendered before ($GI_CACHE_DIR, default ~/.cache/gi-render)

@@ -4,7 +4,7 @@
 // docs/effects.md.
 //
 // Effects and the knob each one drives:
-//   direct        the spotlight at all (FrameState::lightEnabled); off only when it lights nothing
+//   direct        the lights at all (FrameLight::enabled); off only when they light nothing
 //                 that reaches the view, directly or after one bounce
 //   indirect      the technique's indirect passes (technique `none` when off)
 //   occlusion     indirect visibility (`vpl_shadows`, where the technique has it)

@@ -142,7 +142,7 @@ const ParamTable& frameParamTable() {
         {.name = "effect_direct",
          .type = ParamType::Enum,
          .defaultValue = 0,
-         .help = "force the spotlight off, or leave it to the planner (on keeps it as it is)",
+         .help = "force every light off, or leave it to the planner (on keeps them as they are)",
          .source = "eng",
          .options = {"auto", "on", "off"}},
         {.name = "effect_indirect",
@@ -169,7 +169,7 @@ const ParamTable& frameParamTable() {
          .type = ParamType::Enum,
          .defaultValue = 0,
          .help =
-             "direct specular highlights from the spotlight: auto = on when a material has a specular lobe",
+             "direct specular highlights from the lights: auto = on when a material has a specular lobe",
          .source = "eng",
          .options = {"auto", "on", "off"}},
         {.name = "effect_glossy",

@@ -47,7 +47,7 @@ struct FrameInputs {
     const FrameResources* resources = nullptr;
     int rsmSize = 0;    ///< texels per side of each light view's RSM layer
     int lightViews = 0; ///< RSM layers that hold a light view (0: no light is on)
-    /// Reflected flux luminance of each view's RSM (the VPL budget's split); empty for one view.
+    /// Reflected flux luminance of each view's RSM (the VPL budget's split); empty without a light.
     std::vector<double> viewFlux;
     const shader::LightUniforms* lights = nullptr; ///< CPU copy of the bound gLights block
     /// Glossy VPL transport (effect_glossy): when true, a technique whose glossyTransport() is true

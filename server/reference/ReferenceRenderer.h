@@ -1,5 +1,5 @@
 // CPU ground-truth renderer (DESIGN.md §4 "Reference"): Monte Carlo light transport on Embree ray
-// queries, seeing exactly the scene, camera and spotlight the GL pipeline sees, so that a GL image
+// queries, seeing exactly the scene, camera and lights the GL pipeline sees, so that a GL image
 // and a reference image differ only by the light transport.
 //
 // Notation: x a receiver (first hit of the camera ray through a pixel centre), n_x its shading normal
@@ -21,7 +21,7 @@
 //        surface vertices (1 = direct only), Russian roulette after vertex 3, next-event estimation
 //        to the (delta) light at every vertex, emission added where a path hits an emissive surface.
 // The one-bounce modes bounce the light source only: emissive surfaces are seen directly but do not
-// light other surfaces (as in the GL pipeline, whose VPLs come from the spotlight's RSM).
+// light other surfaces (as in the GL pipeline, whose VPLs come from the lights' RSMs).
 //
 // Non-diffuse surfaces: every rho / pi above stands for the whole BRDF f(l, wo) of scene/Brdf.h (lobe
 // and specular switch from the frame parameters specular_lobe and effect_specular), and bounces sample
@@ -63,7 +63,7 @@ struct ReferenceOptions {
     bool jitter = false; ///< box-filtered jitter inside each pixel instead of the pixel centre
     int threads = 0;     ///< 0 = all hardware threads
     /// Caustic regularisation (perceptual roughness, [0, 1]; 0 = none, the unbiased default): at a bounce
-    /// vertex, the spotlight's reflection through a specular lobe smoother than this is left out when the
+    /// vertex, the lights' reflection through a specular lobe smoother than this is left out when the
     /// path found the vertex by sampling a wider lobe (diffuse, or a rougher specular one): paths
     /// light -> sharp lobe -> wider lobe ... -> camera, e.g. caustics. A path tracer finds those for a
     /// point light only by chance and they dominate its noise (README.md "Non-diffuse surfaces"); the
@@ -91,7 +91,7 @@ public:
     ReferenceRenderer(const ReferenceRenderer&) = delete;
     ReferenceRenderer& operator=(const ReferenceRenderer&) = delete;
 
-    /// Renders `state` (camera, light, lightEnabled, width, height, and the frame parameters specular_lobe
+    /// Renders `state` (camera, lights, width, height, and the frame parameters max_lights, specular_lobe
     /// and effect_specular; the rest of the parameter tables is ignored).
     /// `progress` is called after each pass with the samples per pixel and seconds so far.
     /// Throws InputError naming the option for bad options or sizes.

@@ -1,7 +1,7 @@
 // Dynamic environment reflections (004 §2.1 cube maps, §2.2.1 Fresnel decomposition, §2.2.2 glossy
 // prefiltering), rendered on the fly every frame:
 //   1. env_render: six 90-degree forward renders of the scene (render/forward.*: emission + shadowed
-//      spotlight) from the probe into an RGBA16F cube map of env_size^2 per face with a depth buffer,
+//      lights) from the probe into an RGBA16F cube map of env_size^2 per face with a depth buffer,
 //      face by face; then its box-filtered mip chain (the source of filtered importance sampling);
 //   2. env_prefilter (shaders/render/env_prefilter.comp): a second cube whose level k holds roughness
 //      k / (levels - 1), levels = min(log2(env_size) + 1, kMaxLevels); level 0 is a copy (roughness

@@ -55,23 +55,43 @@ std::vector<float> readRgba32f(const gl::Framebuffer& fbo, int attachment, int w
 
 } // namespace
 
-nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set) {
+nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set,
+                             const std::vector<double>& viewFlux) {
     nlohmann::json rendered = nlohmann::json::array();
+    std::vector<std::string> dark;
     for (const LightModel& l : set.lights) {
         const char* type = l.type == LightType::Spot    ? "spot"
                            : l.type == LightType::Point ? "point"
                                                         : "directional";
-        rendered.push_back({{"id", l.id}, {"name", l.name}, {"type", type}, {"views", l.viewCount}});
+        nlohmann::json entry = {{"id", l.id}, {"name", l.name}, {"type", type}, {"views", l.viewCount}};
+        if (!viewFlux.empty()) {
+            double flux = 0.0;
+            for (int v = l.firstView; v < l.firstView + l.viewCount && v < static_cast<int>(viewFlux.size());
+                 ++v)
+                flux += viewFlux[static_cast<size_t>(v)];
+            entry["reflected_flux"] = flux;
+            if (!(flux > 0.0)) dark.push_back("light '" + l.name + "' (" + l.id + ")");
+        }
+        rendered.push_back(std::move(entry));
     }
     nlohmann::json out = {{"source", state.lightSource},     {"note", state.lightNote},
                           {"rendered", std::move(rendered)}, {"skipped", set.skipped},
                           {"views", set.views.size()},       {"shadow_side", set.shadowSide},
                           {"rsm_side", set.rsmSide}};
-    if (set.lights.empty())
+    if (set.lights.empty()) {
         out["warning"] = state.lights.empty()
                              ? "there are no lights: the view shows emission only"
                              : "none of the lights is rendered (see skipped): the view shows "
                                "emission only";
+    } else if (!dark.empty()) {
+        // Measured from the RSMs: no surface reflects such a light (it points into empty space, its cone
+        // or range misses everything, or all it reaches is black).
+        std::string names;
+        for (const std::string& d : dark) names += (names.empty() ? "" : ", ") + d;
+        out["warning"] = std::string(dark.size() == set.lights.size() ? "no surface reflects any light"
+                                                                      : "no surface reflects") +
+                         ": " + names + " (pointing into empty space, or at black surfaces only?)";
+    }
     return out;
 }
 
@@ -248,7 +268,7 @@ void FrameRenderer::renderRsms(int views) {
 }
 
 std::vector<double> FrameRenderer::measureViewFlux(int views) {
-    if (views <= 1) return {};
+    if (views <= 0) return {};
     {
         gl::Pass pass(mTimer, "rsm_flux");
         pass.use(mFluxPass.program).set(mFluxPass.rsmSize, mRsmSize);
@@ -258,7 +278,8 @@ std::vector<double> FrameRenderer::measureViewFlux(int views) {
     }
     // A small synchronous read (views floats): the split must be known before the technique's
     // extraction is dispatched, and using the previous frame's would make a single render depend on
-    // the frame before it.
+    // the frame before it. With one view it only feeds the stats (each light's reflected flux, and a
+    // warning for a light that reaches no surface).
     std::vector<float> sums(static_cast<size_t>(views), 0.0f);
     glGetNamedBufferSubData(mFluxSums.id(), 0, static_cast<GLsizeiptr>(sums.size() * sizeof(float)),
                             sums.data());
@@ -438,7 +459,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
                  {"params", std::move(params)}};
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
-    out.stats["lighting"] = lightingStats(state, lightSet);
+    out.stats["lighting"] = lightingStats(state, lightSet, viewFlux);
     return out;
 }
 

@@ -33,8 +33,11 @@ namespace gis {
 void writeLightUniforms(const LightSetModel& set, shader::LightUniforms& u);
 
 /// The stats' `lighting` object: where the lights came from, which are rendered (id, name, type,
-/// views), which are skipped and why, the view sizes, and a warning when no light is rendered.
-nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set);
+/// views, and with the views' measured RSM flux `viewFlux` their reflected flux), which are skipped
+/// and why, the view sizes, and a warning when no light is rendered or a rendered one reaches no
+/// surface.
+nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set,
+                             const std::vector<double>& viewFlux);
 
 struct FrameOutput {
     int width = 0;
@@ -68,7 +71,7 @@ private:
     // The frame's stages, in order; each publishes what it writes in mResources.
     void renderShadowMaps(int views);
     void renderRsms(int views);
-    /// Reflected flux luminance of every view's RSM (pass "rsm_flux", read back); empty for one view.
+    /// Reflected flux luminance of every view's RSM (pass "rsm_flux", read back); empty without views.
     std::vector<double> measureViewFlux(int views);
     void renderGBuffer(int width, int height);
     void renderDirect();

@@ -276,3 +276,23 @@ TEST(Lights, SplitVplGridByFlux) {
     EXPECT_EQ(splitVplGrid(16, {1.0, 1e-9}, 2, 256), std::vector<int>({16, 1})) << "a lit view keeps one VPL";
     EXPECT_EQ(splitVplGrid(16, {1.0, std::nan("")}, 2, 256), std::vector<int>({16, 0}));
 }
+
+// A rendered light that no surface reflects (here a spot above the room pointing up) is named in
+// the stats' warning; the file's other light is not.
+TEST(Lights, WarnsAboutALightThatReachesNoSurface) {
+    const FrameOutput f = renderWith("builtin:cornell", "rsm_gather", 32, 32, [](FrameState& s) {
+        Light away = s.lights.at(0).light;
+        away.name = "skyward";
+        away.position = {0.0f, 5.0f, 0.0f};
+        away.direction = {0.0f, 1.0f, 0.0f};
+        s.lights.push_back({"up", away, true});
+    });
+    const nlohmann::json& lighting = f.stats["lighting"];
+    ASSERT_EQ(lighting["rendered"].size(), 2u);
+    EXPECT_GT(lighting["rendered"][0]["reflected_flux"].get<double>(), 0.0);
+    EXPECT_EQ(lighting["rendered"][1]["reflected_flux"].get<double>(), 0.0);
+    ASSERT_TRUE(lighting.contains("warning")) << lighting.dump();
+    const std::string warning = lighting["warning"];
+    EXPECT_NE(warning.find("skyward"), std::string::npos) << warning;
+    EXPECT_EQ(warning.find("ceiling_spot"), std::string::npos) << warning;
+}

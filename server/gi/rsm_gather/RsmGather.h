@@ -6,7 +6,7 @@
 // It is the full-resolution baseline that the multiresolution techniques are measured against.
 //
 // Pipeline:
-//   1. (renderer) RSM from the spotlight: position, normal, reflected flux per texel
+//   1. (renderer) an RSM per light view: position, normal, reflected flux per texel
 //   2. vpl_extract: a compute pass turns each of vpl_grid^2 cells into one VPL (centre texel's
 //      position and normal, the cell's summed flux) written to a buffer
 //   3. vpl_gather: a full-screen pass per batch of up to 1024 VPLs (read as a uniform block)
