@@ -161,6 +161,7 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     mFluxSums = gl::Buffer::create(GIS_MAX_LIGHT_VIEWS * sizeof(float));
     mFrameUbo = gl::Buffer::create(sizeof(shader::FrameUniforms));
     mLightUbo = gl::Buffer::create(sizeof(shader::LightUniforms));
+    mLightBlock = std::make_unique<shader::LightUniforms>();
     mEmptyVao = gl::VertexArray::create();
     gl::checkErrors("renderer setup");
 }
@@ -267,19 +268,17 @@ void FrameRenderer::renderRsms(int views) {
     mResources.publish("lights.rsm.specular", "rsm", mRsmSpecular);
 }
 
-std::vector<double> FrameRenderer::measureViewFlux(int views) {
+void FrameRenderer::measureViewFlux(int views) {
+    if (views <= 0) return;
+    gl::Pass pass(mTimer, "rsm_flux");
+    pass.use(mFluxPass.program).set(mFluxPass.rsmSize, mRsmSize);
+    pass.texture(mFluxPass.position, mRsmPosition).texture(mFluxPass.flux, mRsmFlux);
+    pass.buffer(mFluxPass.sums, mFluxSums);
+    pass.dispatch(views).barrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+std::vector<double> FrameRenderer::readViewFlux(int views) const {
     if (views <= 0) return {};
-    {
-        gl::Pass pass(mTimer, "rsm_flux");
-        pass.use(mFluxPass.program).set(mFluxPass.rsmSize, mRsmSize);
-        pass.texture(mFluxPass.position, mRsmPosition).texture(mFluxPass.flux, mRsmFlux);
-        pass.buffer(mFluxPass.sums, mFluxSums);
-        pass.dispatch(views).barrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    }
-    // A small synchronous read (views floats): the split must be known before the technique's
-    // extraction is dispatched, and using the previous frame's would make a single render depend on
-    // the frame before it. With one view it only feeds the stats (each light's reflected flux, and a
-    // warning for a light that reaches no surface).
     std::vector<float> sums(static_cast<size_t>(views), 0.0f);
     glGetNamedBufferSubData(mFluxSums.id(), 0, static_cast<GLsizeiptr>(sums.size() * sizeof(float)),
                             sums.data());
@@ -347,8 +346,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
 
     // Frame and light uniforms.
     shader::FrameUniforms u{};
-    auto lights = std::make_unique<shader::LightUniforms>();
-    writeLightUniforms(lightSet, *lights);
+    shader::LightUniforms& lights = *mLightBlock;
+    lights = shader::LightUniforms{};
+    writeLightUniforms(lightSet, lights);
     float widestTan = 0.0f;
     for (const LightViewModel& v : lightSet.views)
         if (!v.orthographic) widestTan = std::max(widestTan, v.tanHalfFov);
@@ -364,7 +364,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f,
                               fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);
-    mLightUbo.upload(0, sizeof *lights, lights.get());
+    mLightUbo.upload(0, sizeof lights, &lights);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
 
@@ -374,9 +374,15 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     renderShadowMaps(views);
     // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
     std::vector<double> viewFlux;
-    if (findTechniqueInfo(state.technique).readsRsm) {
+    const bool readsRsm = findTechniqueInfo(state.technique).readsRsm;
+    if (readsRsm) {
         renderRsms(views);
-        viewFlux = measureViewFlux(views);
+        measureViewFlux(views);
+        // Several views: the VPL split needs the sums before the technique's extraction is dispatched,
+        // so they are read now (a small synchronous read; the previous frame's would make a single
+        // render depend on the frame before it). One view: the sums only feed the stats, read after
+        // the frame's own read-back, when waiting costs nothing.
+        if (views > 1) viewFlux = readViewFlux(views);
     } else {
         for (const char* name :
              {"lights.rsm.position", "lights.rsm.normal", "lights.rsm.flux", "lights.rsm.specular"})
@@ -394,7 +400,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     in.rsmSize = lightSet.rsmSide;
     in.lightViews = views;
     in.viewFlux = viewFlux;
-    in.lights = lights.get();
+    in.lights = &lights;
     in.glossy = nonDiffuse.glossy;
     in.glossyMinRoughness = fp.getFloat("glossy_split");
     in.lightEnabled = lightOn;
@@ -438,6 +444,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     out.rgba8 = readRgba8(mCompositeFbo, 0, state.width, state.height);
     if (wantLinear) out.linear = readRgba32f(mCompositeFbo, 1, state.width, state.height);
     const double readbackMs = readClock.elapsedMs();
+    if (readsRsm && views == 1) viewFlux = readViewFlux(views);
     std::vector<gl::PassTiming> passes = mTimer.resolve();
     gl::logErrors("frame");
 

@@ -71,8 +71,10 @@ private:
     // The frame's stages, in order; each publishes what it writes in mResources.
     void renderShadowMaps(int views);
     void renderRsms(int views);
-    /// Reflected flux luminance of every view's RSM (pass "rsm_flux", read back); empty without views.
-    std::vector<double> measureViewFlux(int views);
+    /// Sums the reflected flux luminance of every view's RSM on the GPU (pass "rsm_flux").
+    void measureViewFlux(int views);
+    /// Those sums, read back (waits for the pass); empty without views.
+    std::vector<double> readViewFlux(int views) const;
     void renderGBuffer(int width, int height);
     void renderDirect();
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
@@ -105,6 +107,8 @@ private:
         gl::BlockBinding sums;
     } mFluxPass;
     gl::Buffer mFrameUbo, mLightUbo, mFluxSums;
+    /// CPU copy of the light block (47 KB: kept, not reallocated per frame); FrameInputs::lights.
+    std::unique_ptr<shader::LightUniforms> mLightBlock;
     gl::VertexArray mEmptyVao;
 
     int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0, mShadowLayers = 0, mRsmLayers = 0;

@@ -17,21 +17,10 @@ using namespace gis;
 
 namespace {
 
-/// A renderer per test binary, with the scene `name` and `edit` applied to its default state.
+// test::renderScene with the state edit first, as most tests here give it.
 FrameOutput renderWith(const std::string& name, const std::string& technique, int w, int h,
                        const std::function<void(FrameState&)>& edit, const nlohmann::json& params = {}) {
-    test::sharedContext();
-    static std::map<std::string, std::shared_ptr<Scene>> scenes;
-    auto& scene = scenes[name];
-    if (!scene) scene = std::make_shared<Scene>(loadScene(name));
-    FrameRenderer& renderer = test::sharedRenderer();
-    if (renderer.scene() != scene.get()) renderer.setScene(scene);
-    FrameState state = makeFrameState(*scene, technique);
-    state.width = w;
-    state.height = h;
-    if (!params.is_null()) applyParams(state, params, "test");
-    if (edit) edit(state);
-    return renderer.render(state, true);
+    return test::renderScene(name, technique, w, h, params, edit);
 }
 
 Light pointAt(glm::vec3 p, float intensity, glm::vec3 colour) {
@@ -143,17 +132,10 @@ TEST(Lights, EachTypeApproachesTheReferenceWithEveryTechnique) {
             nlohmann::json params = {{"rsm_size", 64}};
             if (exact) params = {{"rsm_size", 64}, {"vpl_grid", 64}, {"min_distance", 0.0}};
             const FrameOutput gl = test::renderScene(scenes[k], technique, w, h, params);
-            std::vector<float> glIndirect(ref.rgb.size()), refIndirect(ref.rgb.size());
-            double glSum = 0, refSum = 0;
-            for (size_t i = 0; i < static_cast<size_t>(w * h); ++i)
-                for (size_t c = 0; c < 3; ++c) {
-                    glIndirect[i * 3 + c] = gl.linear[i * 4 + c] - glDirect.linear[i * 4 + c];
-                    refIndirect[i * 3 + c] = ref.rgb[i * 3 + c] - refDirect.rgb[i * 3 + c];
-                    glSum += glIndirect[i * 3 + c];
-                    refSum += refIndirect[i * 3 + c];
-                }
+            const test::IndirectPair ind = test::indirectOnly(gl, glDirect, ref.rgb, refDirect.rgb);
+            const double glSum = ind.glSum, refSum = ind.refSum;
             const double indirect =
-                test::relativeRmseOf(glIndirect, 3, refIndirect, 3, refIndirect.size() / 3);
+                test::relativeRmseOf(ind.gl, 3, ind.reference, 3, ind.reference.size() / 3);
             std::printf("%-24s %-36s indirect relative RMSE %.4f, mean indirect GL/reference %.3f (reference "
                         "%d spp)\n",
                         scenes[k], label.c_str(), indirect, refSum > 0 ? glSum / refSum : 0.0, ref.spp);
@@ -295,4 +277,17 @@ TEST(Lights, WarnsAboutALightThatReachesNoSurface) {
     const std::string warning = lighting["warning"];
     EXPECT_NE(warning.find("skyward"), std::string::npos) << warning;
     EXPECT_EQ(warning.find("ceiling_spot"), std::string::npos) << warning;
+    // Alone (one view: its flux is read after the frame's read-back), the same light is warned about.
+    const FrameOutput alone = renderWith("builtin:cornell", "rsm_gather", 32, 32, [](FrameState& s) {
+        s.lights.at(0).light.name = "skyward";
+        s.lights.at(0).light.position = {0.0f, 5.0f, 0.0f};
+        s.lights.at(0).light.direction = {0.0f, 1.0f, 0.0f};
+    });
+    ASSERT_TRUE(alone.stats["lighting"].contains("warning")) << alone.stats["lighting"].dump();
+    EXPECT_NE(alone.stats["lighting"]["warning"].get<std::string>().find("no surface reflects any light"),
+              std::string::npos);
+    // The file's own light, alone: measured, positive, no warning.
+    const FrameOutput own = renderWith("builtin:cornell", "rsm_gather", 32, 32, nullptr);
+    EXPECT_GT(own.stats["lighting"]["rendered"][0]["reflected_flux"].get<double>(), 0.0);
+    EXPECT_FALSE(own.stats["lighting"].contains("warning"));
 }

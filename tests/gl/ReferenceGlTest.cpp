@@ -72,16 +72,9 @@ TEST(ReferenceGl, RsmGatherApproachesOneBounceUnoccluded) {
         const double direct =
             test::relativeRmseOf(glDirect.linear, 4, refDirect.rgb, 3, refDirect.rgb.size() / 3);
         // Indirect alone (each side's total minus its own direct term): the light-transport comparison.
-        std::vector<float> glIndirect(ref.rgb.size()), refIndirect(ref.rgb.size());
-        double glSum = 0, refSum = 0;
-        for (size_t i = 0; i < static_cast<size_t>(w * h); ++i)
-            for (size_t c = 0; c < 3; ++c) {
-                glIndirect[i * 3 + c] = gl.linear[i * 4 + c] - glDirect.linear[i * 4 + c];
-                refIndirect[i * 3 + c] = ref.rgb[i * 3 + c] - refDirect.rgb[i * 3 + c];
-                glSum += glIndirect[i * 3 + c];
-                refSum += refIndirect[i * 3 + c];
-            }
-        const double indirect = test::relativeRmseOf(glIndirect, 3, refIndirect, 3, refIndirect.size() / 3);
+        const test::IndirectPair ind = test::indirectOnly(gl, glDirect, ref.rgb, refDirect.rgb);
+        const double glSum = ind.glSum, refSum = ind.refSum;
+        const double indirect = test::relativeRmseOf(ind.gl, 3, ind.reference, 3, ind.reference.size() / 3);
         std::printf(
             "cornell-empty %dx%d, GL rsm_gather (rsm_size = vpl_grid = %d, min_distance 0) vs reference "
             "one-bounce-unoccluded (%d spp, %.2f s), relative RMSE over %d covered pixels: total %.4f, "
