@@ -32,6 +32,15 @@ struct FrameState {
     std::string lightNote;
     int width = 512;
     int height = 512;
+    /// A tile of a larger image (tiled refinement, frame/Tiles.h): this frame renders the pixels
+    /// [x, x + width) x [y, y + height), rows top to bottom, of a fullWidth x fullHeight image seen
+    /// through the same camera; a tile may reach past the image's edges. fullWidth == 0: the frame is
+    /// the whole image.
+    struct Window {
+        int x = 0, y = 0;
+        int fullWidth = 0, fullHeight = 0;
+        bool active() const { return fullWidth > 0 && fullHeight > 0; }
+    } window;
     std::string technique = "rsm_gather";
     ParamSet frameParams;     ///< frameParamTable(): exposure, tone map, shadow and RSM sizes
     ParamSet techniqueParams; ///< the technique's own table

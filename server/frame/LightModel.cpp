@@ -40,6 +40,23 @@ glm::mat4 cameraViewProj(const Camera& camera, int width, int height) {
     return glm::perspective(fov, aspect, znear, zfar) * view;
 }
 
+glm::mat4 frameViewProj(const FrameState& state) {
+    if (!state.window.active()) return cameraViewProj(state.camera, state.width, state.height);
+    const auto& w = state.window;
+    const glm::mat4 full = cameraViewProj(state.camera, w.fullWidth, w.fullHeight);
+    // The tile's edges in the full image's NDC (y up, rows counted from the top), then the affine map
+    // taking them to [-1, 1]; sizes are >= 1 px, so no division by zero.
+    const double fw = w.fullWidth, fh = w.fullHeight;
+    const double left = -1.0 + 2.0 * w.x / fw, right = -1.0 + 2.0 * (w.x + state.width) / fw;
+    const double top = 1.0 - 2.0 * w.y / fh, bottom = 1.0 - 2.0 * (w.y + state.height) / fh;
+    glm::mat4 crop(1.0f);
+    crop[0][0] = static_cast<float>(2.0 / (right - left));
+    crop[3][0] = static_cast<float>(-(right + left) / (right - left));
+    crop[1][1] = static_cast<float>(2.0 / (top - bottom));
+    crop[3][1] = static_cast<float>(-(top + bottom) / (top - bottom));
+    return crop * full;
+}
+
 namespace {
 
 // Near and far planes of a perspective view from `eye` that must see the whole bounds: far past

@@ -37,6 +37,9 @@ namespace gis {
 /// Perspective view-projection of `camera` for a width x height frame: the field of view clamped to
 /// [0.01, 3] rad, znear >= 1e-4 and zfar >= 2 znear, so any camera gives a finite matrix.
 glm::mat4 cameraViewProj(const Camera& camera, int width, int height);
+/// The view-projection of `state`'s frame: cameraViewProj at its size or, for a tile
+/// (FrameState::window), the full image's projection cropped to the tile's pixels.
+glm::mat4 frameViewProj(const FrameState& state);
 
 /// The spot light's shadow-map and RSM frustum: a perspective along the light's axis with the
 /// outer cone as half-angle (at most 85 degrees), near and far planes from the distances to the

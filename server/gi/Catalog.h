@@ -24,6 +24,10 @@ struct TechniqueInfo {
     /// The most VPLs (or virtual lights) one frame with these technique and frame parameters uses:
     /// what --max-vpls bounds and what the refinement predictor scales by. Empty: none.
     std::function<long(const ParamSet& technique, const ParamSet& frame)> vplEstimate;
+    /// Lowers the technique's VPL knob so that vplEstimate is at most `vpls` (never raises it): how
+    /// the session's frame budget (session/FrameBudget.h) makes an interactive frame cheaper. Empty:
+    /// the count cannot be capped (hier_isr's cut adapts per receiver instead).
+    std::function<void(ParamSet& technique, long vpls)> limitVpls;
     /// Effect knobs the effect plan may set (docs/effects.md): the multiresolution eye hierarchy
     /// (coarsest_size and the discontinuity thresholds of gi/common/ParamSpecs.h), VPL visibility
     /// (vpl_shadows) and bias compensation (clamp_b, ssbc_iterations).
@@ -33,6 +37,10 @@ struct TechniqueInfo {
     /// Whether execute() reads the lights' RSMs (lights.rsm.*): the renderer skips the RSM passes,
     /// one per light view, for a technique that does not.
     bool readsRsm = true;
+    /// Whether it samples lights from the camera's view (second_order's negative lights): a tile of a
+    /// refinement step (frame/Tiles.h) then samples its own set, so tiles differ slightly at their
+    /// seams where a whole frame would not (tests/gl/TilesGlTest.cpp measures by how much).
+    bool viewSampled = false;
 };
 
 /// Every technique, in the registry's stable order.
@@ -48,6 +56,8 @@ inline long squared(long x) {
 inline long gridVplEstimate(const ParamSet& technique, const ParamSet&) {
     return squared(technique.getInt("vpl_grid"));
 }
+/// limitVpls of the grid-VPL techniques: the largest vpl_grid with vpl_grid^2 <= vpls.
+void limitGridVpls(ParamSet& technique, long vpls);
 
 // The entries, one per technique folder (gi/<name>/Info.cpp).
 TechniqueInfo noIndirectInfo();

@@ -26,6 +26,9 @@ public:
     /// Waits for the results; call after the frame's last pass.
     std::vector<PassTiming> resolve();
     bool usesQueries() const { return mUseQueries; }
+    /// Passes begun since beginFrame(): an index into resolve()'s list, so that a caller can tell
+    /// which passes one stage of the frame issued.
+    size_t passCount() const { return mUsed; }
 
 private:
     struct Slot {

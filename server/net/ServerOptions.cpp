@@ -159,11 +159,33 @@ std::vector<ServerOption> buildOptions() {
                           &ServerConfig::jpegQuality));
     {
         ServerOption o{"--interactive-scale", "GI_INTERACTIVE_SCALE", "F",
-                       "size factor of interactive frames while input arrives, 0.1..1 (default 0.5)"};
+                       "largest size factor of interactive frames while input arrives (the frame budget "
+                       "picks one up to it; with --frame-target-ms 0, the factor), 0.1..1 (default 1)"};
         o.set = [](ServerConfig& c, const std::string& v) {
             c.session.limits.interactiveScale = parseNumber("--interactive-scale", v, 0.1, 1.0);
         };
         o.show = [](const ServerConfig& c) { return numberText(c.session.limits.interactiveScale); };
+        t.push_back(o);
+    }
+    {
+        ServerOption o{"--frame-target-ms", "GI_FRAME_TARGET_MS", "MS",
+                       "render + encode time an interactive frame should take: each session sizes its "
+                       "interactive frames and caps their VPLs from what its frames measured; a client may "
+                       "ask for its own; 0 = no budget, 0..2000 (default 80)"};
+        o.set = [](ServerConfig& c, const std::string& v) {
+            c.session.limits.frameTargetMs = static_cast<int>(parseInteger("--frame-target-ms", v, 0, 2000));
+        };
+        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.frameTargetMs); };
+        t.push_back(o);
+    }
+    {
+        ServerOption o{"--slice-ms", "GI_SLICE_MS", "MS",
+                       "time one tile of a refinement step should take: input waits at most about this long "
+                       "for the tile in progress, 5..1000 (default 40)"};
+        o.set = [](ServerConfig& c, const std::string& v) {
+            c.session.limits.sliceMs = static_cast<int>(parseInteger("--slice-ms", v, 5, 1000));
+        };
+        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.sliceMs); };
         t.push_back(o);
     }
     {
@@ -179,8 +201,8 @@ std::vector<ServerOption> buildOptions() {
     {
         ServerOption o{
             "--refine-budget-ms", "GI_REFINE_BUDGET_MS", "MS",
-            "skip a refinement step predicted to take longer, so input never waits long behind it; 0 = "
-            "no limit, 0..600000 (default 5000)"};
+            "skip a refinement step predicted to take longer in all (steps render in tiles input "
+            "interrupts: this bounds the work, not the wait); 0 = no limit, 0..600000 (default 30000)"};
         o.set = [](ServerConfig& c, const std::string& v) {
             c.session.limits.refineBudgetMs =
                 static_cast<int>(parseInteger("--refine-budget-ms", v, 0, 600000));

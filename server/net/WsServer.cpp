@@ -972,30 +972,34 @@ struct WsServer::Impl {
     nlohmann::json welcomeFor(const SessionEntry& entry, ClientRole role, bool resumed, int maxInFlight) {
         const StreamOptions stream = entry.session->streamOptions();
         const SessionLimits& l = config.session.limits;
-        nlohmann::json w = {{"type", "welcome"},
-                            {"protocol", kProtocolVersion},
-                            {"server", kServerName},
-                            {"session", entry.session->id()},
-                            {"role", roleName(role)},
-                            {"resumed", resumed},
-                            {"codec", codecName(stream.codec)},
-                            {"quality", stream.quality},
-                            {"max_in_flight", maxInFlight},
-                            {"adaptive", stream.adaptive},
-                            {"limits",
-                             {{"max_size", {l.maxWidth, l.maxHeight}},
-                              {"max_vpls", l.maxVpls},
-                              {"max_message_bytes", config.maxMessageBytes},
-                              {"messages_per_second", config.messagesPerSecond},
-                              {"resume_grace_s", config.resumeGraceS},
-                              {"idle_timeout_s", config.idleTimeoutS},
-                              {"interactive_scale", l.interactiveScale},
-                              {"settle_ms", l.settleMs},
-                              {"refine_budget_ms", l.refineBudgetMs}}},
-                            {"scenes", entry.session->sceneNames()},
-                            {"techniques", techniquesJson()},
-                            {"frame_params_schema", frameParamTable().jsonSchema()},
-                            {"state", entry.session->stateJson()}};
+        nlohmann::json w = {
+            {"type", "welcome"},
+            {"protocol", kProtocolVersion},
+            {"server", kServerName},
+            {"session", entry.session->id()},
+            {"role", roleName(role)},
+            {"resumed", resumed},
+            {"codec", codecName(stream.codec)},
+            {"quality", stream.quality},
+            {"max_in_flight", maxInFlight},
+            {"adaptive", stream.adaptive},
+            {"frame_target_ms", stream.frameTargetMs >= 0 ? stream.frameTargetMs : l.frameTargetMs},
+            {"limits",
+             {{"max_size", {l.maxWidth, l.maxHeight}},
+              {"max_vpls", l.maxVpls},
+              {"max_message_bytes", config.maxMessageBytes},
+              {"messages_per_second", config.messagesPerSecond},
+              {"resume_grace_s", config.resumeGraceS},
+              {"idle_timeout_s", config.idleTimeoutS},
+              {"interactive_scale", l.interactiveScale},
+              {"frame_target_ms", l.frameTargetMs},
+              {"slice_ms", l.sliceMs},
+              {"settle_ms", l.settleMs},
+              {"refine_budget_ms", l.refineBudgetMs}}},
+            {"scenes", entry.session->sceneNames()},
+            {"techniques", techniquesJson()},
+            {"frame_params_schema", frameParamTable().jsonSchema()},
+            {"state", entry.session->stateJson()}};
         if (role == ClientRole::Controller) {
             w["resume_token"] = entry.resumeToken;
             w["view_token"] = entry.viewToken;
@@ -1040,6 +1044,7 @@ struct WsServer::Impl {
         StreamOptions stream;
         stream.quality = hello.value("quality", config.jpegQuality);
         stream.adaptive = hello.value("adaptive", true);
+        stream.frameTargetMs = hello.value("frame_target_ms", -1);
         if (hello.contains("codecs")) stream.codec = parseImageCodec(hello["codecs"][0].get<std::string>());
 
         if (hello.contains("view")) {

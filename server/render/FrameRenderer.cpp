@@ -172,6 +172,7 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
     GIS_ASSERT(scene != nullptr);
     mSceneGpu = std::make_unique<SceneGpu>(*scene);
     mScene = std::move(scene);
+    mLightPassesValid = false;
 }
 
 void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadowSide, int views) {
@@ -187,6 +188,7 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
             mShadowFbos.push_back(gl::Framebuffer::ofLayer("shadow map", {}, &mShadowDepth, v));
         mShadowSize = shadowSide;
         mShadowLayers = layers;
+        mLightPassesValid = false;
     }
     if (rsmSide != mRsmSize || layers != mRsmLayers) {
         mRsmPosition = gl::Texture::create2DArray(GL_RGBA32F, rsmSide, rsmSide, layers);
@@ -201,6 +203,7 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
                 v));
         mRsmSize = rsmSide;
         mRsmLayers = layers;
+        mLightPassesValid = false;
     }
     if (width != mWidth || height != mHeight) {
         mGPosition = gl::Texture::create2D(GL_RGBA32F, width, height);
@@ -352,7 +355,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     float widestTan = 0.0f;
     for (const LightViewModel& v : lightSet.views)
         if (!v.orthographic) widestTan = std::max(widestTan, v.tanHalfFov);
-    u.viewProj = cameraViewProj(state.camera, state.width, state.height);
+    u.viewProj = frameViewProj(state);
     u.cameraPos = glm::vec4(state.camera.position, 0.0f);
     const bool lightOn = lightSet.any();
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
@@ -371,11 +374,29 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     mTimer.beginFrame();
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
-    renderShadowMaps(views);
-    // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
     std::vector<double> viewFlux;
     const bool readsRsm = findTechniqueInfo(state.technique).readsRsm;
-    if (readsRsm) {
+    // The light views depend on the lights, the scene and the RSM's solid-angle rule only, never on
+    // the camera: with reuse on, an unchanged light block keeps last frame's maps (an orbit or the
+    // tiles of one refinement step render them once).
+    const glm::vec4 lightKey(static_cast<float>(lightSet.rsmSide), static_cast<float>(lightSet.shadowSide),
+                             u.toneInfo.w, readsRsm ? 1.0f : 0.0f);
+    const bool reuseLights = mReuseLightPasses && mLightPassesValid && lightKey == mLightPassKey &&
+                             std::memcmp(mLightPassBlock.get(), &lights, sizeof lights) == 0;
+    if (reuseLights) {
+        viewFlux = mLightPassFlux;
+        mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
+        if (readsRsm)
+            for (auto [name, texture] : {std::pair{"lights.rsm.position", &mRsmPosition},
+                                         {"lights.rsm.normal", &mRsmNormal},
+                                         {"lights.rsm.flux", &mRsmFlux},
+                                         {"lights.rsm.specular", &mRsmSpecular}})
+                mResources.publish(name, "rsm", *texture);
+    } else {
+        renderShadowMaps(views);
+    }
+    // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
+    if (readsRsm && !reuseLights) {
         renderRsms(views);
         measureViewFlux(views);
         // Several views: the VPL split needs the sums before the technique's extraction is dispatched,
@@ -383,7 +404,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
         // render depend on the frame before it). One view: the sums only feed the stats, read after
         // the frame's own read-back, when waiting costs nothing.
         if (views > 1) viewFlux = readViewFlux(views);
-    } else {
+    } else if (!readsRsm) {
         for (const char* name :
              {"lights.rsm.position", "lights.rsm.normal", "lights.rsm.flux", "lights.rsm.specular"})
             mResources.withdraw(name);
@@ -409,7 +430,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
         mSceneGpu->draw(program, nullptr, instances);
     };
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
+    const size_t techniqueFirstPass = mTimer.passCount();
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
+    const size_t techniqueEndPass = mTimer.passCount();
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     const gl::Texture* indirect = mTechnique->indirect();
@@ -444,26 +467,36 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     out.rgba8 = readRgba8(mCompositeFbo, 0, state.width, state.height);
     if (wantLinear) out.linear = readRgba32f(mCompositeFbo, 1, state.width, state.height);
     const double readbackMs = readClock.elapsedMs();
-    if (readsRsm && views == 1) viewFlux = readViewFlux(views);
+    if (readsRsm && views == 1 && !reuseLights) viewFlux = readViewFlux(views);
+    if (mReuseLightPasses && !reuseLights) {
+        if (!mLightPassBlock) mLightPassBlock = std::make_unique<shader::LightUniforms>();
+        *mLightPassBlock = lights;
+        mLightPassKey = lightKey;
+        mLightPassFlux = viewFlux;
+        mLightPassesValid = true;
+    }
     std::vector<gl::PassTiming> passes = mTimer.resolve();
     gl::logErrors("frame");
 
     nlohmann::json passJson = nlohmann::json::array();
-    for (const auto& p : passes)
+    double techniqueMs = 0.0;
+    for (size_t i = 0; i < passes.size(); ++i) {
+        const auto& p = passes[i];
         passJson.push_back({{"name", p.name}, {"gpu_ms", p.gpuMs}, {"cpu_ms", p.cpuMs}});
+        if (i >= techniqueFirstPass && i < techniqueEndPass) techniqueMs += p.gpuMs;
+    }
     nlohmann::json countJson = nlohmann::json::object();
     countJson["triangles"] = mSceneGpu->triangleCount();
     countJson["pixels"] = state.width * state.height;
+    if (reuseLights) countJson["light_views_reused"] = views;
     for (const auto& [k, v] : counters) countJson[k] = v;
     nlohmann::json params = paramsJson(state);
-    out.stats = {{"technique", state.technique},
-                 {"size", {state.width, state.height}},
-                 {"frame_ms", frameClock.elapsedMs()},
-                 {"readback_ms", readbackMs},
-                 {"timing", mTimer.usesQueries() ? "gpu_query" : "cpu_finish"},
-                 {"passes", std::move(passJson)},
-                 {"counts", std::move(countJson)},
-                 {"params", std::move(params)}};
+    out.stats = {
+        {"technique", state.technique},       {"size", {state.width, state.height}},
+        {"frame_ms", frameClock.elapsedMs()}, {"readback_ms", readbackMs},
+        {"technique_ms", techniqueMs},        {"timing", mTimer.usesQueries() ? "gpu_query" : "cpu_finish"},
+        {"passes", std::move(passJson)},      {"counts", std::move(countJson)},
+        {"params", std::move(params)}};
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
     out.stats["lighting"] = lightingStats(state, lightSet, viewFlux);

@@ -57,6 +57,10 @@ public:
     const Scene* scene() const { return mScene.get(); }
     /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics).
     FrameOutput render(const FrameState& state, bool wantLinear = false);
+    /// Keep the light views' shadow maps and RSMs while the lights, the scene and the RSM settings stay
+    /// the same (the stats' counts then have `light_views_reused`). Off by default, so that benchmarks
+    /// and tests time every pass of every frame; the service turns it on.
+    void setReuseLightPasses(bool reuse) { mReuseLightPasses = reuse; }
 
     /// The technique of the last frame (tests inspect its intermediate buffers); may be null.
     Technique* technique() { return mTechnique.get(); }
@@ -125,6 +129,12 @@ private:
     gl::Framebuffer mCompositeFbo;
 
     Reflections mReflections;
+
+    bool mReuseLightPasses = false;
+    bool mLightPassesValid = false; ///< the maps hold mLightPassBlock's views
+    std::unique_ptr<shader::LightUniforms> mLightPassBlock;
+    glm::vec4 mLightPassKey{0.0f};
+    std::vector<double> mLightPassFlux;
 
     std::string mTechniqueName;
     std::unique_ptr<Technique> mTechnique;

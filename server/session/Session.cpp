@@ -16,7 +16,9 @@
 #include "frame/Presets.h"
 #include "job/RenderRequest.h"
 #include "frame/StateJson.h"
+#include "frame/Tiles.h"
 #include "scene/SceneLoader.h"
+#include "session/FrameBudget.h"
 #include "session/RenderGate.h"
 #if GIS_HAVE_EFFECTS
 #include "effects/EffectPlan.h"
@@ -92,6 +94,7 @@ Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCach
     mDesired = makeFrameState(*mScene, mConfig.technique);
     mDesired.width = mConfig.width;
     mDesired.height = mConfig.height;
+    mSceneCamera = mDesired.camera;
 }
 
 Session::~Session() {
@@ -112,7 +115,11 @@ nlohmann::json Session::stateJsonLocked() const {
             {"camera", cameraJson(mDesired.camera)},
             {"light", lightJson(mDesired)},
             {"lights", lightsJson(mDesired)},
-            {"lighting", {{"source", mDesired.lightSource}, {"note", mDesired.lightNote}}}};
+            {"lighting", {{"source", mDesired.lightSource}, {"note", mDesired.lightNote}}},
+            {"scene_camera", cameraJson(mSceneCamera)},
+            {"bounds",
+             {{"min", {mScene->bounds.min.x, mScene->bounds.min.y, mScene->bounds.min.z}},
+              {"max", {mScene->bounds.max.x, mScene->bounds.max.y, mScene->bounds.max.z}}}}};
 }
 
 nlohmann::json Session::stateJson() const {
@@ -325,6 +332,7 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
             mSceneRequest = name;
         } else if (type == "quality") {
             mStream.adaptive = msg["adaptive"].get<bool>();
+            if (msg.contains("frame_target_ms")) mStream.frameTargetMs = msg["frame_target_ms"].get<int>();
         } else if (type == "snapshot") {
             mSnapshotFor = from;
             mSnapshotCodec = msg.value("codec", "png") == "webp" ? ImageCodec::Webp : ImageCodec::Png;
@@ -375,26 +383,236 @@ bool Session::readyLocked(Clock::time_point now) const {
            now >= mLastInput + std::chrono::milliseconds(mConfig.limits.settleMs);
 }
 
-void Session::workerMain() {
-    std::unique_ptr<gl::Context> context;
+struct Session::Worker {
     std::unique_ptr<FrameRenderer> renderer;
+    nlohmann::json presets;
+    std::shared_ptr<const Scene> scene;
+    std::uint32_t frameId = 0;
+    FrameBudget budget{FrameBudget::Config{}};
+    /// The last image sent to the controller (RGBA8): the canvas a tiled step starts from.
+    std::vector<std::uint8_t> lastImage;
+    int lastWidth = 0, lastHeight = 0;
+};
+
+int Session::frameTargetMs(const StreamOptions& stream) const {
+    return stream.frameTargetMs >= 0 ? stream.frameTargetMs : mConfig.limits.frameTargetMs;
+}
+
+bool Session::inputPending() const {
+    std::lock_guard lock(mMutex);
+    return mStop || mDirty || !mSnapshotFor.expired() || !mSceneRequest.empty();
+}
+
+void Session::recordRefineCost(const std::string& sceneName, const FrameState& state, int step,
+                               double msPerPixel) {
+    if (!(msPerPixel > 0.0) || !std::isfinite(msPerPixel)) return;
+    mRefineCost[sceneName + "/" + state.technique + "/" + std::to_string(step)] = {
+        msPerPixel, std::max(1L, vplEstimate(state))};
+}
+
+bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int width, int height,
+                      nlohmann::json stats, const std::string& quality, const StreamOptions& stream,
+                      const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec) {
+    const ImageCodec codec = snapshotFor ? snapshotCodec : stream.codec;
+    Stopwatch encodeClock;
+    std::vector<std::uint8_t> encoded;
+    try {
+        encoded = snapshotFor && codec == ImageCodec::Webp
+                      ? encodeWebpLossless(rgba.data(), width, height)
+                      : encodeImage(codec, rgba.data(), width, height, stream.quality);
+    } catch (const std::exception& e) {
+        fail(std::string("the frame could not be encoded: ") + e.what());
+        return false;
+    }
+    const double encodeMs = encodeClock.elapsedMs();
+    const std::uint32_t frameId = ++w.frameId;
+    ++mFramesRendered;
+    std::vector<std::uint8_t> message = makeFrameMessage(frameId, width, height, codec, encoded);
+    auto shared = std::make_shared<const std::string>(message.begin(), message.end());
+
+    stats["type"] = "stats";
+    stats["frame"] = frameId;
+    stats["quality"] = quality;
+    stats["refined"] = quality == "balanced" || quality == "final";
+    stats["snapshot"] = snapshotFor != nullptr;
+    stats["encode_ms"] = encodeMs;
+    stats["bytes"] = shared->size();
+    stats["codec"] = codecName(codec);
+    stats["scene"] = mSceneName.empty() ? w.scene->name : mSceneName;
+
+    FrameReport report;
+    report.quality = quality;
+    report.snapshot = snapshotFor != nullptr;
+    report.frameMs = stats.value("frame_ms", 0.0);
+    report.queueMs = stats.value("queue_ms", 0.0);
+    report.encodeMs = encodeMs;
+    report.bytes = shared->size();
+    if (stats.contains("passes"))
+        for (const auto& p : stats["passes"])
+            report.passMs.emplace_back(p.value("name", ""), p.value("gpu_ms", 0.0));
+    std::vector<std::shared_ptr<ClientLink>> targets;
+    if (snapshotFor)
+        targets.push_back(snapshotFor);
+    else
+        targets = clients();
+    const std::size_t viewers = viewerCount();
+    for (const auto& client : targets) {
+        stats["viewers"] = viewers;
+        stats["dropped_frames"] = client->droppedFrames();
+        if (client->offerFrame(frameId, stats.dump(), shared, snapshotFor != nullptr))
+            ++report.delivered;
+        else
+            ++report.dropped;
+    }
+    FrameObserver onFrame;
+    {
+        std::lock_guard lock(mMutex);
+        onFrame = mOnFrame;
+        if (!snapshotFor) mLastFrame = {frameId, stats, shared};
+    }
+    if (!snapshotFor) {
+        w.lastImage = rgba;
+        w.lastWidth = width;
+        w.lastHeight = height;
+    }
+    if (onFrame) onFrame(report);
+    return true;
+}
+
+bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
+                            const std::string& note) {
+    const std::string stepLabel = stepName(step);
+    const double fullPixels = static_cast<double>(full.width) * full.height;
+    auto progress = [&](const char* state, double share, double etaMs, const std::string& reason) {
+        nlohmann::json msg = {{"type", "progress"}, {"state", state},  {"step", stepLabel},
+                              {"share", share},     {"eta_ms", etaMs}, {"reason", reason}};
+        broadcastText(msg);
+    };
+    const int sliceMs = std::max(5, mConfig.limits.sliceMs);
+    // ms per rendered pixel of this step's tiles: measured once a tile ran, before that predicted from
+    // the interactive frames' model (VPLs included) with a margin, else a 64 x 64 first tile.
+    double rate = 0.0;
+    if (auto own = mRefineCost.find(w.scene->name + "/" + full.technique + "/" + std::to_string(step));
+        own != mRefineCost.end())
+        rate = own->second.msPerPixel;
+    if (!(rate > 0.0)) {
+        const double predicted =
+            w.budget.predictMs(w.scene->name + "/" + full.technique, fullPixels, vplEstimate(full));
+        if (predicted > 0.0) rate = 2.0 * predicted / fullPixels;
+    }
+    const int guard = tileGuardPx(full);
+    std::vector<std::uint8_t> canvas =
+        resizeRgba8(w.lastImage, w.lastWidth, w.lastHeight, full.width, full.height);
+    TilePlan plan(full.width, full.height);
+    Stopwatch stepClock;
+    Stopwatch sinceSend;
+    bool sentOnce = false;
+    double renderedMs = 0.0;
+    progress("refining", 0.0, rate > 0.0 ? rate * fullPixels : 0.0,
+             "the view is still: rendering the " + stepLabel + " step in tiles of about " +
+                 std::to_string(sliceMs) + " ms" + (note.empty() ? std::string() : "; " + note));
+    while (!plan.done()) {
+        if (inputPending()) {
+            progress("abandoned", plan.shareDone(), 0.0, "input arrived: the frame answers it first");
+            return true;
+        }
+        const double pixels = rate > 0.0 ? sliceMs / rate : 64.0 * 64.0;
+        // The guard band is rendered too: ask for fewer inner pixels so the whole tile fits the slice.
+        const double side = std::sqrt(std::max(pixels, 1.0));
+        const double inner = std::max(1.0, side - 2.0 * guard);
+        const TileRect rect = plan.next(inner * inner);
+        FrameState tile = tileState(full, rect, guard);
+        Stopwatch queueClock;
+        std::optional<RenderGate::Permit> permit;
+        if (mGate) {
+            permit = mGate->acquire(mStop);
+            if (!permit) return true;
+        }
+        const double queueMs = queueClock.elapsedMs();
+        FrameOutput frame;
+        Stopwatch renderClock;
+        try {
+            frame = w.renderer->render(tile);
+        } catch (const std::exception& e) {
+            fail(std::string("the frame could not be rendered: ") + e.what());
+            return false;
+        }
+        permit.reset();
+        const double tileMs = renderClock.elapsedMs();
+        renderedMs += tileMs;
+        const double tilePixels = static_cast<double>(tile.width) * tile.height;
+        const double measured = tileMs / tilePixels;
+        // The newest tile counts most, but a slow one counts at once: tiles must not overrun.
+        rate = rate > 0.0 ? std::max(measured, 0.5 * (rate + measured)) : measured;
+        recordRefineCost(w.scene->name, full, step, rate);
+        pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
+
+        const bool last = plan.done();
+        const double share = plan.shareDone();
+        const double etaMs = rate * fullPixels * (1.0 - share) * (tilePixels / std::max(1.0, inner * inner));
+        // Send when the controller's window has room, at most every 150 ms, and always the last tile
+        // (waiting for room, unless input comes first).
+        bool send = false;
+        {
+            std::unique_lock lock(mMutex);
+            if (last)
+                mCv.wait(lock, [&] { return mStop || mDirty || !mController || !mController->windowFull(); });
+            send = mController && !mController->windowFull() &&
+                   (last || !sentOnce || sinceSend.elapsedMs() >= 150.0);
+        }
+        if (!send) continue;
+        nlohmann::json stats = frame.stats;
+        stats["size"] = {full.width, full.height};
+        stats["tile"] = {{"x", rect.x}, {"y", rect.y}, {"size", {rect.width, rect.height}}, {"guard", guard}};
+        stats["scale"] = 1.0;
+        stats["queue_ms"] = queueMs;
+        stats["params"] = paramsJson(full);
+        if (!full.plan.is_null()) stats["plan"] = full.plan;
+        stats["refine"] = {{"step", stepLabel},       {"tiles_done", plan.tilesDone()},
+                           {"share", share},          {"elapsed_ms", stepClock.elapsedMs()},
+                           {"render_ms", renderedMs}, {"eta_ms", last ? 0.0 : etaMs},
+                           {"complete", last}};
+        if (!deliver(w, canvas, full.width, full.height, std::move(stats), stepLabel, stream, nullptr,
+                     ImageCodec::Png))
+            return false;
+        sentOnce = true;
+        sinceSend = Stopwatch();
+    }
+    if (step == static_cast<int>(Step::Final))
+        progress("done", 1.0, 0.0,
+                 "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) +
+                     " ms");
+    return true;
+}
+
+void Session::workerMain() {
+    Worker w;
+    std::unique_ptr<gl::Context> context;
     try {
         context = gl::createContext(mConfig.backend);
-        renderer = std::make_unique<FrameRenderer>();
-        renderer->setScene(mScene);
+        w.renderer = std::make_unique<FrameRenderer>();
+        w.renderer->setReuseLightPasses(true);
+        w.renderer->setScene(mScene);
     } catch (const std::exception& e) {
         fail(std::string("the renderer could not start: ") + e.what());
         return;
     }
-    nlohmann::json presets;
     try {
-        presets = loadPresets(defaultPresetsPath());
+        w.presets = loadPresets(defaultPresetsPath());
     } catch (const std::exception& e) {
         logWarn("session " + mId +
                 ": no presets, adaptive quality renders every step as requested: " + e.what());
     }
-    std::uint32_t frameId = 0;
-    std::shared_ptr<const Scene> scene = mScene;
+    {
+        FrameBudget::Config budget;
+        budget.targetMs = mConfig.limits.frameTargetMs;
+        budget.maxScale = std::clamp(mConfig.limits.interactiveScale, 0.05, 1.0);
+        budget.preferredMinScale = std::min(budget.preferredMinScale, budget.maxScale);
+        budget.minScale = std::min(budget.minScale, budget.preferredMinScale);
+        budget.firstScale = std::min(budget.firstScale, budget.maxScale);
+        w.budget = FrameBudget(budget);
+    }
+    w.scene = mScene;
 #if GIS_HAVE_EFFECTS
     std::string planKey;
     EffectPlan plan;
@@ -456,13 +674,14 @@ void Session::workerMain() {
                         (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
                         std::to_string(next->triangleCount()) + " triangles, " +
                         std::to_string(static_cast<long>(loadClock.elapsedMs())) + " ms)");
-                renderer->setScene(next);
-                scene = next;
+                w.renderer->setScene(next);
+                w.scene = next;
                 nlohmann::json stateMsg;
                 {
                     std::lock_guard lock(mMutex);
                     FrameState fresh = makeFrameState(*next, mDesired.technique);
                     mDesired.camera = fresh.camera;
+                    mSceneCamera = fresh.camera;
                     mDesired.lights = fresh.lights;
                     mDesired.lightSource = fresh.lightSource;
                     mDesired.lightNote = fresh.lightNote;
@@ -478,23 +697,29 @@ void Session::workerMain() {
                 if (mOnError) mOnError("scene_load_failed");
             }
         }
+        const std::shared_ptr<const Scene>& scene = w.scene;
         {
             std::lock_guard lock(mMutex);
             state = mDesired;
         }
-        // Adaptive steps: the step's preset under the client's explicit parameters, smaller frames
-        // while interacting (protocol/PROTOCOL.md, "Adaptive quality").
+        // Adaptive steps: the step's preset under the client's explicit parameters; interactive
+        // frames sized (and their VPLs capped) by the frame budget (protocol/PROTOCOL.md, "Adaptive
+        // quality").
         double scale = 1.0;
+        std::string refineNote; // why a refinement step renders less than its preset
+        nlohmann::json budgetJson;
+        const std::string budgetKey = scene->name + "/" + state.technique;
+        long budgetVpls = 0;
         if (step >= 0) {
             static const char* presetNames[] = {"interactive", "balanced", "final"};
             const FrameState requested = state;
             auto presetState = [&](int s) {
                 FrameState out = requested;
-                if (presets.is_null()) return out;
+                if (w.presets.is_null()) return out;
                 try {
                     FrameState preset = requested;
                     preset.techniqueParams.resetToDefaults();
-                    applyPreset(preset, presets, presetNames[s]);
+                    applyPreset(preset, w.presets, presetNames[s]);
                     nlohmann::json techniqueExplicit = nlohmann::json::object();
                     for (const auto& [k, v] : explicitParams.items())
                         if (preset.techniqueParams.has(k)) techniqueExplicit[k] = v;
@@ -527,11 +752,56 @@ void Session::workerMain() {
             }
             if (step != static_cast<int>(Step::Interactive) && !snapshotFor &&
                 mConfig.limits.refineBudgetMs > 0) {
+                const double budgetMs = mConfig.limits.refineBudgetMs;
                 const double predictedMs = predictRefineMs(scene->name, state, step);
-                if (predictedMs > mConfig.limits.refineBudgetMs) continue; // too slow to refine to
+                if (predictedMs > budgetMs) {
+                    // Over the budget: fewer VPLs where the technique can take them (the step's cost is
+                    // about proportional to them), else the step is skipped; the client is told which.
+                    const TechniqueInfo& info = findTechniqueInfo(state.technique);
+                    const long vpls = vplEstimate(state);
+                    const long cap =
+                        static_cast<long>(0.9 * static_cast<double>(vpls) * budgetMs / predictedMs);
+                    const std::string over =
+                        "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
+                        " s, over the server's refinement budget of " +
+                        std::to_string(std::lround(budgetMs / 1000.0)) + " s (--refine-budget-ms)";
+                    if (info.limitVpls && cap >= 16) {
+                        info.limitVpls(state.techniqueParams, cap);
+                        refineNote = "capped at " + std::to_string(vplEstimate(state)) + " of " +
+                                     std::to_string(vpls) + " VPLs: " + over;
+                    } else {
+                        broadcastText({{"type", "progress"},
+                                       {"state", "skipped"},
+                                       {"step", stepName(step)},
+                                       {"share", 0.0},
+                                       {"eta_ms", predictedMs},
+                                       {"reason", over}});
+                        continue;
+                    }
+                }
             }
             if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
-                scale = std::clamp(mConfig.limits.interactiveScale, 0.05, 1.0);
+                const int target = frameTargetMs(stream);
+                budgetVpls = vplEstimate(state);
+                if (target > 0) {
+                    w.budget.setTargetMs(target);
+                    const TechniqueInfo& info = findTechniqueInfo(state.technique);
+                    const BudgetChoice choice =
+                        w.budget.choose(budgetKey, budgetVpls, static_cast<bool>(info.limitVpls),
+                                        static_cast<double>(state.width) * state.height);
+                    scale = choice.scale;
+                    if (choice.vplCap > 0 && info.limitVpls)
+                        info.limitVpls(state.techniqueParams, choice.vplCap);
+                    budgetJson = choice.toJson(target, budgetVpls);
+                } else {
+                    scale = std::clamp(mConfig.limits.interactiveScale, 0.05, 1.0);
+                    budgetJson = {{"target_ms", 0},
+                                  {"scale", scale},
+                                  {"vpls", budgetVpls},
+                                  {"vpl_cap", nullptr},
+                                  {"predicted_ms", 0},
+                                  {"reason", "no frame-time target: the server's interactive scale"}};
+                }
                 state.width = std::max(16, static_cast<int>(std::lround(state.width * scale)));
                 state.height = std::max(16, static_cast<int>(std::lround(state.height * scale)));
             }
@@ -548,6 +818,12 @@ void Session::workerMain() {
             applyEffectPlan(state, plan);
         }
 #endif
+        const bool refinement = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
+                                                 step == static_cast<int>(Step::Final));
+        if (refinement) {
+            if (!refineInTiles(w, state, step, stream, refineNote)) break;
+            continue;
+        }
         // Admission: at most the server's cap of renders at once, first come first served.
         Stopwatch queueClock;
         std::optional<RenderGate::Permit> permit;
@@ -559,7 +835,7 @@ void Session::workerMain() {
         FrameOutput frame;
         Stopwatch renderClock;
         try {
-            frame = renderer->render(state);
+            frame = w.renderer->render(state);
         } catch (const std::exception& e) {
             // A failed render leaves the context in an unknown state: the session ends rather than
             // failing again on every input.
@@ -568,73 +844,31 @@ void Session::workerMain() {
         }
         permit.reset();
         if (step >= 0 && frame.width > 0 && frame.height > 0)
-            mRefineCost[scene->name + "/" + state.technique + "/" + std::to_string(step)] = {
-                renderClock.elapsedMs() / (static_cast<double>(frame.width) * frame.height),
-                std::max(1L, vplEstimate(state))};
-        const ImageCodec codec = snapshotFor ? snapshotCodec : stream.codec;
-        Stopwatch encodeClock;
-        std::vector<std::uint8_t> encoded;
-        try {
-            encoded = snapshotFor && codec == ImageCodec::Webp
-                          ? encodeWebpLossless(frame.rgba8.data(), frame.width, frame.height)
-                          : encodeImage(codec, frame.rgba8.data(), frame.width, frame.height, stream.quality);
-        } catch (const std::exception& e) {
-            fail(std::string("the frame could not be encoded: ") + e.what());
-            break;
-        }
-        const double encodeMs = encodeClock.elapsedMs();
-        ++frameId;
-        ++mFramesRendered;
-        std::vector<std::uint8_t> message =
-            makeFrameMessage(frameId, frame.width, frame.height, codec, encoded);
-        auto shared = std::make_shared<const std::string>(message.begin(), message.end());
-
+            recordRefineCost(scene->name, state, step,
+                             renderClock.elapsedMs() / (static_cast<double>(frame.width) * frame.height));
         nlohmann::json stats = frame.stats;
-        stats["type"] = "stats";
-        stats["frame"] = frameId;
-        stats["quality"] = stepName(step);
-        stats["refined"] = step == static_cast<int>(Step::Balanced) || step == static_cast<int>(Step::Final);
         stats["scale"] = scale;
-        stats["snapshot"] = snapshotFor != nullptr;
         stats["queue_ms"] = queueMs;
-        stats["encode_ms"] = encodeMs;
-        stats["bytes"] = shared->size();
-        stats["codec"] = codecName(codec);
-        stats["scene"] = mSceneName.empty() ? scene->name : mSceneName;
-
-        FrameReport report;
-        report.quality = stepName(step);
-        report.snapshot = snapshotFor != nullptr;
-        report.frameMs = stats.value("frame_ms", 0.0);
-        report.queueMs = queueMs;
-        report.encodeMs = encodeMs;
-        report.bytes = shared->size();
-        if (stats.contains("passes"))
-            for (const auto& p : stats["passes"])
-                report.passMs.emplace_back(p.value("name", ""), p.value("gpu_ms", 0.0));
-        std::vector<std::shared_ptr<ClientLink>> targets;
-        if (snapshotFor)
-            targets.push_back(snapshotFor);
-        else
-            targets = clients();
-        const std::size_t viewers = viewerCount();
-        for (const auto& client : targets) {
-            stats["viewers"] = viewers;
-            stats["dropped_frames"] = client->droppedFrames();
-            if (client->offerFrame(frameId, stats.dump(), shared, snapshotFor != nullptr))
-                ++report.delivered;
-            else
-                ++report.dropped;
+        if (!budgetJson.is_null()) stats["budget"] = budgetJson;
+        const double frameMs = frame.stats.value("frame_ms", 0.0);
+        const double techniqueMs = frame.stats.value("technique_ms", 0.0);
+        if (!deliver(w, frame.rgba8, frame.width, frame.height, std::move(stats), stepName(step), stream,
+                     snapshotFor, snapshotCodec))
+            break;
+        if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
+            FrameCost cost;
+            cost.pixels = static_cast<double>(frame.width) * frame.height;
+            cost.vpls = vplEstimate(state);
+            cost.frameMs = frameMs;
+            cost.techniqueMs = techniqueMs;
+            {
+                std::lock_guard lock(mMutex);
+                cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);
+            }
+            w.budget.record(budgetKey, cost);
         }
-        FrameObserver onFrame;
-        {
-            std::lock_guard lock(mMutex);
-            onFrame = mOnFrame;
-            if (!snapshotFor) mLastFrame = {frameId, stats, shared};
-        }
-        if (onFrame) onFrame(report);
     }
-    renderer.reset(); // GL objects die while the context is still current
+    w.renderer.reset(); // GL objects die while the context is still current
     context.reset();
 }
 

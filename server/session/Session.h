@@ -39,12 +39,21 @@ class RenderGate;
 struct SessionLimits {
     int maxWidth = 2048, maxHeight = 2048; ///< px; larger requests are scaled down, aspect kept
     long maxVpls = 65536;                  ///< upper bound on VPLs a parameter set may ask for
-    double interactiveScale = 0.5;         ///< (0, 1]: size factor of interactive frames
-    int settleMs = 250;                    ///< ms without input before refinement starts
-    /// ms; a refinement step whose predicted time exceeds this is skipped, so input never waits long
-    /// behind it: from the last one of its kind scaled by the pixel count, or before the first one,
-    /// from the previous step scaled by pixels and VPLs. 0 = no limit.
-    int refineBudgetMs = 5000;
+    /// (0, 1]: the largest size factor of interactive frames (with frameTargetMs 0: the factor).
+    double interactiveScale = 1.0;
+    /// ms of render and encode an interactive frame should take: the frame budget picks its size and
+    /// VPL cap from measured costs (session/FrameBudget.h); a client may ask for its own in `hello` or
+    /// `quality`. 0 = no budget: interactive frames at interactiveScale with their preset.
+    int frameTargetMs = 80;
+    /// ms one tile of a refinement step should take (tiles are sized from measured slice times), so an
+    /// input waits for at most about this much before its own frame starts rendering.
+    int sliceMs = 40;
+    int settleMs = 250; ///< ms without input before refinement starts
+    /// ms; a refinement step whose predicted total time exceeds this is skipped (and the client told
+    /// so): from the measured tiles of its kind, or before the first one, from the previous step scaled
+    /// by pixels and VPLs. Steps are rendered in tiles that input interrupts, so this bounds the work,
+    /// not the wait. 0 = no limit.
+    int refineBudgetMs = 30000;
 };
 
 struct SessionConfig {
@@ -60,6 +69,7 @@ struct StreamOptions {
     ImageCodec codec = ImageCodec::Jpeg;
     int quality = 85; ///< JPEG/WebP quality [1, 100]
     bool adaptive = true;
+    int frameTargetMs = -1; ///< the client's frame-time target; -1: the server's (limits)
 };
 
 /// What one rendered frame cost, for the server's metrics (called on the worker thread).
@@ -130,7 +140,20 @@ public:
 
 private:
     enum class Step { Interactive, Balanced, Final, Done };
-    struct Job;
+    struct Worker;
+    /// Encodes and offers one image to the clients (or to the snapshot's), with its stats; false when
+    /// the encoder failed (the session has failed then).
+    bool deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int width, int height,
+                 nlohmann::json stats, const std::string& quality, const StreamOptions& stream,
+                 const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec);
+    /// Renders a balanced or final step in tiles of about limits.sliceMs each, sending the image as
+    /// it fills in; returns at the first tile boundary after input arrives (progress "abandoned"),
+    /// when done, or false when the renderer failed.
+    bool refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
+                       const std::string& note);
+    /// True when input (or a snapshot, or stop) waits: refinement yields to it.
+    bool inputPending() const;
+    int frameTargetMs(const StreamOptions& stream) const;
     nlohmann::json stateJsonLocked() const;
     void markInput(); // requires mMutex
     bool readyLocked(std::chrono::steady_clock::time_point now) const;
@@ -153,6 +176,7 @@ private:
     mutable std::mutex mMutex;
     std::condition_variable mCv;
     FrameState mDesired;
+    Camera mSceneCamera; ///< the scene's own camera (state.scene_camera: what "reset camera" returns to)
     nlohmann::json mExplicit = nlohmann::json::object(); ///< parameters the client set (win over presets)
     std::string mSceneName;
     std::shared_ptr<const Scene> mScene;
@@ -177,6 +201,7 @@ private:
     /// Worker only: scene/technique/step -> the last measured cost of that adaptive step.
     std::map<std::string, StepCost> mRefineCost;
     double predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const;
+    void recordRefineCost(const std::string& sceneName, const FrameState& state, int step, double msPerPixel);
     std::atomic<bool> mStop{false};
     std::atomic<std::uint64_t> mFramesRendered{0};
     std::thread mWorker;

@@ -411,9 +411,12 @@ check('over --rate-limit messages are dropped with rate_limited and the connecti
 // Adaptive quality
 
 check('adaptive quality: interactive at half size while steering, then balanced and final without input', async () => {
-    const client = await open(servers.main, { adaptive: true });
+    // frame_target_ms 0: no frame budget, so interactive frames are exactly --interactive-scale.
+    const client = await open(servers.main, { adaptive: true, frame_target_ms: 0 });
     assert.equal(client.welcome.adaptive, true);
+    assert.equal(client.welcome.frame_target_ms, 0, 'welcome.frame_target_ms echoes hello');
     assert.equal(client.welcome.limits?.interactive_scale, 0.5, 'welcome.limits.interactive_scale');
+    assert.equal(client.welcome.limits?.frame_target_ms, 80, 'welcome.limits.frame_target_ms');
     client.send({ type: 'technique', name: 'rsm_gather' });
     client.send({ type: 'params', values: { vpl_grid: 4 } }); // parameters set by the client win over every preset
     const interactive = await client.frame('interactive frame',
@@ -421,24 +424,76 @@ check('adaptive quality: interactive at half size while steering, then balanced 
     assert.equal(interactive.stats.scale, 0.5, 'stats.scale');
     assert.deepEqual(interactive.stats.size, SIZE.map((v) => v * 0.5), 'half the requested size');
     assert.equal(interactive.stats.refined, false, 'interactive frames are not refined');
+    assert.match(interactive.stats.budget?.reason ?? '', /no frame-time target/);
 
-    // No further input: the session refines on its own.
+    // No further input: the session refines on its own, in tiles, each frame the full image so far.
     const steps = [];
     let frame = interactive;
-    while (frame.stats.quality !== 'final') {
+    while (!(frame.stats.quality === 'final' && frame.stats.refine?.complete)) {
         frame = await client.frame('refinement frame', (s) => s.frame > frame.stats.frame);
         steps.push(frame.stats.quality);
-        assert.ok(steps.length <= 4, `refinement ends with final: ${steps}`);
+        assert.ok(steps.length <= 200, `refinement ends with a complete final: ${steps}`);
+        if (frame.stats.refined) {
+            assert.deepEqual(frame.stats.size, SIZE, 'refinement frames are full size');
+            assert.ok(frame.stats.refine.share > 0 && frame.stats.refine.share <= 1, 'refine.share');
+        }
     }
-    assert.deepEqual(steps.filter((q) => q !== 'interactive'), ['balanced', 'final'], `balanced, then final: ${steps}`);
-    assert.equal(frame.stats.refined, true, 'final is refined');
-    assert.deepEqual(frame.stats.size, SIZE, 'final is full size');
+    assert.deepEqual([...new Set(steps.filter((q) => q !== 'interactive'))], ['balanced', 'final'], `balanced, then final: ${steps}`);
+    assert.equal(frame.stats.refine.share, 1, 'the final frame covers the image');
+    const done = await client.inbox.next((m) => m.type === 'progress' && m.state === 'done', 'progress done', 5000);
+    assert.equal(done.step, 'final');
     await assert.rejects(client.inbox.nextOfType('stats', 'a frame after final', 600), /nothing within/,
         'nothing is rendered after final without input');
 
     client.send({ type: 'camera', position: [0.7, 1.1, 3.6], target: [0, 1, 0] });
     const again = await client.frame('input restarts at interactive', (s) => s.frame > frame.stats.frame);
     assert.equal(again.stats.quality, 'interactive');
+});
+
+check('the frame budget sizes interactive frames from what they measured, and says why', async () => {
+    const client = await open(servers.main, { adaptive: true, frame_target_ms: 200 });
+    client.send({ type: 'technique', name: 'rsm_gather' });
+    let frame = await client.frame('first interactive frame', (s) => s.quality === 'interactive' && s.technique === 'rsm_gather');
+    for (let i = 0; i < 4; i++) {
+        client.send({ type: 'camera', position: [0.2 * i, 1, 3.9], target: [0, 1, 0] });
+        frame = await client.frame('interactive frame', (s) => s.quality === 'interactive' && s.frame > frame.stats.frame);
+    }
+    const budget = frame.stats.budget;
+    assert.equal(budget.target_ms, 200);
+    assert.ok(budget.scale > 0 && budget.scale <= 0.5, `scale within (0, interactive_scale]: ${budget.scale}`);
+    assert.equal(frame.stats.scale, budget.scale);
+    assert.ok(typeof budget.reason === 'string' && budget.reason.length > 10, 'a reason');
+    assert.ok(budget.predicted_ms > 0, 'predicted from measured frames');
+    // A tiny target caps the VPLs of a large set and says so.
+    client.send({ type: 'quality', adaptive: true, frame_target_ms: 1 });
+    client.send({ type: 'params', values: { vpl_grid: 64 } });
+    for (let i = 0; i < 4; i++) {
+        client.send({ type: 'camera', position: [0.1 * i, 1, 3.8], target: [0, 1, 0] });
+        frame = await client.frame('interactive frame', (s) => s.quality === 'interactive' && s.frame > frame.stats.frame);
+    }
+    assert.equal(frame.stats.budget.target_ms, 1);
+    assert.equal(frame.stats.budget.vpls, 4096);
+    assert.ok(frame.stats.budget.vpl_cap > 0 && frame.stats.budget.vpl_cap < 4096, `VPLs capped: ${JSON.stringify(frame.stats.budget)}`);
+    assert.ok(frame.stats.counts.vpl_count < 4096, 'the frame rendered fewer VPLs');
+    // stats.params are what the frame rendered with; the session keeps what the client set.
+    assert.ok(frame.stats.params.vpl_grid ** 2 <= frame.stats.budget.vpl_cap, 'rendered within the cap');
+});
+
+check('input during a slow refinement is answered at the next tile', async () => {
+    // 65,536 VPLs: seconds per refinement step on a CPU, rendered in tiles that input interrupts.
+    const client = await open(servers.main, { adaptive: true });
+    client.send({ type: 'technique', name: 'rsm_gather' });
+    client.send({ type: 'params', values: { vpl_grid: 256 } });
+    const refining = await client.frame('a refinement tile', (s) => s.refined && s.refine && !s.refine.complete, 60000);
+    assert.ok(refining.stats.refine.share < 1);
+    const sent = Date.now();
+    client.send({ type: 'camera', position: [0.5, 1.1, 3.7], target: [0, 1, 0] });
+    const answer = await client.frame('the answer to input', (s) => s.quality === 'interactive' && s.frame > refining.stats.frame, 10000);
+    const waited = Date.now() - sent;
+    const abandoned = await client.inbox.next((m) => m.type === 'progress' && m.state === 'abandoned', 'progress abandoned', 5000);
+    assert.ok(abandoned.share < 1);
+    // One tile (about --slice-ms) plus one interactive frame; generous for a loaded CI machine.
+    assert.ok(waited < 3000, `input answered after ${waited} ms (frame ${answer.stats.frame_ms} ms)`);
 });
 
 // ---------------------------------------------------------------------------------------------

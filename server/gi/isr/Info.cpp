@@ -1,5 +1,7 @@
 // The catalog entry of `isr` (image-space radiosity): its parameter table and capabilities, GL-free
 // (gi/Catalog.h). The passes are in Isr.cpp.
+#include <algorithm>
+
 #include "gi/Catalog.h"
 #include "gi/common/ParamSpecs.h"
 
@@ -46,6 +48,13 @@ TechniqueInfo isrInfo() {
                        "image-space radiosity: per-frame light-space patches gathered at stencil receivers",
                        "001 §3.4", ParamTable(std::move(specs))};
     info.vplEstimate = [](const ParamSet& p, const ParamSet&) { return squared(p.getInt("isr_finest")); };
+    // The cut never goes finer than isr_finest (nor than the coarsest level, isr_coarsest).
+    info.limitVpls = [](ParamSet& p, long vpls) {
+        long side = p.getInt("isr_finest");
+        while (side > 1 && side * side > vpls) side = side / 2;
+        p.set("isr_finest", std::max(1L, side));
+        if (p.getInt("isr_coarsest") > side) p.set("isr_coarsest", side);
+    };
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     return info;

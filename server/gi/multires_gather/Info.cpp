@@ -11,6 +11,7 @@ TechniqueInfo multiresGatherInfo() {
     TechniqueInfo info{"multires_gather", "stencil-selected multiresolution gather from grid VPLs, upsampled",
                        "001 §3.2", ParamTable(std::move(specs))};
     info.vplEstimate = gridVplEstimate;
+    info.limitVpls = limitGridVpls;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     return info;

@@ -66,6 +66,7 @@ TechniqueInfo multiresSplatInfo() {
                        "000 §3", ParamTable(std::move(specs)),
                        [](const ParamSet& params) { return params.getEnum("refinement") == "illumination"; }};
     info.vplEstimate = gridVplEstimate;
+    info.limitVpls = limitGridVpls;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     return info;

@@ -11,6 +11,7 @@ TechniqueInfo rsmGatherInfo() {
                        "000 §3, Eq. 2", ParamTable(withVplShadowParams(vplParamSpecs(VplKernel::Point))),
                        [](const ParamSet&) { return true; }};
     info.vplEstimate = gridVplEstimate;
+    info.limitVpls = limitGridVpls;
     info.vplVisibility = true;
     info.biasCompensation = true;
     return info;
@@ -28,6 +29,7 @@ TechniqueInfo ssbcInfo() {
     TechniqueInfo info{"ssbc", "clamped grid-VPL gather (K3) with screen-space bias compensation", "002 §3-4",
                        ParamTable(std::move(specs)), [](const ParamSet&) { return true; }};
     info.vplEstimate = gridVplEstimate;
+    info.limitVpls = limitGridVpls;
     info.vplVisibility = true;
     info.biasCompensation = true;
     return info;

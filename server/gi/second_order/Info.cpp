@@ -1,5 +1,8 @@
 // The catalog entry of `second_order` (second-order illumination with negative lights): its parameter table
 // and capabilities, GL-free (gi/Catalog.h). The passes are in SecondOrder.cpp.
+#include <algorithm>
+#include <cmath>
+
 #include "gi/Catalog.h"
 #include "gi/common/ParamSpecs.h"
 #include "gi/second_order/Limits.h"
@@ -62,7 +65,20 @@ TechniqueInfo secondOrderInfo() {
     info.vplEstimate = [](const ParamSet& p, const ParamSet&) {
         return static_cast<long>(p.getInt("positive_count")) + p.getInt("negative_count");
     };
+    // Negative lights shadow what the positive ones light: both shrink in proportion.
+    info.limitVpls = [](ParamSet& p, long vpls) {
+        const long positive = p.getInt("positive_count"), negative = p.getInt("negative_count");
+        if (positive + negative <= vpls || positive + negative <= 0) return;
+        const double f = static_cast<double>(std::max(vpls, 1L)) / static_cast<double>(positive + negative);
+        const ParamSpec* spec = p.table().find("positive_count");
+        const long minPositive = spec ? static_cast<long>(spec->min) : 1;
+        p.set("positive_count", std::max(minPositive, static_cast<long>(std::floor(positive * f))));
+        const ParamSpec* nspec = p.table().find("negative_count");
+        const long minNegative = nspec ? static_cast<long>(nspec->min) : 0;
+        p.set("negative_count", std::max(minNegative, static_cast<long>(std::floor(negative * f))));
+    };
     info.biasCompensation = true;
+    info.viewSampled = true;
     return info;
 }
 

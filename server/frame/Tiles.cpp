@@ -1,0 +1,151 @@
+#include "frame/Tiles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "core/Error.h"
+#include "gi/Catalog.h"
+
+namespace gis {
+
+int tileGuardPx(const FrameState& full) {
+    const TechniqueInfo& info = findTechniqueInfo(full.technique);
+    const ParamSet& p = full.techniqueParams;
+    int guard = 0;
+    if (info.eyeHierarchy && p.has("coarsest_size")) {
+        const int longer = std::max(full.width, full.height);
+        const int coarsest = std::max(1, p.getInt("coarsest_size"));
+        guard = std::min(64, (longer + coarsest - 1) / coarsest);
+    }
+    if (info.biasCompensation && p.has("ssbc_iterations") && p.getInt("ssbc_iterations") > 0)
+        guard = std::max(guard, 32);
+    return guard;
+}
+
+FrameState tileState(const FrameState& full, const TileRect& rect, int guard) {
+    GIS_ASSERT(rect.width > 0 && rect.height > 0 && guard >= 0);
+    GIS_ASSERT(!full.window.active());
+    FrameState tile = full;
+    tile.width = rect.width + 2 * guard;
+    tile.height = rect.height + 2 * guard;
+    tile.window = {rect.x - guard, rect.y - guard, full.width, full.height};
+    const TechniqueInfo& info = findTechniqueInfo(full.technique);
+    if (info.eyeHierarchy && tile.techniqueParams.has("coarsest_size")) {
+        const double ratio = static_cast<double>(std::max(tile.width, tile.height)) /
+                             static_cast<double>(std::max({full.width, full.height, 1}));
+        const ParamSpec* spec = tile.techniqueParams.table().find("coarsest_size");
+        const int maxSize = spec ? static_cast<int>(spec->max) : 256;
+        const int scaled =
+            static_cast<int>(std::lround(full.techniqueParams.getInt("coarsest_size") * ratio));
+        tile.techniqueParams.set("coarsest_size", std::clamp(scaled, 1, maxSize));
+    }
+    return tile;
+}
+
+void pasteTile(std::vector<std::uint8_t>& canvas, int fullWidth, int fullHeight,
+               const std::vector<std::uint8_t>& tile, int tileWidth, int tileHeight, const TileRect& rect,
+               int guard) {
+    GIS_ASSERT(canvas.size() == static_cast<std::size_t>(fullWidth) * fullHeight * 4);
+    GIS_ASSERT(tile.size() == static_cast<std::size_t>(tileWidth) * tileHeight * 4);
+    const int x0 = std::max(rect.x, 0), x1 = std::min(rect.x + rect.width, fullWidth);
+    const int y0 = std::max(rect.y, 0), y1 = std::min(rect.y + rect.height, fullHeight);
+    if (x1 <= x0) return;
+    for (int y = y0; y < y1; ++y) {
+        const int ty = y - rect.y + guard, tx = x0 - rect.x + guard;
+        if (ty < 0 || ty >= tileHeight || tx < 0 || tx + (x1 - x0) > tileWidth) continue;
+        std::memcpy(canvas.data() + (static_cast<std::size_t>(y) * fullWidth + x0) * 4,
+                    tile.data() + (static_cast<std::size_t>(ty) * tileWidth + tx) * 4,
+                    static_cast<std::size_t>(x1 - x0) * 4);
+    }
+}
+
+std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
+                                      int width, int height) {
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(width) * height * 4, 0);
+    if (srcWidth <= 0 || srcHeight <= 0 || src.size() < static_cast<std::size_t>(srcWidth) * srcHeight * 4)
+        return out;
+    const double sx = static_cast<double>(srcWidth) / width, sy = static_cast<double>(srcHeight) / height;
+    for (int y = 0; y < height; ++y) {
+        // Pixel centres map to pixel centres; samples outside the source clamp to its edge.
+        const double fy = std::clamp((y + 0.5) * sy - 0.5, 0.0, srcHeight - 1.0);
+        const int y0 = static_cast<int>(fy), y1 = std::min(y0 + 1, srcHeight - 1);
+        const double wy = fy - y0;
+        for (int x = 0; x < width; ++x) {
+            const double fx = std::clamp((x + 0.5) * sx - 0.5, 0.0, srcWidth - 1.0);
+            const int x0 = static_cast<int>(fx), x1 = std::min(x0 + 1, srcWidth - 1);
+            const double wx = fx - x0;
+            for (int c = 0; c < 4; ++c) {
+                auto at = [&](int px, int py) {
+                    return static_cast<double>(src[(static_cast<std::size_t>(py) * srcWidth + px) * 4 + c]);
+                };
+                const double v = (at(x0, y0) * (1 - wx) + at(x1, y0) * wx) * (1 - wy) +
+                                 (at(x0, y1) * (1 - wx) + at(x1, y1) * wx) * wy;
+                out[(static_cast<std::size_t>(y) * width + x) * 4 + c] =
+                    static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
+            }
+        }
+    }
+    return out;
+}
+
+TilePlan::TilePlan(int fullWidth, int fullHeight, int align, int minSide)
+    : mFullWidth(std::max(fullWidth, 1)), mFullHeight(std::max(fullHeight, 1)), mAlign(std::max(align, 1)),
+      mMinSide(std::max(minSide, 1)) {}
+
+int TilePlan::sideFor(double pixels, int limit) const {
+    // Rounded up to the alignment, at least minSide, at most the image's (aligned) extent.
+    const double side = std::sqrt(std::max(pixels, 1.0));
+    int s = static_cast<int>(std::ceil(side / mAlign)) * mAlign;
+    const int cap = ((limit + mAlign - 1) / mAlign) * mAlign;
+    return std::clamp(s, std::min(mMinSide, cap), cap);
+}
+
+TileRect TilePlan::next(double pixels) {
+    GIS_ASSERT(!done());
+    pixels = std::max(pixels, 1.0);
+    if (mBandHeight == 0) {
+        const double last = static_cast<double>(mTileWidth) * mLastHeight;
+        if (mLastHeight > 0 && pixels >= last / 1.6 && pixels <= last * 1.6) {
+            mBandHeight = mLastHeight; // the same tiles as the band before: no new targets
+        } else {
+            // Square tiles of the requested area, or full-width bands when a row of them fits.
+            const int side = sideFor(pixels, std::min(mFullWidth, mFullHeight));
+            if (pixels >= static_cast<double>(mFullWidth) * side) {
+                const int rows = static_cast<int>(std::ceil(pixels / mFullWidth / mAlign)) * mAlign;
+                mBandHeight = std::clamp(rows, side, ((mFullHeight + mAlign - 1) / mAlign) * mAlign);
+                mTileWidth = mFullWidth;
+            } else {
+                mBandHeight = side;
+                mTileWidth = side;
+            }
+        }
+    } else {
+        const double current = static_cast<double>(mTileWidth) * mBandHeight;
+        if (pixels < current / 1.6 || pixels > current * 1.6) {
+            const int w = static_cast<int>(std::ceil(pixels / mBandHeight / mAlign)) * mAlign;
+            mTileWidth =
+                std::clamp(w, std::min(mMinSide, mFullWidth), ((mFullWidth + mAlign - 1) / mAlign) * mAlign);
+        }
+    }
+    TileRect r{mX, mY, mTileWidth, mBandHeight};
+    const long long w = std::min(mX + mTileWidth, mFullWidth) - mX;
+    const long long h = std::min(mY + mBandHeight, mFullHeight) - mY;
+    mCoveredPixels += w * h;
+    ++mTiles;
+    mX += mTileWidth;
+    if (mX >= mFullWidth) {
+        mX = 0;
+        mY += mBandHeight;
+        mLastHeight = mBandHeight;
+        mBandHeight = 0;
+    }
+    return r;
+}
+
+double TilePlan::shareDone() const {
+    return std::clamp(static_cast<double>(mCoveredPixels) / (static_cast<double>(mFullWidth) * mFullHeight),
+                      0.0, 1.0);
+}
+
+} // namespace gis

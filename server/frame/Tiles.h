@@ -1,0 +1,68 @@
+// Tiled refinement: a refinement step of the live view is rendered as a sequence of tiles that each
+// fit one slice of time (session/Session.cpp), so input waits for at most the tile in progress.
+// A tile is an ordinary frame (FrameState::window) whose projection is the full image's cropped to
+// its pixels, widened by a guard band for the screen-space steps near its edges (the eye hierarchy,
+// bias compensation); the inner part is pasted into the full image (docs/interactive.md).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "frame/FrameState.h"
+
+namespace gis {
+
+/// Pixels of the full image, top-left origin; a tile may reach past the image's right and bottom
+/// edges (its outside part is rendered, never pasted), so every tile of a band has one size.
+struct TileRect {
+    int x = 0, y = 0, width = 0, height = 0;
+};
+
+/// Guard band in pixels on each side of a tile of `full`: 0 for per-pixel techniques, the eye
+/// hierarchy's coarsest patch (at most 64 px) where the technique builds one, 32 px where bias
+/// compensation integrates screen-space neighbours.
+int tileGuardPx(const FrameState& full);
+
+/// The state that renders `rect` of `full` with `guard` px around it: the window, the rendered size
+/// and, for an eye hierarchy, `coarsest_size` scaled so that the coarsest patches keep their size in
+/// pixels (the hierarchy over the tile then matches the full image's, up to its cell boundaries).
+FrameState tileState(const FrameState& full, const TileRect& rect, int guard);
+
+/// Copies the part of a rendered tile (RGBA8, rows top to bottom, `guard` px around `rect`) that lies
+/// inside the full image into `canvas` (fullWidth x fullHeight RGBA8).
+void pasteTile(std::vector<std::uint8_t>& canvas, int fullWidth, int fullHeight,
+               const std::vector<std::uint8_t>& tile, int tileWidth, int tileHeight, const TileRect& rect,
+               int guard);
+
+/// Bilinear resize of an RGBA8 image (the interactive frame stretched to full size as the canvas a
+/// refinement step starts from).
+std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
+                                      int width, int height);
+
+/// The order and sizes of one step's tiles: bands from the top, tiles left to right within a band.
+/// Each next() asks for about `pixels` pixels (from measured slice times); the tile size is kept
+/// while the request stays within a factor 1.6 of it, since every new size reallocates the
+/// renderer's targets, and a band's height is fixed when it starts.
+class TilePlan {
+public:
+    TilePlan(int fullWidth, int fullHeight, int align = 16, int minSide = 32);
+    bool done() const { return mY >= mFullHeight; }
+    TileRect next(double pixels);
+    /// Fraction of the image's pixels covered by the tiles handed out, [0, 1].
+    double shareDone() const;
+    int tilesDone() const { return mTiles; }
+    int fullWidth() const { return mFullWidth; }
+    int fullHeight() const { return mFullHeight; }
+
+private:
+    int sideFor(double pixels, int limit) const;
+    int mFullWidth, mFullHeight, mAlign, mMinSide;
+    int mY = 0, mX = 0;  ///< next tile's corner
+    int mBandHeight = 0; ///< 0 before a band starts
+    int mLastHeight = 0; ///< the previous band's
+    int mTileWidth = 0;  ///< the current tile width
+    long long mCoveredPixels = 0;
+    int mTiles = 0;
+};
+
+} // namespace gis

@@ -1,0 +1,125 @@
+#include "session/FrameBudget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+namespace gis {
+namespace {
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, f, a, b, c, d);
+    return buf;
+}
+
+struct Candidate {
+    double scale;
+    long vpls; ///< 0: uncapped
+};
+
+} // namespace
+
+nlohmann::json BudgetChoice::toJson(double targetMs, long requestedVpls) const {
+    return {{"target_ms", targetMs},
+            {"scale", scale},
+            {"vpls", requestedVpls},
+            {"vpl_cap", vplCap > 0 ? nlohmann::json(vplCap) : nlohmann::json(nullptr)},
+            {"predicted_ms", predictedMs},
+            {"reason", reason}};
+}
+
+double FrameBudget::predictMs(const std::string& key, double pixels, long vpls) const {
+    const auto it = mRates.find(key);
+    if (it == mRates.end() || it->second.frames == 0) return 0.0;
+    const Rates& r = it->second;
+    const double technique = vpls > 0 ? r.vpl * pixels * static_cast<double>(vpls) : r.tech * pixels;
+    return pixels * (r.base + r.encode) + technique;
+}
+
+void FrameBudget::record(const std::string& key, const FrameCost& cost) {
+    if (!(cost.pixels > 0) || !std::isfinite(cost.frameMs) || cost.frameMs < 0) return;
+    Rates& r = mRates[key];
+    const double technique = std::clamp(cost.techniqueMs, 0.0, cost.frameMs);
+    const double base = (cost.frameMs - technique) / cost.pixels;
+    const double encode = std::max(cost.encodeMs, 0.0) / cost.pixels;
+    const double vpl = cost.vpls > 0 ? technique / (cost.pixels * static_cast<double>(cost.vpls)) : 0.0;
+    const double tech = technique / cost.pixels;
+    // Half the weight on the newest frame: one noisy frame moves the choice, two confirm it.
+    const double a = r.frames == 0 ? 1.0 : 0.5;
+    r.base += a * (base - r.base);
+    r.encode += a * (encode - r.encode);
+    if (cost.vpls > 0) r.vpl += a * (vpl - r.vpl);
+    r.tech += a * (tech - r.tech);
+    ++r.frames;
+}
+
+BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, bool cappable,
+                                 double fullPixels) {
+    const Config& c = mConfig;
+    BudgetChoice out;
+    auto it = mRates.find(key);
+    if (it == mRates.end() || it->second.frames == 0) {
+        out.scale = std::clamp(c.firstScale, c.minScale, c.maxScale);
+        if (cappable && requestedVpls > c.firstVplCap) out.vplCap = c.firstVplCap;
+        out.reason = "first frame of this scene and technique: nothing measured yet, so a small one (" +
+                     fmt("%.2f", out.scale) + " of the size" +
+                     (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) + ")";
+        return out;
+    }
+    Rates& rates = it->second;
+    // The ladder from the best frame to the cheapest: size down to the preferred minimum, then VPLs
+    // down, then size down to the minimum.
+    std::vector<Candidate> ladder;
+    for (double s = c.maxScale; s > c.preferredMinScale * 1.0001; s *= 0.9) ladder.push_back({s, 0});
+    ladder.push_back({c.preferredMinScale, 0});
+    long lastVpls = 0;
+    if (cappable && requestedVpls > c.minVpls) {
+        for (double v = requestedVpls * 0.7; v > c.minVpls; v *= 0.7)
+            ladder.push_back({c.preferredMinScale, lastVpls = static_cast<long>(v)});
+        ladder.push_back({c.preferredMinScale, lastVpls = c.minVpls});
+    }
+    for (double s = c.preferredMinScale * 0.9; s > c.minScale; s *= 0.9) ladder.push_back({s, lastVpls});
+    ladder.push_back({c.minScale, lastVpls});
+
+    const double target = c.targetMs;
+    const int previous = rates.level;
+    int chosen = static_cast<int>(ladder.size()) - 1;
+    double predicted = 0.0;
+    for (int i = 0; i < static_cast<int>(ladder.size()); ++i) {
+        const Candidate& cand = ladder[static_cast<size_t>(i)];
+        const long vpls = cand.vpls > 0 ? cand.vpls : requestedVpls;
+        const double ms = predictMs(key, fullPixels * cand.scale * cand.scale, vpls);
+        // Climbing above the last choice needs 15 % headroom, so measurement noise does not make the
+        // size flicker between two frames.
+        const double allowed = previous >= 0 && i < previous ? target * 0.85 : target;
+        if (ms <= allowed) {
+            chosen = i;
+            predicted = ms;
+            break;
+        }
+        predicted = ms;
+    }
+    rates.level = chosen;
+    const Candidate& pick = ladder[static_cast<size_t>(chosen)];
+    out.scale = pick.scale;
+    out.vplCap = pick.vpls > 0 && pick.vpls < requestedVpls ? pick.vpls : 0;
+    out.predictedMs = predicted;
+    if (predicted > target)
+        out.reason = fmt("even the cheapest frame (%.2f of the size", pick.scale) +
+                     (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) +
+                     fmt(") is predicted at %.0f ms, over the %.0f ms target", predicted, target);
+    else if (chosen == 0)
+        out.reason = fmt("full quality fits: %.0f ms predicted for the %.0f ms target", predicted, target);
+    else
+        out.reason =
+            fmt("%.2f of the size", pick.scale) +
+            (out.vplCap > 0
+                 ? " and " + std::to_string(out.vplCap) + " of " + std::to_string(requestedVpls) + " VPLs"
+                 : std::string()) +
+            fmt(" meet the %.0f ms target (%.0f ms predicted from this session's frames)", target, predicted);
+    return out;
+}
+
+} // namespace gis

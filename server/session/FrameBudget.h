@@ -1,0 +1,74 @@
+// The live view's frame-time budget: which size and VPL cap the next interactive frame renders with so
+// that it meets the session's target (protocol `frame_target_ms`), chosen from what this session's
+// frames of that scene and technique measured, never from a fixed table. The counterpart of an
+// adaptive frame rate for GI: resolution first, then the VPLs, then resolution again
+// (docs/interactive.md).
+//
+// Model, per scene and technique, from the last interactive frames (exponential means):
+//   ms(pixels, vpls) = pixels * (baseRate + encodeRate) + pixels * vpls * vplRate
+// where baseRate comes from the renderer's own stages (shadow maps, G-buffer, direct, composite,
+// reflections, overheads) and vplRate from the technique's passes. Counting all of the technique's
+// passes as VPL-bound over-predicts what more VPLs cost, so the budget climbs cautiously.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace gis {
+
+/// One measured interactive frame.
+struct FrameCost {
+    double pixels = 0;      ///< rendered
+    long vpls = 0;          ///< rendered (0: the technique has none)
+    double frameMs = 0;     ///< the renderer's frame_ms
+    double techniqueMs = 0; ///< the technique's passes within it
+    double encodeMs = 0;
+};
+
+/// What the next interactive frame renders with, and why.
+struct BudgetChoice {
+    double scale = 1.0;     ///< size factor (0, 1]
+    long vplCap = 0;        ///< 0: the parameters' own count
+    double predictedMs = 0; ///< 0: nothing measured yet
+    std::string reason;
+    nlohmann::json toJson(double targetMs, long requestedVpls) const;
+};
+
+class FrameBudget {
+public:
+    struct Config {
+        double targetMs = 80; ///< render + encode of one interactive frame
+        double maxScale = 1.0;
+        double preferredMinScale = 0.3; ///< below this, VPLs go first
+        double minScale = 0.1;
+        long minVpls = 16;
+        /// A frame with nothing measured for its scene and technique: this size factor, at most
+        /// firstVplCap VPLs (a guess kept small, so that the one unmeasured frame stays short).
+        double firstScale = 0.35;
+        long firstVplCap = 1024;
+    };
+    explicit FrameBudget(Config config) : mConfig(config) {}
+    const Config& config() const { return mConfig; }
+    void setTargetMs(double ms) { mConfig.targetMs = ms; }
+
+    /// The choice for a frame of `key` (scene/technique) whose parameters ask for `requestedVpls`
+    /// (0: none) and can be capped (`cappable`) at fullPixels full-size pixels.
+    BudgetChoice choose(const std::string& key, long requestedVpls, bool cappable, double fullPixels);
+    void record(const std::string& key, const FrameCost& cost);
+    /// Predicted ms of a frame of `key` at `pixels` with `vpls`; 0 when nothing is measured.
+    double predictMs(const std::string& key, double pixels, long vpls) const;
+
+private:
+    struct Rates {
+        double base = 0, encode = 0, vpl = 0; ///< ms per pixel, ms per pixel, ms per pixel per VPL
+        double tech = 0;                      ///< ms per pixel of the technique when it has no VPLs
+        int frames = 0;
+        int level = -1; ///< index of the last choice in the candidate ladder
+    };
+    Config mConfig;
+    std::map<std::string, Rates> mRates;
+};
+
+} // namespace gis

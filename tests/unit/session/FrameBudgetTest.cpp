@@ -1,0 +1,107 @@
+#include <gtest/gtest.h>
+
+#include "session/FrameBudget.h"
+
+namespace gis {
+namespace {
+
+// A synthetic renderer: ms = pixels * (base + pixels-independent VPL part) like a gather.
+FrameCost synthetic(double pixels, long vpls, double basePerPixel, double perPixelVpl) {
+    FrameCost c;
+    c.pixels = pixels;
+    c.vpls = vpls;
+    c.techniqueMs = pixels * static_cast<double>(vpls) * perPixelVpl;
+    c.frameMs = pixels * basePerPixel + c.techniqueMs;
+    c.encodeMs = 0.0;
+    return c;
+}
+
+// Runs the loop choose -> render -> record a few times and returns the settled choice.
+BudgetChoice settle(FrameBudget& budget, long vpls, double fullPixels, double base, double perVpl,
+                    double* lastMs = nullptr) {
+    BudgetChoice choice;
+    for (int i = 0; i < 12; ++i) {
+        choice = budget.choose("k", vpls, true, fullPixels);
+        const double pixels = fullPixels * choice.scale * choice.scale;
+        const long rendered = choice.vplCap > 0 ? choice.vplCap : vpls;
+        const FrameCost cost = synthetic(pixels, rendered, base, perVpl);
+        if (lastMs) *lastMs = cost.frameMs;
+        budget.record("k", cost);
+    }
+    return choice;
+}
+
+TEST(FrameBudget, FirstFrameIsSmallAndSaysWhy) {
+    FrameBudget budget(FrameBudget::Config{});
+    const BudgetChoice c = budget.choose("k", 65536, true, 960 * 800);
+    EXPECT_LE(c.scale, 0.35);
+    EXPECT_EQ(c.vplCap, 1024);
+    EXPECT_NE(c.reason.find("nothing measured"), std::string::npos);
+}
+
+TEST(FrameBudget, CheapFramesGetFullQuality) {
+    FrameBudget budget(FrameBudget::Config{});
+    double ms = 0;
+    const BudgetChoice c = settle(budget, 256, 512 * 512, 1e-5, 1e-9, &ms);
+    EXPECT_DOUBLE_EQ(c.scale, 1.0);
+    EXPECT_EQ(c.vplCap, 0);
+    EXPECT_LE(ms, 80.0);
+}
+
+TEST(FrameBudget, ResolutionGoesFirstThenVpls) {
+    FrameBudget budget(FrameBudget::Config{});
+    double ms = 0;
+    // 256 VPLs at 768k pixels cost 4 ns per pixel and VPL (llvmpipe's gather): 800 ms at full size.
+    BudgetChoice c = settle(budget, 256, 960 * 800, 2e-5, 4e-6, &ms);
+    EXPECT_LE(ms, 80.0 * 1.05);
+    EXPECT_GE(c.scale, 0.3 - 1e-9);
+    // 65,536 VPLs: the size alone cannot do it; the VPLs are capped.
+    FrameBudget big(FrameBudget::Config{});
+    c = settle(big, 65536, 960 * 800, 2e-5, 4e-6, &ms);
+    EXPECT_LE(ms, 80.0 * 1.05);
+    EXPECT_GT(c.vplCap, 0);
+    EXPECT_LT(c.vplCap, 65536);
+    EXPECT_NE(c.reason.find("VPLs"), std::string::npos);
+}
+
+TEST(FrameBudget, ImpossibleTargetsGiveTheCheapestFrameAndSayIt) {
+    FrameBudget::Config config;
+    config.targetMs = 1.0;
+    FrameBudget budget(config);
+    const BudgetChoice c = settle(budget, 256, 960 * 800, 1e-3, 1e-6);
+    EXPECT_DOUBLE_EQ(c.scale, config.minScale);
+    EXPECT_NE(c.reason.find("over the"), std::string::npos);
+}
+
+TEST(FrameBudget, NoisyMeasurementsDoNotFlicker) {
+    FrameBudget budget(FrameBudget::Config{});
+    settle(budget, 256, 960 * 800, 2e-5, 4e-6);
+    int changes = 0;
+    double previous = -1;
+    for (int i = 0; i < 40; ++i) {
+        const BudgetChoice c = budget.choose("k", 256, true, 960 * 800);
+        if (previous >= 0 && c.scale != previous) ++changes;
+        previous = c.scale;
+        const double pixels = 960.0 * 800.0 * c.scale * c.scale;
+        FrameCost cost = synthetic(pixels, c.vplCap > 0 ? c.vplCap : 256, 2e-5, 4e-6);
+        cost.frameMs *= i % 2 ? 1.08 : 0.92; // +-8 % noise
+        cost.techniqueMs *= i % 2 ? 1.08 : 0.92;
+        budget.record("k", cost);
+    }
+    EXPECT_LE(changes, 6);
+}
+
+TEST(FrameBudget, GarbageMeasurementsAreIgnored) {
+    FrameBudget budget(FrameBudget::Config{});
+    FrameCost bad;
+    bad.pixels = 0;
+    bad.frameMs = 10;
+    budget.record("k", bad);
+    bad.pixels = 100;
+    bad.frameMs = std::numeric_limits<double>::quiet_NaN();
+    budget.record("k", bad);
+    EXPECT_EQ(budget.predictMs("k", 1000, 16), 0.0);
+}
+
+} // namespace
+} // namespace gis
