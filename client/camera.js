@@ -3,7 +3,7 @@
 // does. The math is pure; attachViewControls() binds it (and the light drags) to pointer, wheel,
 // touch and keyboard input.
 
-import { add, clamp, cross, length, normalize, roundVec, scale, sub } from './vec.js';
+import { add, clamp, cross, dot, length, normalize, roundVec, scale, sub } from './vec.js';
 
 const DEG = Math.PI / 180;
 // Keep the eye off the poles: at exactly +-90 degrees the look-at basis with up = +Y degenerates.
@@ -43,6 +43,42 @@ export function cameraBasis(yaw, pitch) {
     const right = [Math.cos(yaw), 0, -Math.sin(yaw)];
     const up = [-Math.sin(pitch) * Math.sin(yaw), Math.cos(pitch), -Math.sin(pitch) * Math.cos(yaw)];
     return { right, up };
+}
+
+/**
+ * The bounding sphere of `state.bounds` ({min, max} in metres): {centre, radius}, or null when
+ * the bounds are missing or malformed.
+ */
+export function boundsSphere(bounds) {
+    const { min, max } = bounds ?? {};
+    const ok = (v) => Array.isArray(v) && v.length === 3 && v.every(Number.isFinite);
+    if (!ok(min) || !ok(max) || min.some((v, i) => v > max[i])) return null;
+    return { centre: scale(add(min, max), 0.5), radius: length(sub(max, min)) / 2 };
+}
+
+/**
+ * The eye distance at which a sphere of `radius` fits a view of vertical field `fovDeg` and
+ * width/height `aspect`: the narrower of the two fields decides.
+ */
+export function fitDistance(radius, fovDeg, aspect = 1) {
+    const half = (clamp(fovDeg, MIN_FOV_DEG, MAX_FOV_DEG) * DEG) / 2;
+    const halfH = Math.atan(Math.tan(half) * (aspect > 0 ? aspect : 1));
+    return clamp(Math.max(radius, MIN_DISTANCE) / Math.sin(Math.min(half, halfH)), MIN_DISTANCE, MAX_DISTANCE);
+}
+
+/**
+ * `camera` with its orbit target moved along the view ray to the depth of the bounds' centre, so
+ * that orbiting turns around the model instead of a point a metre ahead of the eye (what a glTF
+ * camera's look-at gives). The view is unchanged. Without usable bounds, or with the model behind
+ * the eye, the camera is returned as it is.
+ */
+export function withOrbitTarget(camera, bounds) {
+    const sphere = boundsSphere(bounds);
+    if (!sphere || !camera?.position || !camera?.target) return camera;
+    const forward = normalize(sub(camera.target, camera.position));
+    const depth = dot(sub(sphere.centre, camera.position), forward);
+    if (!(length(forward) > 0) || !(depth > MIN_DISTANCE)) return camera;
+    return { ...structuredClone(camera), target: roundVec(add(camera.position, scale(forward, depth))) };
 }
 
 export class OrbitCamera {
@@ -136,6 +172,19 @@ export class OrbitCamera {
         this.fovDeg = clamp(deg, MIN_FOV_DEG, MAX_FOV_DEG);
     }
 
+    /**
+     * Frames the model: the target goes to the centre of `bounds`, the eye back along the current
+     * view direction until the bounding sphere fits both fields of view (`aspect` = width/height).
+     * Returns false (and changes nothing) without usable bounds.
+     */
+    frame(bounds, aspect = 1) {
+        const sphere = boundsSphere(bounds);
+        if (!sphere) return false;
+        this.target = [...sphere.centre];
+        this.distance = fitDistance(sphere.radius, this.fovDeg, aspect);
+        return true;
+    }
+
     /** The protocol camera for a `camera` message. */
     toCamera() {
         return {
@@ -196,11 +245,12 @@ export function keyMotion(keys, tool, dt, speed, fast = false) {
  *   to onLight(gesture, dx, dy) instead of the camera;
  * - two fingers: pinch zooms, moving both pans;
  * - wheel: zoom (fly: moves forward and back);
- * - keys while the canvas has focus: keyMotion(), and Home or R for onHome().
- * Options: {camera, getTool(), onCamera(), onLight(gesture, dx, dy), onHome(), flySpeed()}.
+ * - keys while the canvas has focus: keyMotion(), Home or R for onHome(), and the single-press
+ *   `shortcuts` ({KeyboardEvent.code: fn}, e.g. fullscreen).
+ * Options: {camera, getTool(), onCamera(), onLight(gesture, dx, dy), onHome(), flySpeed(), shortcuts}.
  * Returns a function that removes the listeners.
  */
-export function attachViewControls(element, { camera, getTool, onCamera, onLight, onHome, flySpeed }) {
+export function attachViewControls(element, { camera, getTool, onCamera, onLight, onHome, flySpeed, shortcuts = {} }) {
     const pointers = new Map(); // pointerId -> {x, y, gesture}
     let pinch = null; // {span, cx, cy}
     const keys = new Set();
@@ -287,6 +337,12 @@ export function attachViewControls(element, { camera, getTool, onCamera, onLight
         if (e.code === 'Home' || e.code === 'KeyR') {
             e.preventDefault();
             onHome?.();
+            return;
+        }
+        if (Object.hasOwn(shortcuts, e.code)) {
+            e.preventDefault();
+            // Held keys repeat: a toggle such as fullscreen must not flicker.
+            if (!e.repeat) shortcuts[e.code]();
             return;
         }
         if (!MOTION_KEYS.has(e.code)) return;

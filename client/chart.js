@@ -4,6 +4,8 @@
 
 import uPlot from 'uplot';
 
+import { axisSize, msTickLabels } from './stats.js';
+
 const PALETTE = ['#5aa9ff', '#ffc857', '#4cd17b', '#ff6b6b', '#c792ea', '#2ec4b6', '#ff9f1c', '#e4e6ea',
     '#8d99ae', '#f72585', '#b5e48c', '#4361ee'];
 
@@ -53,14 +55,15 @@ export class PassChart {
             },
             axes: [
                 { ...axis, size: 18, values: (u, ticks) => ticks.map((t) => `${Math.round(t - this.now)}s`) },
-                { ...axis, size: 34, values: (u, ticks) => ticks.map((t) => `${t}`) },
+                // Room for the longest label, unit included: a fixed width clipped "1200".
+                { ...axis, size: (u, values) => axisSize(values), values: (u, ticks) => msTickLabels(ticks) },
             ],
             series,
         }, [[], ...names.map(() => [])], this.container);
         this.plot.root.setAttribute('aria-label', 'per-pass render time, stacked, milliseconds over the last seconds');
     }
 
-    /** Draws PassHistory.series() as of `nowS` seconds. */
+    /** Draws PassHistory.series() with the window ending at `nowS` seconds. */
     update({ names, times, values, stacked }, nowS) {
         this.now = nowS;
         if (!this.plot || names.length !== this.names.length || names.some((n, i) => n !== this.names[i])) {

@@ -129,3 +129,9 @@ export class StreamConnection {
         this.handlers.onState?.('closed');
     }
 }
+
+/** The reconnect countdown: whole seconds from 1 s, tenths below ("retrying in 3 s", "0.4 s"). */
+export function formatCountdown(ms) {
+    const left = Math.max(0, ms);
+    return left >= 1000 ? `${Math.ceil(left / 1000)} s` : `${(left / 1000).toFixed(1)} s`;
+}

@@ -4,7 +4,7 @@
 
 import GUI from 'lil-gui';
 
-import { controlSpec, paramHelp } from './params.js';
+import { checkTypedNumber, controlSpec, orderedProperties, paramHelp } from './params.js';
 
 export { GUI };
 
@@ -57,16 +57,44 @@ function addSpecController(gui, holder, spec) {
     }
 }
 
+/**
+ * A number field that commits what was typed on Enter or blur, and only when `check(text)` accepts
+ * it ({value} or {error}). lil-gui itself sets the value on every keystroke, clamped into the
+ * slider's range, so 9999 would be sent as the maximum; its input listener is kept from seeing the
+ * typing (a capture listener on the row runs first), and the slider, arrow keys and wheel work as
+ * before.
+ */
+export function guardTypedNumber(controller, check, onRefuse) {
+    const input = controller.$input;
+    if (!input) return;
+    controller.domElement.addEventListener('input', (e) => {
+        if (e.target === input) e.stopPropagation();
+    }, true);
+    // 'change' comes before lil-gui's blur handler, which shows the controller's value again.
+    input.addEventListener('change', () => {
+        const result = check(input.value);
+        controller.domElement.classList.toggle('refused', Boolean(result.error));
+        if (result.error) {
+            onRefuse?.(result.error);
+            controller.updateDisplay();
+        } else if (result.value !== controller.getValue()) {
+            controller.setValue(result.value);
+        }
+    });
+    input.addEventListener('focus', () => controller.domElement.classList.remove('refused'));
+}
+
 function isEditing(controller) {
     const active = document.activeElement;
     return active !== null && active !== document.body && controller.domElement.contains(active);
 }
 
 /**
- * The generated parameter folders of the Technique section. build(groups, values, onChange)
- * replaces them: groups are [{title, schema, closed}], onChange(name, value) runs when the user
- * sets a value. update(values) shows values without calling onChange; a control the user is
- * typing into keeps what they typed unless `force` (a refused value is put back).
+ * The generated parameter folders of the Technique section. build(groups, values, onChange,
+ * {onRefuse}) replaces them: groups are [{title, schema, closed}], in the schema's order;
+ * onChange(name, value) runs when the user sets a value, onRefuse(sentence) when a typed number
+ * is outside the schema. update(values) shows values without calling onChange; a control the user
+ * is typing into keeps what they typed unless `force` (a refused value is put back).
  */
 export class ParamPanel {
     constructor(gui) {
@@ -75,12 +103,12 @@ export class ParamPanel {
         this.controls = new Map(); // name -> {controller, holder, spec}
     }
 
-    build(groups, values, onChange) {
+    build(groups, values, onChange, { onRefuse } = {}) {
         for (const folder of this.folders) folder.destroy();
         this.folders = [];
         this.controls.clear();
         for (const { title, schema, closed } of groups) {
-            const props = Object.entries(schema?.properties ?? {});
+            const props = orderedProperties(schema);
             if (props.length === 0) continue;
             const folder = this.gui.addFolder(title);
             folder.domElement.classList.add('param-folder');
@@ -90,6 +118,11 @@ export class ParamPanel {
                 const controller = addSpecController(folder, holder, spec).name(spec.label);
                 describe(controller, `param-${name}`, paramHelp(paramSchema));
                 controller.domElement.dataset.param = name;
+                // The label may wrap or be cut on a narrow sidebar: the full name is the name's tooltip.
+                controller.$name.title = spec.label;
+                if (spec.kind === 'integer' || spec.kind === 'number') {
+                    guardTypedNumber(controller, (text) => checkTypedNumber(name, paramSchema, text), onRefuse);
+                }
                 // Numbers report every slider step; the sender coalesces them per animation frame.
                 controller.onChange((v) => onChange(name, spec.kind === 'integer' ? Math.round(v) : v));
                 this.controls.set(name, { controller, holder, spec });

@@ -1,31 +1,39 @@
 // App wiring: connection and session role, frame display, the sidebar sections, the stats overlay,
-// the lights panel and gizmo, and the accuracy view. The pure pieces live in their own modules
-// (protocol, camera, light, lights, params, stats, accuracy, messages, upload); this file talks to
-// the DOM.
+// refinement progress and the busy badge, the lights panel and gizmo, and the accuracy view. The
+// pure pieces live in their own modules (protocol, camera, light, lights, params, stats, progress,
+// budget, restore, accuracy, messages, upload); this file talks to the DOM.
 
 import {
     ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, lightAddMsg, lightMsg, lightRemoveMsg, paramsMsg,
-    parseFrameHeader, parseServerMessage, pingMsg, qualityMsg, resizeMsg, sceneMsg, snapshotMsg, techniqueMsg,
-    validateClientMessage, validateParamValues, viewportFor,
+    isKnownServerMessage, parseFrameHeader, parseServerMessage, pingMsg, qualityMsg, resizeMsg, sceneMsg,
+    snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
 } from './protocol.js';
 import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from './schemas.js';
-import { DRAG_TOOLS, MAX_FOV_DEG, MIN_FOV_DEG, OrbitCamera, attachViewControls } from './camera.js';
+import {
+    DRAG_TOOLS, MAX_FOV_DEG, MIN_FOV_DEG, OrbitCamera, attachViewControls, boundsSphere, withOrbitTarget,
+} from './camera.js';
 import { aimLight, gizmoKinds, moveLight } from './light.js';
 import {
     LIGHT_TYPES, applyLightChanges, intensityUnit, lightLabel, lightStatuses, lightType, lightingLines, lightsOfState,
     newLightFor, pickSelection,
 } from './lights.js';
-import { StreamConnection, pageOptions, shareLink, streamUrl } from './connection.js';
+import { StreamConnection, formatCountdown, pageOptions, shareLink, streamUrl } from './connection.js';
 import { ParamPanel, addBlock, describe, makeSection } from './controls.js';
-import { presetChanges, schemaDefaults } from './params.js';
+import { presetChanges, resetPlan, schemaDefaults } from './params.js';
 import { LatencyTracker, PassHistory, RateCounter, formatBytes, formatMs, networkMs } from './stats.js';
+import { DEFAULT_FRAME_TARGET_MS, InputWatch, RefineTracker, busyText, formatSeconds } from './progress.js';
+import {
+    DEFAULT_PIXEL_BUDGET, PIXEL_BUDGETS, budgetLine, budgetViewport, frameTargetOptions, frameTargetSupported,
+    normalizeFrameTarget, normalizePixelBudget,
+} from './budget.js';
+import { restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
 import { PassChart } from './chart.js';
 import { LightGizmo } from './gizmo.js';
 import {
     COMPARE_MODES, DEFAULT_COMPARE, buildCompareRequest, canCompare, diffImage, formatCompare, validateCompareRequest,
     viewKey,
 } from './accuracy.js';
-import { describeError, describeHttpError } from './messages.js';
+import { MessageStack, describeError, describeHttpError, noticeFor } from './messages.js';
 import { uploadGlb, uploadName } from './upload.js';
 
 const RESIZE_DEBOUNCE_MS = 200;
@@ -65,6 +73,12 @@ const ui = {
     connDot: $('conn-dot'),
     connText: $('conn-text'),
     retryNow: $('retry-now'),
+    busy: $('busy'),
+    fullscreen: $('fullscreen'),
+    notice: $('notice'),
+    noticeTitle: $('notice-title'),
+    noticeText: $('notice-text'),
+    noticeAction: $('notice-action'),
     role: $('role'),
     sessionToggle: $('session-toggle'),
     messages: $('messages'),
@@ -73,6 +87,12 @@ const ui = {
     ovTimes: $('ov-times'),
     ovBytes: $('ov-bytes'),
     ovAccuracy: $('ov-accuracy'),
+    ovStale: $('ov-stale'),
+    ovBudget: $('ov-budget'),
+    ovRefine: $('ov-refine'),
+    ovRefineBar: $('ov-refine-bar'),
+    ovRefineText: $('ov-refine-text'),
+    ovChartNote: $('ov-chart-note'),
     ovChart: $('ov-chart'),
     ovLegend: $('ov-legend'),
     dropHint: $('drop-hint'),
@@ -86,13 +106,16 @@ function loadSettings() {
     const defaults = {
         tool: 'orbit', flySpeed: 0.5, overlay: true, chart: true, help: false, gizmo: true,
         compareMode: DEFAULT_COMPARE.mode, compareSpp: DEFAULT_COMPARE.spp, compareMaxSide: DEFAULT_COMPARE.maxSide,
-        compareView: 'live', diffGain: 4,
+        compareView: 'live', diffGain: 4, frameTargetMs: null, pixelBudget: DEFAULT_PIXEL_BUDGET,
     };
+    let stored = {};
     try {
-        return { ...defaults, ...JSON.parse(localStorage.getItem(SETTINGS_KEY) ?? '{}') };
-    } catch {
-        return defaults;
-    }
+        stored = JSON.parse(localStorage.getItem(SETTINGS_KEY) ?? '{}') ?? {};
+    } catch { /* unreadable: the defaults */ }
+    const s = { ...defaults, ...stored };
+    s.frameTargetMs = normalizeFrameTarget(s.frameTargetMs);
+    s.pixelBudget = normalizePixelBudget(s.pixelBudget);
+    return s;
 }
 const settings = loadSettings();
 function saveSettings() {
@@ -110,6 +133,13 @@ const state = {
     scenes: [],
     uploads: [], // upload:NAME scenes of this session
     params: {}, // the session's own parameter values (what the panel shows)
+    explicit: new Set(), // parameters this page set in this session: they win over the adaptive presets
+    bounds: null, // state.bounds {min, max} of the scene (protocol 2), for framing and the orbit target
+    restore: null, // what the page knew of a session that was lost, for the next new session
+    restoreAfterScene: null, // {scene, messages, saved} to send once the restored scene has loaded
+    deadView: false, // this page's view token no longer works: never retried
+    retryAt: null, // when the next reconnect attempt starts (performance.now() ms)
+    frameTargetMs: null, // the session's frame-time target (welcome.frame_target_ms), when the server has one
     lights: [], // the session's lights as this client knows them (state.lights, or protocol 1's one light)
     lightList: false, // the server lists its lights with ids (protocol 2): only then can they be added and removed
     selectedLightId: null, // the light the Light section and the gizmo edit
@@ -138,6 +168,9 @@ const camera = new OrbitCamera();
 const rate = new RateCounter(1000);
 const latency = new LatencyTracker();
 const passes = new PassHistory(CHART_WINDOW_S);
+const refine = new RefineTracker();
+const watch = new InputWatch();
+const toasts = new MessageStack({ max: 4, ttlMs: MESSAGE_HIDE_MS });
 const chart = new PassChart(ui.ovChart, ui.ovLegend, { windowS: CHART_WINDOW_S });
 const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
@@ -166,6 +199,18 @@ const hook = {
     get compare() { return state.compare?.result ?? null; },
     get rttMs() { return state.rttMs; },
     get latencyMs() { return latency.typical; },
+    viewport: null, // the last {size, dpr} announced in hello or resize
+    sent: [], // the last messages sent, oldest first (camera, ack and ping left out: they would crowd the rest)
+    get refine() { return refine.view(performance.now()); },
+    get busy() { return ui.busy.hidden ? null : ui.busy.textContent; },
+    get stale() { return ui.overlay.classList.contains('stale'); },
+    get notice() { return ui.notice.hidden ? null : ui.noticeTitle.textContent; },
+    get bounds() { return state.bounds ? structuredClone(state.bounds) : null; },
+    get welcome() { return state.welcome ? structuredClone(state.welcome) : null; },
+    get frameTargetMs() { return state.frameTargetMs; },
+    get explicit() { return [...state.explicit]; },
+    // Benchmarks and tests steer through the page's own connection, exactly as the panels do.
+    send: (msg) => send(msg),
 };
 window.giClient = hook;
 
@@ -179,19 +224,30 @@ function send(msg) {
         showMessage(`Not sent (${problem.code}): ${problem.where || '/'}: ${problem.message}`);
         return false;
     }
-    return connection.send(msg);
+    const sent = connection.send(msg);
+    if (sent && msg.type !== 'camera' && msg.type !== 'ack' && msg.type !== 'ping') {
+        hook.sent.push(structuredClone(msg));
+        if (hook.sent.length > 50) hook.sent.shift();
+    }
+    return sent;
 }
 
 /** A steering message: sent, and counted as input for the latency. */
 function steer(msg) {
     if (state.viewer) return false;
     const sent = send(msg);
-    if (sent) latency.input(performance.now());
+    if (sent) {
+        const now = performance.now();
+        latency.input(now);
+        watch.input(now);
+    }
     return sent;
 }
 
+/** The viewport to announce: its CSS size and the device pixel ratio, capped by the pixel budget. */
 function currentViewport() {
-    return viewportFor(ui.viewport.clientWidth, ui.viewport.clientHeight, window.devicePixelRatio);
+    return budgetViewport(ui.viewport.clientWidth, ui.viewport.clientHeight, window.devicePixelRatio,
+        settings.pixelBudget);
 }
 
 let lastSize = null; // the last viewport sent, "WxH@dpr"
@@ -200,7 +256,11 @@ function sendResize(force = false) {
     const { size, dpr } = currentViewport();
     const key = `${size[0]}x${size[1]}@${dpr}`;
     if (!force && key === lastSize) return;
-    if (send(resizeMsg(size[0], size[1], dpr))) lastSize = key;
+    if (send(resizeMsg(size[0], size[1], dpr))) {
+        lastSize = key;
+        hook.viewport = { size, dpr };
+        qualityGui.update();
+    }
 }
 
 // Pointer moves and slider drags arrive faster than frames: coalesce them into one message of each
@@ -290,6 +350,7 @@ function sendParamsNow(values) {
     }
     if (steer(paramsMsg(values))) {
         Object.assign(state.params, values);
+        for (const name of Object.keys(values)) state.explicit.add(name);
         paramPanel.update(values);
         sceneGui.update();
     }
@@ -301,7 +362,28 @@ function buildHello() {
     if (state.viewer) return helloMsg({ ...common, view: page.view });
     const { size, dpr } = currentViewport();
     lastSize = `${size[0]}x${size[1]}@${dpr}`;
-    return helloMsg({ ...common, resume: sessionStorage.getItem(RESUME_KEY) ?? undefined, size, dpr });
+    hook.viewport = { size, dpr };
+    // Only where this page's schema copy has the field: an older server refuses a hello with it.
+    const target = settings.frameTargetMs !== null && frameTargetSupported(null, CLIENT_SCHEMAS, 'hello')
+        ? settings.frameTargetMs : undefined;
+    return helloMsg({
+        ...common, resume: sessionStorage.getItem(RESUME_KEY) ?? undefined, size, dpr, frame_target_ms: target,
+    });
+}
+
+/** The session's frame-time target: what welcome said (or the quality control set), else the default. */
+function frameTargetMs() {
+    return state.frameTargetMs ?? state.welcome?.limits?.frame_target_ms ?? DEFAULT_FRAME_TARGET_MS;
+}
+
+/** The quality message for the current adaptive choice and, where the server takes one, the frame target. */
+function sendQuality() {
+    const adaptive = techniqueGui.model.adaptive;
+    const target = frameTargetSupported(state.welcome, CLIENT_SCHEMAS)
+        ? settings.frameTargetMs ?? state.welcome?.limits?.frame_target_ms : undefined;
+    if (!steer(qualityMsg(adaptive, Number.isInteger(target) ? target : undefined))) return false;
+    if (Number.isInteger(target)) state.frameTargetMs = target;
+    return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -312,12 +394,28 @@ function handleOpen() {
     state.pending = null;
     state.snapshotWanted = false;
     latency.reset();
+    watch.reset();
+    refine.reset();
     send(buildHello());
     sendPing();
 }
 
+/** A close the user did not ask for: what the session was is kept for a new session to restore. */
 function handleClose(code) {
     if (code === 1013) showMessage(describeError({ code: 'busy' }));
+    // A restore still waiting for its scene knows more than the half-restored session does.
+    if (!state.viewer && state.welcome && !state.restore) {
+        state.restore = state.restoreAfterScene?.saved ?? snapshotSession();
+    }
+    refine.reset();
+    watch.reset();
+}
+
+function snapshotSession() {
+    return sessionSnapshot({
+        scene: state.scene, technique: state.technique, params: state.params, explicit: state.explicit,
+        camera: camera.toCamera(), adaptive: techniqueGui.model.adaptive,
+    });
 }
 
 function handleText(text) {
@@ -345,12 +443,20 @@ function handleText(text) {
     case 'pong':
         if (Number.isFinite(msg.t)) state.rttMs = performance.now() - msg.t;
         break;
-    default: console.warn('unhandled server message', msg);
+    case 'progress':
+        refine.message(msg, performance.now());
+        showProgress();
+        break;
+    default:
+        if (!isKnownServerMessage(msg.type)) console.warn('unhandled server message', msg);
     }
 }
 
 function handleError(msg) {
-    showMessage(describeError(msg));
+    const notice = FATAL_ERRORS.has(msg.code) ? noticeFor(msg.code, { viewer: state.viewer }) : null;
+    // A notice stays until it is dealt with; a toast would fade and leave a black view behind.
+    if (notice) showNotice(notice, describeError(msg));
+    else showMessage(describeError(msg));
     if (msg.code === 'resume_failed' || msg.code === 'shutting_down') {
         // The session is gone (grace period over, server restarted): the reconnect that follows
         // the close starts a new one.
@@ -358,7 +464,12 @@ function handleError(msg) {
         connection.markHealthy();
     } else if (FATAL_ERRORS.has(msg.code)) {
         if (msg.code === 'session_ended' || msg.code === 'idle_timeout') sessionStorage.removeItem(RESUME_KEY);
+        // A view token dies with its session: Connect would only be refused again.
+        if (state.viewer && (msg.code === 'unknown_view_token' || msg.code === 'session_ended')) state.deadView = true;
         connection.stopReconnecting();
+    } else if ((msg.code === 'unknown_scene' || msg.code === 'scene_load_failed') && state.restoreAfterScene) {
+        // The old scene did not come back: the rest of the restore belongs to it.
+        state.restoreAfterScene = null;
     } else if (msg.request === 'light_add' || msg.request === 'light_remove') {
         // Refused: no state answer will come for it.
         const index = state.lightOps.indexOf(msg.request === 'light_add' ? 'add' : 'remove');
@@ -375,17 +486,87 @@ function handleWelcome(msg) {
     hook.resumed = msg.resumed === true;
     state.welcome = msg;
     state.lightOps = [];
+    state.frameTargetMs = Number.isFinite(msg.frame_target_ms) ? msg.frame_target_ms : null;
+    hideNotice();
     setRole(msg.role === 'viewer');
     if (msg.resume_token) sessionStorage.setItem(RESUME_KEY, msg.resume_token);
-    if (!msg.resumed) state.uploads = [];
+    if (!msg.resumed) {
+        state.uploads = [];
+        state.explicit = new Set();
+        state.restoreAfterScene = null;
+    }
     state.techniques = new Map((msg.techniques ?? []).map((t) => [t.name, t]));
     state.scenes = msg.scenes ?? [];
     techniqueGui.setTechniques([...state.techniques.keys()]);
     techniqueGui.adaptive(msg.adaptive !== false);
     shareGui.update();
     applyState(msg.state ?? {}, { resumed: msg.resumed === true, fresh: true });
+    qualityGui.update();
     // A resumed session still has the viewport of before the outage (or the reload).
     if (msg.resumed) sendResize(true);
+    const saved = state.restore;
+    state.restore = null;
+    if (state.viewer) return;
+    const qualitySent = !msg.resumed && saved ? restoreSession(saved, msg) : false;
+    // A resumed session may run another target than the one chosen here since.
+    if (!qualitySent && settings.frameTargetMs !== null && frameTargetSupported(msg, CLIENT_SCHEMAS)
+        && msg.frame_target_ms !== settings.frameTargetMs) {
+        sendQuality();
+    }
+}
+
+/**
+ * Brings a new session to what the lost one was: its scene first (which resets the camera and
+ * lights when it loads), then technique, explicit parameters and camera. Returns whether it sent
+ * a quality message.
+ */
+function restoreSession(saved, welcome) {
+    const plan = restorePlan(saved, welcome);
+    const messages = restoreMessages(plan);
+    const restored = [];
+    let quality = null;
+    if (plan.adaptive !== null) {
+        techniqueGui.adaptive(plan.adaptive);
+        if (sendQuality()) quality = plan.adaptive ? 'adaptive quality' : 'fixed quality';
+    }
+    if (plan.scene) {
+        if (steer(sceneMsg(plan.scene))) {
+            state.scene = plan.scene;
+            sceneGui.setScenes();
+            state.restoreAfterScene = { scene: plan.scene, messages, saved };
+            restored.push(plan.scene);
+        }
+    } else {
+        sendRestoreMessages(messages);
+    }
+    if (plan.technique) restored.push(plan.technique);
+    const count = Object.keys(plan.params).length;
+    if (count) restored.push(`${count} parameter${count === 1 ? '' : 's'}`);
+    if (plan.camera) restored.push('the camera');
+    if (quality) restored.push(quality);
+    const list = restored.length > 1 ? `${restored.slice(0, -1).join(', ')} and ${restored.at(-1)}` : restored[0];
+    const text = restored.length ? `New session: restored ${list}.` : '';
+    const missing = plan.notes.length ? ` Not restored: ${plan.notes.join('; ')}.` : '';
+    if (text || missing) showMessage(`${text || 'New session.'}${missing}`, 'info');
+    return quality !== null;
+}
+
+function sendRestoreMessages(messages) {
+    for (const msg of messages) {
+        if (msg.type === 'technique') {
+            if (!steer(msg)) continue;
+            const technique = state.techniques.get(msg.name);
+            Object.assign(state.params, schemaDefaults(technique?.params_schema));
+            showTechnique(msg.name);
+        } else if (msg.type === 'params') {
+            sendParamsNow(msg.values);
+        } else if (msg.type === 'camera') {
+            camera.set(msg);
+            cameraGui.update();
+            steer(cameraMsg(camera.toCamera()));
+            gizmo.render();
+        }
+    }
 }
 
 /**
@@ -396,11 +577,19 @@ function applyState(s, { resumed = false, fresh = false } = {}) {
     if (s.scene !== undefined) state.scene = s.scene;
     state.serverScene = state.scene;
     sceneGui.setScenes();
+    if (s.bounds !== undefined) state.bounds = boundsSphere(s.bounds) ? structuredClone(s.bounds) : null;
+    else if (s.scene !== undefined) state.bounds = null;
     if (s.camera) {
-        if (resumed) camera.set(s.camera);
-        else camera.setHome(s.camera);
+        // The orbit target at the model's depth: a glTF camera's look-at point is a metre ahead.
+        const current = withOrbitTarget(s.camera, state.bounds);
+        // "Reset camera" goes to the scene's own camera where the server names it; else to the
+        // camera a new session or scene started with.
+        if (s.scene_camera) camera.setHome(withOrbitTarget(s.scene_camera, state.bounds));
+        else if (!resumed) camera.setHome(current);
+        camera.set(current);
         cameraGui.update();
     }
+    cameraGui.setBounds(Boolean(state.bounds));
     const lights = lightsOfState(s);
     if (lights) {
         showLights(lights, s, {});
@@ -428,6 +617,11 @@ function applyServerState(s) {
         return;
     }
     applyState(s);
+    const pending = state.restoreAfterScene;
+    if (pending && s.scene === pending.scene) {
+        state.restoreAfterScene = null;
+        sendRestoreMessages(pending.messages);
+    }
 }
 
 /** Shows the light list of a state; edits still in the outbox are newer than it and stay applied. */
@@ -539,7 +733,11 @@ function recordDraw(frame, decodeMs, frameBytes) {
     if (stats && !stats.snapshot) {
         latency.frameDrawn(frame.arrivedAt, now, stats, state.rttMs ?? 0);
         passes.push(now / 1000, stats.passes);
+        refine.stats(stats, now);
     }
+    // When the frame's render began on this clock, as the latency estimates it.
+    const renderStart = frame.arrivedAt - (state.rttMs ?? 0) - (stats?.frame_ms ?? 0) - (stats?.encode_ms ?? 0);
+    watch.frameDrawn(renderStart, now);
     // A viewer follows what the controller does; a controller's own choice is already shown (and
     // frames of the previous choice may still be on their way).
     if (state.viewer && stats?.technique && stats.technique !== state.technique && state.techniques.has(stats.technique)) {
@@ -558,22 +756,72 @@ function recordDraw(frame, decodeMs, frameBytes) {
     statsGui.showDetails(stats);
     accuracyGui.frameDrawn();
     gizmo.render();
+    showProgress();
 }
 
+/** The 4-per-second tick: rate, busy badge, stale figures, chart, countdown and fading toasts. */
 function showRate() {
     const now = performance.now();
     const fps = rate.rate(now);
     const lat = latency.typical;
     ui.ovRate.textContent = `${fps.toFixed(0)} fps · input→frame ${lat === null ? '–' : formatMs(lat, 0)}`
         + ` · decode ${formatMs(state.decodeMs)}`;
+    showProgress(now);
     if (settings.chart && settings.overlay) {
-        passes.prune(now / 1000);
-        chart.update(passes.series(), now / 1000);
+        const nowS = now / 1000;
+        passes.prune(nowS);
+        const end = passes.windowEnd(nowS);
+        chart.update(passes.series(), end);
+        const age = passes.ageS(nowS);
+        // A chart that stops scrolling says why instead of looking like a live one.
+        ui.ovChartNote.hidden = end === nowS && age !== null;
+        const why = state.connState !== 'open' ? ' (not connected)'
+            : watch.pending ? ' (waiting for the server)' : ' (the view is still)';
+        ui.ovChartNote.textContent = age === null ? 'no frame timings yet'
+            : `last frame ${formatSeconds(age * 1000)} ago${why}`;
+    }
+    if (state.connState === 'waiting' && state.retryAt !== null) {
+        ui.connText.textContent = `disconnected, retrying in ${formatCountdown(state.retryAt - now)}`;
+    }
+    for (const entry of toasts.expire(now)) document.querySelector(`.message[data-id="${entry.id}"]`)?.remove();
+}
+
+/**
+ * The refinement line of the overlay, the busy badge and the stale mark. Stale: the figures are
+ * those of a frame from before input that has waited too long for one that shows it.
+ */
+function showProgress(now = performance.now()) {
+    const connected = state.connState === 'open';
+    const view = connected ? refine.view(now) : null;
+    ui.ovRefine.hidden = !view;
+    if (view) {
+        ui.ovRefine.dataset.kind = view.kind;
+        ui.ovRefineText.textContent = view.text;
+        ui.ovRefineBar.hidden = view.share === null;
+        if (view.share !== null) ui.ovRefineBar.value = view.share;
+    }
+    const late = connected && !state.viewer ? watch.lateMs(now, frameTargetMs()) : null;
+    const busy = connected ? busyText({ lateMs: late, refine: view }) : null;
+    ui.busy.hidden = busy === null;
+    ui.busy.textContent = busy ?? '';
+    ui.busy.dataset.kind = late !== null ? 'late' : 'refining';
+    const stale = connected && !state.viewer && watch.stale(now, frameTargetMs());
+    ui.overlay.classList.toggle('stale', stale);
+    ui.ovStale.hidden = !stale;
+    if (stale) {
+        ui.ovStale.textContent = `stale: figures from before your input ${formatSeconds(now - watch.pendingSince)} ago`;
     }
 }
 
 function showFrameStats(header, stats, { decodeMs, net, bytes }) {
     const ms = (v) => (Number.isFinite(v) ? v.toFixed(1) : '–');
+    const budget = budgetLine(stats?.budget);
+    ui.ovBudget.hidden = !budget;
+    if (budget) {
+        ui.ovBudget.textContent = budget.text;
+        ui.ovBudget.title = budget.reason;
+        ui.ovBudget.classList.toggle('capped', budget.capped);
+    }
     ui.ovTimes.textContent = `render ${ms(stats?.frame_ms)} · encode ${ms(stats?.encode_ms)} · net ${ms(net)} ms`;
     state.decodeMs = decodeMs;
     ui.ovBytes.textContent = [
@@ -600,8 +848,9 @@ function showAccuracyLine() {
 function setRole(viewer) {
     state.viewer = viewer;
     document.body.classList.toggle('viewer', viewer);
-    ui.role.textContent = viewer ? 'viewing' : 'controlling';
+    showRoleBadge();
     for (const section of [techniqueGui.gui, lightGui.gui, cameraGui.gui, accuracyGui.gui]) section.show(!viewer);
+    qualityGui.setViewer(viewer);
     sceneGui.setViewer(viewer);
     shareGui.setViewer(viewer);
     gizmo.enabled = !viewer;
@@ -609,35 +858,88 @@ function setRole(viewer) {
 }
 
 function toggleSession() {
-    if (connection.socket || state.connState === 'waiting') {
-        // A deliberate end: close with 1000 so the server frees the session now.
+    if (state.deadView) {
+        openOwnSession();
+    } else if (connection.socket || state.connState === 'waiting') {
+        // A deliberate end: close with 1000 so the server frees the session now, and the next
+        // Connect starts afresh instead of restoring it.
         sessionStorage.removeItem(RESUME_KEY);
+        state.restore = null;
         connection.close();
     } else {
+        hideNotice();
         connection.connect();
     }
+}
+
+/** This page without the dead view token: a session of one's own. */
+function openOwnSession() {
+    window.location.assign(`${window.location.origin}${window.location.pathname}${window.location.search}`);
+}
+
+function showRoleBadge() {
+    const closed = state.connState === 'closed';
+    ui.role.textContent = closed ? 'disconnected' : state.viewer ? 'viewing' : 'controlling';
+    ui.role.dataset.state = closed ? 'closed' : state.viewer ? 'viewer' : 'controller';
 }
 
 function showConnectionState(connState, delayMs) {
     state.connState = connState;
     hook.states.push(connState);
     if (hook.states.length > 20) hook.states.shift();
+    state.retryAt = connState === 'waiting' ? performance.now() + delayMs : null;
     ui.connDot.dataset.state = connState;
     ui.connText.textContent = connState === 'waiting'
-        ? `disconnected, retrying in ${(delayMs / 1000).toFixed(1)} s`
+        ? `disconnected, retrying in ${formatCountdown(delayMs)}`
         : connState === 'open' ? 'connected' : connState;
     ui.retryNow.hidden = connState !== 'waiting';
-    ui.sessionToggle.textContent = connState === 'closed' ? 'Connect' : 'Disconnect';
+    ui.sessionToggle.textContent = state.deadView ? 'New session' : connState === 'closed' ? 'Connect' : 'Disconnect';
+    showRoleBadge();
+    showProgress();
 }
 
 function showMessage(text, kind = 'error') {
-    const item = document.createElement('div');
-    item.className = `message ${kind}`;
-    item.textContent = text;
+    const { entry, added, dropped } = toasts.add(text, kind, performance.now());
+    for (const old of dropped) ui.messages.querySelector(`.message[data-id="${old.id}"]`)?.remove();
+    let item = ui.messages.querySelector(`.message[data-id="${entry.id}"]`);
+    if (added || !item) {
+        item = document.createElement('div');
+        item.className = `message ${kind}`;
+        item.dataset.id = String(entry.id);
+        item.append(block('span', 'message-text', text), block('span', 'message-count'));
+    }
+    // Newest last: a repeated message moves down to where the eye expects the latest one.
     ui.messages.append(item);
-    // Older messages go first so that a burst of errors cannot fill the view.
-    while (ui.messages.children.length > 4) ui.messages.firstChild.remove();
-    setTimeout(() => item.remove(), MESSAGE_HIDE_MS);
+    const count = item.querySelector('.message-count');
+    count.textContent = entry.count > 1 ? `×${entry.count}` : '';
+    item.dataset.count = String(entry.count);
+}
+
+/** A persistent explanation over the view, with the one thing to do about it. */
+function showNotice(notice, details) {
+    ui.noticeTitle.textContent = notice.title;
+    ui.noticeText.textContent = notice.text;
+    ui.notice.dataset.details = details ?? '';
+    ui.notice.title = details ?? '';
+    const labels = { connect: 'Connect', 'own-session': 'Start my own session', reload: 'Reload' };
+    ui.noticeAction.hidden = !notice.action;
+    ui.noticeAction.textContent = labels[notice.action] ?? '';
+    ui.noticeAction.dataset.action = notice.action ?? '';
+    ui.notice.hidden = false;
+}
+
+function hideNotice() {
+    ui.notice.hidden = true;
+}
+
+function noticeAction() {
+    const action = ui.noticeAction.dataset.action;
+    if (action === 'own-session') openOwnSession();
+    else if (action === 'reload') window.location.reload();
+    else if (action === 'connect') {
+        hideNotice();
+        connection.connect();
+    }
 }
 
 let lastLightingNote = null;
@@ -759,11 +1061,7 @@ const techniqueGui = (() => {
     const gui = makeSection(ui.sections, 'Technique & parameters', { id: 'technique' });
     const model = {
         technique: '', adaptive: true, help: settings.help,
-        reset: () => {
-            const technique = state.techniques.get(state.technique);
-            queueParams({ ...schemaDefaults(state.welcome?.frame_params_schema), ...schemaDefaults(technique?.params_schema) });
-            paramPanel.update({ ...state.params, ...outbox.params }, { force: true });
-        },
+        reset: () => resetParams(),
     };
     const techniqueCtl = describe(gui.add(model, 'technique', ['']).name('technique'), 'technique',
         'the global-illumination technique; its parameters reset to their defaults');
@@ -773,22 +1071,25 @@ const techniqueGui = (() => {
         if (!steer(techniqueMsg(name))) return;
         const technique = state.techniques.get(name);
         Object.assign(state.params, schemaDefaults(technique?.params_schema));
+        forgetTechniqueParams();
         showTechnique(name);
     });
     const info = addBlock(gui, block('p', 'technique-info block'));
     describe(gui.add(model, 'adaptive').name('adaptive quality'), 'adaptive',
         'render quickly while you steer, then refine the still view (balanced, then final preset)')
-        .onChange((on) => steer(qualityMsg(on)));
+        .onChange(() => sendQuality());
     describe(gui.add(model, 'help').name('show help'), 'help', 'show each parameter\'s description, range and source')
         .onChange((on) => {
             settings.help = on;
             saveSettings();
             ui.sidebar.classList.toggle('show-help', on);
         });
-    describe(gui.add(model, 'reset').name('Reset parameters'), 'reset-params', 'every parameter back to its default');
+    describe(gui.add(model, 'reset').name('Reset parameters'), 'reset-params',
+        'every parameter back to its default; the technique\'s parameters follow the adaptive presets again');
     ui.sidebar.classList.toggle('show-help', settings.help);
     return {
         gui,
+        model,
         setTechniques(names) {
             techniqueCtl.options(names.length ? names : ['']);
         },
@@ -808,6 +1109,35 @@ const techniqueGui = (() => {
 // The generated parameter folders go at the end of the Technique section.
 const paramPanel = new ParamPanel(techniqueGui.gui);
 
+/** A technique message makes the server forget explicit technique parameters; frame parameters stay. */
+function forgetTechniqueParams() {
+    const frame = state.welcome?.frame_params_schema?.properties ?? {};
+    state.explicit = new Set([...state.explicit].filter((k) => Object.hasOwn(frame, k)));
+}
+
+/**
+ * "Reset parameters" without making every value explicit (explicit values win over the adaptive
+ * presets): the current technique again resets its parameters and forgets the explicit ones, and
+ * only frame parameters off their default are sent (see params.js resetPlan for the limit).
+ */
+function resetParams() {
+    if (state.viewer) return;
+    flushOutbox();
+    const technique = state.techniques.get(state.technique);
+    const plan = resetPlan({
+        techniqueSchema: technique?.params_schema, frameSchema: state.welcome?.frame_params_schema,
+        params: state.params, explicit: state.explicit,
+    });
+    if (plan.technique && steer(techniqueMsg(state.technique))) {
+        Object.assign(state.params, plan.techniqueDefaults);
+        forgetTechniqueParams();
+    }
+    if (Object.keys(plan.frame).length > 0) sendParamsNow(plan.frame);
+    paramPanel.update(state.params, { force: true });
+    sceneGui.update();
+    if (!plan.technique && Object.keys(plan.frame).length === 0) showMessage('Every parameter is at its default.', 'info');
+}
+
 /** Rebuilds the parameter folders for technique `name` with the session's values. */
 function showTechnique(name) {
     state.technique = name;
@@ -816,8 +1146,68 @@ function showTechnique(name) {
     paramPanel.build([
         { title: `${name ?? 'technique'} parameters`, schema: technique?.params_schema },
         { title: 'frame parameters', schema: state.welcome?.frame_params_schema, closed: true },
-    ], state.params, (param, value) => queueParams({ [param]: value }));
+    ], state.params, (param, value) => queueParams({ [param]: value }), { onRefuse: (text) => showMessage(text) });
 }
+
+const qualityGui = (() => {
+    const gui = makeSection(ui.sections, 'Resolution & quality', { id: 'quality' });
+    const model = { frameTarget: settings.frameTargetMs ?? 'default', pixelBudget: settings.pixelBudget };
+    const targetCtl = describe(gui.add(model, 'frameTarget', frameTargetOptions(null)).name('frame time target'),
+        'frame-target', 'what interactive frames must take at most while you steer: smooth renders fewer VPLs and '
+        + 'pixels, sharp more; refinement of the still view follows');
+    targetCtl.onChange((v) => {
+        settings.frameTargetMs = v === 'default' ? null : v;
+        saveSettings();
+        sendQuality();
+        update();
+    });
+    const budgetCtl = describe(gui.add(model, 'pixelBudget', Object.fromEntries(PIXEL_BUDGETS.map((b) => [b.label, b.px])))
+        .name('pixel budget'), 'pixel-budget',
+    'the most pixels a frame may have: on high-density screens the device pixel ratio sent to the server is lowered '
+        + 'to stay within it');
+    budgetCtl.onChange((v) => {
+        settings.pixelBudget = v;
+        saveSettings();
+        sendResize();
+        update();
+    });
+    const info = addBlock(gui, block('div', 'quality-info block'));
+    info.dataset.block = 'quality-info';
+
+    function update() {
+        const supported = frameTargetSupported(state.welcome, CLIENT_SCHEMAS);
+        targetCtl.show(supported && !state.viewer);
+        if (supported) {
+            targetCtl.options(frameTargetOptions(state.welcome?.limits?.frame_target_ms));
+            model.frameTarget = settings.frameTargetMs ?? 'default';
+            targetCtl.updateDisplay();
+        }
+        const vp = hook.viewport;
+        const lines = [];
+        if (vp) {
+            const device = window.devicePixelRatio || 1;
+            const px = [Math.round(vp.size[0] * vp.dpr), Math.round(vp.size[1] * vp.dpr)];
+            lines.push(['frame size', `${px[0]}×${px[1]} (${(px[0] * px[1] / 1e6).toFixed(2)} MP)`]);
+            lines.push(['pixel ratio', vp.dpr < device ? `${vp.dpr} of this screen's ${device}` : String(vp.dpr)]);
+        }
+        if (state.frameTargetMs !== null) lines.push(['session target', `${state.frameTargetMs} ms`]);
+        const slice = state.welcome?.limits?.slice_ms;
+        if (Number.isFinite(slice)) lines.push(['refinement slice', `${slice} ms`]);
+        info.replaceChildren(...lines.map(([k, v]) => {
+            const div = block('div', 'kv');
+            div.append(block('span', 'k', k), block('span', 'v', v));
+            return div;
+        }));
+    }
+
+    return {
+        gui,
+        update,
+        setViewer(viewer) {
+            gui.show(!viewer);
+        },
+    };
+})();
 
 const lightGui = (() => {
     const gui = makeSection(ui.sections, 'Light', { id: 'light' });
@@ -964,6 +1354,7 @@ const cameraGui = (() => {
         fov: 40,
         speed: settings.flySpeed,
         reset: () => resetCamera(),
+        frame: () => frameModel(),
     };
     const toolOptions = Object.fromEntries(DRAG_TOOLS.map((t) => [TOOL_NAMES[t], t]));
     describe(gui.add(model, 'tool', toolOptions).name('drag tool'), 'drag-tool',
@@ -986,10 +1377,13 @@ const cameraGui = (() => {
             saveSettings();
         });
     describe(gui.add(model, 'reset').name('Reset camera'), 'reset-camera', 'back to the scene\'s camera (Home or R)');
+    const frameCtl = describe(gui.add(model, 'frame').name('Frame the model'), 'frame-model',
+        'orbit around the model\'s centre from far enough to see all of it, keeping the view direction (.)');
+    frameCtl.show(false);
     addBlock(gui, block('p', 'hint block',
         'Drag: the tool above · Shift- or right-drag: pan · wheel or pinch: zoom · two fingers: pan · '
-        + 'W A S D: fly, E/Q: up/down · arrows: orbit (fly: look) · +/−: zoom · Home or R: reset. '
-        + 'Click the view first for the keys.'));
+        + 'W A S D: fly, E/Q: up/down · arrows: orbit (fly: look) · +/−: zoom · Home or R: reset · '
+        + '. (full stop): frame the model · F: fullscreen. Click the view first for the keys.'));
     ui.canvas.dataset.tool = model.tool;
     return {
         gui,
@@ -1001,12 +1395,47 @@ const cameraGui = (() => {
                 fovCtl.updateDisplay();
             }
         },
+        /** Framing needs the scene's bounds (protocol 2's state.bounds). */
+        setBounds(known) {
+            frameCtl.show(known);
+        },
     };
 })();
 
 function resetCamera() {
     camera.reset();
     scheduleCamera();
+}
+
+/** Fits the orbit camera to the scene's bounds, seen from the current direction. */
+function frameModel() {
+    if (state.viewer || !state.bounds) return;
+    const aspect = ui.viewport.clientWidth / Math.max(1, ui.viewport.clientHeight);
+    if (camera.frame(state.bounds, aspect)) scheduleCamera();
+}
+
+/** The view (stream, gizmo, overlay) fills the screen; F or the ⛶ button again leaves. */
+function toggleFullscreen() {
+    if (document.fullscreenElement) {
+        document.exitFullscreen?.().catch(() => {});
+        return;
+    }
+    const view = ui.viewport;
+    // Safari before 16.4 has only the prefixed form.
+    const request = view.requestFullscreen ?? view.webkitRequestFullscreen;
+    if (!request) {
+        showMessage('This browser cannot show the view fullscreen.');
+        return;
+    }
+    Promise.resolve(request.call(view)).catch((e) => showMessage(`Fullscreen was refused: ${e.message}`));
+}
+
+function showFullscreenState() {
+    const on = document.fullscreenElement === ui.viewport;
+    ui.fullscreen.setAttribute('aria-pressed', String(on));
+    ui.fullscreen.title = on ? 'leave fullscreen (F or Esc)' : 'show the view fullscreen (F)';
+    // Keys go to the view: the canvas keeps focus across the switch.
+    ui.canvas.focus({ preventScroll: true });
 }
 
 const statsGui = (() => {
@@ -1016,6 +1445,7 @@ const statsGui = (() => {
         ui.overlay.hidden = !settings.overlay;
         ui.ovChart.hidden = !settings.chart;
         ui.ovLegend.hidden = !settings.chart;
+        if (!settings.chart) ui.ovChartNote.hidden = true;
     };
     describe(gui.add(model, 'overlay').name('overlay'), 'stats-overlay', 'frame rate, latency and times over the view')
         .onChange((on) => {
@@ -1043,9 +1473,15 @@ const statsGui = (() => {
         showDetails(stats) {
             if (!stats) return;
             const changed = presetChanges(stats.params, state.params);
+            const budget = budgetLine(stats.budget);
+            const r = stats.refine;
             details.replaceChildren(
                 row('quality', `${stats.quality ?? '–'}${stats.refined ? ' (refined)' : ''}`
                     + `${stats.scale !== undefined ? `, scale ${stats.scale}` : ''}`),
+                ...(budget ? [row('frame budget', budget.text), row('why', budget.reason || '–')] : []),
+                ...(r ? [row('refinement', `${r.step ?? stats.quality}: ${r.tiles_done ?? '?'} tiles, `
+                    + `${Math.round(100 * (r.share ?? 0))} %, ${formatMs(r.elapsed_ms, 0)}`
+                    + `${r.complete ? ', complete' : `, ${formatMs(r.eta_ms, 0)} left`}`)] : []),
                 row('queue', formatMs(stats.queue_ms)),
                 row('readback', formatMs(stats.readback_ms)),
                 row('timing', stats.timing ?? '–'),
@@ -1463,9 +1899,14 @@ function start() {
         onLight: onLightDrag,
         onHome: resetCamera,
         flySpeed: () => cameraGui.speed(),
+        shortcuts: { KeyF: toggleFullscreen, Period: frameModel, NumpadDecimal: frameModel },
     });
     ui.sessionToggle.addEventListener('click', toggleSession);
     ui.retryNow.addEventListener('click', () => connection.connect());
+    ui.noticeAction.addEventListener('click', noticeAction);
+    ui.fullscreen.addEventListener('click', toggleFullscreen);
+    ui.fullscreen.hidden = !(ui.viewport.requestFullscreen || ui.viewport.webkitRequestFullscreen);
+    document.addEventListener('fullscreenchange', showFullscreenState);
     bindDragAndDrop();
     // The viewport changes size with the window and when the sidebar opens or closes.
     new ResizeObserver(debounce(() => {

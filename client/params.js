@@ -1,7 +1,9 @@
 // Parameter schemas (welcome: a technique's params_schema and frame_params_schema) turned into
 // control descriptions: what widget, range, step, label and help text each parameter gets.
-// Pure (no DOM, no libraries) so node's test runner checks it; controls.js builds the lil-gui
-// widgets from these descriptions.
+// Pure (no DOM) so node's test runner checks it; controls.js builds the lil-gui widgets from these
+// descriptions.
+
+import { validateJson } from './protocol.js';
 
 /** The kind of widget a parameter schema gets: 'number', 'integer', 'boolean', 'enum' or 'text'. */
 export function widgetKind(schema) {
@@ -30,18 +32,23 @@ function formatNumber(v) {
     return Number.isInteger(v) ? String(v) : String(Number(v.toPrecision(6)));
 }
 
+/** "range 1 to 256 VPLs per side", "at least 0 m", or '' for a schema without bounds. */
+export function rangeText(schema) {
+    const unit = schema?.['x-unit'] ? ` ${schema['x-unit']}` : '';
+    if (Number.isFinite(schema?.minimum) && Number.isFinite(schema?.maximum)) {
+        return `range ${formatNumber(schema.minimum)} to ${formatNumber(schema.maximum)}${unit}`;
+    }
+    if (Number.isFinite(schema?.minimum)) return `at least ${formatNumber(schema.minimum)}${unit}`;
+    if (Number.isFinite(schema?.maximum)) return `at most ${formatNumber(schema.maximum)}${unit}`;
+    return '';
+}
+
 /** One line of help: the description, then range, default and source. */
 export function paramHelp(schema) {
     const parts = [];
     if (schema?.description) parts.push(schema.description);
-    const unit = schema?.['x-unit'] ? ` ${schema['x-unit']}` : '';
-    if (Number.isFinite(schema?.minimum) && Number.isFinite(schema?.maximum)) {
-        parts.push(`range ${formatNumber(schema.minimum)} to ${formatNumber(schema.maximum)}${unit}`);
-    } else if (Number.isFinite(schema?.minimum)) {
-        parts.push(`at least ${formatNumber(schema.minimum)}${unit}`);
-    } else if (Number.isFinite(schema?.maximum)) {
-        parts.push(`at most ${formatNumber(schema.maximum)}${unit}`);
-    }
+    const range = rangeText(schema);
+    if (range) parts.push(range);
     if (Array.isArray(schema?.enum)) parts.push(`one of ${schema.enum.join(', ')}`);
     if (schema?.default !== undefined) parts.push(`default ${schema.default}`);
     if (schema?.['x-source']) parts.push(`source: ${schema['x-source']}`);
@@ -90,4 +97,53 @@ export function presetChanges(frameParams, ownParams) {
     return Object.entries(frameParams)
         .filter(([k, v]) => Object.hasOwn(ownParams, k) && ownParams[k] !== v)
         .map(([k, v]) => [k, v, ownParams[k]]);
+}
+
+/**
+ * A number typed into a parameter's field: {value} when the schema accepts it, else {error}, a
+ * sentence naming the parameter and its range. A slider cannot leave the range, but the field
+ * accepts any text, and lil-gui would clamp 9999 to the maximum and send that.
+ */
+export function checkTypedNumber(name, schema, text) {
+    const typed = String(text ?? '').trim();
+    const value = typed === '' ? NaN : Number(typed);
+    const range = rangeText(schema);
+    const within = range ? ` (${range})` : '';
+    if (!Number.isFinite(value)) return { error: `${name}: "${typed}" is not a number${within}; not sent.` };
+    if (schema?.type === 'integer' && !Number.isInteger(value)) {
+        return { error: `${name}: ${typed} is not a whole number${within}; not sent.` };
+    }
+    if (validateJson(value, schema)) return { error: `${name}: ${typed} is out of range${within}; not sent.` };
+    return { value };
+}
+
+/**
+ * The properties of a parameter schema in the order the controls show them: the server's order
+ * (most important first), or `x-order` where the schema carries it, since a JSON object's key
+ * order may not survive every encoder.
+ */
+export function orderedProperties(schema) {
+    const entries = Object.entries(schema?.properties ?? {});
+    const rank = (s) => (Number.isFinite(s?.['x-order']) ? s['x-order'] : Infinity);
+    return entries
+        .map((entry, i) => ({ entry, i }))
+        .sort((a, b) => (rank(a.entry[1]) - rank(b.entry[1])) || (a.i - b.i))
+        .map(({ entry }) => entry);
+}
+
+/**
+ * What "Reset parameters" sends. The protocol has no message that forgets explicit values, but a
+ * `technique` message naming the current technique resets its parameters and forgets the explicit
+ * ones, so the adaptive presets apply to them again: {technique: true} when any technique
+ * parameter is explicit or off its default. Frame parameters can only be set: `frame` holds those
+ * whose value differs from the default (a frame parameter set before stays explicit, at its
+ * default).
+ */
+export function resetPlan({ techniqueSchema, frameSchema, params = {}, explicit = new Set() }) {
+    const techniqueDefaults = schemaDefaults(techniqueSchema);
+    const technique = Object.keys(techniqueSchema?.properties ?? {})
+        .some((k) => explicit.has(k) || (Object.hasOwn(params, k) && params[k] !== techniqueDefaults[k]));
+    const frame = Object.fromEntries(Object.entries(schemaDefaults(frameSchema))
+        .filter(([k, v]) => Object.hasOwn(params, k) && params[k] !== v));
+    return { technique, frame, techniqueDefaults };
 }

@@ -11,6 +11,12 @@ export const CLIENT_MESSAGE_TYPES = Object.freeze([
     'snapshot', 'ack', 'ping',
 ]);
 
+// What the server sends as text. `progress` (protocol 2) reports refinement; a type outside this
+// list is logged and ignored, so a newer server's additions cannot break the page.
+export const SERVER_MESSAGE_TYPES = Object.freeze([
+    'welcome', 'stats', 'state', 'error', 'pong', 'shutdown', 'progress',
+]);
+
 // The bounds of the resize/hello schemas; the server scales the product size x dpr down to its
 // own limits.max_size, so the client only has to stay inside the schema.
 export const MIN_VIEWPORT_SIDE = 16;
@@ -21,7 +27,8 @@ export const MAX_DPR = 4;
 // ---------------------------------------------------------------------------------------------
 // Message builders
 
-const HELLO_FIELDS = ['client', 'token', 'resume', 'view', 'codecs', 'quality', 'max_in_flight', 'adaptive', 'size', 'dpr'];
+const HELLO_FIELDS = ['client', 'token', 'resume', 'view', 'codecs', 'quality', 'max_in_flight', 'adaptive', 'size', 'dpr',
+    'frame_target_ms'];
 
 /** The opening message; only the fields given (not undefined) are sent, so the server's defaults apply to the rest. */
 export function helloMsg(fields = {}) {
@@ -83,8 +90,11 @@ export function sceneMsg(name) {
     return { type: 'scene', name };
 }
 
-export function qualityMsg(adaptive) {
-    return { type: 'quality', adaptive };
+/** Adaptive quality on or off; `frameTargetMs` (protocol 2, 20..1000) also changes the frame-time target. */
+export function qualityMsg(adaptive, frameTargetMs) {
+    const msg = { type: 'quality', adaptive };
+    if (frameTargetMs !== undefined) msg.frame_target_ms = frameTargetMs;
+    return msg;
 }
 
 /** codec 'png' (the server's default) or 'webp'; both lossless. */
@@ -352,6 +362,11 @@ export function validateParamValues(values, ...paramSchemas) {
         if (v) return { code: 'invalid_param', where: where + v.where, message: v.message };
     }
     return null;
+}
+
+/** Whether `type` is a server message this client knows (SERVER_MESSAGE_TYPES). */
+export function isKnownServerMessage(type) {
+    return SERVER_MESSAGE_TYPES.includes(type);
 }
 
 /** Parses a server text message; returns null for anything that is not a JSON object with a type. */

@@ -108,7 +108,23 @@ export class PassHistory {
     }
 
     prune(now) {
-        while (this.samples.length && this.samples[0].t < now - this.windowS) this.samples.shift();
+        const end = this.windowEnd(now);
+        while (this.samples.length && this.samples[0].t < end - this.windowS) this.samples.shift();
+    }
+
+    /**
+     * Where the chart's window ends: now while frames arrive, else at the newest frame, so a still
+     * view (or a stalled server) keeps its last seconds on the chart instead of scrolling them out.
+     */
+    windowEnd(now) {
+        const newest = this.samples.at(-1)?.t;
+        return newest !== undefined && newest < now - this.windowS ? newest : now;
+    }
+
+    /** Seconds since the newest sample, or null without one. */
+    ageS(now) {
+        const newest = this.samples.at(-1)?.t;
+        return newest === undefined ? null : now - newest;
     }
 
     clear() {
@@ -143,6 +159,17 @@ export function stackSeries(values) {
         out.push(row.map((v, i) => (k === 0 ? 0 : out[k - 1][i]) + (Number.isFinite(v) ? v : 0)));
     });
     return out;
+}
+
+/** The chart's y-axis labels: "0 ms", "50 ms", "1.5 ms". */
+export function msTickLabels(ticks) {
+    return ticks.map((t) => `${Number(t.toPrecision(4))} ms`);
+}
+
+/** Pixels the y axis needs for `labels` in a font of `charPx` per character, plus the tick. */
+export function axisSize(labels, charPx = 6) {
+    const longest = Math.max(4, ...(labels ?? []).map((l) => String(l ?? '').length));
+    return Math.ceil(longest * charPx + 10);
 }
 
 export function formatMs(v, digits = 1) {

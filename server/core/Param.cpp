@@ -11,10 +11,14 @@ namespace gis {
 
 std::string paramTypeName(ParamType type) {
     switch (type) {
-    case ParamType::Int: return "integer";
-    case ParamType::Float: return "number";
-    case ParamType::Bool: return "boolean";
-    case ParamType::Enum: return "string";
+    case ParamType::Int:
+        return "integer";
+    case ParamType::Float:
+        return "number";
+    case ParamType::Bool:
+        return "boolean";
+    case ParamType::Enum:
+        return "string";
     }
     return "?";
 }
@@ -39,7 +43,8 @@ std::string valueText(const nlohmann::json& v) {
 
 std::string rangeText(const ParamSpec& s) {
     switch (s.type) {
-    case ParamType::Bool: return "true or false";
+    case ParamType::Bool:
+        return "true or false";
     case ParamType::Enum: {
         std::string out = "one of ";
         for (size_t i = 0; i < s.options.size(); ++i) out += (i ? ", '" : "'") + s.options[i] + "'";
@@ -56,10 +61,14 @@ std::string rangeText(const ParamSpec& s) {
 
 nlohmann::json defaultJson(const ParamSpec& s) {
     switch (s.type) {
-    case ParamType::Int: return static_cast<long long>(std::llround(s.defaultValue));
-    case ParamType::Float: return s.defaultValue;
-    case ParamType::Bool: return s.defaultValue != 0.0;
-    case ParamType::Enum: return s.options.at(static_cast<size_t>(s.defaultValue));
+    case ParamType::Int:
+        return static_cast<long long>(std::llround(s.defaultValue));
+    case ParamType::Float:
+        return s.defaultValue;
+    case ParamType::Bool:
+        return s.defaultValue != 0.0;
+    case ParamType::Enum:
+        return s.options.at(static_cast<size_t>(s.defaultValue));
     }
     return nullptr;
 }
@@ -70,12 +79,14 @@ ParamTable::ParamTable(std::vector<ParamSpec> specs) : mSpecs(std::move(specs)) 
     for (size_t i = 0; i < mSpecs.size(); ++i) {
         const ParamSpec& s = mSpecs[i];
         GIS_ASSERT_MSG(!s.name.empty(), "parameter without a name");
-        for (size_t j = 0; j < i; ++j) GIS_ASSERT_MSG(mSpecs[j].name != s.name, "duplicate parameter " + s.name);
+        for (size_t j = 0; j < i; ++j)
+            GIS_ASSERT_MSG(mSpecs[j].name != s.name, "duplicate parameter " + s.name);
         if (s.type == ParamType::Enum) {
             GIS_ASSERT_MSG(s.defaultValue >= 0 && s.defaultValue < static_cast<double>(s.options.size()),
                            "enum default out of range: " + s.name);
         } else if (s.type != ParamType::Bool) {
-            GIS_ASSERT_MSG(s.min <= s.defaultValue && s.defaultValue <= s.max, "default outside range: " + s.name);
+            GIS_ASSERT_MSG(s.min <= s.defaultValue && s.defaultValue <= s.max,
+                           "default outside range: " + s.name);
             GIS_ASSERT_MSG(!s.logScale || s.min > 0, "log-scale parameter needs min > 0: " + s.name);
         }
     }
@@ -95,9 +106,12 @@ ParamTable ParamTable::merged(const ParamTable& other) const {
 
 nlohmann::json ParamTable::jsonSchema() const {
     nlohmann::json props = nlohmann::json::object();
+    int order = 0;
     for (const auto& s : mSpecs) {
         nlohmann::json p;
         p["type"] = paramTypeName(s.type);
+        // JSON objects do not keep their keys' order: the table's (most important first) goes along.
+        p["x-order"] = order++;
         p["default"] = defaultJson(s);
         p["description"] = s.help;
         if (s.type == ParamType::Int || s.type == ParamType::Float) {
@@ -117,11 +131,13 @@ std::vector<nlohmann::json> ParamTable::sweepValues(const ParamSpec& s, int coun
     std::vector<nlohmann::json> out;
     count = std::max(count, 1);
     switch (s.type) {
-    case ParamType::Bool: return {false, true};
+    case ParamType::Bool:
+        return {false, true};
     case ParamType::Enum:
         for (const auto& o : s.options) out.emplace_back(o);
         return out;
-    default: break;
+    default:
+        break;
     }
     for (int i = 0; i < count; ++i) {
         double t = count == 1 ? 0.5 : static_cast<double>(i) / (count - 1);
@@ -147,7 +163,9 @@ std::string ParamTable::describe() const {
     return o.str();
 }
 
-ParamSet::ParamSet(ParamTable table) : mTable(std::move(table)) { resetToDefaults(); }
+ParamSet::ParamSet(ParamTable table) : mTable(std::move(table)) {
+    resetToDefaults();
+}
 
 void ParamSet::resetToDefaults() {
     mValues = nlohmann::json::object();
@@ -160,7 +178,8 @@ const ParamSpec& ParamSet::spec(std::string_view name) const {
     return *s;
 }
 
-nlohmann::json ParamSet::validated(const ParamSpec& s, const nlohmann::json& value, const std::string& where) const {
+nlohmann::json ParamSet::validated(const ParamSpec& s, const nlohmann::json& value,
+                                   const std::string& where) const {
     const std::string loc = where.empty() ? s.name : where;
     auto fail = [&](const std::string& got) -> nlohmann::json {
         throw InputError(loc, "'" + s.name + "' must be " + rangeText(s) + ", got " + got);
@@ -172,7 +191,8 @@ nlohmann::json ParamSet::validated(const ParamSpec& s, const nlohmann::json& val
     case ParamType::Enum: {
         if (!value.is_string()) return fail(valueText(value));
         const auto& str = value.get_ref<const std::string&>();
-        if (std::find(s.options.begin(), s.options.end(), str) == s.options.end()) return fail("'" + str + "'");
+        if (std::find(s.options.begin(), s.options.end(), str) == s.options.end())
+            return fail("'" + str + "'");
         return value;
     }
     case ParamType::Int: {
@@ -196,9 +216,10 @@ void ParamSet::set(std::string_view name, const nlohmann::json& value, const std
     if (!s) {
         std::string known;
         for (const auto& k : mTable.specs()) known += (known.empty() ? "" : ", ") + k.name;
-        throw InputError(where.empty() ? std::string(name) : where,
-                         "unknown parameter '" + std::string(name) + "'" +
-                             (known.empty() ? " (this technique has no parameters)" : " (known: " + known + ")"));
+        throw InputError(
+            where.empty() ? std::string(name) : where,
+            "unknown parameter '" + std::string(name) + "'" +
+                (known.empty() ? " (this technique has no parameters)" : " (known: " + known + ")"));
     }
     mValues[s->name] = validated(*s, value, where);
 }
@@ -209,17 +230,24 @@ void ParamSet::setFromString(std::string_view name, std::string_view text, const
     std::string t(text);
     nlohmann::json v;
     switch (s->type) {
-    case ParamType::Enum: v = t; break;
+    case ParamType::Enum:
+        v = t;
+        break;
     case ParamType::Bool:
-        if (t == "true" || t == "1" || t == "on") v = true;
-        else if (t == "false" || t == "0" || t == "off") v = false;
-        else v = t;
+        if (t == "true" || t == "1" || t == "on")
+            v = true;
+        else if (t == "false" || t == "0" || t == "off")
+            v = false;
+        else
+            v = t;
         break;
     default: {
         double d = 0;
         auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), d);
-        if (ec != std::errc() || ptr != t.data() + t.size()) v = t;
-        else v = d;
+        if (ec != std::errc() || ptr != t.data() + t.size())
+            v = t;
+        else
+            v = d;
         break;
     }
     }
@@ -227,7 +255,8 @@ void ParamSet::setFromString(std::string_view name, std::string_view text, const
 }
 
 std::vector<std::string> ParamSet::apply(const nlohmann::json& object, const std::string& where) {
-    if (!object.is_object()) throw InputError(where, "parameters must be a JSON object, got " + object.dump());
+    if (!object.is_object())
+        throw InputError(where, "parameters must be a JSON object, got " + object.dump());
     ParamSet copy = *this;
     std::vector<std::string> changed;
     for (const auto& [key, value] : object.items()) {

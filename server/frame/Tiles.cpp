@@ -91,12 +91,16 @@ std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int 
 
 TilePlan::TilePlan(int fullWidth, int fullHeight, int align, int minSide)
     : mFullWidth(std::max(fullWidth, 1)), mFullHeight(std::max(fullHeight, 1)), mAlign(std::max(align, 1)),
-      mMinSide(std::max(minSide, 1)) {}
+      mMinSide(std::max(minSide, 1)) {
+    mCellsX = (mFullWidth + mAlign - 1) / mAlign;
+    mCellsY = (mFullHeight + mAlign - 1) / mAlign;
+    mCovered.assign(static_cast<std::size_t>(mCellsX) * mCellsY, 0);
+}
 
 int TilePlan::sideFor(double pixels, int limit) const {
     // Rounded up to the alignment, at least minSide, at most the image's (aligned) extent.
     const double side = std::sqrt(std::max(pixels, 1.0));
-    int s = static_cast<int>(std::ceil(side / mAlign)) * mAlign;
+    const int s = static_cast<int>(std::ceil(side / mAlign)) * mAlign;
     const int cap = ((limit + mAlign - 1) / mAlign) * mAlign;
     return std::clamp(s, std::min(mMinSide, cap), cap);
 }
@@ -104,48 +108,33 @@ int TilePlan::sideFor(double pixels, int limit) const {
 TileRect TilePlan::next(double pixels) {
     GIS_ASSERT(!done());
     pixels = std::max(pixels, 1.0);
-    if (mBandHeight == 0) {
-        const double last = static_cast<double>(mTileWidth) * mLastHeight;
-        if (mLastHeight > 0 && pixels >= last / 1.6 && pixels <= last * 1.6) {
-            mBandHeight = mLastHeight; // the same tiles as the band before: no new targets
-        } else {
-            // Square tiles of the requested area, or full-width bands when a row of them fits.
-            const int side = sideFor(pixels, std::min(mFullWidth, mFullHeight));
-            if (pixels >= static_cast<double>(mFullWidth) * side) {
-                const int rows = static_cast<int>(std::ceil(pixels / mFullWidth / mAlign)) * mAlign;
-                mBandHeight = std::clamp(rows, side, ((mFullHeight + mAlign - 1) / mAlign) * mAlign);
-                mTileWidth = mFullWidth;
-            } else {
-                mBandHeight = side;
-                mTileWidth = side;
+    // Square tiles; the side is kept while the request stays within a factor 1.6 of its area.
+    const double current = static_cast<double>(mSide) * mSide;
+    if (mSide == 0 || pixels < current / 1.6 || pixels > current * 1.6)
+        mSide = sideFor(pixels, std::max(mFullWidth, mFullHeight));
+    while (mCovered[static_cast<std::size_t>(mNextCell)]) ++mNextCell;
+    const int cx = mNextCell % mCellsX, cy = mNextCell / mCellsX;
+    const int cells = mSide / mAlign;
+    // The tile starts at the first cell not yet covered; it may reach over cells covered by a larger
+    // tile of an earlier row (rendered twice, never missed) and past the image's edges.
+    long long newly = 0;
+    for (int y = cy; y < std::min(cy + cells, mCellsY); ++y)
+        for (int x = cx; x < std::min(cx + cells, mCellsX); ++x) {
+            auto& c = mCovered[static_cast<std::size_t>(y) * mCellsX + x];
+            if (!c) {
+                c = 1;
+                ++newly;
             }
         }
-    } else {
-        const double current = static_cast<double>(mTileWidth) * mBandHeight;
-        if (pixels < current / 1.6 || pixels > current * 1.6) {
-            const int w = static_cast<int>(std::ceil(pixels / mBandHeight / mAlign)) * mAlign;
-            mTileWidth =
-                std::clamp(w, std::min(mMinSide, mFullWidth), ((mFullWidth + mAlign - 1) / mAlign) * mAlign);
-        }
-    }
-    TileRect r{mX, mY, mTileWidth, mBandHeight};
-    const long long w = std::min(mX + mTileWidth, mFullWidth) - mX;
-    const long long h = std::min(mY + mBandHeight, mFullHeight) - mY;
-    mCoveredPixels += w * h;
+    mCoveredCells += newly;
     ++mTiles;
-    mX += mTileWidth;
-    if (mX >= mFullWidth) {
-        mX = 0;
-        mY += mBandHeight;
-        mLastHeight = mBandHeight;
-        mBandHeight = 0;
-    }
-    return r;
+    while (mNextCell < static_cast<int>(mCovered.size()) && mCovered[static_cast<std::size_t>(mNextCell)])
+        ++mNextCell;
+    return TileRect{cx * mAlign, cy * mAlign, mSide, mSide};
 }
 
 double TilePlan::shareDone() const {
-    return std::clamp(static_cast<double>(mCoveredPixels) / (static_cast<double>(mFullWidth) * mFullHeight),
-                      0.0, 1.0);
+    return std::clamp(static_cast<double>(mCoveredCells) / static_cast<double>(mCovered.size()), 0.0, 1.0);
 }
 
 } // namespace gis

@@ -39,16 +39,17 @@ void pasteTile(std::vector<std::uint8_t>& canvas, int fullWidth, int fullHeight,
 std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
                                       int width, int height);
 
-/// The order and sizes of one step's tiles: bands from the top, tiles left to right within a band.
-/// Each next() asks for about `pixels` pixels (from measured slice times); the tile size is kept
-/// while the request stays within a factor 1.6 of it, since every new size reallocates the
-/// renderer's targets, and a band's height is fixed when it starts.
+/// The order and sizes of one step's tiles: square tiles in reading order, each at the first cell
+/// (align x align px) not yet covered. Each next() asks for about `pixels` pixels (from measured
+/// slice times); the side is kept while the request stays within a factor 1.6 of its area, since
+/// every new size reallocates the renderer's targets. A tile may overlap cells a larger tile of an
+/// earlier row covered: such pixels are rendered twice, none is missed.
 class TilePlan {
 public:
     TilePlan(int fullWidth, int fullHeight, int align = 16, int minSide = 32);
-    bool done() const { return mY >= mFullHeight; }
+    bool done() const { return mNextCell >= static_cast<int>(mCovered.size()); }
     TileRect next(double pixels);
-    /// Fraction of the image's pixels covered by the tiles handed out, [0, 1].
+    /// Fraction of the image's cells covered by the tiles handed out, [0, 1].
     double shareDone() const;
     int tilesDone() const { return mTiles; }
     int fullWidth() const { return mFullWidth; }
@@ -57,11 +58,11 @@ public:
 private:
     int sideFor(double pixels, int limit) const;
     int mFullWidth, mFullHeight, mAlign, mMinSide;
-    int mY = 0, mX = 0;  ///< next tile's corner
-    int mBandHeight = 0; ///< 0 before a band starts
-    int mLastHeight = 0; ///< the previous band's
-    int mTileWidth = 0;  ///< the current tile width
-    long long mCoveredPixels = 0;
+    int mCellsX = 0, mCellsY = 0;
+    std::vector<std::uint8_t> mCovered; ///< per cell, row-major
+    int mNextCell = 0;                  ///< the first cell not covered
+    int mSide = 0;                      ///< the current tile side
+    long long mCoveredCells = 0;
     int mTiles = 0;
 };
 

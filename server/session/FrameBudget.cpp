@@ -38,6 +38,11 @@ double FrameBudget::predictMs(const std::string& key, double pixels, long vpls) 
     return pixels * (r.base + r.encode) + technique;
 }
 
+double FrameBudget::msPerPixelVpl(const std::string& key) const {
+    const auto it = mRates.find(key);
+    return it == mRates.end() || it->second.frames == 0 ? 0.0 : it->second.vpl;
+}
+
 void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     if (!(cost.pixels > 0) || !std::isfinite(cost.frameMs) || cost.frameMs < 0) return;
     Rates& r = mRates[key];

@@ -59,6 +59,8 @@ public:
     void record(const std::string& key, const FrameCost& cost);
     /// Predicted ms of a frame of `key` at `pixels` with `vpls`; 0 when nothing is measured.
     double predictMs(const std::string& key, double pixels, long vpls) const;
+    /// The measured ms per pixel and VPL of the technique's passes; 0 when nothing is measured.
+    double msPerPixelVpl(const std::string& key) const;
 
 private:
     struct Rates {

@@ -74,8 +74,10 @@ std::string effectPlanKey(const Scene& scene, const FrameState& s) {
 double Session::predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const {
     const std::string prefix = sceneName + "/" + state.technique + "/";
     const double pixels = static_cast<double>(state.width) * state.height;
+    // Measured at the VPLs that step rendered with (perhaps capped): scaled to this state's.
     if (auto own = mRefineCost.find(prefix + std::to_string(step)); own != mRefineCost.end())
-        return own->second.msPerPixel * pixels;
+        return own->second.msPerPixel * pixels * static_cast<double>(std::max(1L, vplEstimate(state))) /
+               static_cast<double>(own->second.vpls);
     // Not rendered yet: scale the nearest measured step by pixels and VPLs (gather cost grows with
     // their product), so a final preset with 256 times the VPLs is predicted before it runs.
     for (int other = step - 1; other >= 0; --other)
@@ -542,8 +544,9 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
         renderedMs += tileMs;
         const double tilePixels = static_cast<double>(tile.width) * tile.height;
         const double measured = tileMs / tilePixels;
-        // The newest tile counts most, but a slow one counts at once: tiles must not overrun.
-        rate = rate > 0.0 ? std::max(measured, 0.5 * (rate + measured)) : measured;
+        // A slow tile counts at once (tiles must not overrun); a cheap one (mostly background) lowers
+        // the estimate by at most a fifth, since the next one may cover geometry.
+        rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
         recordRefineCost(w.scene->name, full, step, rate);
         pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
 
@@ -754,30 +757,41 @@ void Session::workerMain() {
                 mConfig.limits.refineBudgetMs > 0) {
                 const double budgetMs = mConfig.limits.refineBudgetMs;
                 const double predictedMs = predictRefineMs(scene->name, state, step);
+                // Fewer VPLs where the technique can take them (a step's cost is about proportional
+                // to them) when the whole step would overrun the budget, or when even a 32 x 32 tile
+                // would overrun a slice (input waits for at most one tile); else a step over the
+                // budget is skipped. The client is told which.
+                const TechniqueInfo& info = findTechniqueInfo(state.technique);
+                const long vpls = vplEstimate(state);
+                double cap = static_cast<double>(vpls);
+                std::string why;
                 if (predictedMs > budgetMs) {
-                    // Over the budget: fewer VPLs where the technique can take them (the step's cost is
-                    // about proportional to them), else the step is skipped; the client is told which.
-                    const TechniqueInfo& info = findTechniqueInfo(state.technique);
-                    const long vpls = vplEstimate(state);
-                    const long cap =
-                        static_cast<long>(0.9 * static_cast<double>(vpls) * budgetMs / predictedMs);
-                    const std::string over =
-                        "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
-                        " s, over the server's refinement budget of " +
-                        std::to_string(std::lround(budgetMs / 1000.0)) + " s (--refine-budget-ms)";
-                    if (info.limitVpls && cap >= 16) {
-                        info.limitVpls(state.techniqueParams, cap);
-                        refineNote = "capped at " + std::to_string(vplEstimate(state)) + " of " +
-                                     std::to_string(vpls) + " VPLs: " + over;
-                    } else {
-                        broadcastText({{"type", "progress"},
-                                       {"state", "skipped"},
-                                       {"step", stepName(step)},
-                                       {"share", 0.0},
-                                       {"eta_ms", predictedMs},
-                                       {"reason", over}});
-                        continue;
+                    cap = 0.9 * static_cast<double>(vpls) * budgetMs / predictedMs;
+                    why = "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
+                          " s, over the server's refinement budget of " +
+                          std::to_string(std::lround(budgetMs / 1000.0)) + " s (--refine-budget-ms)";
+                }
+                const double vplRate = w.budget.msPerPixelVpl(budgetKey);
+                if (vplRate > 0.0) {
+                    const double sliceCap = 0.8 * mConfig.limits.sliceMs / (vplRate * 32.0 * 32.0);
+                    if (sliceCap < cap) {
+                        cap = sliceCap;
+                        why = "a 32 x 32 tile must fit one " + std::to_string(mConfig.limits.sliceMs) +
+                              " ms slice (--slice-ms)";
                     }
+                }
+                if (cap < static_cast<double>(vpls) && info.limitVpls && cap >= 16.0) {
+                    info.limitVpls(state.techniqueParams, static_cast<long>(cap));
+                    refineNote = "capped at " + std::to_string(vplEstimate(state)) + " of " +
+                                 std::to_string(vpls) + " VPLs: " + why;
+                } else if (predictedMs > budgetMs) {
+                    broadcastText({{"type", "progress"},
+                                   {"state", "skipped"},
+                                   {"step", stepName(step)},
+                                   {"share", 0.0},
+                                   {"eta_ms", predictedMs},
+                                   {"reason", why}});
+                    continue;
                 }
             }
             if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {

@@ -2,7 +2,12 @@
 // real gi-server. The page connects and draws frames; the technique, a parameter, the light, adding
 // and removing a light, the accuracy view, an upload, a snapshot and a view-only link work through the UI; the stats overlay
 // shows per-pass times; the phone layout has a drawer; the page reconnects after the server
-// restarts. Screenshots of the page are saved as test artifacts (the path is printed).
+// restarts and restores the session. Typed values outside a parameter's range are refused,
+// repeated messages counted, "Reset parameters" lets the presets apply again; the frame-time
+// target, the frame budget, refinement progress, framing the model and fullscreen work; a late
+// frame and stale figures are marked (a proxy holds frames back and injects progress messages);
+// a dpr-3 phone stays within the pixel budget; an expired view link says so and is not retried.
+// Screenshots of the page are saved as test artifacts (the path is printed).
 // Run: GI_SERVER=build/dev/bin/gi-server node --test tests/e2e/browser.test.mjs
 //   GI_CHROMIUM        the browser (default /usr/bin/chromium, installed by deploy/install-deps.sh)
 //   GI_TEST_ARTIFACTS  where screenshots go (default: test-artifacts/ next to the server's bin/)
@@ -66,6 +71,37 @@ function meanAbsDiff(a, b) {
 }
 
 const control = (id, inner = '') => page.locator(`[data-control="${id}"] ${inner}`.trim());
+
+/** A short orbit drag over the middle of the view of page `p`. */
+async function drag(p = page, dx = 20) {
+    const box = await p.locator('#view').boundingBox();
+    await p.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await p.mouse.down();
+    await p.mouse.move(box.x + box.width / 2 + dx, box.y + box.height / 2 + 5, { steps: 3 });
+    await p.mouse.up();
+}
+
+/** The messages the page sent since the last clearSent(), camera, ack and ping left out. */
+const sent = (type) => page.evaluate((t) => window.giClient.sent.filter((m) => !t || m.type === t), type);
+const clearSent = () => page.evaluate(() => { window.giClient.sent.length = 0; });
+
+/** Runs fn with adaptive quality on, and turns it off again (the tests around expect fixed frames). */
+async function withAdaptive(fn) {
+    await control('adaptive', 'input').check();
+    try {
+        await until('an adaptive frame', () => window.giClient.lastStats && window.giClient.lastStats.quality !== 'fixed');
+        await fn();
+    } finally {
+        await control('adaptive', 'input').uncheck();
+        await until('fixed-quality frames again', () => window.giClient.lastStats?.quality === 'fixed', null, 60000);
+    }
+}
+
+const vsub = (a, b) => a.map((v, i) => v - b[i]);
+const vdot = (a, b) => a.reduce((s, v, i) => s + v * b[i], 0);
+const vlen = (a) => Math.hypot(...a);
+const vnorm = (a) => a.map((v) => v / vlen(a));
+const near = (a, b, eps) => a.every((v, i) => Math.abs(v - b[i]) <= eps);
 
 before(async () => {
     mkdirSync(ARTIFACTS, { recursive: true });
@@ -144,6 +180,137 @@ test('a parameter change reaches the server and the stats echo it', async () => 
     await control('help', 'input').check();
     assert.match(await control('param-vpl_grid', '.control-help').textContent(), /range 1 to 256 VPLs per side/);
     await control('help', 'input').uncheck();
+});
+
+test('a typed value outside a parameter\'s range is refused with the range, not clamped and sent', async () => {
+    await clearSent();
+    const input = control('param-vpl_grid', 'input');
+    await input.fill('9999');
+    await input.press('Enter');
+    const refusal = /vpl_grid: 9999 is out of range \(range 1 to 256 VPLs per side\); not sent/;
+    await until('the refusal names the range', (re) => [...document.querySelectorAll('.message')]
+        .some((m) => new RegExp(re).test(m.textContent)), refusal.source);
+    assert.equal(await input.inputValue(), '6', 'the field shows the session\'s value again');
+    assert.equal(await page.locator('[data-control="param-vpl_grid"].refused').count(), 1, 'the field is marked');
+    await page.waitForTimeout(300);
+    assert.deepEqual(await sent('params'), [], 'nothing was sent (lil-gui alone would have sent 256)');
+    assert.equal(await page.evaluate(() => window.giClient.params.vpl_grid), 6);
+    assert.equal(await page.evaluate(() => window.giClient.lastStats.params.vpl_grid), 6);
+});
+
+test('the same message again is counted on one toast instead of stacking', async () => {
+    const input = control('param-vpl_grid', 'input');
+    await input.fill('9999');
+    await input.press('Enter');
+    const toast = await until('one toast counting two refusals', () => {
+        const toasts = [...document.querySelectorAll('.message')].filter((m) => m.textContent.includes('9999 is out of range'));
+        return toasts.length === 1 && toasts[0].dataset.count === '2' && toasts[0].textContent;
+    });
+    assert.match(toast, /×2$/);
+    assert.deepEqual(await sent('params'), []);
+});
+
+test('the parameter folders keep the schema\'s order and show whole names', async () => {
+    const expected = await page.evaluate(() => {
+        const schema = window.giClient.welcome.techniques.find((t) => t.name === 'rsm_gather').params_schema;
+        const rank = (s) => (Number.isFinite(s['x-order']) ? s['x-order'] : Infinity);
+        return Object.entries(schema.properties).map(([k, s], i) => ({ k, r: rank(s), i }))
+            .sort((a, b) => (a.r - b.r) || (a.i - b.i)).map((e) => e.k);
+    });
+    const folder = page.locator('.param-folder').first();
+    assert.deepEqual(await folder.locator('[data-param]').evaluateAll((els) => els.map((e) => e.dataset.param)), expected,
+        'the order the server sent (x-order where given), not re-sorted');
+    const cut = await folder.locator('[data-param] > .lil-name').evaluateAll((els) => els
+        .filter((e) => e.scrollWidth > e.clientWidth + 1 || e.title !== e.textContent).map((e) => e.textContent));
+    assert.deepEqual(cut, [], 'no label is cut off, and each has its full name as the tooltip');
+});
+
+test('"Reset parameters" sends no explicit defaults: the adaptive presets apply again', async () => {
+    // min_distance: the interactive preset of rsm_gather sets it to 1/3, the default is 0.1.
+    const input = control('param-min_distance', 'input');
+    await input.fill('0.2');
+    await input.press('Enter');
+    await until('min_distance 0.2 rendered', () => window.giClient.lastStats?.params?.min_distance === 0.2);
+    await clearSent();
+    await control('reset-params', 'button').click();
+    await until('the defaults rendered', () => {
+        const p = window.giClient.lastStats?.params;
+        return p?.vpl_grid === 16 && Math.abs(p.min_distance - 0.1) < 1e-9 && window.giClient.lastStats.quality === 'fixed';
+    });
+    const messages = await sent();
+    assert.ok(messages.some((m) => m.type === 'technique' && m.name === 'rsm_gather'),
+        `the technique again, which makes the server forget explicit values: ${JSON.stringify(messages)}`);
+    assert.ok(!messages.some((m) => m.type === 'params' && ('vpl_grid' in m.values || 'min_distance' in m.values)),
+        `no technique parameter sent explicitly: ${JSON.stringify(messages)}`);
+    assert.equal(await input.inputValue(), '0.1', 'the panel shows the default');
+    await withAdaptive(async () => {
+        await drag();
+        await until('an interactive frame with the preset\'s min_distance', () => {
+            const s = window.giClient.lastStats;
+            return s?.quality === 'interactive' && Math.abs(s.params.min_distance - 1 / 3) < 1e-6;
+        });
+    });
+    // Back to the value the later tests were written for.
+    await control('param-vpl_grid', 'input').fill('6');
+    await control('param-vpl_grid', 'input').press('Enter');
+    await until('vpl_grid 6 again', () => window.giClient.lastStats?.params?.vpl_grid === 6);
+});
+
+test('the frame-time target is offered, sent with quality and kept; interactive frames show their budget', async () => {
+    const welcome = await page.evaluate(() => window.giClient.welcome);
+    assert.ok(Number.isInteger(welcome.frame_target_ms), `welcome.frame_target_ms: ${welcome.frame_target_ms}`);
+    assert.ok(Number.isInteger(welcome.limits.frame_target_ms), 'the server default');
+    assert.ok(await control('frame-target').isVisible(), 'the control is shown');
+    await withAdaptive(async () => {
+        await clearSent();
+        await control('frame-target', 'select').selectOption({ label: 'smooth (50 ms)' });
+        try {
+            assert.ok((await sent('quality')).some((m) => m.frame_target_ms === 50 && m.adaptive === true));
+            assert.equal(await page.evaluate(() => JSON.parse(localStorage.getItem('gi-client-settings')).frameTargetMs), 50);
+            await drag();
+            const budget = await until('an interactive frame with budget.target_ms 50', () => {
+                const s = window.giClient.lastStats;
+                return s?.quality === 'interactive' && s.budget?.target_ms === 50 && s.budget;
+            });
+            assert.ok(Number.isFinite(budget.predicted_ms) && Number.isFinite(budget.vpls), JSON.stringify(budget));
+            assert.equal(typeof budget.reason, 'string');
+            assert.match(await page.locator('#ov-budget').textContent(), /^budget 50 ms: predicted \d+ ms · VPLs \d+/);
+            assert.ok(await page.locator('#ov-budget').isVisible());
+        } finally {
+            await control('frame-target', 'select').selectOption({ index: 0 });
+        }
+        assert.equal(await page.evaluate(() => JSON.parse(localStorage.getItem('gi-client-settings')).frameTargetMs), null);
+    });
+});
+
+test('refinement fills the image in tile by tile and the overlay shows step, share and time left', async () => {
+    await withAdaptive(async () => {
+        await page.evaluate(() => {
+            window.seenRefine = { texts: [], kinds: [], stats: [] };
+            const line = document.getElementById('ov-refine');
+            new MutationObserver(() => {
+                if (line.hidden) return;
+                window.seenRefine.texts.push(document.getElementById('ov-refine-text').textContent);
+                window.seenRefine.kinds.push(line.dataset.kind);
+            }).observe(line, { subtree: true, childList: true, characterData: true, attributes: true });
+            setInterval(() => {
+                const r = window.giClient.lastStats?.refine;
+                if (r && window.seenRefine.stats.at(-1) !== r) window.seenRefine.stats.push(r);
+            }, 20);
+        });
+        await drag();
+        await until('a balanced or final frame with stats.refine', () => window.seenRefine.stats.length > 0);
+        const seen = await until('refinement done or a step skipped', () => window.seenRefine.kinds
+            .some((k) => k === 'done' || k === 'skipped') && window.seenRefine, null, 90000);
+        assert.ok(seen.stats.length > 0, 'balanced or final frames carry stats.refine');
+        for (const r of seen.stats) {
+            assert.ok(['balanced', 'final'].includes(r.step), JSON.stringify(r));
+            assert.ok(r.share >= 0 && r.share <= 1 && Number.isInteger(r.tiles_done), JSON.stringify(r));
+        }
+        assert.ok(seen.texts.some((t) => /^refining (balanced|final) · \d+ %/.test(t)), seen.texts.join(' | '));
+        const last = seen.texts.at(-1);
+        assert.match(last, /refined: final quality|skipped (balanced|final): ./, 'the end is said, a skip with its reason');
+    });
 });
 
 test('the stats overlay shows fps, latency, times, bytes and per-pass timings', async (t) => {
@@ -280,6 +447,55 @@ test('a .glb dropped on the view is uploaded with progress and shown', async () 
     await until('back on the Cornell box', () => window.giClient.lastStats?.scene === 'builtin:cornell');
 });
 
+test('the orbit target sits at the model; "Frame the model" fits it; Reset camera returns to the scene camera',
+    async () => {
+        // The bounds come with welcome and every state: no wait beyond a moment.
+        const bounds = await until('state.bounds of the scene', () => window.giClient.bounds, null, 2000);
+        const centre = bounds.min.map((v, i) => (v + bounds.max[i]) / 2);
+        const radius = vlen(vsub(bounds.max, bounds.min)) / 2;
+        const start = await page.evaluate(() => window.giClient.camera);
+        const depth = vdot(vsub(centre, start.position), vnorm(vsub(start.target, start.position)));
+        assert.ok(Math.abs(vlen(vsub(start.target, start.position)) - depth) < 1e-3 * Math.max(1, depth),
+            `the orbit target is at the depth of the bounds' centre (${depth.toFixed(3)}): ${JSON.stringify(start)}`);
+        assert.ok(await control('frame-model').isVisible());
+        await drag(page, 60);
+        const turned = await page.evaluate(() => window.giClient.camera);
+        const direction = vnorm(vsub(turned.target, turned.position));
+        const frame = await page.evaluate(() => window.giClient.lastFrame);
+        await control('frame-model', 'button').click();
+        const framed = await page.evaluate(() => window.giClient.camera);
+        assert.ok(near(framed.target, centre, 1e-4), `target at the centre: ${framed.target} vs ${centre}`);
+        assert.ok(vdot(vnorm(vsub(framed.target, framed.position)), direction) > 0.9999, 'the view direction is kept');
+        assert.ok(vlen(vsub(framed.position, centre)) > radius, 'the eye is outside the bounding sphere');
+        await until('a frame of the framed view', (f) => window.giClient.lastFrame > f, frame);
+        // The key does the same after a pan moved the target away.
+        await page.keyboard.down('Shift');
+        await drag(page, 40);
+        await page.keyboard.up('Shift');
+        await page.locator('#view').press('Period');
+        assert.ok(near((await page.evaluate(() => window.giClient.camera)).target, centre, 1e-4), '"." frames too');
+        await control('reset-camera', 'button').click();
+        const home = await page.evaluate(() => window.giClient.welcome.state.scene_camera);
+        assert.ok(home, 'state.scene_camera');
+        const reset = await page.evaluate(() => window.giClient.camera);
+        assert.ok(near(reset.position, home.position, 1e-4), `Reset camera: ${reset.position} vs ${home.position}`);
+        assert.ok(vdot(vnorm(vsub(reset.target, reset.position)), vnorm(vsub(home.target, home.position))) > 0.9999);
+    });
+
+test('the view goes fullscreen with the button and F, and back', async () => {
+    await page.locator('#fullscreen').click();
+    await until('the viewport is fullscreen', () => document.fullscreenElement?.id === 'viewport');
+    assert.equal(await page.locator('#fullscreen').getAttribute('aria-pressed'), 'true');
+    assert.ok(await page.locator('#overlay').isVisible(), 'the overlay comes along');
+    await page.locator('#view').press('f');
+    await until('fullscreen left with F', () => document.fullscreenElement === null);
+    await page.locator('#view').press('f');
+    await until('fullscreen again with F', () => document.fullscreenElement?.id === 'viewport');
+    await page.locator('#fullscreen').click();
+    await until('and left with the button', () => document.fullscreenElement === null);
+    assert.equal(await page.locator('#fullscreen').getAttribute('aria-pressed'), 'false');
+});
+
 test('a snapshot downloads a lossless PNG of the view', async () => {
     const download = page.waitForEvent('download', { timeout: 60000 });
     await control('snapshot', 'button').click();
@@ -356,18 +572,190 @@ test('on a phone the sidebar is a drawer', async () => {
     }
 });
 
-test('the page reconnects after the server restarts', async () => {
+test('on a dpr-3 phone the page asks for no more than the pixel budget, which the user can change', async () => {
+    const phone = await browser.newContext({
+        viewport: { width: 390, height: 844 }, deviceScaleFactor: 3, isMobile: true, hasTouch: true,
+    });
+    try {
+        const p = await phone.newPage();
+        p.on('pageerror', (e) => pageErrors.push(`dpr 3 phone: ${e.message}`));
+        await p.goto(url());
+        await p.waitForFunction(() => window.giClient?.framesDrawn > 0, null, { timeout: WAIT_MS, polling: 100 });
+        const vp = await p.evaluate(() => window.giClient.viewport);
+        const px = vp.size[0] * vp.size[1] * vp.dpr ** 2;
+        assert.ok(vp.dpr < 3 && px <= 1e6, `hello asked for ${vp.size} at dpr ${vp.dpr}: ${Math.round(px)} px`);
+        assert.ok(px > 0.9e6, 'but not much less');
+        await p.locator('#sidebar-toggle').tap();
+        await p.locator('[data-control="pixel-budget"] select').selectOption({ label: '0.25 MP (fastest)' });
+        const resize = await p.evaluate(() => window.giClient.sent.filter((m) => m.type === 'resize').at(-1));
+        assert.ok(resize && resize.size[0] * resize.size[1] * resize.dpr ** 2 <= 250_000, JSON.stringify(resize));
+        assert.match(await p.locator('[data-block="quality-info"]').textContent(), /pixel ratio.* of this screen's 3/);
+        await p.reload();
+        await p.waitForFunction(() => window.giClient?.framesDrawn > 0, null, { timeout: WAIT_MS, polling: 100 });
+        const again = await p.evaluate(() => window.giClient.viewport);
+        assert.ok(again.size[0] * again.size[1] * again.dpr ** 2 <= 250_000, `kept after a reload: ${JSON.stringify(again)}`);
+    } finally {
+        await phone.close();
+    }
+});
+
+test('a late frame is said ("rendering… s") and the figures marked stale; injected progress is shown', async () => {
+    // A proxy between page and server holds frames back and adds what a protocol-2 server sends.
+    const proxied = await browser.newContext({ viewport: { width: 1100, height: 700 } });
+    const held = [];
+    let hold = false;
+    let toPage = null;
+    let decorate = null;
+    await proxied.routeWebSocket(/\/ws$/, (ws) => {
+        const upstream = ws.connectToServer();
+        toPage = (m) => ws.send(m);
+        ws.onMessage((m) => upstream.send(m));
+        upstream.onMessage((m) => {
+            if (decorate && typeof m === 'string' && m.includes('"type":"stats"')) m = JSON.stringify(decorate(JSON.parse(m)));
+            if (hold) held.push(m);
+            else ws.send(m);
+        });
+    });
+    try {
+        const p = await proxied.newPage();
+        p.on('pageerror', (e) => pageErrors.push(`proxied: ${e.message}`));
+        await p.goto(url());
+        await p.waitForFunction(() => window.giClient?.framesDrawn > 0, null, { timeout: WAIT_MS, polling: 100 });
+        // Fixed quality: one frame per input, no refinement of this server's own to race the injected one.
+        await p.locator('[data-control="adaptive"] input').uncheck();
+        await p.waitForFunction(() => window.giClient.lastStats?.quality === 'fixed', null, { timeout: WAIT_MS });
+        assert.equal(await p.evaluate(() => window.giClient.busy), null, 'not busy while frames keep up');
+        hold = true;
+        await drag(p);
+        const busy = await p.waitForFunction(() => /^rendering… \d+\.\d s$/.test(window.giClient.busy ?? '')
+            && window.giClient.stale && window.giClient.busy, null, { timeout: WAIT_MS, polling: 50 });
+        assert.match(await busy.jsonValue(), /rendering…/);
+        assert.match(await p.locator('#ov-stale').textContent(), /^stale: figures from before your input \d+\.\d s ago$/);
+        assert.ok(await p.locator('#busy').isVisible());
+        const first = await p.locator('#busy').textContent();
+        await p.waitForTimeout(600);
+        assert.notEqual(await p.locator('#busy').textContent(), first, 'the time counts up');
+        hold = false;
+        for (const m of held.splice(0)) toPage(m);
+        await p.waitForFunction(() => window.giClient.busy === null && !window.giClient.stale, null,
+            { timeout: WAIT_MS, polling: 50 });
+        // The released frames are drawn before anything is injected: a fixed frame ends refinement.
+        for (let frames = -1; ;) {
+            const now = await p.evaluate(() => window.giClient.framesDrawn);
+            if (now === frames) break;
+            frames = now;
+            await p.waitForTimeout(500);
+        }
+
+        const send = (m) => toPage(JSON.stringify({ type: 'progress', ...m }));
+        send({ state: 'refining', step: 'balanced', share: 0.25, eta_ms: 3000, reason: 'the view is still' });
+        await p.waitForFunction(() => !document.getElementById('ov-refine').hidden
+            && /^refining balanced · 25 % · \d\.\d s left$/.test(document.getElementById('ov-refine-text').textContent),
+        null, { timeout: 5000 });
+        assert.equal(await p.locator('#ov-refine-bar').evaluate((e) => e.value), 0.25);
+        assert.match(await p.locator('#busy').textContent(), /^refining balanced/, 'the badge says the server is busy');
+        send({ state: 'skipped', step: 'final', share: 0, eta_ms: 0, reason: 'predicted 9 s, over the refinement budget' });
+        await p.waitForFunction(() => document.getElementById('ov-refine').dataset.kind === 'skipped', null, { timeout: 5000 });
+        assert.equal(await p.locator('#ov-refine-text').textContent(), 'skipped final: predicted 9 s, over the refinement budget');
+        assert.ok(await p.locator('#ov-refine').isVisible(), 'a skipped final step is visible');
+        send({ state: 'abandoned', step: 'balanced', share: 0.5, eta_ms: 0, reason: 'input arrived' });
+        await p.waitForFunction(() => document.getElementById('ov-refine-text').textContent
+            === 'refinement abandoned: input arrived', null, { timeout: 5000 });
+        send({ state: 'refining', step: 'final', share: 0.9, eta_ms: 100 });
+        send({ state: 'done', step: 'final', share: 1, eta_ms: 0 });
+        await p.waitForFunction(() => document.getElementById('ov-refine-text').textContent === 'refined: final quality',
+            null, { timeout: 5000 });
+        await p.waitForFunction(() => document.getElementById('ov-refine').hidden, null, { timeout: 10000 });
+
+        decorate = (stats) => ({ ...stats, budget: { target_ms: 80, scale: 0.31, vpls: 1024, vpl_cap: 256, predicted_ms: 70.2,
+            reason: 'the full VPL set is predicted at 210 ms' } });
+        await drag(p);
+        await p.waitForFunction(() => !document.getElementById('ov-budget').hidden, null, { timeout: WAIT_MS });
+        assert.equal(await p.locator('#ov-budget').textContent(),
+            'budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31');
+        assert.equal(await p.locator('#ov-budget').getAttribute('title'), 'the full VPL set is predicted at 210 ms');
+        assert.ok(!(await p.evaluate(() => window.giClient.states.includes('waiting'))), 'the connection stayed up');
+    } finally {
+        await proxied.close();
+    }
+});
+
+test('an expired view link explains itself, is not retried and offers a session of one\'s own', async () => {
+    const p = await context.newPage();
+    try {
+        await p.goto(url('#view=v-0123456789abcdef0123'));
+        await p.waitForFunction(() => window.giClient?.notice, null, { timeout: WAIT_MS, polling: 100 });
+        assert.match(await p.locator('#notice-title').textContent(), /view link has expired/);
+        assert.match(await p.locator('#notice-text').textContent(), /Ask whoever shared it for a new link/);
+        await p.waitForTimeout(1500);
+        const { states, welcomes, connection } = await p.evaluate(() => ({
+            states: window.giClient.states, welcomes: window.giClient.welcomes, connection: window.giClient.connection,
+        }));
+        assert.equal(connection, 'closed');
+        assert.ok(!states.includes('waiting'), `no retry of the dead token: ${states}`);
+        assert.equal(welcomes, 0);
+        assert.ok(await p.locator('#notice').isVisible(), 'the explanation stays');
+        assert.equal(await p.locator('#session-toggle').textContent(), 'New session', 'Connect would retry the token');
+        await p.locator('#notice-action').click();
+        await p.waitForFunction(() => window.giClient?.role === 'controller' && window.giClient.framesDrawn > 0
+            && !window.location.hash, null, { timeout: WAIT_MS, polling: 100 });
+        assert.ok(!(await p.locator('#notice').isVisible()));
+    } finally {
+        await p.close();
+    }
+});
+
+test('the page reconnects after the server restarts, counting down, and restores the session', async () => {
     const welcomes = await page.evaluate(() => window.giClient.welcomes);
     const frames = await page.evaluate(() => window.giClient.framesDrawn);
-    await server.restart();
-    // The old session died with the server: the resume fails, the page starts a new session
-    // (after backing off while the server was down) and draws again.
+    const before = await page.evaluate(() => ({
+        technique: window.giClient.lastStats.technique, vpl: window.giClient.params.vpl_grid,
+        quality: window.giClient.lastStats.quality, camera: window.giClient.camera,
+    }));
+    assert.equal(before.technique, 'rsm_gather');
+    await page.evaluate(() => {
+        window.countdown = [];
+        const text = document.getElementById('conn-text');
+        new MutationObserver(() => window.countdown.push(text.textContent))
+            .observe(text, { childList: true, characterData: true, subtree: true });
+    });
+    await server.stop();
+    await page.waitForTimeout(4500);
+    await server.launch();
+    // The old session died with the server: the page starts a new session (after backing off
+    // while the server was down), draws again and sends what the old session had.
     await until('a new session after the restart', (n) => window.giClient.connection === 'open'
         && window.giClient.welcomes > n && window.giClient.resumed === false, welcomes, 30000);
     await until('frames from the new session', (n) => window.giClient.framesDrawn > n, frames);
     const states = await page.evaluate(() => window.giClient.states);
     assert.ok(states.includes('waiting'), `the page showed that it was retrying: ${states}`);
     assert.match(await page.locator('#conn-text').textContent(), /connected/);
+    const countdown = await page.evaluate(() => window.countdown.filter((t) => t.startsWith('disconnected, retrying in')));
+    const seconds = countdown.map((t) => Number(/in (\d+) s$/.exec(t)?.[1])).filter(Number.isFinite);
+    assert.ok(seconds.some((v, i) => i > 0 && v === seconds[i - 1] - 1), `the badge counts down each second: ${countdown}`);
+    const restored = await until('the technique, vpl_grid and fixed quality restored', () => {
+        const s = window.giClient.lastStats;
+        return s?.technique === 'rsm_gather' && s.params.vpl_grid === 6 && s.quality === 'fixed' && window.giClient.camera;
+    }, null, 30000);
+    assert.ok(near(restored.position, before.camera.position, 1e-4), `camera restored: ${restored.position}`);
+    await until('the restore is said', () => [...document.querySelectorAll('.message')]
+        .some((m) => /^New session: restored rsm_gather, \d+ parameters?, the camera and fixed quality\./
+            .test(m.textContent)));
+});
+
+test('Disconnect says disconnected, and Connect starts a new session', async () => {
+    const welcomes = await page.evaluate(() => window.giClient.welcomes);
+    await page.locator('#session-toggle').click();
+    await until('disconnected', () => window.giClient.connection === 'closed');
+    assert.equal(await page.locator('#role').textContent(), 'disconnected', 'not "controlling" any more');
+    assert.equal(await page.locator('#conn-text').textContent(), 'closed');
+    assert.equal(await page.locator('#session-toggle').textContent(), 'Connect');
+    await page.locator('#session-toggle').click();
+    await until('a new session', (n) => window.giClient.connection === 'open' && window.giClient.welcomes > n
+        && window.giClient.resumed === false && window.giClient.framesDrawn > 0, welcomes);
+    assert.equal(await page.locator('#role').textContent(), 'controlling');
+    // The server's own technique (--technique none): a deliberate end is not restored.
+    await until('a frame of the fresh session', () => window.giClient.lastStats?.technique === 'none');
 });
 
 test('no script errors on the page', () => {

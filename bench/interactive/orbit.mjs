@@ -1,0 +1,168 @@
+// Interactive benchmark (not a test): starts gi-server with its defaults, opens the real browser
+// client (headless Chromium over loopback) in a 960x800 viewport and measures, per built-in scene:
+//   - orbit fps: frames drawn per second while the arrow key orbits the camera,
+//   - input -> frame from a still view: from a key press (after refinement finished) to the first
+//     interactive frame drawn, p50 and p95, against that frame's own render + encode time,
+//   - input during refinement: the same, pressed while a slow configuration (rsm_gather with 65,536
+//     VPLs, hier_isr with tau 0) refines in tiles.
+// Figures are measured side by side in one run on whatever machine runs it; docs/interactive.md has
+// the ones recorded. usage:
+//   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
+//        [--orbit-s 6] [--chromium /usr/bin/chromium] [--out report.json]
+import { spawn } from 'node:child_process';
+import { writeFileSync } from 'node:fs';
+import net from 'node:net';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const opts = { server: path.join(root, 'build/ci/bin/gi-server'), scenes: '', presses: 10, 'orbit-s': 6,
+    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '' };
+const argv = process.argv.slice(2);
+for (let i = 0; i < argv.length; i++) {
+    const key = argv[i].replace(/^--/, '');
+    if (key === 'help') {
+        console.log('usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--chromium PATH] [--out FILE]');
+        process.exit(0);
+    }
+    if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
+    opts[key] = typeof opts[key] === 'number' ? Number(argv[++i]) : argv[++i];
+}
+
+const freePort = () => new Promise((resolve) => {
+    const s = net.createServer().listen(0, '127.0.0.1', () => { const { port } = s.address(); s.close(() => resolve(port)); });
+});
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const percentile = (values, p) => {
+    if (!values.length) return null;
+    const v = [...values].sort((a, b) => a - b);
+    return v[Math.min(v.length - 1, Math.floor(p * v.length))];
+};
+
+const port = await freePort();
+const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client')],
+    { stdio: ['ignore', 'ignore', 'pipe'] });
+let serverLog = '';
+server.stderr.on('data', (d) => { serverLog += d; });
+for (let i = 0; i < 100 && !serverLog.includes('listening'); i++) await sleep(100);
+if (!serverLog.includes('listening')) throw new Error(`gi-server did not start:\n${serverLog}`);
+
+const { chromium } = await import('playwright-core');
+const browser = await chromium.launch({ executablePath: opts.chromium,
+    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--disable-background-timer-throttling',
+        '--disable-renderer-backgrounding'] });
+const page = await (await browser.newContext({ viewport: { width: 960 + 320, height: 800 } })).newPage();
+await page.goto(`http://127.0.0.1:${port}/`);
+const until = async (what, fn, arg, timeoutMs = 120000) => {
+    try {
+        await page.waitForFunction(fn, arg, { timeout: timeoutMs, polling: 20 });
+    } catch (e) {
+        throw new Error(`timed out waiting for ${what}`);
+    }
+};
+await until('the first frame', () => window.giClient?.framesDrawn > 0);
+// Every drawn frame with its time (epoch ms) and stats, recorded in the page.
+await page.evaluate(() => {
+    window.benchDraws = [];
+    let seen = window.giClient.framesDrawn;
+    const poll = () => {
+        const n = window.giClient.framesDrawn;
+        if (n !== seen) {
+            seen = n;
+            const s = window.giClient.lastStats ?? {};
+            window.benchDraws.push({ t: performance.timeOrigin + performance.now(), quality: s.quality,
+                ms: (s.frame_ms ?? 0) + (s.encode_ms ?? 0), refine: s.refine ?? null, size: s.size });
+        }
+        requestAnimationFrame(poll);
+    };
+    requestAnimationFrame(poll);
+});
+const view = await page.$('canvas') ?? await page.$('#view');
+const box = await view.boundingBox();
+await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2); // focus for the keys
+const scenes = opts.scenes ? opts.scenes.split(',') : (await page.evaluate(() => window.giClient.welcome.scenes))
+    .filter((s) => s.startsWith('builtin:'));
+const viewport = await page.evaluate(() => window.giClient.viewport);
+const draws = (since) => page.evaluate((t) => window.benchDraws.filter((d) => d.t >= t), since);
+const still = async () => until('refinement done',
+    () => { const d = window.benchDraws.at(-1); return d && d.quality === 'final' && d.refine?.complete; }, null, 180000)
+    .catch(async () => { await sleep(2000); });
+
+async function pressLatency(key) {
+    // The view moves while a key is held, one step per animation frame: hold it for two frames.
+    const t0 = Date.now();
+    await page.keyboard.down(key);
+    await sleep(40);
+    await page.keyboard.up(key);
+    await until('an interactive frame', (t) => window.benchDraws.some((d) => d.t > t && d.quality === 'interactive'), t0, 30000);
+    const d = (await draws(t0)).find((x) => x.quality === 'interactive');
+    return { latency: d.t - t0, frameMs: d.ms };
+}
+
+async function measureScene(scene, technique, params) {
+    await page.evaluate(({ scene, technique, params }) => {
+        window.giClient.send?.({ type: 'scene', name: scene });
+        window.giClient.send?.({ type: 'technique', name: technique });
+        if (params) window.giClient.send?.({ type: 'params', values: params });
+    }, { scene, technique, params });
+    await sleep(1500);
+    // Orbit: hold the left arrow.
+    const orbitStart = Date.now();
+    await page.keyboard.down('ArrowLeft');
+    await sleep(opts['orbit-s'] * 1000);
+    await page.keyboard.up('ArrowLeft');
+    const orbit = (await draws(orbitStart + 1000)).filter((d) => d.t <= orbitStart + opts['orbit-s'] * 1000);
+    const fps = orbit.length > 1 ? (orbit.length - 1) / ((orbit.at(-1).t - orbit[0].t) / 1000) : 0;
+    const frameMs = orbit.map((d) => d.ms);
+    // Input from a still view.
+    const stillLat = [], stillFrame = [];
+    for (let i = 0; i < opts.presses; i++) {
+        await still();
+        const r = await pressLatency(i % 2 ? 'ArrowLeft' : 'ArrowRight');
+        stillLat.push(r.latency);
+        stillFrame.push(r.frameMs);
+    }
+    return { scene, technique, params: params ?? {}, orbit_fps: +fps.toFixed(2), orbit_frame_ms_p50: percentile(frameMs, 0.5),
+        still_input_to_frame_ms: { p50: percentile(stillLat, 0.5), p95: percentile(stillLat, 0.95) },
+        still_frame_ms_p50: percentile(stillFrame, 0.5), presses: stillLat.length,
+        last_size: orbit.at(-1)?.size };
+}
+
+async function duringRefinement(scene, technique, params) {
+    await page.evaluate(({ scene, technique, params }) => {
+        window.giClient.send?.({ type: 'scene', name: scene });
+        window.giClient.send?.({ type: 'technique', name: technique });
+        window.giClient.send?.({ type: 'params', values: params });
+    }, { scene, technique, params });
+    const lat = [], frame = [];
+    let refining = 0;
+    for (let i = 0; i < opts.presses; i++) {
+        const t = Date.now();
+        // A step over the refinement budget that cannot be made cheaper is skipped: then the input
+        // comes to a still view.
+        const tile = await until('a refinement tile', (s) => window.benchDraws.some((d) => d.t > s && d.refine && !d.refine.complete), t, 20000)
+            .then(() => true, () => false);
+        if (tile) refining++;
+        await sleep(50 + 37 * (i % 3)); // somewhere inside a tile
+        const r = await pressLatency(i % 2 ? 'ArrowLeft' : 'ArrowRight');
+        lat.push(r.latency);
+        frame.push(r.frameMs);
+    }
+    return { scene, technique, params, input_to_frame_ms: { p50: percentile(lat, 0.5), p95: percentile(lat, 0.95) },
+        frame_ms_p50: percentile(frame, 0.5), presses: lat.length, presses_during_refinement: refining };
+}
+
+const report = { viewport, machine: process.env.GI_BENCH_MACHINE ?? null, scenes: [], refinement: [] };
+for (const scene of scenes) {
+    const r = await measureScene(scene, 'rsm_gather');
+    report.scenes.push(r);
+    console.log(JSON.stringify(r));
+}
+for (const [technique, params] of [['rsm_gather', { vpl_grid: 256 }], ['hier_isr', { tau: 0 }]]) {
+    const r = await duringRefinement('builtin:cornell', technique, params);
+    report.refinement.push(r);
+    console.log(JSON.stringify(r));
+}
+if (opts.out) writeFileSync(opts.out, JSON.stringify(report, null, 2));
+await browser.close();
+server.kill('SIGINT');

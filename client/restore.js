@@ -1,0 +1,64 @@
+// Carrying a session over to a new one. When the server restarts (resume_failed) or drains
+// (shutdown), the new session starts from the server's defaults although the page still knows
+// the scene, technique, explicit parameters and camera the user had: they are sent again with
+// ordinary messages, as PROTOCOL.md's shutdown section asks of clients. Pure.
+
+import { cameraMsg, paramsMsg, techniqueMsg, validateParamValues } from './protocol.js';
+
+/**
+ * What the page knew of a session: {scene, technique, params (the explicit values only), camera,
+ * adaptive}. `explicit` names the parameters the user set.
+ */
+export function sessionSnapshot({ scene, technique, params = {}, explicit = new Set(), camera, adaptive }) {
+    const own = Object.fromEntries([...explicit].filter((k) => Object.hasOwn(params, k)).map((k) => [k, params[k]]));
+    return structuredClone({ scene, technique, params: own, camera, adaptive });
+}
+
+/**
+ * How to bring the new session of `welcome` to `saved`: {scene (to load first, or null), technique
+ * (or null), params (valid under the new session's schemas), camera (null when the scene could not
+ * be restored: the old camera belongs to the old scene), adaptive (or null when unchanged), notes
+ * (what could not be restored, as sentences)}. Null without a snapshot.
+ */
+export function restorePlan(saved, welcome) {
+    if (!saved) return null;
+    const s = welcome?.state ?? {};
+    const notes = [];
+    let scene = null;
+    let sameScene = !saved.scene || saved.scene === s.scene;
+    if (!sameScene) {
+        if ((welcome?.scenes ?? []).includes(saved.scene)) {
+            scene = saved.scene;
+            sameScene = true;
+        } else if (saved.scene.startsWith('upload:')) {
+            notes.push(`${saved.scene.slice('upload:'.length)} was deleted with the old session: upload it again`);
+        } else {
+            notes.push(`the server no longer offers ${saved.scene}`);
+        }
+    }
+    const techniques = new Map((welcome?.techniques ?? []).map((t) => [t.name, t]));
+    let technique = null;
+    if (saved.technique && saved.technique !== s.technique) {
+        if (techniques.has(saved.technique)) technique = saved.technique;
+        else notes.push(`the server no longer offers the technique ${saved.technique}`);
+    }
+    const schema = techniques.get(technique ?? s.technique)?.params_schema;
+    const params = {};
+    for (const [k, v] of Object.entries(saved.params ?? {})) {
+        if (validateParamValues({ [k]: v }, schema, welcome?.frame_params_schema) === null) params[k] = v;
+        else notes.push(`${k} = ${JSON.stringify(v)} is not a parameter of the new session`);
+    }
+    const adaptive = typeof saved.adaptive === 'boolean' && saved.adaptive !== (welcome?.adaptive !== false)
+        ? saved.adaptive : null;
+    return { scene, technique, params, camera: sameScene && saved.camera ? saved.camera : null, adaptive, notes };
+}
+
+/** The messages that follow the scene (once it has loaded): technique, parameters, camera. */
+export function restoreMessages(plan) {
+    if (!plan) return [];
+    const out = [];
+    if (plan.technique) out.push(techniqueMsg(plan.technique));
+    if (Object.keys(plan.params).length > 0) out.push(paramsMsg(plan.params));
+    if (plan.camera) out.push(cameraMsg(plan.camera));
+    return out;
+}
