@@ -16,7 +16,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const opts = { server: path.join(root, 'build/ci/bin/gi-server'), scenes: '', presses: 10, 'orbit-s': 6,
+const opts = { server: path.join(root, 'build/ci/bin/gi-server'), scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
     chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '' };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
@@ -84,9 +84,11 @@ const scenes = opts.scenes ? opts.scenes.split(',') : (await page.evaluate(() =>
     .filter((s) => s.startsWith('builtin:'));
 const viewport = await page.evaluate(() => window.giClient.viewport);
 const draws = (since) => page.evaluate((t) => window.benchDraws.filter((d) => d.t >= t), since);
+// A still view: refinement finished, or (a final step can take the refinement budget, 30 s) at most
+// --still-s seconds after the last input, when the view refines in tiles.
 const still = async () => until('refinement done',
-    () => { const d = window.benchDraws.at(-1); return d && d.quality === 'final' && d.refine?.complete; }, null, 180000)
-    .catch(async () => { await sleep(2000); });
+    () => { const d = window.benchDraws.at(-1); return d && d.quality === 'final' && d.refine?.complete; }, null,
+    opts['still-s'] * 1000).catch(() => {});
 
 async function pressLatency(key) {
     // The view moves while a key is held, one step per animation frame: hold it for two frames.
