@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <span>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 
 #include "core/Log.h"
 #include "gl/Pass.h"
+#include "gl/ShaderShared.h"
 #include "gl/Shader.h"
 
 namespace gis {
@@ -27,6 +29,9 @@ int log2Floor(int v) {
 
 struct EnvProbe::Impl {
     ForwardProgram forward;
+    /// What the prefiltered cubes were rendered with (probes, sizes, shading switches, the scene);
+    /// with the light views reused and the same key, a frame keeps them.
+    std::string cubesKey;
     /// shaders/render/env_prefilter.comp: one roughness level of a cube from the source's mips.
     struct PrefilterPass {
         gl::Program program;
@@ -188,7 +193,19 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     const float extent = std::max(glm::length(bounds.max - bounds.min), 1e-3f);
     const float zNear = std::max(1e-3f * extent, 1e-4f), zFar = 1.01f * extent + zNear;
 
-    for (size_t p = 0; p < probes.size(); ++p) {
+    std::ostringstream keyText;
+    keyText << in.scene << '/' << size << '/' << samples << '/' << phong;
+    for (const ProbeSpec& p : probes)
+        keyText << '/' << p.position.x << ',' << p.position.y << ',' << p.position.z << ',' << p.skipMesh;
+    if (in.frame)
+        keyText << '/' << in.frame->rsmInfo.z << '/' << in.frame->rsmInfo.w << '/' << in.frame->toneInfo.z
+                << '/' << in.frame->shadingInfo.x << '/' << in.frame->shadingInfo.z;
+    const std::string key = keyText.str();
+    const bool keepCubes = in.lightViewsReused && key == m.cubesKey;
+    counters["env_cubes_reused"] = keepCubes ? 1 : 0;
+    m.cubesKey = key;
+
+    for (size_t p = 0; p < probes.size() && !keepCubes; ++p) {
         const glm::vec3 probe = probes[p].position;
         const gl::Texture& prefiltered = m.prefiltered[p];
 

@@ -449,6 +449,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     rin.frame = &u;
     rin.scene = mScene.get();
     rin.sceneGpu = mSceneGpu.get();
+    rin.lightViewsReused = reuseLights;
     rin.envMaxRoughness = nonDiffuse.glossy ? fp.getFloat("glossy_split") : 1.01f;
     const gl::Texture* reflection = mReflections.execute(nonDiffuse, rin, fp, mTimer, counters);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());

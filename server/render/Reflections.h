@@ -65,6 +65,9 @@ struct ReflectionInputs {
     /// True when the planar-mirror pass shades the mirror pixels (gNormal.w > 0); otherwise the
     /// environment probe shades them too (mirror_depth=0, effect_mirrors=off).
     bool mirrorPass = false;
+    /// True when the lights, their shadow maps and the scene are last frame's (FrameRenderer's light
+    /// view reuse): the environment probes, lit by them only and not by the camera, may keep theirs.
+    bool lightViewsReused = false;
 
     /// The resource `name`, or nullptr when the frame did not produce it.
     const gl::Texture* find(const std::string& name) const {

@@ -550,6 +550,11 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
         recordRefineCost(w.scene->name, full, step, rate);
         pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
 
+        // Input waits: its frame goes first, the unsent tiles are not worth encoding.
+        if (inputPending()) {
+            progress("abandoned", plan.shareDone(), 0.0, "input arrived: the frame answers it first");
+            return true;
+        }
         const bool last = plan.done();
         const double share = plan.shareDone();
         const double etaMs = rate * fullPixels * (1.0 - share) * (tilePixels / std::max(1.0, inner * inner));

@@ -97,5 +97,26 @@ TEST(TilesGl, ReusedLightViewsRenderTheSameFrame) {
     EXPECT_EQ(c.rgba8, d.rgba8);
 }
 
+TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {
+    sharedContext();
+    const Scene scene = loadScene("builtin:gallery"); // a room probe and a local one
+    FrameRenderer fresh, reusing;
+    fresh.setScene(std::make_shared<const Scene>(scene));
+    reusing.setScene(std::make_shared<const Scene>(scene));
+    reusing.setReuseLightPasses(true);
+    FrameState s = stateFor(scene, "rsm_gather", 96, 80);
+    (void)reusing.render(s);
+    s.camera.position += glm::vec3(0.2f, 0.1f, 0.0f);
+    const FrameOutput a = fresh.render(s), b = reusing.render(s);
+    ASSERT_EQ(counter(b, "env_probe"), 1.0);
+    EXPECT_EQ(counter(b, "env_cubes_reused"), 1.0);
+    EXPECT_EQ(counter(a, "env_cubes_reused"), 0.0);
+    EXPECT_EQ(a.rgba8, b.rgba8);
+    s.lights[0].light.intensity *= 0.5f; // the probes see the light: rendered again
+    const FrameOutput c = reusing.render(s), d = fresh.render(s);
+    EXPECT_EQ(counter(c, "env_cubes_reused"), 0.0);
+    EXPECT_EQ(c.rgba8, d.rgba8);
+}
+
 } // namespace
 } // namespace gis::test

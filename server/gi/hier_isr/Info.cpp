@@ -1,5 +1,7 @@
 // The catalog entry of `hier_isr` (hierarchical image-space radiosity): its parameter table and capabilities,
 // GL-free (gi/Catalog.h). The passes are in HierIsr.cpp.
+#include <algorithm>
+
 #include "gi/Catalog.h"
 #include "gi/common/ParamSpecs.h"
 
@@ -40,8 +42,17 @@ TechniqueInfo hierIsrInfo() {
                        "hierarchical image-space radiosity: per-receiver cuts through the light tree",
                        "001 §3.5", ParamTable(std::move(specs))};
     // Every RSM texel is a leaf of the light tree: a full traversal reaches rsm_size^2 lights.
-    info.vplEstimate = [](const ParamSet&, const ParamSet& frame) {
-        return squared(frame.getInt("rsm_size"));
+    // max_depth (a resolution) caps it: the traversal never goes finer.
+    info.vplEstimate = [](const ParamSet& p, const ParamSet& frame) {
+        return squared(std::min(frame.getInt("rsm_size"), p.getInt("max_depth")));
+    };
+    // The count is capped by the finest level a traversal may reach (a power of two, the tree's
+    // level sides), and the start level with it.
+    info.limitVpls = [](ParamSet& p, long vpls) {
+        long side = 1;
+        while ((side * 2) * (side * 2) <= vpls) side *= 2;
+        if (side < p.getInt("max_depth")) p.set("max_depth", side);
+        if (p.getInt("hier_coarsest") > p.getInt("max_depth")) p.set("hier_coarsest", p.getInt("max_depth"));
     };
     info.eyeHierarchy = true;
     info.biasCompensation = true;

@@ -39,9 +39,34 @@ TEST(Catalog, VplEstimatesFollowEachTechniquesParameters) {
     EXPECT_EQ(estimate("rsm_gather", {{"vpl_grid", 64}}), 64 * 64);
     EXPECT_EQ(estimate("multires_splat", {{"vpl_grid", 256}}), 65536);
     EXPECT_EQ(estimate("isr", {{"isr_finest", 32}}), 32 * 32);
-    EXPECT_EQ(estimate("hier_isr", {{"rsm_size", 512}}), 512 * 512)
+    EXPECT_EQ(estimate("hier_isr", {{"rsm_size", 512}, {"max_depth", 1024}}), 512 * 512)
         << "a full traversal reaches every RSM texel";
+    EXPECT_EQ(estimate("hier_isr", {{"rsm_size", 512}, {"max_depth", 64}}), 64 * 64)
+        << "or stops at max_depth";
     EXPECT_EQ(estimate("second_order", {{"positive_count", 100}, {"negative_count", 50}}), 150);
+}
+
+// The frame budget's VPL cap: after limitVpls(n) a technique renders at most n VPLs (or its
+// parameters' minimum), and a cap above the current count changes nothing.
+TEST(Catalog, LimitVplsCapsTheEstimateAndNeverRaisesIt) {
+    for (const TechniqueInfo& info : techniqueCatalog()) {
+        if (!info.limitVpls) continue;
+        for (long cap : {16L, 100L, 1000L, 5000L}) {
+            FrameState s;
+            s.frameParams = ParamSet(frameParamTable());
+            setTechnique(s, info.name);
+            s.frameParams.set("rsm_size", 1024);
+            const long before = vplEstimate(s);
+            info.limitVpls(s.techniqueParams, cap);
+            const long after = vplEstimate(s);
+            EXPECT_LE(after, std::max(cap, 16L)) << info.name << " cap " << cap;
+            EXPECT_LE(after, before) << info.name;
+            const nlohmann::json kept = s.techniqueParams.toJson();
+            info.limitVpls(s.techniqueParams, after + 1000);
+            EXPECT_EQ(s.techniqueParams.toJson(), kept)
+                << info.name << ": a cap above the count changes nothing";
+        }
+    }
 }
 
 } // namespace
