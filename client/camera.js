@@ -349,8 +349,10 @@ export function attachViewControls(element, { camera, getTool, onCamera, onLight
         e.preventDefault();
         keys.add(e.code);
         if (!keyFrame) {
-            lastKeyTime = performance.now();
-            keyFrame = requestAnimationFrame(keyLoop);
+            // The first step now, as one frame's motion, rather than at the next animation frame.
+            const now = performance.now();
+            lastKeyTime = now - 1000 / 60;
+            keyLoop(now);
         }
     };
 

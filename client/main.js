@@ -268,8 +268,10 @@ function sendResize(force = false) {
 // Light changes are kept per light (key: its id, '' for protocol 1's unnamed one), so switching
 // the selected light mid-drag cannot send one light's changes to another.
 const outbox = { camera: false, lights: new Map(), params: null, frame: 0 };
+let lastFlush = -Infinity;
 function flushOutbox() {
     outbox.frame = 0;
+    lastFlush = performance.now();
     if (outbox.camera) {
         outbox.camera = false;
         steer(cameraMsg(camera.toCamera()));
@@ -284,7 +286,16 @@ function flushOutbox() {
     }
 }
 function scheduleFlush() {
-    if (!outbox.frame) outbox.frame = requestAnimationFrame(flushOutbox);
+    if (outbox.frame) return;
+    // The first change after a pause goes out at once (after this task, so that what one event changes
+    // goes together): waiting for an animation frame would add up to one to the answer to input.
+    // Changes that follow within a frame are merged into one message per animation frame.
+    if (performance.now() - lastFlush > 20) {
+        outbox.frame = -1;
+        queueMicrotask(flushOutbox);
+        return;
+    }
+    outbox.frame = requestAnimationFrame(flushOutbox);
 }
 
 function scheduleCamera() {

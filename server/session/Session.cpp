@@ -565,8 +565,13 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
             std::unique_lock lock(mMutex);
             if (last)
                 mCv.wait(lock, [&] { return mStop || mDirty || !mController || !mController->windowFull(); });
-            send = mController && !mController->windowFull() &&
-                   (last || !sentOnce || sinceSend.elapsedMs() >= 150.0);
+            // Keep one slot of a larger window free for the answer to input: a tile the client is
+            // still decoding must not hold it back.
+            const bool slotLeft =
+                mController && !mController->windowFull() &&
+                (last || mController->maxInFlight() < 2 ||
+                 mController->inFlight() + 1 < static_cast<std::size_t>(mController->maxInFlight()));
+            send = slotLeft && (last || !sentOnce || sinceSend.elapsedMs() >= 150.0);
         }
         if (!send) continue;
         nlohmann::json stats = frame.stats;
