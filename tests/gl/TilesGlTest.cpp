@@ -76,15 +76,25 @@ TEST(TilesGl, TiledFramesMatchWholeFramesForEveryTechnique) {
     }
 }
 
-TEST(TilesGl, ReusedLightViewsRenderTheSameFrame) {
-    sharedContext();
-    const Scene scene = loadScene("builtin:cornell-point");
+// Two renderers of one scene, one reusing light views; the reusing one has rendered the state once.
+struct ReusePair {
+    explicit ReusePair(const std::string& name) : scene(std::make_shared<const Scene>(loadScene(name))) {
+        fresh.setScene(scene);
+        reusing.setScene(scene);
+        reusing.setReuseLightPasses(true);
+        state = stateFor(*scene, "rsm_gather", 96, 80);
+        (void)reusing.render(state);
+    }
+    gl::Context& context = sharedContext(); // first: the renderers below need it
+    std::shared_ptr<const Scene> scene;
     FrameRenderer fresh, reusing;
-    fresh.setScene(std::make_shared<const Scene>(scene));
-    reusing.setScene(std::make_shared<const Scene>(scene));
-    reusing.setReuseLightPasses(true);
-    FrameState s = stateFor(scene, "rsm_gather", 96, 80);
-    (void)reusing.render(s);
+    FrameState state;
+};
+
+TEST(TilesGl, ReusedLightViewsRenderTheSameFrame) {
+    ReusePair pair("builtin:cornell-point");
+    FrameRenderer &fresh = pair.fresh, &reusing = pair.reusing;
+    FrameState s = pair.state;
     s.camera.position += glm::vec3(0.3f, 0.0f, 0.0f); // the camera moves, the light does not
     const FrameOutput a = fresh.render(s), b = reusing.render(s);
     EXPECT_EQ(counter(b, "light_views_reused"), 6.0); // the point light's six faces
@@ -98,14 +108,9 @@ TEST(TilesGl, ReusedLightViewsRenderTheSameFrame) {
 }
 
 TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {
-    sharedContext();
-    const Scene scene = loadScene("builtin:gallery"); // a room probe and a local one
-    FrameRenderer fresh, reusing;
-    fresh.setScene(std::make_shared<const Scene>(scene));
-    reusing.setScene(std::make_shared<const Scene>(scene));
-    reusing.setReuseLightPasses(true);
-    FrameState s = stateFor(scene, "rsm_gather", 96, 80);
-    (void)reusing.render(s);
+    ReusePair pair("builtin:gallery"); // a room probe and a local one
+    FrameRenderer &fresh = pair.fresh, &reusing = pair.reusing;
+    FrameState s = pair.state;
     s.camera.position += glm::vec3(0.2f, 0.1f, 0.0f);
     const FrameOutput a = fresh.render(s), b = reusing.render(s);
     ASSERT_EQ(counter(b, "env_probe"), 1.0);
