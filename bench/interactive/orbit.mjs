@@ -8,7 +8,8 @@
 // Figures are measured side by side in one run on whatever machine runs it; docs/interactive.md has
 // the ones recorded. usage:
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
-//        [--orbit-s 6] [--chromium /usr/bin/chromium] [--out report.json]
+//        [--orbit-s 6] [--still-s 3] [--chromium /usr/bin/chromium] [--out report.json]
+//        [--server-args "--slice-ms 20"]
 import { spawn } from 'node:child_process';
 import { writeFileSync } from 'node:fs';
 import net from 'node:net';
@@ -17,12 +18,12 @@ import { fileURLToPath } from 'node:url';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const opts = { server: path.join(root, 'build/ci/bin/gi-server'), scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
-    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '' };
+    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '' };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
     const key = argv[i].replace(/^--/, '');
     if (key === 'help') {
-        console.log('usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--chromium PATH] [--out FILE]');
+        console.log('usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"]');
         process.exit(0);
     }
     if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
@@ -40,7 +41,8 @@ const percentile = (values, p) => {
 };
 
 const port = await freePort();
-const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client')],
+const serverArgs = opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : [];
+const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client'), ...serverArgs],
     { stdio: ['ignore', 'ignore', 'pipe'] });
 let serverLog = '';
 server.stderr.on('data', (d) => { serverLog += d; });
@@ -52,6 +54,18 @@ const browser = await chromium.launch({ executablePath: opts.chromium,
     args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--disable-background-timer-throttling',
         '--disable-renderer-backgrounding'] });
 const page = await (await browser.newContext({ viewport: { width: 960 + 320, height: 800 } })).newPage();
+// The socket's traffic as this process sees it (through the browser's debugging protocol, so a few ms
+// late): when camera messages left and when interactive frames' stats arrived, for the breakdown.
+const wire = { cameraSent: [], interactiveStats: [] };
+page.on('websocket', (ws) => {
+    ws.on('framesent', ({ payload }) => {
+        if (typeof payload === 'string' && payload.includes('"camera"')) wire.cameraSent.push(Date.now());
+    });
+    ws.on('framereceived', ({ payload }) => {
+        if (typeof payload === 'string' && payload.includes('"stats"') && payload.includes('"interactive"'))
+            wire.interactiveStats.push(Date.now());
+    });
+});
 await page.goto(`http://127.0.0.1:${port}/`);
 const until = async (what, fn, arg, timeoutMs = 120000) => {
     try {
@@ -98,7 +112,10 @@ async function pressLatency(key) {
     await page.keyboard.up(key);
     await until('an interactive frame', (t) => window.benchDraws.some((d) => d.t > t && d.quality === 'interactive'), t0, 30000);
     const d = (await draws(t0)).find((x) => x.quality === 'interactive');
-    return { latency: d.t - t0, frameMs: d.ms };
+    const sent = wire.cameraSent.find((t) => t >= t0);
+    const arrived = wire.interactiveStats.find((t) => t >= t0);
+    return { latency: d.t - t0, frameMs: d.ms, toSend: sent ? sent - t0 : null,
+        toStats: arrived && sent ? arrived - sent : null, toDraw: arrived ? d.t - arrived : null };
 }
 
 async function measureScene(scene, technique, params) {
@@ -117,16 +134,20 @@ async function measureScene(scene, technique, params) {
     const fps = orbit.length > 1 ? (orbit.length - 1) / ((orbit.at(-1).t - orbit[0].t) / 1000) : 0;
     const frameMs = orbit.map((d) => d.ms);
     // Input from a still view.
-    const stillLat = [], stillFrame = [];
+    const stillLat = [], stillFrame = [], parts = { toSend: [], toStats: [], toDraw: [] };
     for (let i = 0; i < opts.presses; i++) {
         await still();
         const r = await pressLatency(i % 2 ? 'ArrowLeft' : 'ArrowRight');
         stillLat.push(r.latency);
         stillFrame.push(r.frameMs);
+        for (const k of Object.keys(parts)) if (r[k] !== null) parts[k].push(r[k]);
     }
+    // Where the time goes, medians: key press -> camera message on the socket -> the frame's stats
+    // back -> the frame drawn.
+    const breakdown = Object.fromEntries(Object.entries(parts).map(([k, v]) => [k, percentile(v, 0.5)]));
     return { scene, technique, params: params ?? {}, orbit_fps: +fps.toFixed(2), orbit_frame_ms_p50: percentile(frameMs, 0.5),
         still_input_to_frame_ms: { p50: percentile(stillLat, 0.5), p95: percentile(stillLat, 0.95) },
-        still_frame_ms_p50: percentile(stillFrame, 0.5), presses: stillLat.length,
+        still_frame_ms_p50: percentile(stillFrame, 0.5), still_breakdown_ms_p50: breakdown, presses: stillLat.length,
         last_size: orbit.at(-1)?.size };
 }
 

@@ -181,7 +181,7 @@ std::vector<ServerOption> buildOptions() {
     {
         ServerOption o{"--slice-ms", "GI_SLICE_MS", "MS",
                        "time one tile of a refinement step should take: input waits at most about this long "
-                       "for the tile in progress, 5..1000 (default 40)"};
+                       "for the tile in progress, 5..1000 (default 20)"};
         o.set = [](ServerConfig& c, const std::string& v) {
             c.session.limits.sliceMs = static_cast<int>(parseInteger("--slice-ms", v, 5, 1000));
         };

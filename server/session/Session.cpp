@@ -29,6 +29,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Refinement tiles: 16 px cells, 16 x 16 at the smallest (a few ms of fixed cost per tile on llvmpipe,
+// so smaller ones would mostly repeat it).
+constexpr int kTileAlign = 16;
+constexpr int kMinTileSide = 16;
+
 const char* stepName(int step) {
     static const char* names[] = {"interactive", "balanced", "final"};
     return step >= 0 && step < 3 ? names[step] : "fixed";
@@ -505,7 +510,7 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
     const int guard = tileGuardPx(full);
     std::vector<std::uint8_t> canvas =
         resizeRgba8(w.lastImage, w.lastWidth, w.lastHeight, full.width, full.height);
-    TilePlan plan(full.width, full.height);
+    TilePlan plan(full.width, full.height, kTileAlign, kMinTileSide);
     Stopwatch stepClock;
     Stopwatch sinceSend;
     bool sentOnce = false;
@@ -768,7 +773,7 @@ void Session::workerMain() {
                 const double budgetMs = mConfig.limits.refineBudgetMs;
                 const double predictedMs = predictRefineMs(scene->name, state, step);
                 // Fewer VPLs where the technique can take them (a step's cost is about proportional
-                // to them) when the whole step would overrun the budget, or when even a 32 x 32 tile
+                // to them) when the whole step would overrun the budget, or when even the smallest tile
                 // would overrun a slice (input waits for at most one tile); else a step over the
                 // budget is skipped. The client is told which.
                 const TechniqueInfo& info = findTechniqueInfo(state.technique);
@@ -783,10 +788,12 @@ void Session::workerMain() {
                 }
                 const double vplRate = w.budget.msPerPixelVpl(budgetKey);
                 if (vplRate > 0.0) {
-                    const double sliceCap = 0.8 * mConfig.limits.sliceMs / (vplRate * 32.0 * 32.0);
+                    const double sliceCap =
+                        0.8 * mConfig.limits.sliceMs / (vplRate * double(kMinTileSide) * kMinTileSide);
                     if (sliceCap < cap) {
                         cap = sliceCap;
-                        why = "a 32 x 32 tile must fit one " + std::to_string(mConfig.limits.sliceMs) +
+                        why = "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +
+                              " tile must fit one " + std::to_string(mConfig.limits.sliceMs) +
                               " ms slice (--slice-ms)";
                     }
                 }

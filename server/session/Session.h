@@ -47,7 +47,7 @@ struct SessionLimits {
     int frameTargetMs = 80;
     /// ms one tile of a refinement step should take (tiles are sized from measured slice times), so an
     /// input waits for at most about this much before its own frame starts rendering.
-    int sliceMs = 40;
+    int sliceMs = 20;
     int settleMs = 250; ///< ms without input before refinement starts
     /// ms; a refinement step whose predicted total time exceeds this is skipped (and the client told
     /// so): from the measured tiles of its kind, or before the first one, from the previous step scaled
