@@ -33,6 +33,7 @@ using Clock = std::chrono::steady_clock;
 // so smaller ones would mostly repeat it).
 constexpr int kTileAlign = 16;
 constexpr int kMinTileSide = 16;
+constexpr int kSnapshotBudgetMs = 5000;
 
 const char* stepName(int step) {
     static const char* names[] = {"interactive", "balanced", "final"};
@@ -752,10 +753,13 @@ void Session::workerMain() {
             // A snapshot is the best step that fits the refinement budget, judged like refinement:
             // a step never measured nor predictable counts as too slow, the interactive one (at full
             // size) always fits.
+            // A snapshot renders in one piece, and the controller's input waits behind it: it gets at
+            // most kSnapshotBudgetMs even where tiled refinement may take the whole refinement budget.
             if (snapshotFor && mConfig.limits.refineBudgetMs > 0) {
+                const double snapshotBudgetMs = std::min(mConfig.limits.refineBudgetMs, kSnapshotBudgetMs);
                 while (step > static_cast<int>(Step::Interactive)) {
                     const double predictedMs = predictRefineMs(scene->name, state, step);
-                    if (predictedMs > 0.0 && predictedMs <= mConfig.limits.refineBudgetMs) break;
+                    if (predictedMs > 0.0 && predictedMs <= snapshotBudgetMs) break;
                     state = presetState(--step);
                 }
             }
