@@ -487,8 +487,8 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     return true;
 }
 
-bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
-                            const std::string& note) {
+Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, int step,
+                                             const StreamOptions& stream, const std::string& note) {
     const std::string stepLabel = stepName(step);
     const double fullPixels = static_cast<double>(full.width) * full.height;
     auto progress = [&](const char* state, double share, double etaMs, const std::string& reason) {
@@ -522,7 +522,7 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
     while (!plan.done()) {
         if (inputPending()) {
             progress("abandoned", plan.shareDone(), 0.0, "input arrived: the frame answers it first");
-            return true;
+            return RefineResult::Abandoned;
         }
         const double pixels = rate > 0.0 ? sliceMs / rate : 64.0 * 64.0;
         // The guard band is rendered too: ask for fewer inner pixels so the whole tile fits the slice.
@@ -534,7 +534,7 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
         std::optional<RenderGate::Permit> permit;
         if (mGate) {
             permit = mGate->acquire(mStop);
-            if (!permit) return true;
+            if (!permit) return RefineResult::Abandoned;
         }
         const double queueMs = queueClock.elapsedMs();
         FrameOutput frame;
@@ -543,7 +543,7 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
             frame = w.renderer->render(tile);
         } catch (const std::exception& e) {
             fail(std::string("the frame could not be rendered: ") + e.what());
-            return false;
+            return RefineResult::Failed;
         }
         permit.reset();
         const double tileMs = renderClock.elapsedMs();
@@ -554,12 +554,30 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
         // the estimate by at most a fifth, since the next one may cover geometry.
         rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
         recordRefineCost(w.scene->name, full, step, rate);
+        // A smallest tile over the slice: its cost is mostly per VPL (each batch of them is a draw),
+        // so the step starts again with the VPLs this measurement allows (workerMain caps them).
+        const long vpls = std::max(1L, vplEstimate(full));
+        if (rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
+            const std::string key = w.scene->name + "/" + full.technique + "/" + std::to_string(step);
+            const double perVpl = tileMs / static_cast<double>(vpls);
+            auto known = mMinTileMsPerVpl.find(key);
+            const bool news = known == mMinTileMsPerVpl.end() || perVpl > 1.2 * known->second;
+            mMinTileMsPerVpl[key] =
+                known == mMinTileMsPerVpl.end() ? perVpl : std::max(perVpl, known->second);
+            if (news && vpls > 16 && findTechniqueInfo(full.technique).limitVpls) {
+                progress("abandoned", plan.shareDone(), 0.0,
+                         "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +
+                             " tile took " + std::to_string(std::lround(tileMs)) +
+                             " ms: starting again with fewer VPLs");
+                return RefineResult::Retune;
+            }
+        }
         pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
 
         // Input waits: its frame goes first, the unsent tiles are not worth encoding.
         if (inputPending()) {
             progress("abandoned", plan.shareDone(), 0.0, "input arrived: the frame answers it first");
-            return true;
+            return RefineResult::Abandoned;
         }
         const bool last = plan.done();
         const double share = plan.shareDone();
@@ -593,7 +611,7 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
                            {"complete", last}};
         if (!deliver(w, canvas, full.width, full.height, std::move(stats), stepLabel, stream, nullptr,
                      ImageCodec::Png))
-            return false;
+            return RefineResult::Failed;
         sentOnce = true;
         sinceSend = Stopwatch();
     }
@@ -601,7 +619,7 @@ bool Session::refineInTiles(Worker& w, const FrameState& full, int step, const S
         progress("done", 1.0, 0.0,
                  "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) +
                      " ms");
-    return true;
+    return RefineResult::Done;
 }
 
 void Session::workerMain() {
@@ -790,10 +808,16 @@ void Session::workerMain() {
                           " s, over the server's refinement budget of " +
                           std::to_string(std::lround(budgetMs / 1000.0)) + " s (--refine-budget-ms)";
                 }
+                // The smallest tile's measured cost per VPL where a step measured one, else the
+                // interactive frames' cost per pixel and VPL.
+                const auto minTile =
+                    mMinTileMsPerVpl.find(scene->name + "/" + state.technique + "/" + std::to_string(step));
                 const double vplRate = w.budget.msPerPixelVpl(budgetKey);
-                if (vplRate > 0.0) {
-                    const double sliceCap =
-                        0.8 * mConfig.limits.sliceMs / (vplRate * double(kMinTileSide) * kMinTileSide);
+                const double minTileMsPerVpl = minTile != mMinTileMsPerVpl.end()
+                                                   ? minTile->second
+                                                   : vplRate * double(kMinTileSide) * kMinTileSide;
+                if (minTileMsPerVpl > 0.0) {
+                    const double sliceCap = 0.8 * mConfig.limits.sliceMs / minTileMsPerVpl;
                     if (sliceCap < cap) {
                         cap = sliceCap;
                         why = "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +
@@ -856,7 +880,13 @@ void Session::workerMain() {
         const bool refinement = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
                                                  step == static_cast<int>(Step::Final));
         if (refinement) {
-            if (!refineInTiles(w, state, step, stream, refineNote)) break;
+            const RefineResult result = refineInTiles(w, state, step, stream, refineNote);
+            if (result == RefineResult::Failed) break;
+            if (result == RefineResult::Retune) {
+                // The same step again, now capped by the smallest tile's measured cost.
+                std::lock_guard lock(mMutex);
+                if (!mDirty) mNextStep = static_cast<Step>(step);
+            }
             continue;
         }
         // Admission: at most the server's cap of renders at once, first come first served.

@@ -147,10 +147,12 @@ private:
                  nlohmann::json stats, const std::string& quality, const StreamOptions& stream,
                  const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec);
     /// Renders a balanced or final step in tiles of about limits.sliceMs each, sending the image as
-    /// it fills in; returns at the first tile boundary after input arrives (progress "abandoned"),
-    /// when done, or false when the renderer failed.
-    bool refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
-                       const std::string& note);
+    /// it fills in; returns at the first tile boundary after input arrives (Abandoned, progress
+    /// "abandoned"), when done, Retune when its smallest tile overran the slice (the step starts again
+    /// with fewer VPLs), or Failed when the renderer failed.
+    enum class RefineResult { Done, Abandoned, Retune, Failed };
+    RefineResult refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
+                               const std::string& note);
     /// True when input (or a snapshot, or stop) waits: refinement yields to it.
     bool inputPending() const;
     int frameTargetMs(const StreamOptions& stream) const;
@@ -200,6 +202,9 @@ private:
     };
     /// Worker only: scene/technique/step -> the last measured cost of that adaptive step.
     std::map<std::string, StepCost> mRefineCost;
+    /// Worker only: scene/technique/step -> ms per VPL of the smallest refinement tile, where one
+    /// overran its slice (the VPL cap of that step follows it).
+    std::map<std::string, double> mMinTileMsPerVpl;
     double predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const;
     void recordRefineCost(const std::string& sceneName, const FrameState& state, int step, double msPerPixel);
     std::atomic<bool> mStop{false};
