@@ -98,9 +98,10 @@ TilePlan::TilePlan(int fullWidth, int fullHeight, int align, int minSide)
 }
 
 int TilePlan::sideFor(double pixels, int limit) const {
-    // Rounded up to the alignment, at least minSide, at most the image's (aligned) extent.
+    // Rounded down to the alignment (a tile must not take longer than asked: rounding 19 px up to 32
+    // would nearly triple it), at least minSide, at most the image's (aligned) extent.
     const double side = std::sqrt(std::max(pixels, 1.0));
-    const int s = static_cast<int>(std::ceil(side / mAlign)) * mAlign;
+    const int s = static_cast<int>(std::floor(side / mAlign)) * mAlign;
     const int cap = ((limit + mAlign - 1) / mAlign) * mAlign;
     return std::clamp(s, std::min(mMinSide, cap), cap);
 }

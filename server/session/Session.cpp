@@ -487,6 +487,33 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     return true;
 }
 
+struct Session::Rendered {
+    FrameOutput frame;
+    double queueMs = 0, renderMs = 0;
+};
+
+Session::RenderStatus Session::renderAdmitted(Worker& w, const FrameState& state, Rendered& out) {
+    // Admission: at most the server's cap of renders at once, first come first served.
+    Stopwatch queueClock;
+    std::optional<RenderGate::Permit> permit;
+    if (mGate) {
+        permit = mGate->acquire(mStop);
+        if (!permit) return RenderStatus::Stopped;
+    }
+    out.queueMs = queueClock.elapsedMs();
+    Stopwatch renderClock;
+    try {
+        out.frame = w.renderer->render(state);
+    } catch (const std::exception& e) {
+        // A failed render leaves the context in an unknown state: the session ends rather than
+        // failing again on every input.
+        fail(std::string("the frame could not be rendered: ") + e.what());
+        return RenderStatus::Failed;
+    }
+    out.renderMs = renderClock.elapsedMs();
+    return RenderStatus::Ok;
+}
+
 Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, int step,
                                              const StreamOptions& stream, const std::string& note) {
     const std::string stepLabel = stepName(step);
@@ -497,17 +524,14 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         broadcastText(msg);
     };
     const int sliceMs = std::max(5, mConfig.limits.sliceMs);
-    // ms per rendered pixel of this step's tiles: measured once a tile ran, before that predicted from
-    // the interactive frames' model (VPLs included) with a margin, else a 64 x 64 first tile.
+    // ms per rendered pixel of this step's tiles: measured once a tile ran, before that from the last
+    // complete step of its kind (scaled to these VPLs) or the interactive frames' model, with a margin
+    // (small tiles cost more per pixel than a whole step's average), else a 64 x 64 first tile.
     double rate = 0.0;
-    if (auto own = mRefineCost.find(w.scene->name + "/" + full.technique + "/" + std::to_string(step));
-        own != mRefineCost.end())
-        rate = own->second.msPerPixel;
-    if (!(rate > 0.0)) {
-        const double predicted =
-            w.budget.predictMs(w.scene->name + "/" + full.technique, fullPixels, vplEstimate(full));
-        if (predicted > 0.0) rate = 2.0 * predicted / fullPixels;
-    }
+    double predicted = predictRefineMs(w.scene->name, full, step);
+    if (!(predicted > 0.0))
+        predicted = w.budget.predictMs(w.scene->name + "/" + full.technique, fullPixels, vplEstimate(full));
+    if (predicted > 0.0) rate = 2.0 * predicted / fullPixels;
     const int guard = tileGuardPx(full);
     std::vector<std::uint8_t> canvas =
         resizeRgba8(w.lastImage, w.lastWidth, w.lastHeight, full.width, full.height);
@@ -530,30 +554,18 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const double inner = std::max(1.0, side - 2.0 * guard);
         const TileRect rect = plan.next(inner * inner);
         FrameState tile = tileState(full, rect, guard);
-        Stopwatch queueClock;
-        std::optional<RenderGate::Permit> permit;
-        if (mGate) {
-            permit = mGate->acquire(mStop);
-            if (!permit) return RefineResult::Abandoned;
-        }
-        const double queueMs = queueClock.elapsedMs();
-        FrameOutput frame;
-        Stopwatch renderClock;
-        try {
-            frame = w.renderer->render(tile);
-        } catch (const std::exception& e) {
-            fail(std::string("the frame could not be rendered: ") + e.what());
-            return RefineResult::Failed;
-        }
-        permit.reset();
-        const double tileMs = renderClock.elapsedMs();
+        Rendered rendered;
+        if (const RenderStatus status = renderAdmitted(w, tile, rendered); status != RenderStatus::Ok)
+            return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
+        const FrameOutput& frame = rendered.frame;
+        const double queueMs = rendered.queueMs;
+        const double tileMs = rendered.renderMs;
         renderedMs += tileMs;
         const double tilePixels = static_cast<double>(tile.width) * tile.height;
         const double measured = tileMs / tilePixels;
         // A slow tile counts at once (tiles must not overrun); a cheap one (mostly background) lowers
         // the estimate by at most a fifth, since the next one may cover geometry.
         rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
-        recordRefineCost(w.scene->name, full, step, rate);
         // A smallest tile over the slice: its cost is mostly per VPL (each batch of them is a draw),
         // so the step starts again with the VPLs this measurement allows (workerMain caps them).
         const long vpls = std::max(1L, vplEstimate(full));
@@ -615,6 +627,9 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         sentOnce = true;
         sinceSend = Stopwatch();
     }
+    // The whole step's cost per pixel, which predicts the next one (and its refinement-budget check);
+    // single tiles would over-predict it, their fixed costs and the slowest regions included.
+    recordRefineCost(w.scene->name, full, step, renderedMs / fullPixels);
     if (step == static_cast<int>(Step::Final))
         progress("done", 1.0, 0.0,
                  "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) +
@@ -825,11 +840,20 @@ void Session::workerMain() {
                               " ms slice (--slice-ms)";
                     }
                 }
-                if (cap < static_cast<double>(vpls) && info.limitVpls && cap >= 16.0) {
+                // A final step capped to no more VPLs than the balanced one would only repeat it.
+                const long floorVpls =
+                    step == static_cast<int>(Step::Final)
+                        ? std::max(16L, vplEstimate(presetState(static_cast<int>(Step::Balanced))) + 1)
+                        : 16L;
+                const bool capped = cap < static_cast<double>(vpls);
+                if (capped && info.limitVpls && cap >= static_cast<double>(floorVpls)) {
                     info.limitVpls(state.techniqueParams, static_cast<long>(cap));
                     refineNote = "capped at " + std::to_string(vplEstimate(state)) + " of " +
                                  std::to_string(vpls) + " VPLs: " + why;
-                } else if (predictedMs > budgetMs) {
+                } else if (predictedMs > budgetMs || (capped && info.limitVpls)) {
+                    if (capped && info.limitVpls)
+                        why = "at most " + std::to_string(std::max(0L, static_cast<long>(cap))) + " of " +
+                              std::to_string(vpls) + " VPLs fit (" + why + "), no more than the step before";
                     broadcastText({{"type", "progress"},
                                    {"state", "skipped"},
                                    {"step", stepName(step)},
@@ -889,28 +913,13 @@ void Session::workerMain() {
             }
             continue;
         }
-        // Admission: at most the server's cap of renders at once, first come first served.
-        Stopwatch queueClock;
-        std::optional<RenderGate::Permit> permit;
-        if (mGate) {
-            permit = mGate->acquire(mStop);
-            if (!permit) break;
-        }
-        const double queueMs = queueClock.elapsedMs();
-        FrameOutput frame;
-        Stopwatch renderClock;
-        try {
-            frame = w.renderer->render(state);
-        } catch (const std::exception& e) {
-            // A failed render leaves the context in an unknown state: the session ends rather than
-            // failing again on every input.
-            fail(std::string("the frame could not be rendered: ") + e.what());
-            break;
-        }
-        permit.reset();
+        Rendered rendered;
+        if (renderAdmitted(w, state, rendered) != RenderStatus::Ok) break;
+        const FrameOutput& frame = rendered.frame;
+        const double queueMs = rendered.queueMs;
         if (step >= 0 && frame.width > 0 && frame.height > 0)
             recordRefineCost(scene->name, state, step,
-                             renderClock.elapsedMs() / (static_cast<double>(frame.width) * frame.height));
+                             rendered.renderMs / (static_cast<double>(frame.width) * frame.height));
         nlohmann::json stats = frame.stats;
         stats["scale"] = scale;
         stats["queue_ms"] = queueMs;

@@ -151,6 +151,11 @@ private:
     /// "abandoned"), when done, Retune when its smallest tile overran the slice (the step starts again
     /// with fewer VPLs), or Failed when the renderer failed.
     enum class RefineResult { Done, Abandoned, Retune, Failed };
+    struct Rendered; ///< a frame with its queue and render times (Session.cpp)
+    enum class RenderStatus { Ok, Stopped, Failed };
+    /// One render through the admission gate; Stopped when the session stops while waiting, Failed
+    /// (after fail()) when the renderer threw.
+    RenderStatus renderAdmitted(Worker& w, const FrameState& state, Rendered& out);
     RefineResult refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
                                const std::string& note);
     /// True when input (or a snapshot, or stop) waits: refinement yields to it.

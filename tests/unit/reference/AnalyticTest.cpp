@@ -43,6 +43,22 @@ glm::dvec3 planeRadiance(const glm::dvec3& p, double rho, const Light& light, do
     return rho / M_PI * light.intensity * glm::dvec3(light.color) * factor * std::max(cosTheta, 0.0) / d2;
 }
 
+// Pixels of the plane y = 0 seen by `cam` (away from its edges) with their points.
+template <class F> int forPlanePixels(const Camera& cam, int w, int h, F&& each) {
+    int n = 0;
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px) {
+            glm::dvec3 o, d;
+            pixelRay(cam, w, h, px, py, o, d);
+            if (d.y >= -1e-3) continue;
+            const glm::dvec3 p = o + d * (-o.y / d.y);
+            if (std::abs(p.x) > 4.9 || std::abs(p.z) > 4.9) continue;
+            each(static_cast<size_t>(py) * w + px, p);
+            ++n;
+        }
+    return n;
+}
+
 } // namespace
 
 TEST(ReferenceAnalytic, PlaneUnderPointLightMatchesInverseSquareCosine) {
@@ -54,22 +70,12 @@ TEST(ReferenceAnalytic, PlaneUnderPointLightMatchesInverseSquareCosine) {
     ReferenceRenderer renderer(scene);
     const ReferenceImage img = renderer.render(frameFor(cam, light, w, h), {.mode = "direct", .spp = 1});
     ASSERT_EQ(img.rgb.size(), static_cast<size_t>(w * h * 3));
-    int checked = 0;
-    for (int py = 0; py < h; ++py)
-        for (int px = 0; px < w; ++px) {
-            glm::dvec3 o, d;
-            pixelRay(cam, w, h, px, py, o, d);
-            if (d.y >= -1e-3) continue;
-            const glm::dvec3 p = o + d * (-o.y / d.y);
-            if (std::abs(p.x) > 4.9 || std::abs(p.z) > 4.9) continue;
-            const glm::dvec3 expected = planeRadiance(p, rho, light, 1.0);
-            for (int c = 0; c < 3; ++c) {
-                const double got = img.rgb[(static_cast<size_t>(py) * w + px) * 3 + c];
-                EXPECT_NEAR(got, expected[c], 0.005 * expected[c])
-                    << "pixel " << px << "," << py << " channel " << c;
-            }
-            ++checked;
-        }
+    const int checked = forPlanePixels(cam, w, h, [&](size_t i, const glm::dvec3& p) {
+        const glm::dvec3 expected = planeRadiance(p, rho, light, 1.0);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(img.rgb[i * 3 + c], expected[c], 0.005 * expected[c])
+                << "pixel " << i % w << "," << i / w << " channel " << c;
+    });
     EXPECT_GT(checked, w * h / 3);
 }
 
@@ -120,22 +126,6 @@ Mesh makeWallZ(float z0, float halfWidth, float height, int material) {
     wall.indices = {0, 1, 2, 0, 2, 3};
     wall.material = material;
     return wall;
-}
-
-// Pixels of the plane y = 0 seen by `cam` (away from its edges) with their points.
-template <class F> int forPlanePixels(const Camera& cam, int w, int h, F&& each) {
-    int n = 0;
-    for (int py = 0; py < h; ++py)
-        for (int px = 0; px < w; ++px) {
-            glm::dvec3 o, d;
-            pixelRay(cam, w, h, px, py, o, d);
-            if (d.y >= -1e-3) continue;
-            const glm::dvec3 p = o + d * (-o.y / d.y);
-            if (std::abs(p.x) > 4.9 || std::abs(p.z) > 4.9) continue;
-            each(static_cast<size_t>(py) * w + px, p);
-            ++n;
-        }
-    return n;
 }
 
 TEST(ReferenceAnalytic, PlaneUnderDirectionalLightIsUniformLuxTimesCosine) {
