@@ -1,0 +1,60 @@
+// Refinement tile benchmark (not a test): starts gi-server with its defaults, connects one WebSocket
+// client with a 960x800 view, optionally sets a technique and parameters, leaves the view still and
+// reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms.
+// usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--technique T]
+//        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"]
+import { spawn } from 'node:child_process';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import WebSocket from 'ws';
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const opts = { server: path.join(root, 'build/ci/bin/gi-server'), technique: '', params: '', seconds: 15,
+    'server-args': '' };
+const argv = process.argv.slice(2);
+for (let i = 0; i < argv.length; i++) {
+    const key = argv[i].replace(/^--/, '');
+    if (key === 'help') {
+        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"]');
+        process.exit(0);
+    }
+    if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
+    opts[key] = typeof opts[key] === 'number' ? Number(argv[++i]) : argv[++i];
+}
+const port = 20000 + Math.floor(Math.random() * 20000);
+const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client'),
+    ...opts['server-args'].split(' ').filter(Boolean)], { stdio: ['ignore', 'ignore', 'pipe'] });
+let log = '';
+server.stderr.on('data', (d) => { log += d; });
+for (let i = 0; i < 100 && !log.includes('listening'); i++) await new Promise((r) => setTimeout(r, 100));
+if (!log.includes('listening')) throw new Error(`gi-server did not start:\n${log}`);
+
+const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
+let stats = null;
+const tiles = [];
+const progress = [];
+ws.on('open', () => {
+    ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2 }));
+    if (opts.technique) ws.send(JSON.stringify({ type: 'technique', name: opts.technique }));
+    if (opts.params) ws.send(JSON.stringify({ type: 'params', values: JSON.parse(opts.params) }));
+});
+ws.on('message', (data, isBinary) => {
+    if (!isBinary) {
+        const m = JSON.parse(data.toString());
+        if (m.type === 'stats') stats = m;
+        else if (m.type === 'progress') progress.push(`${m.state} ${m.step}: ${m.reason}`);
+        return;
+    }
+    ws.send(JSON.stringify({ type: 'ack', frame: data.readUInt32LE(4) }));
+    if (stats?.refine) tiles.push({ ms: stats.frame_ms, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality });
+});
+setTimeout(() => {
+    const ms = tiles.map((t) => t.ms).sort((a, b) => a - b);
+    const p = (q) => (ms.length ? +ms[Math.min(ms.length - 1, Math.floor(q * ms.length))].toFixed(1) : null);
+    console.log(JSON.stringify({ technique: opts.technique || 'default', params: opts.params || null,
+        tiles_sent: ms.length, tile_ms: { p50: p(0.5), p95: p(0.95), max: p(1) },
+        final_vpls: tiles.filter((t) => t.step === 'final').at(-1)?.vpls ?? null, progress }));
+    ws.close(1000);
+    server.kill('SIGINT');
+    process.exit(0);
+}, opts.seconds * 1000);
