@@ -1428,7 +1428,7 @@ function frameModel() {
 /** The view (stream, gizmo, overlay) fills the screen; F or the ⛶ button again leaves. */
 function toggleFullscreen() {
     if (document.fullscreenElement) {
-        document.exitFullscreen?.().catch(() => {});
+        Promise.resolve(document.exitFullscreen?.()).then(showFullscreenState, () => {});
         return;
     }
     const view = ui.viewport;
@@ -1438,7 +1438,9 @@ function toggleFullscreen() {
         showMessage('This browser cannot show the view fullscreen.');
         return;
     }
-    Promise.resolve(request.call(view)).catch((e) => showMessage(`Fullscreen was refused: ${e.message}`));
+    // The fullscreenchange event also updates the button; the promise covers browsers that fire it late.
+    Promise.resolve(request.call(view)).then(showFullscreenState,
+        (e) => showMessage(`Fullscreen was refused: ${e.message}`));
 }
 
 function showFullscreenState() {

@@ -41,6 +41,16 @@ struct FrameState {
         int fullWidth = 0, fullHeight = 0;
         bool active() const { return fullWidth > 0 && fullHeight > 0; }
     } window;
+    /// One of `count` interleaved VPL subsets of this frame (count 1: all of them). Where the
+    /// technique supports it (TechniqueInfo::vplParts), part k's image shows the average of parts
+    /// 0..k of the same size, window and state rendered just before it, so the image converges as the
+    /// parts come and part count-1 shows every VPL: refinement's way to split a step that one slice
+    /// cannot hold. Elsewhere each part renders the whole frame.
+    struct VplPart {
+        int index = 0;
+        int count = 1;
+        bool active() const { return count > 1; }
+    } vplPart;
     std::string technique = "rsm_gather";
     ParamSet frameParams;     ///< frameParamTable(): exposure, tone map, shadow and RSM sizes
     ParamSet techniqueParams; ///< the technique's own table

@@ -41,6 +41,12 @@ struct TechniqueInfo {
     /// refinement step (frame/Tiles.h) then samples its own set, so tiles differ slightly at their
     /// seams where a whole frame would not (tests/gl/TilesGlTest.cpp measures by how much).
     bool viewSampled = false;
+    /// Whether, with these parameters, the technique honours FrameInputs::vplPart: it renders one of
+    /// vplParts interleaved subsets of its VPLs scaled by vplParts, so that the average of the parts
+    /// is the whole set's indirect light (it is linear in the VPLs: no screen-space pass on the sum).
+    /// Refinement then spreads a step too slow for one slice over several (FrameState::VplPart).
+    /// Empty: never.
+    std::function<bool(const ParamSet& technique)> vplParts;
 };
 
 /// Every technique, in the registry's stable order.

@@ -61,6 +61,10 @@ struct FrameInputs {
     /// `instances` times; techniques see geometry only through this (VPL shadow maps).
     std::function<void(const gl::Program& program, int instances)> drawGeometry;
     float sceneExtent = 1.0f; ///< diagonal of the scene's bounds (m), > 0
+    /// One of vplParts interleaved VPL subsets (TechniqueInfo::vplParts): the VPLs whose index modulo
+    /// vplParts is vplPart, their light scaled by vplParts. 1 part: every VPL.
+    int vplPart = 0;
+    int vplParts = 1;
 
     /// The resource `name`, or nullptr when the frame did not produce it.
     const gl::Texture* find(const std::string& name) const {

@@ -153,6 +153,10 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     mCompositePass.reflection = c.textureUnit("gReflection");
     mCompositePass.hasIndirect = c.location("uHasIndirect");
     mCompositePass.hasReflection = c.location("uHasReflection");
+    mPartAverage.program =
+        gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/vpl_part_average.frag"}});
+    mPartAverage.part = mPartAverage.program.textureUnit("gPart");
+    mPartAverage.weight = mPartAverage.program.location("uWeight");
     mFluxPass.program = gl::Program::build({{GL_COMPUTE_SHADER, "render/rsm_flux.comp"}});
     mFluxPass.rsmSize = mFluxPass.program.location("uRsmSize");
     mFluxPass.position = mFluxPass.program.textureUnit("gRsmPosition");
@@ -335,6 +339,37 @@ void FrameRenderer::composite(int width, int height, const gl::Texture* indirect
     mResources.publish("linear", "composite", mLinear);
 }
 
+const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const gl::Texture& part,
+                                                 Counters& counters) {
+    PartAverage& a = mPartAverage;
+    if (a.width != state.width || a.height != state.height) {
+        a.mean = gl::Texture::create2D(GL_RGBA32F, state.width, state.height);
+        a.fbo = gl::Framebuffer::of("VPL part mean", {&a.mean});
+        a.width = state.width;
+        a.height = state.height;
+        a.averaged = 0;
+    }
+    const std::array<int, 7> key{state.width,        state.height,           state.window.x,
+                                 state.window.y,     state.window.fullWidth, state.window.fullHeight,
+                                 state.vplPart.count};
+    // Part 0 starts a mean; so does a part that does not follow the ones in it (another image, or a
+    // part left out), which then shows the parts it has rather than mixing two images.
+    if (state.vplPart.index == 0 || key != a.key || a.averaged != state.vplPart.index) a.averaged = 0;
+    a.key = key;
+    {
+        gl::Pass pass(mTimer, "vpl_part_average");
+        pass.target(a.fbo, state.width, state.height)
+            .use(a.program)
+            .texture(a.part, part)
+            .set(a.weight, 1.0f / static_cast<float>(a.averaged + 1))
+            .blend(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ZERO);
+        pass.drawFullscreen(mEmptyVao);
+    }
+    ++a.averaged;
+    counters["vpl_parts_averaged"] = a.averaged;
+    return a.mean;
+}
+
 FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     GIS_ASSERT(mSceneGpu != nullptr);
     GIS_ASSERT(state.width > 0 && state.height > 0);
@@ -430,12 +465,20 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
         mSceneGpu->draw(program, nullptr, instances);
     };
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
+    const TechniqueInfo& techniqueInfo = findTechniqueInfo(state.technique);
+    const bool vplParts =
+        state.vplPart.active() && techniqueInfo.vplParts && techniqueInfo.vplParts(state.techniqueParams);
+    if (vplParts) {
+        in.vplParts = state.vplPart.count;
+        in.vplPart = std::clamp(state.vplPart.index, 0, state.vplPart.count - 1);
+    }
     const size_t techniqueFirstPass = mTimer.passCount();
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     const size_t techniqueEndPass = mTimer.passCount();
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     const gl::Texture* indirect = mTechnique->indirect();
+    if (indirect && vplParts) indirect = &averageVplPart(state, *indirect, counters);
     if (indirect)
         mResources.publish("indirect", "technique", *indirect);
     else

@@ -7,6 +7,7 @@
 // throw gis::Error (shader compile, allocation: setup boundaries); steady-state frames never throw.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -82,6 +83,9 @@ private:
     void renderGBuffer(int width, int height);
     void renderDirect();
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
+    /// Folds one VPL part's indirect light into the running mean of the parts before it
+    /// (FrameState::VplPart) and returns that mean.
+    const gl::Texture& averageVplPart(const FrameState& state, const gl::Texture& part, Counters& counters);
 
     std::shared_ptr<const Scene> mScene;
     std::unique_ptr<SceneGpu> mSceneGpu;
@@ -127,6 +131,19 @@ private:
     gl::Framebuffer mDirectFbo;
     gl::Texture mDisplay, mLinear;
     gl::Framebuffer mCompositeFbo;
+
+    /// The mean of the VPL parts of one image so far, allocated by the first part.
+    struct PartAverage {
+        gl::Program program;
+        gl::TextureUnit part;
+        gl::UniformLocation weight;
+        gl::Texture mean;
+        gl::Framebuffer fbo;
+        int width = 0, height = 0;
+        int averaged = 0; ///< parts in the mean
+        /// What the parts in the mean rendered: a part adds to them only with the same image.
+        std::array<int, 7> key{};
+    } mPartAverage;
 
     Reflections mReflections;
 

@@ -483,19 +483,27 @@ test('the orbit target sits at the model; "Frame the model" fits it; Reset camer
     });
 
 test('the view goes fullscreen with the button and F, and back', async () => {
-    await page.locator('#fullscreen').click();
-    await until('the viewport is fullscreen', () => document.fullscreenElement?.id === 'viewport');
-    assert.equal(await page.locator('#fullscreen').getAttribute('aria-pressed'), 'true');
-    assert.ok(await page.locator('#overlay').isVisible(), 'the overlay comes along');
-    await page.locator('#view').press('f');
-    await until('fullscreen left with F', () => document.fullscreenElement === null);
-    await page.locator('#view').press('f');
-    await until('fullscreen again with F', () => document.fullscreenElement?.id === 'viewport');
-    await page.locator('#fullscreen').click();
-    await until('and left with the button', () => document.fullscreenElement === null);
-    // The button follows the fullscreenchange event, which may come a moment after the element is gone.
-    await until('the button no longer pressed',
-        () => document.getElementById('fullscreen')?.getAttribute('aria-pressed') === 'false');
+    // The button follows the fullscreenchange event, which may come a moment after the element changed.
+    const pressed = (value) => until(`the button's aria-pressed ${value}`,
+        (v) => document.getElementById('fullscreen')?.getAttribute('aria-pressed') === v, value);
+    try {
+        await page.locator('#fullscreen').click();
+        await until('the viewport is fullscreen', () => document.fullscreenElement?.id === 'viewport');
+        await pressed('true');
+        assert.ok(await page.locator('#overlay').isVisible(), 'the overlay comes along');
+        await page.locator('#view').press('f');
+        await until('fullscreen left with F', () => document.fullscreenElement === null);
+        await pressed('false');
+        await page.locator('#view').press('f');
+        await until('fullscreen again with F', () => document.fullscreenElement?.id === 'viewport');
+        await pressed('true');
+        await page.locator('#fullscreen').click();
+        await until('and left with the button', () => document.fullscreenElement === null);
+        await pressed('false');
+    } finally {
+        // A failure above must not leave the view covering the page for the tests that follow.
+        await page.evaluate(() => document.fullscreenElement && document.exitFullscreen());
+    }
 });
 
 test('a snapshot downloads a lossless PNG of the view', async () => {

@@ -123,5 +123,70 @@ TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {
     EXPECT_EQ(c.rgba8, d.rgba8);
 }
 
+/// Largest |a - b| over the RGB of covered pixels, relative to the largest value of `b`.
+double maxRelativeDifference(const std::vector<float>& a, const std::vector<float>& b) {
+    double worst = 0.0, peak = 1e-12;
+    for (std::size_t i = 0; i < b.size(); ++i) {
+        if (i % 4 == 3) continue;
+        worst = std::max(worst, static_cast<double>(std::fabs(a[i] - b[i])));
+        peak = std::max(peak, static_cast<double>(std::fabs(b[i])));
+    }
+    return worst / peak;
+}
+
+// VPL parts (FrameState::VplPart): the running mean of the parts of one image ends at the image of
+// every VPL, its first parts differ from it, and parts of another image or out of order start again.
+TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
+    sharedContext();
+    const Scene scene = loadScene("builtin:cornell");
+    FrameRenderer renderer;
+    renderer.setScene(std::make_shared<const Scene>(scene));
+    FrameState full = stateFor(scene, "rsm_gather", 96, 80);
+    full.techniqueParams.set("vpl_grid", 12); // 144 VPLs: 7 parts do not divide them
+    const FrameOutput whole = renderer.render(full, true);
+    const int parts = 7;
+    std::vector<double> errors;
+    FrameOutput last;
+    for (int p = 0; p < parts; ++p) {
+        FrameState part = full;
+        part.vplPart = {p, parts};
+        last = renderer.render(part, true);
+        EXPECT_EQ(counter(last, "vpl_parts_averaged"), p + 1.0);
+        EXPECT_EQ(counter(last, "vpl_parts"), parts);
+        errors.push_back(maxRelativeDifference(last.linear, whole.linear));
+    }
+    std::printf("[vpl parts] rsm_gather 144 VPLs in %d parts: max relative difference after part 1 %.3g, "
+                "after all %.3g\n",
+                parts, errors.front(), errors.back());
+    EXPECT_GT(errors.front(), 0.01) << "one part alone is not the whole set";
+    EXPECT_LT(errors.back(), 1e-4) << "the mean of all parts is";
+
+    // Tiles in parts: a window's parts end at the window of every VPL.
+    TilePlan plan(full.width, full.height);
+    const TileRect rect = plan.next(40.0 * 40.0);
+    const FrameState tile = tileState(full, rect, tileGuardPx(full));
+    const FrameOutput tileWhole = renderer.render(tile, true);
+    for (int p = 0; p < 3; ++p) {
+        FrameState part = tile;
+        part.vplPart = {p, 3};
+        last = renderer.render(part, true);
+    }
+    EXPECT_LT(maxRelativeDifference(last.linear, tileWhole.linear), 1e-4);
+
+    // A part that does not follow the ones before (here: part 2 after another image) starts a mean.
+    FrameState stray = full;
+    stray.vplPart = {2, 3};
+    EXPECT_EQ(counter(renderer.render(stray), "vpl_parts_averaged"), 1.0);
+
+    // Bias compensation filters the sum: no parts, every part renders the whole set.
+    FrameState compensated = full;
+    compensated.techniqueParams.set("ssbc_iterations", 1);
+    const FrameOutput ssbcWhole = renderer.render(compensated);
+    compensated.vplPart = {0, 3};
+    const FrameOutput ssbcPart = renderer.render(compensated);
+    EXPECT_EQ(counter(ssbcPart, "vpl_parts"), 0.0);
+    EXPECT_EQ(ssbcPart.rgba8, ssbcWhole.rgba8);
+}
+
 } // namespace
 } // namespace gis::test

@@ -6,6 +6,16 @@
 
 namespace gis {
 
+namespace {
+
+/// The gather sums each VPL's (clamped) light; bias compensation filters the sum in screen space,
+/// which an average of partial sums would not reproduce.
+bool gatherVplParts(const ParamSet& technique) {
+    return technique.getInt("ssbc_iterations") == 0;
+}
+
+} // namespace
+
 TechniqueInfo rsmGatherInfo() {
     TechniqueInfo info{"rsm_gather", "full-resolution gather from VPLs on a regular RSM grid",
                        "000 §3, Eq. 2", ParamTable(withVplShadowParams(vplParamSpecs(VplKernel::Point))),
@@ -14,6 +24,7 @@ TechniqueInfo rsmGatherInfo() {
     info.limitVpls = limitGridVpls;
     info.vplVisibility = true;
     info.biasCompensation = true;
+    info.vplParts = gatherVplParts;
     return info;
 }
 
@@ -32,6 +43,7 @@ TechniqueInfo ssbcInfo() {
     info.limitVpls = limitGridVpls;
     info.vplVisibility = true;
     info.biasCompensation = true;
+    info.vplParts = gatherVplParts;
     return info;
 }
 

@@ -10,9 +10,10 @@ RsmGather::GatherProgram::GatherProgram(gl::Program built)
     : program(std::move(built)),
       minDistance(program.optionalLocation("uMinDistance")) /* point kernel only */,
       vplCount(program.location("uVplCount")), vplFirst(program.location("uVplFirst")),
-      position(program.textureUnit("gPosition")), normal(program.textureUnit("gNormal")),
-      albedo(program.textureUnit("gAlbedo")), specular(program.textureUnit("gSpecular")), transport(program),
-      shadows(program) {}
+      vplPhase(program.location("uVplPhase")), vplStride(program.location("uVplStride")),
+      allVpls(program.storageBlock("VplAll")), position(program.textureUnit("gPosition")),
+      normal(program.textureUnit("gNormal")), albedo(program.textureUnit("gAlbedo")),
+      specular(program.textureUnit("gSpecular")), transport(program), shadows(program) {}
 
 RsmGather::RsmGather() {
     mGather = KernelPrograms<GatherProgram>(
@@ -43,11 +44,36 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
             g.transport.set(pass, params, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
             if (glossy) pass.texture(g.specular, in.get("gbuffer.specular"));
             pass.blendAdd();
-            int first = 0;
-            counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
-                pass.set(g.vplCount, count).set(g.vplFirst, first).drawFullscreen(mEmptyVao);
-                first += count;
-            });
+            if (in.vplParts > 1) {
+                // One of the refinement's VPL parts: one draw striding over the whole buffer (the
+                // batches' uniform block is bound but not read).
+                const int parts = in.vplParts;
+                const int part = std::clamp(in.vplPart, 0, parts - 1);
+                pass.buffer(g.allVpls, mVpls.buffer());
+                bool drawn = false;
+                mVpls.forEachBatch([&](int) {
+                    if (drawn || part >= vplCount) return;
+                    pass.set(g.vplCount, vplCount)
+                        .set(g.vplFirst, 0)
+                        .set(g.vplPhase, part)
+                        .set(g.vplStride, parts)
+                        .drawFullscreen(mEmptyVao);
+                    drawn = true;
+                });
+                counters["vpl_batches"] = drawn ? 1 : 0;
+                counters["vpl_part"] = part;
+                counters["vpl_parts"] = parts;
+            } else {
+                int first = 0;
+                counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
+                    pass.set(g.vplCount, count)
+                        .set(g.vplFirst, first)
+                        .set(g.vplPhase, 0)
+                        .set(g.vplStride, 1)
+                        .drawFullscreen(mEmptyVao);
+                    first += count;
+                });
+            }
         }
     }
     mSsbc.apply(in, params, mIndirect.texture, timer, counters);
