@@ -14,6 +14,9 @@ TechniqueInfo multiresGatherInfo() {
     info.limitVpls = limitGridVpls;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
+    // The gather's irradiance is linear in the VPLs up to the reconstruction; bias compensation
+    // filters the sum in screen space.
+    info.vplParts = [](const ParamSet& technique) { return technique.getInt("ssbc_iterations") == 0; };
     return info;
 }
 

@@ -1,11 +1,15 @@
 #include "gi/multires_gather/MultiresGather.h"
 
+#include <algorithm>
+
 namespace gis {
 
 MultiresGather::GatherProgram::GatherProgram(gl::Program built)
     : program(std::move(built)),
       minDistance(program.optionalLocation("uMinDistance")) /* point kernel only */,
-      vplCount(program.location("uVplCount")), transport(program), eye(program) {}
+      vplCount(program.location("uVplCount")), vplPhase(program.location("uVplPhase")),
+      vplStride(program.location("uVplStride")), allVpls(program.storageBlock("VplAll")), transport(program),
+      eye(program) {}
 
 MultiresGather::MultiresGather() {
     mGather = KernelPrograms<GatherProgram>({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
@@ -28,8 +32,31 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
             pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
             g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
             mEye.beginIlluminationPass(pass, g.eye, in, true);
-            counters["vpl_batches"] = mVpls.forEachBatch(
-                [&](int count) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
+            if (in.vplParts > 1) {
+                // A refinement VPL part: one draw striding over the whole buffer (the batches' uniform
+                // block is bound but not read).
+                const int part = std::clamp(in.vplPart, 0, in.vplParts - 1);
+                pass.buffer(g.allVpls, mVpls.buffer());
+                bool drawn = false;
+                mVpls.forEachBatch([&](int) {
+                    if (drawn || part >= vplCount) return;
+                    pass.set(g.vplCount, vplCount)
+                        .set(g.vplPhase, part)
+                        .set(g.vplStride, in.vplParts)
+                        .drawFullscreen(mEye.emptyVao());
+                    drawn = true;
+                });
+                counters["vpl_batches"] = drawn ? 1 : 0;
+                counters["vpl_part"] = part;
+                counters["vpl_parts"] = in.vplParts;
+            } else {
+                counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
+                    pass.set(g.vplCount, count)
+                        .set(g.vplPhase, 0)
+                        .set(g.vplStride, 1)
+                        .drawFullscreen(mEye.emptyVao());
+                });
+            }
         }
     }
 

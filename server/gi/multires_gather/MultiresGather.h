@@ -44,7 +44,8 @@ private:
     struct GatherProgram {
         explicit GatherProgram(gl::Program built);
         gl::Program program;
-        gl::UniformLocation minDistance, vplCount;
+        gl::UniformLocation minDistance, vplCount, vplPhase, vplStride;
+        gl::BlockBinding allVpls;
         VplTransportHandles transport;
         EyeInputHandles eye;
     };
