@@ -1,6 +1,7 @@
 // Refinement tile benchmark (not a test): starts gi-server with its defaults, connects one WebSocket
 // client with a 960x800 view, optionally sets a technique and parameters, leaves the view still and
-// reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms.
+// reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms, the
+// steps' VPL counts and the most VPL parts a tile was split into.
 // usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--technique T]
 //        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"]
 import { spawn } from 'node:child_process';
@@ -46,14 +47,23 @@ ws.on('message', (data, isBinary) => {
         return;
     }
     ws.send(JSON.stringify({ type: 'ack', frame: data.readUInt32LE(4) }));
-    if (stats?.refine) tiles.push({ ms: stats.frame_ms, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality });
+    if (stats?.refine) {
+        tiles.push({ ms: stats.frame_ms, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
+            parts: stats.refine.vpl_parts ?? 1, index: tiles.length, tile: stats.tile?.size,
+            passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(2)])) });
+    }
 });
 setTimeout(() => {
     const ms = tiles.map((t) => t.ms).sort((a, b) => a - b);
     const p = (q) => (ms.length ? +ms[Math.min(ms.length - 1, Math.floor(q * ms.length))].toFixed(1) : null);
     console.log(JSON.stringify({ technique: opts.technique || 'default', params: opts.params || null,
         tiles_sent: ms.length, tile_ms: { p50: p(0.5), p95: p(0.95), max: p(1) },
-        final_vpls: tiles.filter((t) => t.step === 'final').at(-1)?.vpls ?? null, progress }));
+        balanced_vpls: tiles.filter((t) => t.step === 'balanced').at(-1)?.vpls ?? null,
+        final_vpls: tiles.filter((t) => t.step === 'final').at(-1)?.vpls ?? null,
+        vpl_parts_max: Math.max(1, ...tiles.map((t) => t.parts)),
+        slowest_tile: tiles.length ? (({ passes, ...t }) => t)(tiles.reduce((a, b) => (b.ms > a.ms ? b : a))) : null,
+        last_tile: tiles.length ? { ms: tiles.at(-1).ms, parts: tiles.at(-1).parts, passes: tiles.at(-1).passes } : null,
+        progress }));
     ws.close(1000);
     server.kill('SIGINT');
     process.exit(0);

@@ -34,6 +34,11 @@ using Clock = std::chrono::steady_clock;
 constexpr int kTileAlign = 16;
 constexpr int kMinTileSide = 16;
 constexpr int kSnapshotBudgetMs = 5000;
+// Tiles whose VPLs render in parts (FrameState::VplPart): 64 x 64 inner pixels, so that a part's fixed
+// costs (G-buffer, direct light, composite, read-back) stay small beside its share of the VPLs; at
+// most 4096 parts (each at least one VPL).
+constexpr int kPartTileSide = 64;
+constexpr int kMaxVplParts = 4096;
 
 const char* stepName(int step) {
     static const char* names[] = {"interactive", "balanced", "final"};
@@ -524,9 +529,15 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         broadcastText(msg);
     };
     const int sliceMs = std::max(5, mConfig.limits.sliceMs);
-    // ms per rendered pixel of this step's tiles: measured once a tile ran, before that from the last
-    // complete step of its kind (scaled to these VPLs) or the interactive frames' model, with a margin
-    // (small tiles cost more per pixel than a whole step's average), else a 64 x 64 first tile.
+    const long vpls = std::max(1L, vplEstimate(full));
+    const TechniqueInfo& info = findTechniqueInfo(full.technique);
+    // A technique that renders its VPLs in parts (TechniqueInfo::vplParts) spreads a tile too slow
+    // for one slice over several; others get smaller tiles, down to kMinTileSide.
+    const bool splittable = info.vplParts && info.vplParts(full.techniqueParams) && vpls > 1;
+    // ms per rendered pixel of this step's tiles (all their parts): measured once a tile ran, before
+    // that from the last complete step of its kind (scaled to these VPLs) or the interactive frames'
+    // model, with a margin (small tiles cost more per pixel than a whole step's average), else a
+    // 64 x 64 first tile.
     double rate = 0.0;
     double predicted = predictRefineMs(w.scene->name, full, step);
     if (!(predicted > 0.0))
@@ -540,100 +551,147 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     Stopwatch sinceSend;
     bool sentOnce = false;
     double renderedMs = 0.0;
+    // VPL parts: tiles of kPartTileSide^2 inner pixels (their fixed costs stay small beside the VPLs'),
+    // as many parts as make one fit 80 % of a slice; `partsFloor` rises when a part overran, and the
+    // tile shrinks when even the most parts overran.
+    int partsFloor = 1;
+    double partTilePixels = double(kPartTileSide) * kPartTileSide;
+    int maxPartsUsed = 1;
     progress("refining", 0.0, rate > 0.0 ? rate * fullPixels : 0.0,
              "the view is still: rendering the " + stepLabel + " step in tiles of about " +
                  std::to_string(sliceMs) + " ms" + (note.empty() ? std::string() : "; " + note));
+    double shareDone = 0.0; // tiles and parts rendered (plan.shareDone() counts a tile once it starts)
+    auto abandoned = [&] {
+        progress("abandoned", shareDone, 0.0, "input arrived: the frame answers it first");
+        return RefineResult::Abandoned;
+    };
     while (!plan.done()) {
-        if (inputPending()) {
-            progress("abandoned", plan.shareDone(), 0.0, "input arrived: the frame answers it first");
-            return RefineResult::Abandoned;
+        if (inputPending()) return abandoned();
+        // Until a tile of this step was measured, its predicted cost is trusted three times over (the
+        // interactive frames' model has under-predicted the per-VPL cost of full-size tiles 3-fold).
+        const double sizingRate = renderedMs > 0.0 ? rate : 3.0 * rate;
+        double pixels = rate > 0.0 ? sliceMs / sizingRate : 64.0 * 64.0;
+        int parts = 1;
+        if (splittable && rate > 0.0 && (pixels < partTilePixels || partsFloor > 1)) {
+            const double wanted = std::ceil(sizingRate * partTilePixels / (0.8 * sliceMs));
+            parts = static_cast<int>(std::clamp(std::max(wanted, double(partsFloor)), 2.0,
+                                                std::min(double(vpls), double(kMaxVplParts))));
+            pixels = partTilePixels;
         }
-        const double pixels = rate > 0.0 ? sliceMs / rate : 64.0 * 64.0;
         // The guard band is rendered too: ask for fewer inner pixels so the whole tile fits the slice.
         const double side = std::sqrt(std::max(pixels, 1.0));
         const double inner = std::max(1.0, side - 2.0 * guard);
+        const double shareBefore = plan.shareDone();
         const TileRect rect = plan.next(inner * inner);
-        FrameState tile = tileState(full, rect, guard);
-        Rendered rendered;
-        if (const RenderStatus status = renderAdmitted(w, tile, rendered); status != RenderStatus::Ok)
-            return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
-        const FrameOutput& frame = rendered.frame;
-        const double queueMs = rendered.queueMs;
-        const double tileMs = rendered.renderMs;
-        renderedMs += tileMs;
+        const double shareAfter = plan.shareDone();
+        const FrameState tile = tileState(full, rect, guard);
         const double tilePixels = static_cast<double>(tile.width) * tile.height;
+        double tileMs = 0.0, slowestPartMs = 0.0;
+        for (int part = 0; part < parts; ++part) {
+            if (part > 0 && inputPending()) return abandoned();
+            FrameState piece = tile;
+            if (parts > 1) piece.vplPart = {part, parts};
+            Rendered rendered;
+            if (const RenderStatus status = renderAdmitted(w, piece, rendered); status != RenderStatus::Ok)
+                return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
+            const FrameOutput& frame = rendered.frame;
+            tileMs += rendered.renderMs;
+            slowestPartMs = std::max(slowestPartMs, rendered.renderMs);
+            renderedMs += rendered.renderMs;
+            pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
+
+            // Input waits: its frame goes first, the unsent tiles are not worth encoding.
+            const double share = shareBefore + (shareAfter - shareBefore) * (part + 1) / parts;
+            shareDone = share;
+            if (inputPending()) return abandoned();
+            const bool last = plan.done() && part + 1 == parts;
+            const double tileRate = rate > 0.0 ? rate : tileMs * parts / ((part + 1) * tilePixels);
+            const double etaMs =
+                tileRate * fullPixels * (1.0 - share) * (tilePixels / std::max(1.0, inner * inner));
+            // Send when the controller's window has room, at most every 150 ms, and always the last
+            // tile (waiting for room, unless input comes first).
+            bool send = false;
+            {
+                std::unique_lock lock(mMutex);
+                if (last)
+                    mCv.wait(lock,
+                             [&] { return mStop || mDirty || !mController || !mController->windowFull(); });
+                // Keep one slot of a larger window free for the answer to input: a tile the client is
+                // still decoding must not hold it back.
+                const bool slotLeft =
+                    mController && !mController->windowFull() &&
+                    (last || mController->maxInFlight() < 2 ||
+                     mController->inFlight() + 1 < static_cast<std::size_t>(mController->maxInFlight()));
+                send = slotLeft && (last || !sentOnce || sinceSend.elapsedMs() >= 150.0);
+            }
+            if (!send) continue;
+            nlohmann::json stats = frame.stats;
+            stats["size"] = {full.width, full.height};
+            stats["tile"] = {
+                {"x", rect.x}, {"y", rect.y}, {"size", {rect.width, rect.height}}, {"guard", guard}};
+            stats["scale"] = 1.0;
+            stats["queue_ms"] = rendered.queueMs;
+            stats["params"] = paramsJson(full);
+            if (!full.plan.is_null()) stats["plan"] = full.plan;
+            stats["refine"] = {{"step", stepLabel},
+                               {"tiles_done", plan.tilesDone()},
+                               {"share", share},
+                               {"elapsed_ms", stepClock.elapsedMs()},
+                               {"render_ms", renderedMs},
+                               {"eta_ms", last ? 0.0 : etaMs},
+                               {"complete", last},
+                               {"vpl_parts", parts},
+                               {"vpl_parts_done", part + 1}};
+            if (!deliver(w, canvas, full.width, full.height, std::move(stats), stepLabel, stream, nullptr,
+                         ImageCodec::Png))
+                return RefineResult::Failed;
+            sentOnce = true;
+            sinceSend = Stopwatch();
+        }
+        maxPartsUsed = std::max(maxPartsUsed, parts);
         const double measured = tileMs / tilePixels;
         // A slow tile counts at once (tiles must not overrun); a cheap one (mostly background) lowers
         // the estimate by at most a fifth, since the next one may cover geometry.
         rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
-        // A smallest tile over the slice: its cost is mostly per VPL (each batch of them is a draw),
-        // so the step starts again with the VPLs this measurement allows (workerMain caps them).
-        const long vpls = std::max(1L, vplEstimate(full));
-        if (rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
+        if (parts > 1 && slowestPartMs > sliceMs) {
+            // A part overran: more parts next time (as if a part's cost were all VPLs), and once the
+            // parts are at their limit, a smaller tile.
+            const double more = std::ceil(parts * slowestPartMs / (0.8 * sliceMs));
+            if (more > std::min(double(vpls), double(kMaxVplParts)))
+                partTilePixels = std::max(double(kMinTileSide) * kMinTileSide,
+                                          partTilePixels * 0.8 * sliceMs / slowestPartMs);
+            partsFloor = static_cast<int>(std::min(more, double(kMaxVplParts)));
+        } else if (parts > 1 && slowestPartMs < 0.4 * sliceMs && partsFloor > 1) {
+            partsFloor = std::max(1, partsFloor / 2);
+        }
+        // A smallest tile over the slice that cannot split its VPLs: its cost is mostly per VPL (each
+        // batch of them is a draw), so the step starts again with the VPLs this measurement allows
+        // (workerMain caps them).
+        if (!splittable && rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
             const std::string key = w.scene->name + "/" + full.technique + "/" + std::to_string(step);
             const double perVpl = tileMs / static_cast<double>(vpls);
             auto known = mMinTileMsPerVpl.find(key);
             const bool news = known == mMinTileMsPerVpl.end() || perVpl > 1.2 * known->second;
             mMinTileMsPerVpl[key] =
                 known == mMinTileMsPerVpl.end() ? perVpl : std::max(perVpl, known->second);
-            if (news && vpls > 16 && findTechniqueInfo(full.technique).limitVpls) {
-                progress("abandoned", plan.shareDone(), 0.0,
+            if (news && vpls > 16 && info.limitVpls && !plan.done()) {
+                progress("abandoned", shareDone, 0.0,
                          "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +
                              " tile took " + std::to_string(std::lround(tileMs)) +
                              " ms: starting again with fewer VPLs");
                 return RefineResult::Retune;
             }
         }
-        pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
-
-        // Input waits: its frame goes first, the unsent tiles are not worth encoding.
-        if (inputPending()) {
-            progress("abandoned", plan.shareDone(), 0.0, "input arrived: the frame answers it first");
-            return RefineResult::Abandoned;
-        }
-        const bool last = plan.done();
-        const double share = plan.shareDone();
-        const double etaMs = rate * fullPixels * (1.0 - share) * (tilePixels / std::max(1.0, inner * inner));
-        // Send when the controller's window has room, at most every 150 ms, and always the last tile
-        // (waiting for room, unless input comes first).
-        bool send = false;
-        {
-            std::unique_lock lock(mMutex);
-            if (last)
-                mCv.wait(lock, [&] { return mStop || mDirty || !mController || !mController->windowFull(); });
-            // Keep one slot of a larger window free for the answer to input: a tile the client is
-            // still decoding must not hold it back.
-            const bool slotLeft =
-                mController && !mController->windowFull() &&
-                (last || mController->maxInFlight() < 2 ||
-                 mController->inFlight() + 1 < static_cast<std::size_t>(mController->maxInFlight()));
-            send = slotLeft && (last || !sentOnce || sinceSend.elapsedMs() >= 150.0);
-        }
-        if (!send) continue;
-        nlohmann::json stats = frame.stats;
-        stats["size"] = {full.width, full.height};
-        stats["tile"] = {{"x", rect.x}, {"y", rect.y}, {"size", {rect.width, rect.height}}, {"guard", guard}};
-        stats["scale"] = 1.0;
-        stats["queue_ms"] = queueMs;
-        stats["params"] = paramsJson(full);
-        if (!full.plan.is_null()) stats["plan"] = full.plan;
-        stats["refine"] = {{"step", stepLabel},       {"tiles_done", plan.tilesDone()},
-                           {"share", share},          {"elapsed_ms", stepClock.elapsedMs()},
-                           {"render_ms", renderedMs}, {"eta_ms", last ? 0.0 : etaMs},
-                           {"complete", last}};
-        if (!deliver(w, canvas, full.width, full.height, std::move(stats), stepLabel, stream, nullptr,
-                     ImageCodec::Png))
-            return RefineResult::Failed;
-        sentOnce = true;
-        sinceSend = Stopwatch();
     }
     // The whole step's cost per pixel, which predicts the next one (and its refinement-budget check);
     // single tiles would over-predict it, their fixed costs and the slowest regions included.
     recordRefineCost(w.scene->name, full, step, renderedMs / fullPixels);
-    if (step == static_cast<int>(Step::Final))
-        progress("done", 1.0, 0.0,
-                 "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) +
-                     " ms");
+    if (step == static_cast<int>(Step::Final)) {
+        std::string done =
+            "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) + " ms";
+        if (maxPartsUsed > 1) done += " in tiles of up to " + std::to_string(maxPartsUsed) + " VPL parts";
+        progress("done", 1.0, 0.0, done);
+    }
     return RefineResult::Done;
 }
 
@@ -810,9 +868,10 @@ void Session::workerMain() {
                 const double budgetMs = mConfig.limits.refineBudgetMs;
                 const double predictedMs = predictRefineMs(scene->name, state, step);
                 // Fewer VPLs where the technique can take them (a step's cost is about proportional
-                // to them) when the whole step would overrun the budget, or when even the smallest tile
-                // would overrun a slice (input waits for at most one tile); else a step over the
-                // budget is skipped. The client is told which.
+                // to them) when the whole step would overrun the budget, or, for a technique that
+                // cannot render its VPLs in parts, when even the smallest tile would overrun a slice
+                // (input waits for at most one tile); else a step over the budget is skipped. The
+                // client is told which.
                 const TechniqueInfo& info = findTechniqueInfo(state.technique);
                 const long vpls = vplEstimate(state);
                 double cap = static_cast<double>(vpls);
@@ -831,7 +890,8 @@ void Session::workerMain() {
                 const double minTileMsPerVpl = minTile != mMinTileMsPerVpl.end()
                                                    ? minTile->second
                                                    : vplRate * double(kMinTileSide) * kMinTileSide;
-                if (minTileMsPerVpl > 0.0) {
+                const bool inParts = info.vplParts && info.vplParts(state.techniqueParams);
+                if (minTileMsPerVpl > 0.0 && !inParts) {
                     const double sliceCap = 0.8 * mConfig.limits.sliceMs / minTileMsPerVpl;
                     if (sliceCap < cap) {
                         cap = sliceCap;

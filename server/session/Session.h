@@ -147,8 +147,10 @@ private:
                  nlohmann::json stats, const std::string& quality, const StreamOptions& stream,
                  const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec);
     /// Renders a balanced or final step in tiles of about limits.sliceMs each, sending the image as
-    /// it fills in; returns at the first tile boundary after input arrives (Abandoned, progress
-    /// "abandoned"), when done, Retune when its smallest tile overran the slice (the step starts again
+    /// it fills in; a technique with VPL parts (TechniqueInfo::vplParts) renders a tile too slow for
+    /// one slice as several parts of its VPLs, sending the tile as its parts add up. Returns at the
+    /// first slice boundary after input arrives (Abandoned, progress "abandoned"), when done, Retune
+    /// when a smallest tile of a technique without parts overran the slice (the step starts again
     /// with fewer VPLs), or Failed when the renderer failed.
     enum class RefineResult { Done, Abandoned, Retune, Failed };
     struct Rendered; ///< a frame with its queue and render times (Session.cpp)

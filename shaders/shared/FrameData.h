@@ -8,8 +8,6 @@
 #define GIS_UBO_VPLS 1
 #define GIS_UBO_LIGHTS 5
 #define GIS_MAX_VPLS_PER_BATCH 1024
-// The whole VPL buffer as a storage block, for gathers that stride over it (refinement's VPL parts).
-#define GIS_SSBO_VPLS 3
 
 // Punctual lights (glTF KHR_lights_punctual) and the views their shadow maps and RSMs are rendered
 // from: a spot light has one perspective view, a point light six (cube faces, 90 degrees each), a

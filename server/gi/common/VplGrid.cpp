@@ -46,6 +46,10 @@ VplGrid::VplGrid() {
                 p.storageBlock("VplOut"),
                 p.storageBlock("VplGlossyOut")};
     mExtract.program = std::move(p);
+    gl::Program q = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/vpl_interleave.comp"}});
+    mInterleave = {
+        {}, q.location("uCount"), q.location("uParts"), q.storageBlock("VplIn"), q.storageBlock("VplOut")};
+    mInterleave.program = std::move(q);
 }
 
 std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int views, int rsmSide) {
@@ -120,6 +124,35 @@ int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(
 
 int VplGrid::forEachBatch(const std::function<void(int batchCount)>& draw) const {
     return forEachVplBatch(mVpls, mCount, draw);
+}
+
+int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
+    parts = std::max(parts, 1);
+    part = std::clamp(part, 0, parts - 1);
+    mPartFirst = part * (mCount / parts) + std::min(part, mCount % parts);
+    mPartCount = mCount / parts + (part < mCount % parts ? 1 : 0);
+    if (mCount == 0) return 0;
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(mCount) * sizeof(shader::Vpl);
+    if (mPartVpls.size() < bytes) mPartVpls = gl::Buffer::create(bytes);
+    gl::Pass pass(timer, "vpl_interleave");
+    pass.use(mInterleave.program).set(mInterleave.count, mCount).set(mInterleave.parts, parts);
+    pass.buffer(mInterleave.in, mVpls).buffer(mInterleave.out, mPartVpls);
+    pass.dispatch((mCount + 63) / 64);
+    pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    return mPartCount;
+}
+
+int VplGrid::forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) const {
+    int batches = 0;
+    for (int first = 0; first < mPartCount; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
+        const int n = std::min(GIS_MAX_VPLS_PER_BATCH, mPartCount - first);
+        glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, mPartVpls.id(),
+                          static_cast<GLintptr>(mPartFirst + first) *
+                              static_cast<GLintptr>(sizeof(shader::Vpl)),
+                          static_cast<GLsizeiptr>(n) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
+        draw(n, first);
+    }
+    return batches;
 }
 
 } // namespace gis

@@ -77,6 +77,14 @@ public:
     /// Binds the VPLs batch by batch (GIS_MAX_VPLS_PER_BATCH each) at GIS_UBO_VPLS and calls
     /// `draw(batchCount)` for each batch. Returns the number of batches.
     int forEachBatch(const std::function<void(int batchCount)>& draw) const;
+    /// Refinement's VPL parts (FrameInputs::vplPart): lays the VPLs part, part + parts, ... of the
+    /// extracted set out contiguously (pass "vpl_interleave", gi/common/vpl_interleave.comp) for
+    /// forEachPartBatch(); returns how many there are. The set's index of the part's k-th VPL is
+    /// part + k * parts (its glossy data and shadow maps).
+    int preparePart(int part, int parts, gl::PassTimer& timer);
+    /// Like forEachBatch() over the prepared part's VPLs; `draw(batchCount, first)` gets the index in
+    /// the part of the batch's first VPL.
+    int forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) const;
 
 private:
     struct ExtractProgram {
@@ -85,9 +93,16 @@ private:
         gl::TextureUnit position, normal, flux, specular;
         gl::BlockBinding vpls, glossy;
     } mExtract;
+    struct InterleaveProgram {
+        gl::Program program;
+        gl::UniformLocation count, parts;
+        gl::BlockBinding in, out;
+    } mInterleave;
     gl::Buffer mVpls;
     gl::Buffer mGlossy;
+    gl::Buffer mPartVpls; ///< every part's VPLs, part by part (preparePart)
     int mCount = 0;
+    int mPartFirst = 0, mPartCount = 0; ///< the prepared part's run in mPartVpls
 };
 
 } // namespace gis

@@ -7,8 +7,7 @@ namespace gis {
 MultiresGather::GatherProgram::GatherProgram(gl::Program built)
     : program(std::move(built)),
       minDistance(program.optionalLocation("uMinDistance")) /* point kernel only */,
-      vplCount(program.location("uVplCount")), vplPhase(program.location("uVplPhase")),
-      vplStride(program.location("uVplStride")), allVpls(program.storageBlock("VplAll")), transport(program),
+      vplCount(program.location("uVplCount")), vplScale(program.location("uVplScale")), transport(program),
       eye(program) {}
 
 MultiresGather::MultiresGather() {
@@ -24,6 +23,7 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
                              Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mEye.build(in, params, timer);
+    if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
 
     {
         gl::Pass pass(timer, "vpl_gather");
@@ -32,30 +32,17 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
             pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
             g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
             mEye.beginIlluminationPass(pass, g.eye, in, true);
-            if (in.vplParts > 1) {
-                // A refinement VPL part: one draw striding over the whole buffer (the batches' uniform
-                // block is bound but not read).
-                const int part = std::clamp(in.vplPart, 0, in.vplParts - 1);
-                pass.buffer(g.allVpls, mVpls.buffer());
-                bool drawn = false;
-                mVpls.forEachBatch([&](int) {
-                    if (drawn || part >= vplCount) return;
-                    pass.set(g.vplCount, vplCount)
-                        .set(g.vplPhase, part)
-                        .set(g.vplStride, in.vplParts)
-                        .drawFullscreen(mEye.emptyVao());
-                    drawn = true;
-                });
-                counters["vpl_batches"] = drawn ? 1 : 0;
-                counters["vpl_part"] = part;
-                counters["vpl_parts"] = in.vplParts;
+            // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.
+            const int parts = std::max(1, in.vplParts);
+            pass.set(g.vplScale, static_cast<float>(parts));
+            if (parts > 1) {
+                counters["vpl_batches"] = mVpls.forEachPartBatch(
+                    [&](int count, int) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
+                counters["vpl_part"] = std::clamp(in.vplPart, 0, parts - 1);
+                counters["vpl_parts"] = parts;
             } else {
-                counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
-                    pass.set(g.vplCount, count)
-                        .set(g.vplPhase, 0)
-                        .set(g.vplStride, 1)
-                        .drawFullscreen(mEye.emptyVao());
-                });
+                counters["vpl_batches"] = mVpls.forEachBatch(
+                    [&](int count) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
             }
         }
     }

@@ -44,8 +44,7 @@ private:
     struct GatherProgram {
         explicit GatherProgram(gl::Program built);
         gl::Program program;
-        gl::UniformLocation minDistance, vplCount, vplPhase, vplStride;
-        gl::BlockBinding allVpls;
+        gl::UniformLocation minDistance, vplCount, vplScale;
         VplTransportHandles transport;
         EyeInputHandles eye;
     };

@@ -11,9 +11,9 @@ RsmGather::GatherProgram::GatherProgram(gl::Program built)
       minDistance(program.optionalLocation("uMinDistance")) /* point kernel only */,
       vplCount(program.location("uVplCount")), vplFirst(program.location("uVplFirst")),
       vplPhase(program.location("uVplPhase")), vplStride(program.location("uVplStride")),
-      allVpls(program.storageBlock("VplAll")), position(program.textureUnit("gPosition")),
-      normal(program.textureUnit("gNormal")), albedo(program.textureUnit("gAlbedo")),
-      specular(program.textureUnit("gSpecular")), transport(program), shadows(program) {}
+      position(program.textureUnit("gPosition")), normal(program.textureUnit("gNormal")),
+      albedo(program.textureUnit("gAlbedo")), specular(program.textureUnit("gSpecular")), transport(program),
+      shadows(program) {}
 
 RsmGather::RsmGather() {
     mGather = KernelPrograms<GatherProgram>(
@@ -29,6 +29,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
                         Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mShadows.render(in, params, mVpls.buffer(), vplCount, timer, counters);
+    if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
 
     {
         gl::Pass pass(timer, "vpl_gather");
@@ -44,33 +45,24 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
             g.transport.set(pass, params, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
             if (glossy) pass.texture(g.specular, in.get("gbuffer.specular"));
             pass.blendAdd();
-            if (in.vplParts > 1) {
-                // One of the refinement's VPL parts: one draw striding over the whole buffer (the
-                // batches' uniform block is bound but not read).
-                const int parts = in.vplParts;
-                const int part = std::clamp(in.vplPart, 0, parts - 1);
-                pass.buffer(g.allVpls, mVpls.buffer());
-                bool drawn = false;
-                mVpls.forEachBatch([&](int) {
-                    if (drawn || part >= vplCount) return;
-                    pass.set(g.vplCount, vplCount)
-                        .set(g.vplFirst, 0)
-                        .set(g.vplPhase, part)
-                        .set(g.vplStride, parts)
-                        .drawFullscreen(mEmptyVao);
-                    drawn = true;
-                });
-                counters["vpl_batches"] = drawn ? 1 : 0;
+            // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.
+            const int parts = std::max(1, in.vplParts);
+            const int part = std::clamp(in.vplPart, 0, parts - 1);
+            auto drawBatch = [&](int count, int first) {
+                pass.set(g.vplCount, count)
+                    .set(g.vplFirst, first)
+                    .set(g.vplPhase, parts > 1 ? part : 0)
+                    .set(g.vplStride, parts)
+                    .drawFullscreen(mEmptyVao);
+            };
+            if (parts > 1) {
+                counters["vpl_batches"] = mVpls.forEachPartBatch(drawBatch);
                 counters["vpl_part"] = part;
                 counters["vpl_parts"] = parts;
             } else {
                 int first = 0;
                 counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
-                    pass.set(g.vplCount, count)
-                        .set(g.vplFirst, first)
-                        .set(g.vplPhase, 0)
-                        .set(g.vplStride, 1)
-                        .drawFullscreen(mEmptyVao);
+                    drawBatch(count, first);
                     first += count;
                 });
             }

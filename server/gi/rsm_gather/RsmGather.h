@@ -12,8 +12,8 @@
 //   3. vpl_gather: a full-screen pass per batch of up to 1024 VPLs (read as a uniform block)
 //      evaluates the clamped point kernel at every covered pixel, blended additively
 //   4. output: linear radiance albedo/pi * E, sanitised and >= 0
-//   A refinement VPL part (FrameInputs::vplPart, without bias compensation) replaces 3 by one draw
-//   over every vplParts-th VPL, scaled by vplParts; the renderer averages the parts.
+//   A refinement VPL part (FrameInputs::vplPart, without bias compensation) gathers in 3 only every
+//   vplParts-th VPL, scaled by vplParts; the renderer averages the parts.
 //
 // Parameters:
 //   vpl_grid      VPLs per side, [1, 256] (clamped to rsm_size), default 16 (256 VPLs)
@@ -54,7 +54,6 @@ private:
         explicit GatherProgram(gl::Program built);
         gl::Program program;
         gl::UniformLocation minDistance, vplCount, vplFirst, vplPhase, vplStride;
-        gl::BlockBinding allVpls;
         gl::TextureUnit position, normal, albedo, specular;
         VplTransportHandles transport;
         VplShadowHandles shadows;

@@ -3,8 +3,8 @@
 // multiresolution buffer per batch of VPLs; the early stencil test leaves only receiver patches,
 // each of which sums the irradiance of every VPL in the batch (the VPL cache is the compact VPL
 // buffer bound as a uniform block) at its mean position and normal. Irradiance only: the albedo is
-// applied per pixel after reconstruction. A VPL part (refinement, FrameInputs::vplPart) is one draw
-// striding over the whole buffer (storage block), scaled by the number of parts.
+// applied per pixel after reconstruction. A VPL part (refinement, FrameInputs::vplPart) gathers the
+// batches of its own VPLs (vpl_interleave.comp), scaled by the number of parts uVplScale.
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
 
@@ -19,13 +19,8 @@ layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
     Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
 };
 
-layout(std430, binding = GIS_SSBO_VPLS) readonly buffer VplAll {
-    Vpl gAllVpls[];
-};
-
-uniform int uVplCount;      // VPLs in this batch (a part: in the buffer)
-uniform int uVplPhase;      // a part: its first VPL; else 0
-uniform int uVplStride;     // a part: the number of parts (> 1); else 1
+uniform int uVplCount;
+uniform float uVplScale; // the number of VPL parts (1 without parts)
 uniform float uMinDistance; // m, point kernel only
 
 layout(location = 0) out vec4 outIrradiance; // rgb added by blending; alpha 1 marks data
@@ -36,12 +31,6 @@ void main() {
     vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
     vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
     vec3 e = vec3(0.0);
-    if (uVplStride > 1) {
-        for (int i = uVplPhase; i < uVplCount; i += uVplStride)
-            e += vplIrradianceSelected(pos, n, gAllVpls[i], uMinDistance);
-        e *= float(uVplStride);
-    } else {
-        for (int i = 0; i < uVplCount; ++i) e += vplIrradianceSelected(pos, n, gVpls[i], uMinDistance);
-    }
-    outIrradiance = vec4(max(sanitize(e), vec3(0.0)), 1.0);
+    for (int i = 0; i < uVplCount; ++i) e += vplIrradianceSelected(pos, n, gVpls[i], uMinDistance);
+    outIrradiance = vec4(max(sanitize(e * uVplScale), vec3(0.0)), 1.0);
 }

@@ -1,9 +1,9 @@
 #version 450 core
 // Full-resolution gather (digest S.3 preset rsm_naive, receivers R0): every covered pixel sums the
 // irradiance of every VPL in the current batch. Batches are accumulated with additive blending.
-// A VPL part (refinement, FrameInputs::vplPart) is one draw over the whole buffer instead: the VPLs
-// uVplPhase, uVplPhase + uVplStride, ... read from the storage block, their sum scaled by uVplStride
-// so that the mean of all uVplStride parts is the whole set's light.
+// A VPL part (refinement, FrameInputs::vplPart) gathers the batches of its own VPLs (every
+// uVplStride-th of the set, from uVplPhase on, laid out contiguously by vpl_interleave.comp), its
+// light scaled by uVplStride so that the mean of all parts is the whole set's.
 // With glossy transport on (uGlossy), each VPL's specular lobe and the pixel's are added
 // (gi/common/vpl_glossy.glsl).
 #include "common.glsl"
@@ -22,18 +22,14 @@ layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
     Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
 };
 
-layout(std430, binding = GIS_SSBO_VPLS) readonly buffer VplAll {
-    Vpl gAllVpls[];
-};
-
-uniform int uVplCount;       // VPLs in this batch (a part: in the buffer)
-uniform int uVplFirst;       // index of the batch's first VPL (its shadow map layers); a part: 0
-uniform int uVplPhase;       // a part: its first VPL; else 0
-uniform int uVplStride;      // a part: the number of parts (> 1); else 1
+uniform int uVplCount;       // VPLs in this batch
+uniform int uVplFirst;       // index of the batch's first VPL (in its part's sequence)
+uniform int uVplPhase;       // the part (0 without parts)
+uniform int uVplStride;      // the number of parts (1 without parts)
 uniform float uMinDistance;  // m, point kernel only
 
-// VPL `i` of the whole set (uVplFirst <= i < uVplFirst + uVplCount).
-Vpl vplAt(int i) { return uVplStride > 1 ? gAllVpls[i] : gVpls[i - uVplFirst]; }
+// The set's index of the batch's VPL i: its shadow map layers and glossy data.
+int setIndex(int i) { return uVplPhase + (uVplFirst + i) * uVplStride; }
 
 layout(location = 0) out vec4 outRadiance;
 
@@ -48,9 +44,9 @@ void main() {
     vec3 e = vec3(0.0);
     vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
     if (uGlossy == 0) {
-        for (int i = uVplFirst + uVplPhase; i < uVplFirst + uVplCount; i += uVplStride) {
-            Vpl v = vplAt(i);
-            e += vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vplVisibility(i, v.position.xyz, pos.xyz, n);
+        for (int i = 0; i < uVplCount; ++i) {
+            Vpl v = gVpls[i];
+            e += vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vplVisibility(setIndex(i), v.position.xyz, pos.xyz, n);
         }
         outRadiance = vec4(max(sanitize(albedo * kInvPi * e * float(uVplStride)), vec3(0.0)), 1.0);
         return;
@@ -61,12 +57,12 @@ void main() {
     float e2 = dot(toEye, toEye);
     vec3 wo = e2 > 1e-20 ? toEye * inversesqrt(e2) : n;
     vec3 eExtra = vec3(0.0), lGlossy = vec3(0.0);
-    for (int i = uVplFirst + uVplPhase; i < uVplFirst + uVplCount; i += uVplStride) {
-        Vpl v = vplAt(i);
-        float vis = vplVisibility(i, v.position.xyz, pos.xyz, n);
+    for (int i = 0; i < uVplCount; ++i) {
+        Vpl v = gVpls[i];
+        float vis = vplVisibility(setIndex(i), v.position.xyz, pos.xyz, n);
         vec3 ei = vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vis;
         e += ei;
-        vplGlossyAccumulate(v, gVplGlossy[i], ei, vis, uMinDistance, pos.xyz, n, wo, spec, glossyReceiver,
+        vplGlossyAccumulate(v, gVplGlossy[setIndex(i)], ei, vis, uMinDistance, pos.xyz, n, wo, spec, glossyReceiver,
                             eExtra, lGlossy);
     }
     vec3 l = (albedo * kInvPi * (e + eExtra) + lGlossy) * float(uVplStride);
