@@ -1494,6 +1494,7 @@ const statsGui = (() => {
                 ...(budget ? [row('frame budget', budget.text), row('why', budget.reason || '–')] : []),
                 ...(r ? [row('refinement', `${r.step ?? stats.quality}: ${r.tiles_done ?? '?'} tiles, `
                     + `${Math.round(100 * (r.share ?? 0))} %, ${formatMs(r.elapsed_ms, 0)}`
+                    + `${r.vpl_parts > 1 ? `, tile at ${r.vpl_parts_done} of ${r.vpl_parts} VPL parts` : ''}`
                     + `${r.complete ? ', complete' : `, ${formatMs(r.eta_ms, 0)} left`}`)] : []),
                 row('queue', formatMs(stats.queue_ms)),
                 row('readback', formatMs(stats.readback_ms)),

@@ -537,7 +537,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     // ms per rendered pixel of this step's tiles (all their parts): measured once a tile ran, before
     // that from the last complete step of its kind (scaled to these VPLs) or the interactive frames'
     // model, with a margin (small tiles cost more per pixel than a whole step's average), else a
-    // 64 x 64 first tile.
+    // smallest first tile.
     double rate = 0.0;
     double predicted = predictRefineMs(w.scene->name, full, step);
     if (!(predicted > 0.0))
@@ -570,7 +570,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         // Until a tile of this step was measured, its predicted cost is trusted three times over (the
         // interactive frames' model has under-predicted the per-VPL cost of full-size tiles 3-fold).
         const double sizingRate = renderedMs > 0.0 ? rate : 3.0 * rate;
-        double pixels = rate > 0.0 ? sliceMs / sizingRate : 64.0 * 64.0;
+        double pixels = rate > 0.0 ? sliceMs / sizingRate : double(kMinTileSide) * kMinTileSide;
         int parts = 1;
         if (splittable && rate > 0.0 && (pixels < partTilePixels || partsFloor > 1)) {
             const double wanted = std::ceil(sizingRate * partTilePixels / (0.8 * sliceMs));

@@ -479,13 +479,17 @@ check('the frame budget sizes interactive frames from what they measured, and sa
     assert.ok(frame.stats.params.vpl_grid ** 2 <= frame.stats.budget.vpl_cap, 'rendered within the cap');
 });
 
-check('input during a slow refinement is answered at the next tile', async () => {
+check('input during a slow refinement is answered at the next tile or VPL part', async () => {
     // 65,536 VPLs: seconds per refinement step on a CPU, rendered in tiles that input interrupts.
     const client = await open(servers.main, { adaptive: true });
     client.send({ type: 'technique', name: 'rsm_gather' });
     client.send({ type: 'params', values: { vpl_grid: 256 } });
-    const refining = await client.frame('a refinement tile', (s) => s.refined && s.refine && !s.refine.complete, 60000);
+    // A 64 x 64 tile of them takes seconds: it renders in VPL parts, each sent as they add up.
+    const refining = await client.frame('a refinement tile in VPL parts',
+        (s) => s.refined && s.refine && !s.refine.complete && s.refine.vpl_parts > 1, 60000);
     assert.ok(refining.stats.refine.share < 1);
+    assert.ok(refining.stats.refine.vpl_parts_done >= 1 && refining.stats.refine.vpl_parts_done <= refining.stats.refine.vpl_parts);
+    assert.equal(refining.stats.counts.vpl_parts, refining.stats.refine.vpl_parts, 'the renderer rendered that part');
     const sent = Date.now();
     client.send({ type: 'camera', position: [0.5, 1.1, 3.7], target: [0, 1, 0] });
     const answer = await client.frame('the answer to input', (s) => s.quality === 'interactive' && s.frame > refining.stats.frame, 10000);

@@ -30,6 +30,7 @@ Isr::Isr() {
                                     {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}},
                                    kernelDefines(VplKernel::Disk, {}));
     g.vplCount = g.program.location("uVplCount");
+    g.vplScale = g.program.location("uVplScale");
     g.transport = VplTransportHandles(g.program);
     g.eye = EyeInputHandles(g.program);
 }
@@ -101,7 +102,7 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
             g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
             mEye.beginIlluminationPass(pass, g.eye, in, true);
             counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
-                pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao());
+                pass.set(g.vplCount, count).set(g.vplScale, 1.0f).drawFullscreen(mEye.emptyVao());
             });
         }
     }

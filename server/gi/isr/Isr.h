@@ -78,7 +78,7 @@ private:
     } mSelect;
     struct GatherProgram {
         gl::Program program;
-        gl::UniformLocation vplCount;
+        gl::UniformLocation vplCount, vplScale; ///< scale 1: isr renders no VPL parts
         VplTransportHandles transport;
         EyeInputHandles eye;
     } mGather;

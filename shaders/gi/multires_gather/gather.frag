@@ -20,7 +20,7 @@ layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
 };
 
 uniform int uVplCount;
-uniform float uVplScale; // the number of VPL parts (1 without parts)
+uniform float uVplScale = 1.0; // the number of VPL parts (1 without parts, and when not set)
 uniform float uMinDistance; // m, point kernel only
 
 layout(location = 0) out vec4 outIrradiance; // rgb added by blending; alpha 1 marks data

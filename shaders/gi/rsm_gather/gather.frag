@@ -25,7 +25,7 @@ layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
 uniform int uVplCount;       // VPLs in this batch
 uniform int uVplFirst;       // index of the batch's first VPL (in its part's sequence)
 uniform int uVplPhase;       // the part (0 without parts)
-uniform int uVplStride;      // the number of parts (1 without parts)
+uniform int uVplStride = 1;  // the number of parts (1 without parts, and when not set)
 uniform float uMinDistance;  // m, point kernel only
 
 // The set's index of the batch's VPL i: its shadow map layers and glossy data.
