@@ -47,8 +47,12 @@ VplGrid::VplGrid() {
                 p.storageBlock("VplGlossyOut")};
     mExtract.program = std::move(p);
     gl::Program q = gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/vpl_interleave.comp"}});
-    mInterleave = {
-        {}, q.location("uCount"), q.location("uParts"), q.storageBlock("VplIn"), q.storageBlock("VplOut")};
+    mInterleave = {{},
+                   q.location("uPartCount"),
+                   q.location("uPart"),
+                   q.location("uParts"),
+                   q.storageBlock("VplIn"),
+                   q.storageBlock("VplOut")};
     mInterleave.program = std::move(q);
 }
 
@@ -129,15 +133,18 @@ int VplGrid::forEachBatch(const std::function<void(int batchCount)>& draw) const
 int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
     parts = std::max(parts, 1);
     part = std::clamp(part, 0, parts - 1);
-    mPartFirst = part * (mCount / parts) + std::min(part, mCount % parts);
+    // The VPLs part, part + parts, ... below mCount.
     mPartCount = mCount / parts + (part < mCount % parts ? 1 : 0);
-    if (mCount == 0) return 0;
-    const GLsizeiptr bytes = static_cast<GLsizeiptr>(mCount) * sizeof(shader::Vpl);
+    if (mPartCount == 0) return 0;
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(mPartCount) * sizeof(shader::Vpl);
     if (mPartVpls.size() < bytes) mPartVpls = gl::Buffer::create(bytes);
     gl::Pass pass(timer, "vpl_interleave");
-    pass.use(mInterleave.program).set(mInterleave.count, mCount).set(mInterleave.parts, parts);
+    pass.use(mInterleave.program)
+        .set(mInterleave.partCount, mPartCount)
+        .set(mInterleave.part, part)
+        .set(mInterleave.parts, parts);
     pass.buffer(mInterleave.in, mVpls).buffer(mInterleave.out, mPartVpls);
-    pass.dispatch((mCount + 63) / 64);
+    pass.dispatch((mPartCount + 63) / 64);
     pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     return mPartCount;
 }
@@ -147,8 +154,7 @@ int VplGrid::forEachPartBatch(const std::function<void(int batchCount, int first
     for (int first = 0; first < mPartCount; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
         const int n = std::min(GIS_MAX_VPLS_PER_BATCH, mPartCount - first);
         glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, mPartVpls.id(),
-                          static_cast<GLintptr>(mPartFirst + first) *
-                              static_cast<GLintptr>(sizeof(shader::Vpl)),
+                          static_cast<GLintptr>(first) * static_cast<GLintptr>(sizeof(shader::Vpl)),
                           static_cast<GLsizeiptr>(n) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
         draw(n, first);
     }

@@ -77,8 +77,8 @@ public:
     /// Binds the VPLs batch by batch (GIS_MAX_VPLS_PER_BATCH each) at GIS_UBO_VPLS and calls
     /// `draw(batchCount)` for each batch. Returns the number of batches.
     int forEachBatch(const std::function<void(int batchCount)>& draw) const;
-    /// Refinement's VPL parts (FrameInputs::vplPart): lays the VPLs part, part + parts, ... of the
-    /// extracted set out contiguously (pass "vpl_interleave", gi/common/vpl_interleave.comp) for
+    /// Refinement's VPL parts (FrameInputs::vplPart): copies the VPLs part, part + parts, ... of the
+    /// extracted set into one run (pass "vpl_interleave", gi/common/vpl_interleave.comp) for
     /// forEachPartBatch(); returns how many there are. The set's index of the part's k-th VPL is
     /// part + k * parts (its glossy data and shadow maps).
     int preparePart(int part, int parts, gl::PassTimer& timer);
@@ -95,14 +95,14 @@ private:
     } mExtract;
     struct InterleaveProgram {
         gl::Program program;
-        gl::UniformLocation count, parts;
+        gl::UniformLocation partCount, part, parts;
         gl::BlockBinding in, out;
     } mInterleave;
     gl::Buffer mVpls;
     gl::Buffer mGlossy;
-    gl::Buffer mPartVpls; ///< every part's VPLs, part by part (preparePart)
+    gl::Buffer mPartVpls; ///< the prepared part's VPLs (preparePart)
     int mCount = 0;
-    int mPartFirst = 0, mPartCount = 0; ///< the prepared part's run in mPartVpls
+    int mPartCount = 0;
 };
 
 } // namespace gis

@@ -51,7 +51,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
             auto drawBatch = [&](int count, int first) {
                 pass.set(g.vplCount, count)
                     .set(g.vplFirst, first)
-                    .set(g.vplPhase, parts > 1 ? part : 0)
+                    .set(g.vplPhase, part)
                     .set(g.vplStride, parts)
                     .drawFullscreen(mEmptyVao);
             };

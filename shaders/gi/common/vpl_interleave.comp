@@ -1,8 +1,8 @@
 #version 450 core
-// Refinement's VPL parts (FrameInputs::vplPart) in contiguous runs: part p of P is the VPLs p, p + P,
-// p + 2P, ... of the set, and this pass copies them to start_p, start_p + 1, ... of a second buffer
-// (start_p = p floor(N/P) + min(p, N mod P)), so a part's gather reads its VPLs batch by batch through
-// the uniform block like a whole set. The glossy data and shadow maps keep the original indices.
+// Refinement's VPL parts (FrameInputs::vplPart) in a contiguous run: part p of P is the VPLs p, p + P,
+// p + 2P, ... of the set, copied to 0, 1, 2, ... of a second buffer, so the part's gather reads its
+// VPLs batch by batch through the uniform block like a whole set. The glossy data and shadow maps keep
+// the set's indices.
 #include "common.glsl"
 
 layout(local_size_x = 64) in;
@@ -14,13 +14,12 @@ layout(std430, binding = 1) writeonly buffer VplOut {
     Vpl gVplsOut[];
 };
 
-uniform int uCount; // N, VPLs in the set
-uniform int uParts; // P >= 1
+uniform int uPartCount; // VPLs in the part
+uniform int uPart;      // p
+uniform int uParts;     // P >= 1
 
 void main() {
-    int i = int(gl_GlobalInvocationID.x);
-    if (i >= uCount) return;
-    int part = i % uParts;
-    int start = part * (uCount / uParts) + min(part, uCount % uParts);
-    gVplsOut[start + i / uParts] = gVplsIn[i];
+    int k = int(gl_GlobalInvocationID.x);
+    if (k >= uPartCount) return;
+    gVplsOut[k] = gVplsIn[uPart + k * uParts];
 }
