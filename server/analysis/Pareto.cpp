@@ -45,13 +45,21 @@ std::size_t kneeOfFront(const std::vector<TradeoffPoint>& front) {
     return best;
 }
 
-PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs) {
+PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs, double errorTolerance) {
     PresetChoice c;
     if (front.empty()) return c;
-    c.final = front.size() - 1;
+    const double tolerance = std::isfinite(errorTolerance) ? std::max(errorTolerance, 0.0) : 0.0;
+    // The fastest point up to `last` (front order: time up, error down) within the tolerance of it.
+    auto fastestEqualTo = [&](std::size_t last) {
+        for (std::size_t i = 0; i <= last; ++i)
+            if (front[i].error <= front[last].error + tolerance) return i;
+        return last;
+    };
+    c.final = fastestEqualTo(front.size() - 1);
     c.interactive = 0;
     for (std::size_t i = 0; i < front.size(); ++i)
         if (front[i].timeMs <= budgetMs) c.interactive = i;
+    c.interactive = fastestEqualTo(c.interactive);
     c.balanced = std::clamp(kneeOfFront(front), c.interactive, c.final);
     return c;
 }

@@ -31,7 +31,10 @@ struct PresetChoice {
 
 /// interactive: the most accurate front point with time <= budgetMs (the fastest point when none is
 /// that fast); final: the most accurate point; balanced: the knee, moved into [interactive, final] so
-/// the three never go backwards in time.
-PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs);
+/// the three never go backwards in time. Errors within `errorTolerance` (the measurement's noise, in
+/// the error's units) of a more accurate point count as equal, and of equals the fastest is chosen: a
+/// difference the reference cannot resolve never buys a slower preset.
+PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs,
+                           double errorTolerance = 0);
 
 } // namespace gis

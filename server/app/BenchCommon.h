@@ -10,6 +10,7 @@
 #include "render/FrameRenderer.h"
 #include "frame/FrameState.h"
 #include "scene/Scene.h"
+#include "reference/ReferenceRenderer.h"
 
 namespace gis::bench {
 
@@ -56,11 +57,14 @@ std::vector<FrameState> makeStates(const Scene& scene, const std::vector<Config>
 /// slow point to one frame.
 struct Measurement {
     nlohmann::json stats; ///< medianStats of the timed frames
-    FrameOutput last;     ///< the last frame, with linear radiance
+    FrameOutput last;     ///< the last frame, with linear radiance and its direct pass
     int frames = 0;
     bool overBudget = false;
 };
 Measurement measure(FrameRenderer& renderer, const FrameState& state, int frames, double maxFrameMs = 0);
+/// {"image": the reference's relative noise over the pixels it covers, "indirect": the same for its
+/// indirect light (less `direct`, the pixel-centre direct render)}; null where the variance is unknown.
+nlohmann::json referenceNoiseJson(const ReferenceImage& reference, const ReferenceImage& direct);
 /// Sum of the stats' per-pass GPU milliseconds.
 double sumPassMs(const nlohmann::json& stats);
 

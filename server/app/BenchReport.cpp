@@ -38,22 +38,32 @@ with each technique's Pareto front (gnuplot PNG; skipped with a note when gnuplo
 table of the fronts, the seed papers' tables as measured here beside the papers' numbers, and the
 presets chosen from the fronts.
 
+The error axis (--metric) is by default the technique's indirect light alone (each side less its
+own direct light), relative RMSE corrected for the reference's noise; "image" uses the whole image
+(also corrected). Each scene's reference noise is printed with its table, with a warning where it
+exceeds a fifth of the smallest error the table reports.
+
 Presets, per technique, from the front of the points measured in every scene (mean frame time and
-mean relative RMSE over the scenes): interactive = the most accurate front point at most
---budget-ms (the fastest point when none is), final = the most accurate point, balanced = the
-front's knee in log-log space (kept between the two).
+mean error over the scenes): interactive = the most accurate front point at most --budget-ms (the
+fastest point when none is), final = the most accurate point, balanced = the front's knee in
+log-log space (kept between the two). Errors within the references' mean noise of a more
+accurate point count as equal, and of equals the fastest is chosen.
 
   --in DIR           sweep folder (default bench-sweep)
   --out FILE         Markdown report (default docs/accuracy.md)
   --images DIR       plots and their gnuplot scripts (default: images/ beside --out)
   --presets FILE     presets written here (default presets/presets.json)
   --budget-ms MS     frame-time budget of the interactive preset at the sweep size (default 100)
+  --metric WHAT      indirect (default) or image: the error axis of the fronts and presets
 )";
 
 struct ReportOptions {
     std::string in = "bench-sweep", out = "docs/accuracy.md", images, presets = "presets/presets.json";
     double budgetMs = 100;
+    bool indirectMetric = true;
 };
+
+bool gIndirectMetric = true; // ReportOptions::indirectMetric, for err()
 
 std::string fmt(double v, int digits = 1) {
     char buf[64];
@@ -73,8 +83,22 @@ std::string slug(const std::string& scene) {
     return s;
 }
 
+/// The error axis of one row: the indirect light's or the whole image's relative RMSE, corrected for
+/// the reference's noise where the row has it (rows of older sweeps have only the raw whole-image one).
+const json* metricOf(const json& r) {
+    const json& e = r["error"];
+    if (!e.is_object()) return nullptr;
+    if (gIndirectMetric) return e.contains("indirect") ? &e["indirect"]["relative_rmse_corrected"] : nullptr;
+    return e.contains("relative_rmse_corrected") ? &e["relative_rmse_corrected"] : &e["relative_rmse"];
+}
+
 double err(const json& r) {
-    return std::max(r["error"]["relative_rmse"].get<double>(), 1e-6);
+    const json* m = metricOf(r);
+    return std::max(m ? m->get<double>() : 0.0, 1e-6);
+}
+
+std::string metricName() {
+    return gIndirectMetric ? "indirect-light relative RMSE" : "relative RMSE";
 }
 
 const ParamTable* tableOf(const std::string& technique) {
@@ -94,6 +118,7 @@ struct Data {
     int width = 0, height = 0;
     std::vector<std::string> scenes, techniques;
     std::string sweepCommand;
+    std::map<std::string, json> references; ///< the last references.jsonl record per scene at the sweep size
 };
 
 Data load(const ReportOptions& o) {
@@ -131,6 +156,12 @@ Data load(const ReportOptions& o) {
     }
     std::ifstream c(o.in + "/sweep-command.txt");
     std::getline(c, d.sweepCommand);
+    std::ifstream refs(o.in + "/references.jsonl");
+    while (std::getline(refs, line)) {
+        json r = json::parse(line, nullptr, false);
+        if (r.is_discarded() || !r.contains("scene") || !r.contains("size")) continue;
+        if (r["size"][0] == d.width && r["size"][1] == d.height) d.references[r["scene"]] = r;
+    }
     return d;
 }
 
@@ -139,7 +170,7 @@ std::vector<const json*> accuracyRows(const Data& d, const std::string& scene, c
     std::vector<const json*> out;
     for (const auto& r : d.rows)
         if (r["scene"] == scene && r["technique"] == technique && r["size"][0] == d.width &&
-            r["size"][1] == d.height && r["error"].is_object())
+            r["size"][1] == d.height && metricOf(r))
             out.push_back(&r);
     return out;
 }
@@ -204,7 +235,7 @@ bool plotScene(const Data& d, const std::string& scene, const ReportOptions& o,
     g << "set terminal pngcairo size 760,460 font 'sans,9'\nset output '" << base << ".png'\n";
     g << "set termoption noenhanced\nset logscale xy\nset grid\nset key outside right top\n";
     g << "set xlabel 'frame time (ms, " << d.width << "x" << d.height << ", " << glName << ")'\n";
-    g << "set ylabel 'relative RMSE vs " << referenceMode << "'\n";
+    g << "set ylabel '" << metricName() << " vs " << referenceMode << "'\n";
     g << "set title '" << scene << ": all points (dots) and Pareto fronts (lines)'\n";
     std::string plot;
     int n = 0;
@@ -234,6 +265,22 @@ struct PresetRow {
     json params;
     double timeMs = 0, error = 0;
 };
+
+/// The noise of the error axis: each scene's reference noise for the metric, averaged over the scenes
+/// (0 when no scene's is known).
+double meanMetricNoise(const Data& d) {
+    double sum = 0;
+    int n = 0;
+    for (const auto& s : d.scenes)
+        if (auto it = d.references.find(s); it != d.references.end()) {
+            const json& v = it->second[gIndirectMetric ? "indirect_noise" : "noise"];
+            if (v.is_number()) {
+                sum += v.get<double>();
+                ++n;
+            }
+        }
+    return n ? sum / n : 0.0;
+}
 
 /// Presets per technique from the front of the mean time and error over the scenes.
 std::vector<PresetRow> choose(const Data& d, double budgetMs, json& file) {
@@ -265,7 +312,7 @@ std::vector<PresetRow> choose(const Data& d, double budgetMs, json& file) {
         auto front = paretoFront(pts);
         std::vector<TradeoffPoint> fpts;
         for (size_t i : front) fpts.push_back(pts[i]);
-        PresetChoice c = choosePresets(fpts, budgetMs);
+        PresetChoice c = choosePresets(fpts, budgetMs, meanMetricNoise(d));
         const ParamTable* table = tableOf(t);
         const json defaults = table ? defaultParams(*table) : json::object();
         json presets = json::object();
@@ -302,7 +349,12 @@ ReportOptions parseOptions(const std::vector<std::string>& args) {
             o.presets = c.value();
         else if (a == "--budget-ms")
             o.budgetMs = parseDouble("--budget-ms", c.value(), 0, 1e7);
-        else
+        else if (a == "--metric") {
+            const std::string m = c.value();
+            if (m != "indirect" && m != "image")
+                throw UsageError{"report: --metric must be indirect or image, got '" + m + "'"};
+            o.indirectMetric = m == "indirect";
+        } else
             throw UsageError{"report: unknown option '" + a + "' (see gi-bench report --help)"};
     }
     if (o.images.empty()) o.images = (fs::path(o.out).parent_path() / "images").string();
@@ -320,7 +372,18 @@ std::string rel(const std::string& target, const std::string& fromFile) {
 
 int report(const std::vector<std::string>& args) {
     const ReportOptions o = parseOptions(args);
+    gIndirectMetric = o.indirectMetric;
     const Data d = load(o);
+    {
+        bool any = false;
+        for (const auto& r : d.rows) any |= metricOf(r) != nullptr;
+        if (!any)
+            throw InputError(
+                o.in + "/sweep.jsonl",
+                "no row has the " + metricName() +
+                    " (a sweep from before the indirect split): rerun gi-bench sweep with the same "
+                    "--out to measure it, or pass --metric image");
+    }
     std::string referenceMode = "the reference", glName = "GL", refSpp;
     for (const auto& r : d.rows) {
         if (r["reference"].is_object()) {
@@ -339,9 +402,21 @@ int report(const std::vector<std::string>& args) {
        << reportCommand << "\n```\n\n";
     md << "Measured at " << d.width << "x" << d.height << " on " << glName << " (" << d.rows.size()
        << " points). Error is against the CPU reference `" << referenceMode << "`"
-       << (refSpp.empty() ? "" : " at " + refSpp + " spp")
-       << " (relative RMSE on linear radiance; SSIM and FLIP on the tone-mapped image; background left out; "
-          "definitions in `server/analysis/Metrics.h`). Frame time is the median wall time of the timed "
+       << (refSpp.empty()
+               ? ""
+               : " (" + refSpp +
+                     " spp for the first scene; each scene's count and noise are given with its table)")
+       << ". The fronts and presets use the " << metricName()
+       << (gIndirectMetric
+               ? " (each side's total less its own direct light, so that a better shadow map does not pass "
+                 "for better GI)"
+               : "")
+       << "; the tables also give the whole image's relative RMSE and the direct pass's against the "
+          "reference's direct light (what the shadow map costs). Relative RMSE is on linear radiance and "
+          "corrected for the reference's noise: sqrt(max(0, error^2 - noise^2)), with the noise estimated "
+          "from the spread of the reference's samples (`server/analysis/Accuracy.h`); SSIM and FLIP are on "
+          "the tone-mapped image; background left out; definitions in `server/analysis/Metrics.h`. Frame "
+          "time is the median wall time of the timed "
           "frames "
           "with glFinish around each pass (llvmpipe's timer queries attribute deferred work to later "
           "passes). "
@@ -373,7 +448,7 @@ int report(const std::vector<std::string>& args) {
           "points it finds.\n"
           "- **Pareto front.** A point is on its technique's front when no other point of that technique is "
           "both "
-          "at least as fast and at least as accurate (relative RMSE).\n\n";
+          "at least as fast and at least as accurate (the error axis above).\n\n";
 
     // Per scene: plot and fronts.
     const bool plotter = havePlotter();
@@ -385,20 +460,49 @@ int report(const std::vector<std::string>& args) {
         else
             md << "(Plot skipped: " << (plotter ? "gnuplot failed" : "gnuplot is not installed")
                << "; the script is " << rel(o.images + "/accuracy_" + slug(scene) + ".gp", o.out) << ".)\n\n";
-        md << "| technique | points | front point | frame ms | GPU ms | rel. RMSE | SSIM | FLIP |\n"
-              "|---|---|---|---|---|---|---|---|\n";
+        auto figure = [](const json& parent, const char* key) {
+            return parent.is_object() && parent.contains(key) && parent[key].is_number() ? fmt(parent[key], 4)
+                                                                                         : std::string("-");
+        };
+        double noise = -1;
+        if (auto it = d.references.find(scene); it != d.references.end()) {
+            const json& r = it->second;
+            const json& v = r[gIndirectMetric ? "indirect_noise" : "noise"];
+            if (v.is_number()) noise = v.get<double>();
+            md << "Reference `" << r["mode"].get<std::string>() << "` at " << r["spp"].get<int>()
+               << " spp; its relative noise (from the samples' spread) is " << figure(r, "noise")
+               << " of the image and " << figure(r, "indirect_noise") << " of its indirect light.\n\n";
+        }
+        md << "| technique | points | front point | frame ms | GPU ms | indirect rel. RMSE | image rel. RMSE "
+              "| "
+              "direct pass | SSIM | FLIP |\n"
+              "|---|---|---|---|---|---|---|---|---|---|\n";
+        double smallest = INFINITY;
         for (const auto& t : d.techniques) {
             auto rows = accuracyRows(d, scene, t);
             if (rows.empty()) continue;
             for (const json* r : frontOf(rows)) {
                 const auto& e = (*r)["error"];
+                const json none;
+                smallest = std::min(smallest, err(*r));
                 md << "| " << t << " | " << rows.size() << " | " << changesOf(*r)
                    << ((*r)["over_budget"].get<bool>() ? " (1 frame)" : "") << " | " << fmt((*r)["frame_ms"])
-                   << " | " << fmt((*r)["gpu_ms"]) << " | " << fmt(e["relative_rmse"], 4) << " | "
+                   << " | " << fmt((*r)["gpu_ms"]) << " | "
+                   << figure(e.contains("indirect") ? e["indirect"] : none, "relative_rmse_corrected")
+                   << " | "
+                   << figure(e, e.contains("relative_rmse_corrected") ? "relative_rmse_corrected"
+                                                                      : "relative_rmse")
+                   << " | " << figure(e.contains("direct") ? e["direct"] : none, "relative_rmse") << " | "
                    << fmt(e["ssim"], 4) << " | " << fmt(e["flip"], 4) << " |\n";
             }
         }
         md << "\n";
+        if (noise >= 0 && std::isfinite(smallest) && noise > smallest / 5)
+            md << "**The reference's noise (" << fmt(noise, 4)
+               << ") is more than a fifth of the smallest error "
+               << "in this table (" << fmt(smallest, 4)
+               << "):** errors corrected for it are estimates, and differences smaller than the noise are "
+                  "not resolved; a lower `--noise-target` (or a higher `--spp` cap) resolves them.\n\n";
     }
 
     // Presets.
@@ -409,7 +513,9 @@ int report(const std::vector<std::string>& args) {
         {"generated_by", {d.sweepCommand, reportCommand}},
         {"rule", "interactive: most accurate front point with mean frame time <= " + fmt(o.budgetMs, 0) +
                      " ms at the sweep size (else the fastest); balanced: the knee of the front in "
-                     "log-log space; final: the most accurate point; means over the scenes"},
+                     "log-log space; final: the most accurate point; means over the scenes; errors within "
+                     "the references' noise count as equal and the fastest of equals is chosen"},
+        {"metric", metricName()},
         {"sweep", {{"scenes", d.scenes}, {"size", {d.width, d.height}}}}};
     const auto presets = choose(d, o.budgetMs, presetFile);
     fs::path pp(o.presets);
@@ -419,9 +525,12 @@ int report(const std::vector<std::string>& args) {
        << "`" << rel(o.presets, o.out)
        << "` holds three presets per technique, chosen from the measured fronts, not by hand. Per technique, "
           "the "
-          "points measured in every scene are averaged over the scenes (frame time and relative RMSE) and "
+          "points measured in every scene are averaged over the scenes (frame time and error) and "
           "their "
-          "Pareto front is taken; then **interactive** is the most accurate front point with a mean frame "
+          "Pareto front is taken; errors within the references' mean noise ("
+       << fmt(meanMetricNoise(d), 4)
+       << ") of a more accurate point count as equal, and of equals the fastest is chosen; then "
+          "**interactive** is the most accurate front point with a mean frame "
           "time of "
           "at most "
        << fmt(o.budgetMs, 0) << " ms at " << d.width << "x" << d.height
@@ -439,7 +548,8 @@ int report(const std::vector<std::string>& args) {
           "any "
           "`--param`; they are the steps the server's adaptive quality is to move between (gi-server does "
           "not read them yet).\n\n"
-          "| technique | preset | parameters | mean frame ms | mean rel. RMSE |\n|---|---|---|---|---|\n";
+          "| technique | preset | parameters | mean frame ms | mean "
+       << metricName() << " |\n|---|---|---|---|---|\n";
     for (const auto& p : presets)
         md << "| " << p.technique << " | " << p.name << " | " << p.changes << " | " << fmt(p.timeMs) << " | "
            << fmt(p.error, 4) << " |\n";

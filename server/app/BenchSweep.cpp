@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/Accuracy.h"
 #include "analysis/Metrics.h"
 #include "analysis/SweepGrid.h"
 #include "app/BenchCommon.h"
@@ -56,7 +57,10 @@ Skip rules (deterministic, also applied to rows read back on resume):
   --max-frame-ms MS      per-point frame budget for the skip rule (default 2000; 0 = none)
   --reference MODE       reference mode (default one-bounce-unoccluded: what VPL gathering without
                          indirect visibility converges to)
-  --spp N                reference samples per pixel (default 256)
+  --spp N                reference samples per pixel at most (default 65536)
+  --noise-target R       stop each reference once the noise of its indirect light (relative to that
+                         light, estimated from the samples' spread) is at most R (default 0.02; 0 = none:
+                         exactly --spp samples)
   --cache-dir DIR        reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)
   --paper-tables         also measure the configurations of the seed papers' tables (first scene
                          only; see docs/accuracy.md)
@@ -100,7 +104,9 @@ std::string csvField(const std::string& s) {
 
 constexpr const char* kCsvHeader =
     "scene,width,height,technique,set,knob,value,changes,frame_ms,gpu_ms,frames,"
-    "over_budget,relative_rmse,ssim,flip,reference_mode,reference_spp,params";
+    "over_budget,relative_rmse,ssim,flip,reference_mode,reference_spp,params,relative_rmse_corrected,"
+    "reference_noise,indirect_relative_rmse,indirect_relative_rmse_corrected,indirect_reference_noise,"
+    "direct_relative_rmse";
 
 std::string csvRow(const nlohmann::json& r) {
     auto num = [](const nlohmann::json& v) {
@@ -110,7 +116,10 @@ std::string csvRow(const nlohmann::json& r) {
         return std::string(buf);
     };
     const nlohmann::json& e = r["error"];
-    auto err = [&](const char* k) { return e.is_object() ? num(e[k]) : std::string(); };
+    auto err = [&](const char* k) { return e.is_object() && e.contains(k) ? num(e[k]) : std::string(); };
+    auto part = [&](const char* which, const char* k) {
+        return e.is_object() && e.contains(which) ? num(e[which][k]) : std::string();
+    };
     std::string value = r["value"].is_null()
                             ? ""
                             : (r["value"].is_string() ? r["value"].get<std::string>() : r["value"].dump());
@@ -132,7 +141,13 @@ std::string csvRow(const nlohmann::json& r) {
         err("flip"),
         r["reference"].is_object() ? r["reference"]["mode"].get<std::string>() : "",
         r["reference"].is_object() ? std::to_string(r["reference"]["spp"].get<int>()) : "",
-        r["params"].dump()};
+        r["params"].dump(),
+        err("relative_rmse_corrected"),
+        err("reference_noise"),
+        part("indirect", "relative_rmse"),
+        part("indirect", "relative_rmse_corrected"),
+        part("indirect", "reference_noise"),
+        part("direct", "relative_rmse")};
     std::string line;
     for (size_t i = 0; i < f.size(); ++i) {
         if (i > 0) line += ',';
@@ -212,7 +227,9 @@ void checkScenes(const std::vector<std::string>& scenes) {
 Options parseOptions(const std::vector<std::string>& args) {
     Options o;
     o.reference.mode = "one-bounce-unoccluded";
-    o.reference.spp = 256;
+    o.reference.spp = 65536;
+    o.reference.noiseTarget = 0.02;
+    o.reference.noiseOfIndirect = true;
     ArgCursor c{args};
     for (; c.i < args.size(); ++c.i) {
         const std::string& a = args[c.i];
@@ -239,6 +256,8 @@ Options parseOptions(const std::vector<std::string>& args) {
             o.reference.mode = c.value();
         else if (a == "--spp")
             o.reference.spp = parseInt("--spp", c.value(), 1, 1000000);
+        else if (a == "--noise-target")
+            o.reference.noiseTarget = parseDouble("--noise-target", c.value(), 0, 0.5);
         else if (a == "--cache-dir")
             o.cacheDir = c.value();
         else if (a == "--paper-tables")
@@ -314,13 +333,13 @@ int sweep(const std::vector<std::string>& args) {
         std::string name;
         std::shared_ptr<Scene> scene;
         std::vector<std::vector<Planned>> perTechnique;
-        ReferenceImage reference;
+        ReferenceImage reference, referenceDirect;
     };
     std::vector<SceneWork> work;
     size_t total = 0;
     const std::vector<Planned> papers = o.paperTables ? paperPoints(o) : std::vector<Planned>{};
     for (size_t si = 0; si < o.scenes.size(); ++si) {
-        SceneWork w{o.scenes[si], std::make_shared<Scene>(loadScene(o.scenes[si])), {}, {}};
+        SceneWork w{o.scenes[si], std::make_shared<Scene>(loadScene(o.scenes[si])), {}, {}, {}};
         for (const auto& t : o.techniques) {
             const ParamTable& table = findTechnique(t).info.params;
             std::vector<std::string> knobs;
@@ -350,9 +369,21 @@ int sweep(const std::vector<std::string>& args) {
         validateReferenceOptions(o.reference);
         bool hit = false;
         w.reference = renderReferenceCached(*w.scene, s, o.reference, o.cacheDir, &hit);
-        std::fprintf(stderr, "gi-bench: reference %s %s %dx%d, %d spp, %s\n", w.name.c_str(),
-                     o.reference.mode.c_str(), o.width, o.height, w.reference.spp,
-                     hit ? "from the cache" : (std::to_string(w.reference.seconds) + " s").c_str());
+        // The reference's direct light (pixel centres: exact and fast) splits its indirect light off.
+        w.referenceDirect = renderReferenceCached(*w.scene, s, {.mode = "direct", .spp = 1}, o.cacheDir);
+        const ImageView view(w.reference.rgb, o.width, o.height, 3);
+        const nlohmann::json noise = referenceNoiseJson(w.reference, w.referenceDirect);
+        std::fprintf(
+            stderr,
+            "gi-bench: reference %s %s %dx%d, %d spp, %s; noise %s of the image, %s of its indirect light\n",
+            w.name.c_str(), o.reference.mode.c_str(), o.width, o.height, w.reference.spp,
+            hit ? "from the cache" : (std::to_string(w.reference.seconds) + " s").c_str(),
+            noise["image"].dump().c_str(), noise["indirect"].dump().c_str());
+        nlohmann::json record = {
+            {"scene", w.name},         {"size", {o.width, o.height}},        {"mode", o.reference.mode},
+            {"spp", w.reference.spp},  {"seconds", w.reference.seconds},     {"key", w.reference.key},
+            {"noise", noise["image"]}, {"indirect_noise", noise["indirect"]}};
+        std::ofstream(o.out + "/references.jsonl", std::ios::app) << record.dump() << "\n";
     }
 
     auto backend = o.gl.empty() ? gl::defaultBackend() : gl::parseBackend(o.gl);
@@ -360,8 +391,21 @@ int sweep(const std::vector<std::string>& args) {
     const std::string glName = context->info().renderer;
     size_t index = 0, measured = 0, skipped = 0;
     for (auto& w : work) {
-        const ImageView refView(w.reference.rgb.data(), w.reference.width, w.reference.height, 3);
-        const PixelMask mask = maskFromNonZero(refView);
+        auto accuracy = [&](const FrameOutput& f) {
+            AccuracyInputs in;
+            in.test = ImageView(f.linear, f.width, f.height, 4);
+            in.reference = ImageView(w.reference.rgb, w.reference.width, w.reference.height, 3);
+            in.referenceVariance = w.reference.variance;
+            if (f.linearDirect.size() == f.linear.size()) {
+                in.testDirect = ImageView(f.linearDirect, f.width, f.height, 4);
+                in.referenceDirect =
+                    ImageView(w.referenceDirect.rgb, w.referenceDirect.width, w.referenceDirect.height, 3);
+                in.referenceDirectVariance = w.referenceDirect.variance;
+            }
+            return compareAccuracy(in);
+        };
+        const nlohmann::json referenceRecord = {
+            {"mode", o.reference.mode}, {"spp", w.reference.spp}, {"key", w.reference.key}};
         for (auto& plan : w.perTechnique) {
             if (plan.empty()) continue;
             const std::string& technique = plan.front().technique;
@@ -380,7 +424,7 @@ int sweep(const std::vector<std::string>& args) {
                     lastH = height;
                 }
                 return timed ? measure(renderer, state, o.frames, o.maxFrameMs)
-                             : Measurement{{}, renderer.render(state, true), 1, false};
+                             : Measurement{{}, renderer.render(state, true, true), 1, false};
             };
             std::vector<float> defaultImage;
             const nlohmann::json defaults = plan.front().params;
@@ -413,6 +457,23 @@ int sweep(const std::vector<std::string>& args) {
                 if (auto it = done.find(key); it != done.end()) {
                     row = it->second;
                     std::fprintf(stderr, "%s%s: measured before\n", prefix, label.c_str());
+                    const bool staleError =
+                        atSweepSize && (!row["reference"].is_object() ||
+                                        row["reference"].value("key", "") != w.reference.key);
+                    if (staleError) {
+                        // Timed before against another reference: the timing stands, the error is
+                        // measured again (untimed) against this one; the appended row supersedes it.
+                        const FrameOutput f = render(p.params, p.width, p.height, false).last;
+                        image = f.linear;
+                        row["error"] = accuracy(f);
+                        row["reference"] = referenceRecord;
+                        jsonl << row.dump() << "\n" << std::flush;
+                        csv << csvRow(row) << "\n" << std::flush;
+                        done[key] = row;
+                        std::fprintf(stderr,
+                                     "%s%s: error measured again against this reference: rel RMSE %.3f\n",
+                                     prefix, label.c_str(), row["error"]["relative_rmse"].get<double>());
+                    }
                     if (!p.baseline.is_null() && !row.contains("baseline_relative_rmse")) {
                         // Measured by the grid before a paper table asked for its baseline: add it,
                         // untimed; the appended row supersedes the earlier one.
@@ -452,9 +513,8 @@ int sweep(const std::vector<std::string>& args) {
                            {"error", nullptr},
                            {"reference", nullptr}};
                     if (atSweepSize) {
-                        const ImageView test(image.data(), p.width, p.height, 4);
-                        row["error"] = toJson(compareImages(test, refView, mask));
-                        row["reference"] = {{"mode", o.reference.mode}, {"spp", w.reference.spp}};
+                        row["error"] = accuracy(m.last);
+                        row["reference"] = referenceRecord;
                     }
                     if (!p.baseline.is_null()) {
                         const std::string bkey = p.baseline.dump() + std::to_string(p.width);
@@ -484,6 +544,12 @@ int sweep(const std::vector<std::string>& args) {
                                       row["error"]["relative_rmse"].get<double>(),
                                       row["error"]["ssim"].get<double>(), row["error"]["flip"].get<double>());
                         msg += line;
+                        if (row["error"].contains("indirect")) {
+                            std::snprintf(line, sizeof line, ", indirect %.3f (corrected %.3f)",
+                                          row["error"]["indirect"]["relative_rmse"].get<double>(),
+                                          row["error"]["indirect"]["relative_rmse_corrected"].get<double>());
+                            msg += line;
+                        }
                     }
                     std::fprintf(stderr, "%s%s: %s\n", prefix, label.c_str(), msg.c_str());
                 }

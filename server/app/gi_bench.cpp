@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/Accuracy.h"
 #include "analysis/Metrics.h"
 #include "app/BenchCommon.h"
 #include "core/Error.h"
@@ -44,16 +45,22 @@ constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
        gi-bench point-shadows [options]
 
 compare  prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
-         size; pixels black in the reference are left out) as JSON.
+         size; pixels black in the reference are left out) as JSON, with the reference's own
+         noise (when its EXR carries the variance, as gi-render's do) and the error corrected for it.
 
 table    renders each technique configuration with GL (median frame time over --frames after a
          warm-up) and the CPU references, then prints one row per configuration: frame time, the sum
-         of the GPU pass times, and the error against every reference.
+         of the GPU pass times, and the error against every reference: whole image, indirect light
+         alone (each side less its own direct light: the GI technique's error) and the direct pass
+         alone (the shadow map's error), each corrected for the reference's noise, which is
+         printed beside it.
   --scene NAME            (default builtin:cornell)
   --size WxH              (default 256x256)
   --config SPEC           technique[:name=value,...], repeatable (default: none, rsm_gather)
   --reference MODE        reference mode, repeatable (default: one-bounce-unoccluded, one-bounce)
-  --spp N                 reference samples per pixel (default 1024)
+  --spp N                 reference samples per pixel at most (default 65536)
+  --noise-target R        stop each reference once its indirect light's relative noise is at most
+                          R (default 0.02; 0 = exactly --spp samples)
   --caustic-min-roughness R  leave out of the reference the lights' reflection off specular
                           lobes smoother than R reaching a rougher surface (caustics the GL
                           pipeline does not render; biased; default 0 = unbiased; see
@@ -103,8 +110,11 @@ int compare(const std::vector<std::string>& args) {
         throw gis::InputError(args[0], "is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                                            " but " + args[1] + " is " + std::to_string(b.width) + "x" +
                                            std::to_string(b.height));
-    gis::ImageView test(a.rgb.data(), a.width, a.height, 3), ref(b.rgb.data(), b.width, b.height, 3);
-    nlohmann::json out = gis::toJson(gis::compareImages(test, ref, gis::maskFromNonZero(ref)));
+    gis::AccuracyInputs in;
+    in.test = gis::ImageView(a.rgb, a.width, a.height, 3);
+    in.reference = gis::ImageView(b.rgb, b.width, b.height, 3);
+    in.referenceVariance = b.variance;
+    nlohmann::json out = gis::compareAccuracy(in);
     out["test"] = args[0];
     out["reference"] = args[1];
     std::cout << out.dump(2) << "\n";
@@ -266,7 +276,9 @@ int table(const std::vector<std::string>& args) {
     std::vector<Config> configs;
     std::vector<std::string> modes;
     gis::ReferenceOptions ro;
-    ro.spp = 1024;
+    ro.spp = 65536;
+    ro.noiseTarget = 0.02;
+    ro.noiseOfIndirect = true;
     for (size_t i = 0; i < args.size(); ++i) {
         auto value = [&]() -> const std::string& {
             if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
@@ -283,6 +295,8 @@ int table(const std::vector<std::string>& args) {
             modes.push_back(value());
         else if (a == "--spp")
             ro.spp = parseInt("--spp", value(), 1, 1000000);
+        else if (a == "--noise-target")
+            ro.noiseTarget = parseDouble("--noise-target", value(), 0, 0.5);
         else if (a == "--caustic-min-roughness")
             ro.causticMinRoughness =
                 static_cast<float>(parseDouble("--caustic-min-roughness", value(), 0.0, 1.0));
@@ -307,13 +321,20 @@ int table(const std::vector<std::string>& args) {
 
     // References first (CPU, cached), so GL timings are not disturbed by them.
     std::vector<gis::ReferenceImage> refs;
+    std::vector<nlohmann::json> noise;
+    // The direct light at pixel centres (exact): what splits each reference's indirect light off.
+    const gis::ReferenceImage direct =
+        gis::renderReferenceCached(*scene, states.front(), {.mode = "direct", .spp = 1}, cacheDir);
     for (const auto& m : modes) {
         ro.mode = m;
         gis::validateReferenceOptions(ro);
         bool hit = false;
         refs.push_back(gis::renderReferenceCached(*scene, states.front(), ro, cacheDir, &hit));
+        noise.push_back(referenceNoiseJson(refs.back(), direct));
         gis::logInfo("gi-bench: reference " + m + ": " + std::to_string(refs.back().spp) + " spp, " +
-                     (hit ? "from the cache" : std::to_string(refs.back().seconds) + " s"));
+                     (hit ? "from the cache" : std::to_string(refs.back().seconds) + " s") + "; noise " +
+                     noise.back()["image"].dump() + " of the image, " + noise.back()["indirect"].dump() +
+                     " of its indirect light");
     }
 
     auto backend = gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(gl);
@@ -331,36 +352,64 @@ int table(const std::vector<std::string>& args) {
                               {"gpu_ms", gpu},
                               {"counts", s["counts"]},
                               {"params", s["params"]}};
-        gis::ImageView test(f.linear.data(), f.width, f.height, 4);
         for (size_t r = 0; r < refs.size(); ++r) {
-            gis::ImageView ref(refs[r].rgb.data(), refs[r].width, refs[r].height, 3);
-            row["error"][modes[r]] = gis::toJson(gis::compareImages(test, ref, gis::maskFromNonZero(ref)));
+            gis::AccuracyInputs in;
+            in.test = gis::ImageView(f.linear, f.width, f.height, 4);
+            in.testDirect = gis::ImageView(f.linearDirect, f.width, f.height, 4);
+            in.reference = gis::ImageView(refs[r].rgb, refs[r].width, refs[r].height, 3);
+            in.referenceVariance = refs[r].variance;
+            if (modes[r] != "direct") {
+                in.referenceDirect = gis::ImageView(direct.rgb, direct.width, direct.height, 3);
+                in.referenceDirectVariance = direct.variance;
+            }
+            row["error"][modes[r]] = gis::compareAccuracy(in);
         }
         rows.push_back(row);
     }
 
-    std::printf("scene %s, %dx%d, GL %s (%s), references at %d spp\n\n", sceneName.c_str(), width, height,
-                context->info().backend.c_str(), context->info().renderer.c_str(), ro.spp);
+    std::printf("scene %s, %dx%d, GL %s (%s)\n", sceneName.c_str(), width, height,
+                context->info().backend.c_str(), context->info().renderer.c_str());
+    auto figure = [](const nlohmann::json& v) {
+        char buf[32];
+        if (!v.is_number()) return std::string("-");
+        std::snprintf(buf, sizeof buf, "%.4f", v.get<double>());
+        return std::string(buf);
+    };
+    for (size_t r = 0; r < modes.size(); ++r)
+        std::printf("reference %s: %d spp, relative noise %s of the image, %s of its indirect light\n",
+                    modes[r].c_str(), refs[r].spp, figure(noise[r]["image"]).c_str(),
+                    figure(noise[r]["indirect"]).c_str());
+    std::printf("(rel. RMSE corrected for the reference's noise; indirect = each side less its own direct "
+                "light; direct = the direct pass against the reference's)\n\n");
     std::printf("| configuration | frame ms | GPU ms |");
-    for (const auto& m : modes) std::printf(" rel. RMSE vs %s | SSIM | FLIP |", m.c_str());
+    for (const auto& m : modes)
+        std::printf(" rel. RMSE vs %s | indirect | direct | SSIM | FLIP |", m.c_str());
     std::printf("\n|---|---|---|");
-    for (size_t r = 0; r < modes.size(); ++r) std::printf("---|---|---|");
+    for (size_t r = 0; r < modes.size(); ++r) std::printf("---|---|---|---|---|");
     std::printf("\n");
     for (const auto& row : rows) {
         std::printf("| %s | %.1f | %.1f |", row["config"].get<std::string>().c_str(),
                     row["frame_ms"].get<double>(), row["gpu_ms"].get<double>());
         for (const auto& m : modes) {
             const auto& e = row["error"][m];
-            std::printf(" %.4f | %.4f | %.4f |", e["relative_rmse"].get<double>(), e["ssim"].get<double>(),
-                        e["flip"].get<double>());
+            const nlohmann::json none;
+            const auto& ind = e.contains("indirect") ? e["indirect"] : none;
+            const auto& dir = e.contains("direct") ? e["direct"] : none;
+            std::printf(" %s | %s | %s | %.4f | %.4f |", figure(e["relative_rmse_corrected"]).c_str(),
+                        figure(ind.is_object() ? ind["relative_rmse_corrected"] : none).c_str(),
+                        figure(dir.is_object() ? dir["relative_rmse"] : none).c_str(),
+                        e["ssim"].get<double>(), e["flip"].get<double>());
         }
         std::printf("\n");
     }
     if (!jsonPath.empty()) {
         std::ofstream f(jsonPath);
         if (!f) throw gis::InputError(jsonPath, "cannot open for writing");
-        f << nlohmann::json(
-                 {{"scene", sceneName}, {"size", {width, height}}, {"reference_spp", ro.spp}, {"rows", rows}})
+        f << nlohmann::json({{"scene", sceneName},
+                             {"size", {width, height}},
+                             {"reference_spp_max", ro.spp},
+                             {"reference_noise_target", ro.noiseTarget},
+                             {"rows", rows}})
                  .dump(2)
           << "\n";
     }

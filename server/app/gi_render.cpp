@@ -18,6 +18,7 @@
 #include "core/Log.h"
 #include "encode/Encoder.h"
 #include "effects/EffectPlan.h"
+#include "analysis/Accuracy.h"
 #include "analysis/Metrics.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
@@ -70,6 +71,10 @@ Ground truth and error (CPU reference renderer, Embree):
                         one-bounce or path (.exr keeps linear radiance; .png/.jpg are tone-mapped)
   --spp N               reference samples per pixel, 1..1000000 (default 256)
   --time-budget S       stop the reference after S seconds (reports the spp reached)
+  --noise-target R      stop the reference once its relative noise (estimated from the samples'
+                        spread) is at most R, e.g. 0.01; --spp stays the upper bound
+  --noise-of WHAT       total (default) or indirect: what --noise-target is relative to (the image,
+                        or the image less its direct light, as GI comparisons measure)
   --seed N              reference random seed (default 1)
   --max-depth N         path mode: vertices per path, 1..64 (default 8)
   --caustic-min-roughness R  leave out the lights' reflection off specular lobes smoother than R
@@ -79,7 +84,10 @@ Ground truth and error (CPU reference renderer, Embree):
   --no-cache            always render the reference
   --compare REF.exr     compare the rendered frame's linear radiance with a reference EXR of the same
                         size: prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP (background
-                        pixels, black in the reference, are left out)
+                        pixels, black in the reference, are left out), the reference's own noise and
+                        the error corrected for it; and "indirect" (each side less its own direct
+                        light: the GI technique's error) and "direct" (the direct pass against the
+                        reference's, rendered here at pixel centres: the shadow map's error)
   --quiet               only errors on stderr
   --help                this text
 
@@ -165,10 +173,16 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
                                 o.quality);
         }
     }
+    // The noise of the whole image (pixels the reference covers); null when unknown (one sample).
+    nlohmann::json noise = nullptr;
+    if (!image.variance.empty()) {
+        const gis::ImageView view(image.rgb, image.width, image.height, 3);
+        noise = gis::relativeNoise(view, image.variance, gis::maskFromNonZero(view));
+    }
     return {{"reference", ro.mode}, {"size", {image.width, image.height}},
             {"spp", image.spp},     {"seconds", image.seconds},
             {"cache_hit", hit},     {"key", image.key},
-            {"scene", o.scene}};
+            {"noise", noise},       {"scene", o.scene}};
 }
 
 int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
@@ -291,9 +305,9 @@ int run(int argc, char** argv) {
     };
     // Flags whose settings a --request file carries (or that do not apply to one frame of it).
     static const std::vector<std::string> kRequestConflicts = {
-        "--scene",       "--technique", "--preset",    "--param",     "--size",
-        "--quality",     "--frames",    "--explain",   "--reference", "--spp",
-        "--time-budget", "--seed",      "--max-depth", "--compare",   "--lights"};
+        "--scene",     "--technique", "--preset",    "--param",        "--size",        "--quality",
+        "--frames",    "--explain",   "--reference", "--spp",          "--time-budget", "--seed",
+        "--max-depth", "--compare",   "--lights",    "--noise-target", "--noise-of"};
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         if (std::find(kRequestConflicts.begin(), kRequestConflicts.end(), a) != kRequestConflicts.end())
@@ -363,6 +377,22 @@ int run(int argc, char** argv) {
             } catch (const std::exception&) {
                 throw UsageError{"--time-budget must be a positive number of seconds, got '" + t + "'"};
             }
+        } else if (a == "--noise-target") {
+            const std::string& t = value(i);
+            try {
+                size_t used = 0;
+                o.reference.noiseTarget = std::stod(t, &used);
+                if (used != t.size() || !(o.reference.noiseTarget > 0 && o.reference.noiseTarget < 1))
+                    throw std::invalid_argument(t);
+            } catch (const std::exception&) {
+                throw UsageError{"--noise-target must be a relative noise in (0, 1), e.g. 0.01, got '" + t +
+                                 "'"};
+            }
+        } else if (a == "--noise-of") {
+            const std::string& t = value(i);
+            if (t != "total" && t != "indirect")
+                throw UsageError{"--noise-of must be total or indirect, got '" + t + "'"};
+            o.reference.noiseOfIndirect = t == "indirect";
         } else if (a == "--seed")
             o.reference.seed = static_cast<std::uint64_t>(parseInt("--seed", value(i), 0, 2147483647));
         else if (a == "--max-depth")
@@ -477,10 +507,12 @@ int run(int argc, char** argv) {
     renderer.setScene(scene);
 
     const bool wantLinear = gis::imageFileNeedsLinear(o.out) || !o.compare.empty();
-    gis::FrameOutput frame = renderer.render(state, wantLinear); // warm-up (shader JIT, allocation)
+    const bool wantDirect = !o.compare.empty();
+    gis::FrameOutput frame =
+        renderer.render(state, wantLinear, wantDirect); // warm-up (shader JIT, allocation)
     std::vector<nlohmann::json> stats;
     for (int f = 0; f < o.frames; ++f) {
-        frame = renderer.render(state, wantLinear);
+        frame = renderer.render(state, wantLinear, wantDirect);
         stats.push_back(frame.stats);
     }
     if (o.listResources) {
@@ -496,12 +528,9 @@ int run(int argc, char** argv) {
     summary["gl"] = {{"backend", context->info().backend}, {"renderer", context->info().renderer}};
 
     if (!o.compare.empty()) {
-        gis::ImageView test(frame.linear.data(), frame.width, frame.height, 4);
-        gis::ImageView ref(compareWith.rgb.data(), compareWith.width, compareWith.height, 3);
-        gis::ImageMetrics m =
-            gis::compareImages(test, ref, gis::maskFromNonZero(ref), state.frameParams.getFloat("exposure"));
-        summary["compare"] = gis::toJson(m);
-        summary["compare"]["reference"] = o.compare;
+        summary["compare"] = gis::compareWithReference(*scene, state, frame, compareWith,
+                                                       o.useCache ? o.cacheDir : std::string());
+        summary["compare"]["reference"]["file"] = o.compare;
         std::cout << summary["compare"].dump(2) << "\n";
     }
     if (!o.out.empty()) {

@@ -14,6 +14,7 @@
 #include "frame/Presets.h"
 #include "frame/StateJson.h"
 #if GIS_HAVE_REFERENCE && GIS_HAVE_ANALYSIS
+#include "analysis/Accuracy.h"
 #include "analysis/Metrics.h"
 #include "reference/ReferenceRenderer.h"
 #define GIS_RENDER_JOB_COMPARE 1
@@ -66,7 +67,8 @@ std::string hintFor(const std::string& pointer, const std::string& message, cons
                "directional) and the fields of light";
     if (field == "compare")
         return "compare is {\"mode\": \"direct\" | \"one-bounce-unoccluded\" | \"one-bounce\" | \"path\", "
-               "\"spp\": samples per pixel, \"time_budget_s\": seconds}";
+               "\"spp\": samples per pixel, \"time_budget_s\": seconds, \"noise_target\": relative noise to "
+               "stop at (e.g. 0.05), \"noise_of\": \"indirect\" | \"image\"}";
     if (message.rfind("unknown field", 0) == 0) return std::string("known fields: ") + kKnownFields;
     return {};
 }
@@ -91,6 +93,8 @@ ReferenceOptions referenceOptions(const RenderCompare& compare) {
     options.mode = compare.mode;
     options.spp = compare.spp;
     options.timeBudgetSeconds = compare.timeBudgetSeconds;
+    options.noiseTarget = compare.noiseTarget;
+    options.noiseOfIndirect = compare.noiseOfIndirect;
     try {
         validateReferenceOptions(options);
     } catch (const InputError& e) {
@@ -199,6 +203,11 @@ RenderJob parseRenderRequest(const nlohmann::json& request, const RenderLimits& 
                                                      ": ask for fewer samples per pixel");
             cmp.spp = static_cast<int>(spp->get<double>());
         }
+        // With a noise target the render stops when the noise reaches it; spp is then only the cap,
+        // the server's own unless the request asks for fewer.
+        cmp.noiseTarget = c->value("noise_target", 0.0);
+        cmp.noiseOfIndirect = c->value("noise_of", std::string("indirect")) == "indirect";
+        if (cmp.noiseTarget > 0 && !c->contains("spp")) cmp.spp = limits.maxReferenceSpp;
         cmp.timeBudgetSeconds = c->value("time_budget_s", 0.0);
         if (limits.maxReferenceSeconds > 0) {
             if (cmp.timeBudgetSeconds > limits.maxReferenceSeconds)
@@ -252,6 +261,53 @@ bool renderJobsCanCompare() {
     return GIS_RENDER_JOB_COMPARE != 0;
 }
 
+#if GIS_RENDER_JOB_COMPARE
+nlohmann::json compareWithReference(const Scene& scene, const FrameState& state, const FrameOutput& frame,
+                                    const ReferenceImage& reference, const std::string& cacheDir,
+                                    ReferenceRenderer* referenceRenderer) {
+    const auto pixels = static_cast<size_t>(frame.width) * static_cast<size_t>(frame.height);
+    if (reference.width != frame.width || reference.height != frame.height ||
+        frame.linear.size() != pixels * 4)
+        throw InputError("reference", "is " + std::to_string(reference.width) + "x" +
+                                          std::to_string(reference.height) + ", the frame " +
+                                          std::to_string(frame.width) + "x" + std::to_string(frame.height));
+    AccuracyInputs in;
+    in.test = ImageView(frame.linear, frame.width, frame.height, 4);
+    in.reference = ImageView(reference.rgb, reference.width, reference.height, 3);
+    in.referenceVariance = reference.variance;
+    in.exposureEv = state.frameParams.has("exposure") ? state.frameParams.getFloat("exposure") : 0.0;
+    // The reference's own direct light at pixel centres (exact, fast; cached beside the reference):
+    // the split into indirect light and direct pass. A direct reference has nothing to split.
+    ReferenceImage direct;
+    const bool split = reference.mode != "direct" && frame.linearDirect.size() == pixels * 4;
+    if (split) {
+        const ReferenceOptions directOptions{.mode = "direct", .spp = 1};
+        if (!cacheDir.empty()) {
+            direct = renderReferenceCached(scene, state, directOptions, cacheDir);
+        } else if (referenceRenderer) {
+            direct = referenceRenderer->render(state, directOptions);
+        } else {
+            direct = ReferenceRenderer(scene).render(state, directOptions);
+        }
+        in.testDirect = ImageView(frame.linearDirect, frame.width, frame.height, 4);
+        in.referenceDirect = ImageView(direct.rgb, direct.width, direct.height, 3);
+        in.referenceDirectVariance = direct.variance;
+    }
+    nlohmann::json out = compareAccuracy(in);
+    out["reference"] = {{"mode", reference.mode},
+                        {"spp", reference.spp},
+                        {"seconds", reference.seconds},
+                        {"key", reference.key}};
+    if (split) out["direct"]["reference"] = {{"mode", "direct"}, {"spp", direct.spp}, {"key", direct.key}};
+    return out;
+}
+#else
+nlohmann::json compareWithReference(const Scene&, const FrameState&, const FrameOutput&,
+                                    const ReferenceImage&, const std::string&, ReferenceRenderer*) {
+    throw InputError("/compare", "this build has no CPU reference renderer (Embree): leave out compare");
+}
+#endif
+
 RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
                               const SceneResolver& resolveScene) {
     std::shared_ptr<const Scene> scene = resolveScene(job.scene);
@@ -262,7 +318,7 @@ RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
 #endif
     if (renderer.scene() != scene.get()) renderer.setScene(scene);
     const bool wantLinear = job.compare.has_value();
-    FrameOutput frame = renderer.render(state, wantLinear);
+    FrameOutput frame = renderer.render(state, wantLinear, wantLinear);
 
     RenderResult result;
     Stopwatch encodeClock;
@@ -280,23 +336,20 @@ RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
         const ReferenceOptions options = referenceOptions(*job.compare);
         bool cacheHit = false;
         ReferenceImage reference;
+        std::unique_ptr<ReferenceRenderer> referenceRenderer;
         if (!job.referenceCacheDir.empty()) {
             reference = renderReferenceCached(*scene, state, options, job.referenceCacheDir, &cacheHit);
         } else {
-            ReferenceRenderer referenceRenderer(*scene);
-            reference = referenceRenderer.render(state, options);
+            referenceRenderer = std::make_unique<ReferenceRenderer>(*scene);
+            reference = referenceRenderer->render(state, options);
         }
-        const ImageView test(frame.linear.data(), frame.width, frame.height, 4);
         const ImageView truth(reference.rgb.data(), reference.width, reference.height, 3);
-        // Background is black in the reference; leaving it out keeps the metrics about the scene.
-        const ImageMetrics m =
-            compareImages(test, truth, maskFromNonZero(truth), state.frameParams.getFloat("exposure"));
-        nlohmann::json compare = toJson(m);
-        compare["reference"] = {{"mode", reference.mode},
-                                {"spp", reference.spp},
-                                {"seconds", reference.seconds},
-                                {"cache_hit", cacheHit},
-                                {"key", reference.key}};
+        nlohmann::json compare = compareWithReference(*scene, state, frame, reference, job.referenceCacheDir,
+                                                      referenceRenderer.get());
+        compare["reference"]["cache_hit"] = cacheHit;
+        if (options.noiseTarget > 0)
+            compare["reference"]["noise_target"] = {{"value", options.noiseTarget},
+                                                    {"of", options.noiseOfIndirect ? "indirect" : "image"}};
         result.stats["compare"] = std::move(compare);
         // The reference as a PNG through the same display transform as gi-render --reference, so a
         // client can show it beside the frame.

@@ -39,6 +39,8 @@ struct RenderCompare {
     std::string mode; ///< referenceModes()
     int spp = 64;
     double timeBudgetSeconds = 0; ///< 0 = none
+    double noiseTarget = 0;       ///< relative noise to stop at, (0, 0.5]; 0 = none (spp then is the cap)
+    bool noiseOfIndirect = true;  ///< the noise target is relative to the indirect light (else the image)
 };
 
 /// Everything a one-shot render depends on besides the scene's contents. Parameters, camera and
@@ -102,5 +104,16 @@ using SceneResolver = std::function<std::shared_ptr<const Scene>(const std::stri
 /// context is current. Throws InputError for bad requests and scenes, gis::Error for failures.
 RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
                               const SceneResolver& resolveScene);
+
+struct ReferenceImage;
+class ReferenceRenderer;
+/// The accuracy of `frame` (rendered with its linear radiance and direct pass) against `reference` of the
+/// same view: analysis/Accuracy.h's JSON (whole image, indirect light, direct pass, each with the
+/// reference's noise) plus "reference": {mode, spp, seconds, key}. The reference's direct light comes
+/// from a pixel-centre "direct" render, cached in `cacheDir` when it is not empty, rendered with
+/// `referenceRenderer` when given. Throws InputError when the sizes disagree or the build has no reference.
+nlohmann::json compareWithReference(const Scene& scene, const FrameState& state, const FrameOutput& frame,
+                                    const ReferenceImage& reference, const std::string& cacheDir,
+                                    ReferenceRenderer* referenceRenderer = nullptr);
 
 } // namespace gis

@@ -21,7 +21,8 @@ namespace reference {
 // cache files stop matching.
 // 2: non-diffuse materials (scene/Brdf.h: metallic, roughness, specular) and the frame parameters
 // specular_lobe and effect_specular.
-constexpr const char* kKeyVersion = "gis-reference-3"; // 3: every light, range windows
+// 3: every light, range windows.
+constexpr const char* kKeyVersion = "gis-reference-4"; // 4: the pixel means' variance, the noise target
 
 std::string sceneDigest(const Scene& scene) {
     Hasher h;
@@ -99,6 +100,8 @@ std::string requestKey(const std::string& digest, const FrameState& state, const
     h.value(options.seed);
     h.value(options.jitter);
     h.value(options.causticMinRoughness);
+    h.value(options.noiseTarget);
+    h.value(options.noiseOfIndirect);
     return h.hex();
 }
 
@@ -120,14 +123,28 @@ void writeReferenceExr(const std::string& path, const ReferenceImage& image) {
         path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ".exr";
     auto out = OIIO::ImageOutput::create(tmp);
     if (!out) throw Error("reference: cannot write '" + path + "': " + OIIO::geterror());
-    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
+    const bool withVariance = image.variance.size() == expected;
+    const int channels = withVariance ? 6 : 3;
+    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
+    if (withVariance) spec.channelnames = {"R", "G", "B", "variance.R", "variance.G", "variance.B"};
+    std::vector<float> pixels;
+    if (withVariance) {
+        pixels.resize(expected * 2);
+        for (size_t i = 0, n = expected / 3; i < n; ++i)
+            for (size_t c = 0; c < 3; ++c) {
+                pixels[i * 6 + c] = image.rgb[i * 3 + c];
+                pixels[i * 6 + 3 + c] = image.variance[i * 3 + c];
+            }
+    }
     spec.attribute("compression", "zip");
     spec.attribute("gis:mode", image.mode);
     spec.attribute("gis:spp", image.spp);
     spec.attribute("gis:seconds", static_cast<float>(image.seconds));
     spec.attribute("gis:key", image.key);
     const bool ok =
-        out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data()) && out->close();
+        out->open(tmp, spec) &&
+        out->write_image(OIIO::TypeDesc::FLOAT, withVariance ? pixels.data() : image.rgb.data()) &&
+        out->close();
     if (!ok) {
         const std::string why = out->geterror();
         std::error_code ec;
@@ -161,12 +178,26 @@ ReferenceImage readReferenceExr(const std::string& path) {
     std::vector<float> all(pixels * static_cast<size_t>(spec.nchannels));
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
         throw InputError(path, "cannot read pixels: " + in->geterror());
+    const auto stride = static_cast<size_t>(spec.nchannels);
     img.rgb.resize(pixels * 3);
     for (size_t i = 0; i < pixels; ++i)
         for (size_t c = 0; c < 3; ++c) {
-            const float v = all[i * static_cast<size_t>(spec.nchannels) + c];
+            const float v = all[i * stride + c];
             img.rgb[i * 3 + c] = std::isfinite(v) && v > 0.0f ? v : 0.0f; // keep the no-NaN/negative promise
         }
+    // The pixel means' variance, when the file carries it (writeReferenceExr's channel names).
+    int varianceChannel[3] = {-1, -1, -1};
+    for (int c = 0; c < spec.nchannels; ++c)
+        for (int k = 0; k < 3; ++k)
+            if (spec.channel_name(c) == std::string("variance.") + "RGB"[k]) varianceChannel[k] = c;
+    if (varianceChannel[0] >= 0 && varianceChannel[1] >= 0 && varianceChannel[2] >= 0) {
+        img.variance.resize(pixels * 3);
+        for (size_t i = 0; i < pixels; ++i)
+            for (size_t k = 0; k < 3; ++k) {
+                const float v = all[i * stride + static_cast<size_t>(varianceChannel[k])];
+                img.variance[i * 3 + k] = std::isfinite(v) && v > 0.0f ? v : 0.0f;
+            }
+    }
     return img;
 }
 

@@ -40,6 +40,7 @@ enum class Mode { Direct, OneBounceUnoccluded, OneBounce, Path };
 
 constexpr int kTile = 16;
 constexpr int kMaxPassSamples = 64;
+constexpr int kMinNoiseSamples = 32; // samples before the noise target may stop a render
 constexpr int kMaxImageSide = 16384;
 constexpr int kRouletteDepth = 3; // vertices before Russian roulette starts
 
@@ -334,9 +335,21 @@ private:
     float mCausticMinAlpha;
 };
 
-void addSanitized(double* acc, const glm::vec3& c) {
+// Sums of each pixel's samples and of their squares (the squares give the pixel mean's variance).
+void addSanitized(double* acc, double* accSquares, const glm::vec3& c) {
     for (int i = 0; i < 3; ++i)
-        if (std::isfinite(c[i]) && c[i] > 0.0f) acc[i] += static_cast<double>(c[i]);
+        if (std::isfinite(c[i]) && c[i] > 0.0f) {
+            const auto v = static_cast<double>(c[i]);
+            acc[i] += v;
+            accSquares[i] += v * v;
+        }
+}
+
+// Variance of the mean of n samples from their sum and sum of squares (unbiased; 0 against rounding).
+double varianceOfMean(double sum, double sumSquares, int n) {
+    if (n < 2) return 0.0;
+    const double dn = n;
+    return std::max(0.0, (sumSquares - sum * sum / dn) / (dn * (dn - 1.0)));
 }
 
 } // namespace
@@ -355,6 +368,8 @@ void validateReferenceOptions(const ReferenceOptions& options) {
     if (options.threads < 0) throw InputError("threads", "must be >= 0 (0 = all hardware threads)");
     if (!(options.causticMinRoughness >= 0.0f && options.causticMinRoughness <= 1.0f))
         throw InputError("caustic_min_roughness", "must be in [0, 1] (0 = every caustic)");
+    if (!std::isfinite(options.noiseTarget) || options.noiseTarget < 0 || options.noiseTarget >= 1)
+        throw InputError("noise_target", "must be a relative noise in [0, 1) (0 = none, 0.01 = 1%)");
 }
 
 ReferenceRenderer::ReferenceRenderer(const Scene& scene)
@@ -391,7 +406,7 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
     // A pixel-centre direct render has no random decision: one sample is the exact answer.
     const int target = (mode == Mode::Direct && !options.jitter) ? 1 : options.spp;
     const size_t pixels = static_cast<size_t>(w) * static_cast<size_t>(h);
-    std::vector<double> accum(pixels * 3, 0.0);
+    std::vector<double> accum(pixels * 3, 0.0), accumSquares(pixels * 3, 0.0);
     const int tilesX = (w + kTile - 1) / kTile, tilesY = (h + kTile - 1) / kTile;
 
     auto renderPass = [&](int firstSample, int count) {
@@ -419,7 +434,7 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
                                 const double len = glm::length(b - a);
                                 if (!(len > 0.0) || !std::isfinite(len)) continue;
                                 const glm::vec3 dir(glm::normalize(b - a));
-                                addSanitized(&accum[index * 3],
+                                addSanitized(&accum[index * 3], &accumSquares[index * 3],
                                              integrator.sample(glm::vec3(a), dir, static_cast<float>(len),
                                                                rng, scratch));
                             }
@@ -429,6 +444,38 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
     };
 
     tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+
+    // The noise target's signal: the image itself, or (noiseOfIndirect) the image less its direct light,
+    // taken from a pixel-centre direct render (exact for one light; the scale of the signal otherwise).
+    std::vector<float> directForNoise;
+    if (options.noiseTarget > 0 && options.noiseOfIndirect && mode != Mode::Direct) {
+        ReferenceOptions direct = options;
+        direct.mode = "direct";
+        direct.jitter = false;
+        direct.noiseTarget = 0;
+        direct.timeBudgetSeconds = 0;
+        directForNoise = render(state, direct).rgb;
+    }
+    // Relative noise of the current mean over the pixels it covers: sqrt(mean variance of the mean) over
+    // the signal's RMS. +infinity while the signal is 0 (nothing to measure against yet).
+    auto currentNoise = [&](int n) {
+        double variance = 0, signal = 0;
+        size_t covered = 0;
+        for (size_t p = 0; p < pixels; ++p) {
+            const double* a = &accum[p * 3];
+            if (!(a[0] > 0 || a[1] > 0 || a[2] > 0)) continue;
+            ++covered;
+            for (int c = 0; c < 3; ++c) {
+                variance += varianceOfMean(a[c], accumSquares[p * 3 + c], n);
+                double v = a[c] / n;
+                if (!directForNoise.empty()) v = std::max(0.0, v - directForNoise[p * 3 + c]);
+                signal += v * v;
+            }
+        }
+        if (covered == 0 || !(signal > 0)) return std::numeric_limits<double>::infinity();
+        return std::sqrt(variance / signal);
+    };
+
     int done = 0;
     int passSize = 1;
     while (done < target) {
@@ -444,6 +491,10 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
         done += count;
         if (progress) progress(done, elapsed());
         if (options.timeBudgetSeconds > 0 && elapsed() >= options.timeBudgetSeconds) break;
+        // Few samples underestimate the variance of rare bright paths: the target is trusted from
+        // kMinNoiseSamples on.
+        if (options.noiseTarget > 0 && done >= kMinNoiseSamples && currentNoise(done) <= options.noiseTarget)
+            break;
         passSize = std::min(passSize * 2, kMaxPassSamples);
     }
 
@@ -458,6 +509,17 @@ ReferenceImage ReferenceRenderer::render(const FrameState& state, const Referenc
     for (size_t i = 0; i < pixels * 3; ++i) {
         const auto v = static_cast<float>(accum[i] * inv);
         image.rgb[i] = std::isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
+    // A deterministic render is exact (variance 0); one sample of a random one says nothing about its
+    // spread (left empty: unknown).
+    if (target == 1 && mode == Mode::Direct && !options.jitter) {
+        image.variance.assign(pixels * 3, 0.0f);
+    } else if (done >= 2) {
+        image.variance.resize(pixels * 3);
+        for (size_t i = 0; i < pixels * 3; ++i) {
+            const auto v = static_cast<float>(varianceOfMean(accum[i], accumSquares[i], done));
+            image.variance[i] = std::isfinite(v) ? v : 0.0f;
+        }
     }
     image.seconds = elapsed();
     return image;

@@ -71,6 +71,13 @@ struct ReferenceOptions {
     /// is the matching value. Lobes seen from the camera, or through sharper ones (a mirror), keep their
     /// highlights.
     float causticMinRoughness = 0.0f;
+    /// Also stop once the image's relative noise (sqrt of the mean variance of the pixel means over the
+    /// signal's RMS, over the pixels it covers) is at most this, checked between passes from 32 samples
+    /// on; 0 = none. `spp` stays the upper bound.
+    double noiseTarget = 0;
+    /// Measure the noise target against the image less its direct light (what a GI comparison
+    /// measures), not the whole image.
+    bool noiseOfIndirect = false;
 };
 
 struct ReferenceImage {
@@ -78,7 +85,11 @@ struct ReferenceImage {
     int height = 0;
     std::vector<float> rgb; ///< linear radiance, 3 floats per pixel, rows top to bottom; finite and >= 0
     int spp = 0;            ///< samples per pixel actually taken
-    double seconds = 0;     ///< wall-clock render time (0 for a cache hit's load)
+    /// Per pixel and channel, the variance of the pixel's mean (its noise squared, from the samples'
+    /// spread); zeros for a deterministic render, empty when unknown (one sample of a random estimator,
+    /// or an EXR from elsewhere).
+    std::vector<float> variance;
+    double seconds = 0; ///< wall-clock render time (0 for a cache hit's load)
     std::string mode;
     std::string key; ///< referenceCacheKey() of the request (may be empty for images read from elsewhere)
 };
@@ -113,10 +124,11 @@ void validateReferenceOptions(const ReferenceOptions& options);
 
 /// Content hash (hex, 32 digits) of everything the image depends on: geometry, materials, textures,
 /// camera, light, size, specular_lobe, effect_specular (off or not), mode, spp, time budget, seed, depth,
-/// jitter, causticMinRoughness (not the thread count).
+/// jitter, causticMinRoughness, noiseTarget and noiseOfIndirect (not the thread count).
 std::string referenceCacheKey(const Scene& scene, const FrameState& state, const ReferenceOptions& options);
 
-/// Writes an RGB float EXR with metadata gis:mode, gis:spp, gis:seconds, gis:key (atomic: temp + rename).
+/// Writes a float EXR with channels R, G, B and, when the image has them, variance.R/G/B (the pixel
+/// means' variance), and metadata gis:mode, gis:spp, gis:seconds, gis:key (atomic: temp + rename).
 /// Throws gis::Error on I/O failure.
 void writeReferenceExr(const std::string& path, const ReferenceImage& image);
 /// Reads an EXR written by writeReferenceExr (other RGB(A) EXRs load with empty metadata).

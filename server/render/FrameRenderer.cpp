@@ -370,7 +370,7 @@ const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const 
     return a.mean;
 }
 
-FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
+FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool wantDirect) {
     GIS_ASSERT(mSceneGpu != nullptr);
     GIS_ASSERT(state.width > 0 && state.height > 0);
     Stopwatch frameClock;
@@ -510,6 +510,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear) {
     Stopwatch readClock;
     out.rgba8 = readRgba8(mCompositeFbo, 0, state.width, state.height);
     if (wantLinear) out.linear = readRgba32f(mCompositeFbo, 1, state.width, state.height);
+    if (wantDirect) out.linearDirect = readRgba32f(mDirectFbo, 0, state.width, state.height);
     const double readbackMs = readClock.elapsedMs();
     if (readsRsm && views == 1 && !reuseLights) viewFlux = readViewFlux(views);
     if (mReuseLightPasses && !reuseLights) {

@@ -45,6 +45,9 @@ struct FrameOutput {
     int height = 0;
     std::vector<std::uint8_t> rgba8; ///< tone-mapped sRGB, rows top to bottom
     std::vector<float> linear;       ///< linear RGBA radiance, rows top to bottom (when requested)
+    /// The direct pass alone (direct light and emission), linear RGBA like `linear` (when requested):
+    /// linear minus this is the technique's indirect light and reflections.
+    std::vector<float> linearDirect;
     /// The stats object documented in protocol/PROTOCOL.md: technique, size, frame_ms, passes,
     /// counts, params.
     nlohmann::json stats;
@@ -56,8 +59,9 @@ public:
     ~FrameRenderer();
     void setScene(std::shared_ptr<const Scene> scene);
     const Scene* scene() const { return mScene.get(); }
-    /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics).
-    FrameOutput render(const FrameState& state, bool wantLinear = false);
+    /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics),
+    /// `wantDirect` the direct pass's (indirect-only metrics).
+    FrameOutput render(const FrameState& state, bool wantLinear = false, bool wantDirect = false);
     /// Keep the light views' shadow maps and RSMs while the lights, the scene and the RSM settings stay
     /// the same (the stats' counts then have `light_views_reused`). Off by default, so that benchmarks
     /// and tests time every pass of every frame; the service turns it on.

@@ -15,6 +15,18 @@ string(JSON rel GET "${OUT}" relative_rmse)
 if(rel LESS_EQUAL 0 OR rel GREATER 1)
     message(FATAL_ERROR "implausible relative RMSE ${rel}: ${OUT}")
 endif()
+# The reference's noise (its EXR carries the variance), the error corrected for it, and the split into
+# the technique's indirect light and the direct pass.
+string(JSON noise GET "${OUT}" reference_noise)
+string(JSON fixed GET "${OUT}" relative_rmse_corrected)
+string(JSON indirect GET "${OUT}" indirect relative_rmse)
+string(JSON indirectNoise GET "${OUT}" indirect reference_noise)
+string(JSON direct GET "${OUT}" direct relative_rmse)
+if(noise LESS_EQUAL 0 OR NOT fixed LESS rel OR indirect LESS_EQUAL 0 OR NOT indirectNoise GREATER noise
+   OR direct LESS_EQUAL 0 OR NOT direct LESS 1)
+    message(FATAL_ERROR "implausible noise or split (noise ${noise}, corrected ${fixed}, indirect ${indirect}, "
+                        "indirect noise ${indirectNoise}, direct ${direct}): ${OUT}")
+endif()
 run_ok(${BENCH} compare ${WORK}/ref.exr ${WORK}/ref.exr)
 string(JSON rel GET "${OUT}" relative_rmse)
 if(NOT rel EQUAL 0)
@@ -24,5 +36,12 @@ run_ok(${BENCH} table --size 32x32 --spp 8 --frames 1 --config none --config rsm
        --reference one-bounce --cache-dir ${WORK}/cache --json ${WORK}/table.json)
 if(NOT OUT MATCHES "rsm_gather:vpl_grid=4")
     message(FATAL_ERROR "table lacks the configuration row:\n${OUT}")
+endif()
+file(READ ${WORK}/table.json table)
+string(JSON indirect GET "${table}" rows 1 error one-bounce indirect relative_rmse_corrected)
+string(JSON noise GET "${table}" rows 1 error one-bounce indirect reference_noise)
+if(NOT OUT MATCHES "reference one-bounce: 8 spp, relative noise 0\\.[0-9]+ of the image" OR indirect LESS 0
+   OR noise LESS_EQUAL 0)
+    message(FATAL_ERROR "table lacks the reference noise or the indirect error:\n${OUT}")
 endif()
 message(STATUS "ok")

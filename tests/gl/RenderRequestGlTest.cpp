@@ -144,6 +144,33 @@ TEST(RenderRequestGl, CompareAddsMetrics) {
     EXPECT_EQ(compare["reference"]["cache_hit"], false);
     // The GL direct light against the CPU's: the same integral, so the error is small.
     EXPECT_LT(compare["relative_rmse"].get<double>(), 0.3);
+    EXPECT_EQ(compare["reference_noise"], 0.0); // a pixel-centre direct render is exact
+    EXPECT_FALSE(compare.contains("indirect")); // nothing to split off a direct reference
+}
+
+// A GI reference with a noise target: the noise is reported beside the error, and the indirect light
+// and the direct pass are measured apart.
+TEST(RenderRequestGl, CompareSplitsIndirectLightAndReportsTheNoise) {
+    if (!gis::renderJobsCanCompare()) GTEST_SKIP() << "built without the reference layer";
+    gis::RenderJob job = gis::parseRenderRequest(
+        {{"scene", "builtin:cornell"},
+         {"technique", "rsm_gather"},
+         {"params", {{"vpl_grid", 8}}},
+         {"size", {32, 32}},
+         {"compare", {{"mode", "one-bounce-unoccluded"}, {"noise_target", 0.1}}}});
+    EXPECT_EQ(job.compare->spp, gis::RenderLimits{}.maxReferenceSpp); // the target decides, up to the cap
+    const nlohmann::json compare = execute(job).stats["compare"];
+    std::printf("%s\n", compare.dump().c_str());
+    const nlohmann::json& indirect = compare["indirect"];
+    EXPECT_GT(compare["reference"]["spp"].get<int>(), 1);
+    EXPECT_EQ(compare["reference"]["noise_target"]["of"], "indirect");
+    EXPECT_LE(indirect["reference_noise"].get<double>(), 0.1);
+    EXPECT_GT(indirect["reference_noise"].get<double>(), compare["reference_noise"].get<double>());
+    EXPECT_LE(indirect["relative_rmse_corrected"].get<double>(), indirect["relative_rmse"].get<double>());
+    EXPECT_GT(indirect["relative_rmse"].get<double>(), 0.0);
+    EXPECT_NEAR(indirect["mean_ratio"].get<double>(), 1.0, 0.35);
+    EXPECT_EQ(compare["direct"]["reference"]["mode"], "direct");
+    EXPECT_LT(compare["direct"]["relative_rmse"].get<double>(), 0.3);
 }
 
 TEST(RenderRequestGl, ResolverDecidesTheScene) {

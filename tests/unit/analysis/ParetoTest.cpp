@@ -1,3 +1,5 @@
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "analysis/Pareto.h"
@@ -37,6 +39,24 @@ TEST(Pareto, PresetsFollowTheBudget) {
     EXPECT_LE(c.balanced, c.final);
     // Nothing within the budget: the fastest point.
     EXPECT_EQ(gis::choosePresets(front, 1).interactive, 0u);
+}
+
+// Differences within the noise do not buy a slower preset: of points equally accurate within the
+// tolerance the fastest is chosen, for final and interactive alike.
+TEST(Pareto, PresetsIgnoreDifferencesWithinTheNoise) {
+    const std::vector<gis::TradeoffPoint> front = {
+        {10, 0.30}, {40, 0.105}, {90, 0.100}, {400, 0.098}, {2000, 0.097}};
+    const auto exact = gis::choosePresets(front, 100);
+    EXPECT_EQ(exact.final, 4u);
+    EXPECT_EQ(exact.interactive, 2u);
+    const auto tolerant = gis::choosePresets(front, 100, 0.01);
+    EXPECT_EQ(tolerant.final, 1u);       // 0.105 is within 0.01 of 0.097
+    EXPECT_EQ(tolerant.interactive, 1u); // 0.105 is within 0.01 of 0.100
+    EXPECT_GE(tolerant.balanced, tolerant.interactive);
+    EXPECT_LE(tolerant.balanced, tolerant.final);
+    // A tolerance below every gap changes nothing; a non-finite one is treated as none.
+    EXPECT_EQ(gis::choosePresets(front, 100, 0.0005).final, 4u);
+    EXPECT_EQ(gis::choosePresets(front, 100, std::nan("")).final, 4u);
 }
 
 gis::ParamTable table() {

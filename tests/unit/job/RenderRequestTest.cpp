@@ -193,6 +193,20 @@ TEST(RenderRequest, CompareOptionsAndLimits) {
               "/compare/time_budget_s");
     EXPECT_EQ(failureOf(withScene({{"compare", {{"mode", "path"}, {"time_budget_s", 3600}}}})).where,
               "/compare/time_budget_s");
+    // A noise target: spp becomes the cap (the server's unless the request names fewer).
+    const gis::RenderJob noisy = gis::parseRenderRequest(
+        withScene({{"compare", {{"mode", "one-bounce"}, {"noise_target", 0.05}, {"noise_of", "image"}}}}));
+    EXPECT_EQ(noisy.compare->noiseTarget, 0.05);
+    EXPECT_FALSE(noisy.compare->noiseOfIndirect);
+    EXPECT_EQ(noisy.compare->spp, gis::RenderLimits{}.maxReferenceSpp);
+    EXPECT_EQ(gis::parseRenderRequest(
+                  withScene({{"compare", {{"mode", "one-bounce"}, {"noise_target", 0.05}, {"spp", 16}}}}))
+                  .compare->spp,
+              16);
+    EXPECT_EQ(failureOf(withScene({{"compare", {{"mode", "path"}, {"noise_target", 0.9}}}})).where,
+              "/compare/noise_target");
+    EXPECT_EQ(failureOf(withScene({{"compare", {{"mode", "path"}, {"noise_of", "pixels"}}}})).where,
+              "/compare/noise_of");
 }
 
 TEST(RenderRequest, JobFrameStateLayersTheRequestOnTheScene) {

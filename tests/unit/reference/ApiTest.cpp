@@ -149,9 +149,19 @@ TEST(ReferenceApi, ExrRoundTripKeepsPixelsAndMetadata) {
     img.seconds = 1.5;
     img.mode = "one-bounce";
     img.key = "0123456789abcdef0123456789abcdef";
+    img.variance = {0.0f, 1e-6f, 2e-6f, 3e-3f, 4.0f, 5e-9f, 6.0f, 7.0f, 8.0f,
+                    9.0f, 1.0f,  0.5f,  1e4f,  0.0f, 0.0f,  2.0f, 1.0f, 0.25f};
     const std::string path = (dir.path / "x.exr").string();
     writeReferenceExr(path, img);
     const ReferenceImage back = readReferenceExr(path);
+    EXPECT_EQ(back.variance, img.variance);
+    // Without the variance the file has three channels and reads back with the variance unknown.
+    ReferenceImage plain = img;
+    plain.variance.clear();
+    writeReferenceExr((dir.path / "plain.exr").string(), plain);
+    const ReferenceImage plainBack = readReferenceExr((dir.path / "plain.exr").string());
+    EXPECT_EQ(plainBack.rgb, img.rgb);
+    EXPECT_TRUE(plainBack.variance.empty());
     EXPECT_EQ(back.width, 3);
     EXPECT_EQ(back.height, 2);
     EXPECT_EQ(back.rgb, img.rgb);
@@ -176,6 +186,8 @@ TEST(ReferenceApi, CacheRendersOnceThenHits) {
     const ReferenceImage second = renderReferenceCached(scene, state, o, dir.path.string(), &hit);
     EXPECT_TRUE(hit);
     EXPECT_EQ(second.rgb, first.rgb);
+    EXPECT_EQ(second.variance, first.variance);
+    EXPECT_EQ(second.variance.size(), first.rgb.size());
     EXPECT_EQ(second.spp, first.spp);
     EXPECT_EQ(second.key, first.key);
     // A corrupt file for the key is replaced, not trusted.

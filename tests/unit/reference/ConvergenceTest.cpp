@@ -123,3 +123,97 @@ TEST(ReferenceCacheKey, FollowsEveryInputButNotThreads) {
     moved2.meshes[0].positions[0].y += 1e-3f;
     EXPECT_NE(key, referenceCacheKey(moved2, state, o));
 }
+
+namespace {
+// Sums over pixels and channels where the converged image is not black.
+struct ErrorAgainstTruth {
+    double squaredError = 0, reportedVariance = 0, truthVariance = 0, signal = 0;
+};
+ErrorAgainstTruth errorAgainst(const ReferenceImage& img, const ReferenceImage& truth) {
+    ErrorAgainstTruth e;
+    for (size_t i = 0; i < img.rgb.size(); ++i) {
+        if (truth.rgb[i] == 0.0f) continue;
+        const double d = img.rgb[i] - truth.rgb[i];
+        e.squaredError += d * d;
+        e.reportedVariance += img.variance[i];
+        e.truthVariance += truth.variance[i];
+        e.signal += double(truth.rgb[i]) * truth.rgb[i];
+    }
+    return e;
+}
+} // namespace
+
+// The variance each render reports for its pixel means predicts its actual squared error against a
+// converged render (whose own variance is subtracted), for every random mode.
+TEST(ReferenceNoise, ReportedVariancePredictsTheError) {
+    const Scene scene = loadScene("builtin:cornell");
+    const FrameState state = cornellState(scene, 24, 24);
+    ReferenceRenderer renderer(scene);
+    for (const std::string mode : {"one-bounce-unoccluded", "one-bounce", "path"}) {
+        const ReferenceImage truth = renderer.render(state, {.mode = mode, .spp = 2048, .seed = 99});
+        ASSERT_EQ(truth.variance.size(), truth.rgb.size());
+        for (int spp : {16, 64}) {
+            const ReferenceImage img = renderer.render(state, {.mode = mode, .spp = spp, .seed = 3});
+            ASSERT_EQ(img.variance.size(), img.rgb.size());
+            const ErrorAgainstTruth e = errorAgainst(img, truth);
+            const double ratio = (e.squaredError - e.truthVariance) / e.reportedVariance;
+            std::printf(
+                "%s %d spp: relative noise reported %.4f, measured error %.4f (ratio of squares %.3f)\n",
+                mode.c_str(), spp, std::sqrt(e.reportedVariance / e.signal),
+                std::sqrt(std::max(0.0, e.squaredError - e.truthVariance) / e.signal), ratio);
+            // Rare bright paths make the sample variance itself noisy, most at few samples.
+            EXPECT_GT(ratio, 0.6) << mode << " " << spp;
+            EXPECT_LT(ratio, 1.6) << mode << " " << spp;
+        }
+    }
+}
+
+TEST(ReferenceNoise, DeterministicRenderIsExactAndOneRandomSampleIsUnknown) {
+    const Scene scene = loadScene("builtin:cornell");
+    const FrameState state = cornellState(scene, 12, 12);
+    ReferenceRenderer renderer(scene);
+    const ReferenceImage direct = renderer.render(state, {.mode = "direct", .spp = 16});
+    EXPECT_EQ(direct.spp, 1);
+    ASSERT_EQ(direct.variance.size(), direct.rgb.size());
+    for (float v : direct.variance) EXPECT_EQ(v, 0.0f);
+    EXPECT_TRUE(renderer.render(state, {.mode = "one-bounce", .spp = 1}).variance.empty());
+}
+
+// A noise target stops the render once the image's relative noise is below it: a tighter target takes
+// more samples, and both stop short of the spp cap.
+TEST(ReferenceNoise, NoiseTargetStopsWhenReached) {
+    const Scene scene = loadScene("builtin:cornell");
+    const FrameState state = cornellState(scene, 24, 24);
+    ReferenceRenderer renderer(scene);
+    auto noiseOf = [](const ReferenceImage& img, const std::vector<float>* direct) {
+        double variance = 0, signal = 0;
+        for (size_t i = 0; i < img.rgb.size(); ++i) {
+            variance += img.variance[i];
+            const double v = direct ? std::max(0.0, double(img.rgb[i]) - (*direct)[i]) : img.rgb[i];
+            signal += v * v;
+        }
+        return std::sqrt(variance / signal);
+    };
+    ReferenceOptions loose{.mode = "one-bounce", .spp = 100000, .seed = 4};
+    loose.noiseTarget = 0.05;
+    ReferenceOptions tight = loose;
+    tight.noiseTarget = 0.02;
+    const ReferenceImage a = renderer.render(state, loose), b = renderer.render(state, tight);
+    std::printf("noise target 0.05: %d spp (noise %.4f); 0.02: %d spp (noise %.4f)\n", a.spp,
+                noiseOf(a, nullptr), b.spp, noiseOf(b, nullptr));
+    EXPECT_GE(a.spp, 32);
+    EXPECT_LT(b.spp, 100000);
+    EXPECT_GT(b.spp, a.spp);
+    EXPECT_LE(noiseOf(a, nullptr), 0.05);
+    EXPECT_LE(noiseOf(b, nullptr), 0.02);
+    // Against the indirect light alone the same target needs more samples.
+    ReferenceOptions indirect = loose;
+    indirect.noiseOfIndirect = true;
+    const ReferenceImage c = renderer.render(state, indirect);
+    const std::vector<float> direct = renderer.render(state, {.mode = "direct"}).rgb;
+    std::printf("noise target 0.05 of the indirect light: %d spp (noise %.4f)\n", c.spp, noiseOf(c, &direct));
+    EXPECT_GT(c.spp, a.spp);
+    EXPECT_LE(noiseOf(c, &direct), 0.05);
+    EXPECT_NE(referenceCacheKey(scene, state, loose), referenceCacheKey(scene, state, tight));
+    EXPECT_NE(referenceCacheKey(scene, state, loose), referenceCacheKey(scene, state, indirect));
+}
