@@ -30,8 +30,8 @@ import { restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
 import { PassChart } from './chart.js';
 import { LightGizmo } from './gizmo.js';
 import {
-    COMPARE_MODES, DEFAULT_COMPARE, buildCompareRequest, canCompare, diffImage, formatCompare, validateCompareRequest,
-    viewKey,
+    COMPARE_MODES, COMPARE_RANGES, DEFAULT_COMPARE, buildCompareRequest, canCompare, compareSettings, diffImage,
+    formatCompare, referenceLabel, validateCompareRequest, viewKey,
 } from './accuracy.js';
 import { MessageStack, describeError, describeHttpError, noticeFor } from './messages.js';
 import { uploadGlb, uploadName } from './upload.js';
@@ -105,7 +105,8 @@ const page = pageOptions(window.location);
 function loadSettings() {
     const defaults = {
         tool: 'orbit', flySpeed: 0.5, overlay: true, chart: true, help: false, gizmo: true,
-        compareMode: DEFAULT_COMPARE.mode, compareSpp: DEFAULT_COMPARE.spp, compareMaxSide: DEFAULT_COMPARE.maxSide,
+        compareMode: DEFAULT_COMPARE.mode, compareNoiseTarget: DEFAULT_COMPARE.noiseTarget,
+        compareMaxSpp: DEFAULT_COMPARE.maxSpp, compareMaxSide: DEFAULT_COMPARE.maxSide,
         compareView: 'live', diffGain: 4, frameTargetMs: null, pixelBudget: DEFAULT_PIXEL_BUDGET,
     };
     let stored = {};
@@ -115,6 +116,10 @@ function loadSettings() {
     const s = { ...defaults, ...stored };
     s.frameTargetMs = normalizeFrameTarget(s.frameTargetMs);
     s.pixelBudget = normalizePixelBudget(s.pixelBudget);
+    const compare = compareSettings(s);
+    s.compareNoiseTarget = compare.noiseTarget;
+    s.compareMaxSpp = compare.maxSpp;
+    delete s.compareSpp; // an older page's fixed reference spp: the noise target replaces it (compareSettings)
     return s;
 }
 const settings = loadSettings();
@@ -849,7 +854,7 @@ function showAccuracyLine() {
     if (!result) return;
     const f = formatCompare(result);
     const stale = accuracyGui.stale() ? ' (earlier view)' : '';
-    ui.ovAccuracy.textContent = `rel. RMSE ${f.relRmse} vs ${state.compare.request.compare.mode}${stale}`;
+    ui.ovAccuracy.textContent = `${f.overlay} vs ${state.compare.request.compare.mode}${stale}`;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1516,7 +1521,9 @@ const accuracyGui = (() => {
     const gui = makeSection(ui.sections, 'Accuracy', { id: 'accuracy', closed: false });
     const model = {
         mode: COMPARE_MODES.includes(settings.compareMode) ? settings.compareMode : DEFAULT_COMPARE.mode,
-        spp: settings.compareSpp,
+        // The control shows percent; the settings and the request hold the fraction.
+        noisePct: Math.round(1000 * settings.compareNoiseTarget) / 10,
+        maxSpp: settings.compareMaxSpp,
         maxSide: settings.compareMaxSide,
         view: settings.compareView,
         gain: settings.diffGain,
@@ -1526,11 +1533,24 @@ const accuracyGui = (() => {
         settings[key] = v;
         saveSettings();
     };
-    describe(gui.add(model, 'mode', COMPARE_MODES).name('reference'), 'compare-mode',
-        'the CPU reference the frame is measured against (one-bounce-unoccluded matches what the VPL techniques simulate)')
-        .onChange(save('compareMode'));
-    describe(gui.add(model, 'spp', 1, 64, 1).name('reference spp'), 'compare-spp',
-        'samples per pixel of the reference: more is less noisy and slower').onChange(save('compareSpp'));
+    const modeCtl = describe(gui.add(model, 'mode', COMPARE_MODES).name('reference'), 'compare-mode',
+        'the CPU reference the frame is measured against (one-bounce-unoccluded matches what the VPL techniques simulate)');
+    const { noiseTarget: noiseRange, maxSpp: sppRange } = COMPARE_RANGES;
+    const noiseCtl = describe(gui.add(model, 'noisePct', 100 * noiseRange.min, 100 * noiseRange.max, 0.5)
+        .name('noise target (%)'), 'compare-noise',
+        'the reference renders until its own noise, estimated from its samples\' spread, is at most this share of '
+        + 'its indirect light: lower is cleaner and slower (a direct reference is exact and ignores it)')
+        .onChange((v) => save('compareNoiseTarget')(v / 100));
+    describe(gui.add(model, 'maxSpp', sppRange.min, sppRange.max, 1).name('max spp'), 'compare-max-spp',
+        'the most samples per pixel the reference may take on the way to the noise target; the server refuses '
+        + 'more than its limit (gi-server\'s is 1024) and says so').onChange(save('compareMaxSpp'));
+    // A direct reference is one exact sample: its noise target means nothing.
+    const showMode = (mode) => noiseCtl.enable(mode !== 'direct');
+    showMode(model.mode);
+    modeCtl.onChange((v) => {
+        save('compareMode')(v);
+        showMode(v);
+    });
     describe(gui.add(model, 'maxSide', 32, 256, 16).name('size (px)'), 'compare-size',
         'the longer side of the measured image; the current view\'s aspect is kept').onChange(save('compareMaxSide'));
     const measureCtl = describe(gui.add(model, 'measure').name('Measure this view'), 'compare-run',
@@ -1542,6 +1562,10 @@ const accuracyGui = (() => {
     const result = addBlock(gui, block('div', 'compare-result block'));
     result.dataset.block = 'compare-result';
     result.textContent = 'Not measured yet. Measuring costs a few seconds of CPU time on the server.';
+    // How to read the figures (corrected or not, what "indirect" means): under them, once there are some.
+    const resultHint = addBlock(gui, block('p', 'hint block compare-hint'));
+    resultHint.dataset.block = 'compare-hint';
+    resultHint.hidden = true;
     const views = { 'live stream': 'live', 'API render': 'api', reference: 'ref', difference: 'diff' };
     const viewCtl = describe(gui.add(model, 'view', views).name('show'),
         'compare-view', 'the live stream, the measured API render of the view, the CPU reference, or the difference '
@@ -1556,8 +1580,8 @@ const accuracyGui = (() => {
         showCompareLayer();
     });
     addBlock(gui, block('p', 'hint block',
-        'The server reports the error against its CPU reference but does not send the reference image: '
-        + '"API render" is the frame it measured, "difference" compares it with the stream.'));
+        '"API render" is the frame the server measured, "reference" its CPU reference, "difference" the two '
+        + 'apart (the stream instead of the reference when a server sends none).'));
     return {
         gui,
         model,
@@ -1566,7 +1590,8 @@ const accuracyGui = (() => {
             progressText.textContent = text ?? '';
             measureCtl.name(text === null ? 'Measure this view' : 'Cancel');
         },
-        showResult(text, lines) {
+        /** A sentence and/or [label, text] rows, and the hint on how to read them (hidden when null). */
+        showResult(text, lines, hint = null) {
             result.replaceChildren();
             if (text) result.append(block('p', '', text));
             for (const [k, v] of lines ?? []) {
@@ -1574,6 +1599,8 @@ const accuracyGui = (() => {
                 div.append(block('span', 'k', k), block('span', 'v', v));
                 result.append(div);
             }
+            resultHint.hidden = !hint;
+            resultHint.textContent = hint ?? '';
         },
         /** True when the view on screen is no longer the one measured. */
         stale() {
@@ -1662,7 +1689,8 @@ function currentCompareRequest() {
         frameSize: [drawn.width, drawn.height],
         maxSide: m.maxSide,
         mode: m.mode,
-        spp: m.spp,
+        noiseTarget: m.noisePct / 100,
+        maxSpp: m.maxSpp,
     });
 }
 
@@ -1693,7 +1721,7 @@ async function measureAccuracy() {
     const abort = new AbortController();
     const started = performance.now();
     state.compareRunning = { abort, started };
-    const label = `${request.compare.mode}, ${request.compare.spp} spp, ${request.size[0]}×${request.size[1]}`;
+    const label = referenceLabel(request);
     const tick = () => accuracyGui.running(
         `rendering the reference (${label}): ${((performance.now() - started) / 1000).toFixed(1)} s`);
     tick();
@@ -1715,10 +1743,9 @@ async function measureAccuracy() {
         };
         const f = formatCompare(state.compare.result);
         accuracyGui.showResult(null, f ? [
-            ['relative RMSE', f.relRmse], ['PSNR', f.psnr], ['SSIM', f.ssim], ['FLIP', f.flip],
-            ['reference', f.reference], ['frame time', formatMs(body.stats?.frame_ms)],
+            ...f.rows, ['frame time', formatMs(body.stats?.frame_ms)],
             ['measured in', `${((performance.now() - started) / 1000).toFixed(1)} s`],
-        ] : [['result', 'the server sent no comparison']]);
+        ] : [['result', 'the server sent no comparison']], f?.hint ?? null);
         showAccuracyLine();
         showCompareLayer();
     } catch (e) {
@@ -1768,8 +1795,9 @@ function showCompareLayer() {
         return;
     }
     if (view === 'api') {
-        ui.layerLabel.textContent = `API render of the measured view (PNG ${width}×${height}); rel. RMSE `
-            + `${formatCompare(state.compare.result)?.relRmse ?? '–'} vs the ${state.compare.request.compare.mode} reference`;
+        const error = formatCompare(state.compare.result)?.overlay ?? 'no comparison';
+        ui.layerLabel.textContent = `API render of the measured view (PNG ${width}×${height}); ${error} `
+            + `vs the ${state.compare.request.compare.mode} reference`;
         return;
     }
     const a = out.getImageData(0, 0, width, height).data;

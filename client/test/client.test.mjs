@@ -19,7 +19,8 @@ import {
 import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
 import { LatencyTracker, PassHistory, RateCounter, formatBytes, networkMs, passMs, stackSeries } from '../stats.js';
 import {
-    buildCompareRequest, canCompare, compareSize, diffImage, formatCompare, validateCompareRequest, viewKey,
+    DEFAULT_COMPARE, buildCompareRequest, canCompare, compareSettings, compareSize, diffImage, formatCompare, percent,
+    referenceLabel, validateCompareRequest, viewKey,
 } from '../accuracy.js';
 import { describeError, describeHttpError } from '../messages.js';
 import { uploadName } from '../upload.js';
@@ -363,16 +364,24 @@ test('the accuracy request is the view on screen, small, and valid for POST /api
         intensity: 3, color: [1, 0.8, 0.6], range: 4, cone_deg: 45, inner_cone_deg: 36, enabled: false };
     const request = buildCompareRequest({
         scene: 'builtin:cornell', technique: 'rsm_gather', params: { vpl_grid: 4, exposure: 0 }, camera: HOME,
-        lights: [KEY, fill], frameSize: [480, 400], maxSide: 128, mode: 'one-bounce-unoccluded', spp: 8,
+        lights: [KEY, fill], frameSize: [480, 400], maxSide: 128, mode: 'one-bounce-unoccluded', noiseTarget: 0.05, maxSpp: 1024,
     });
     assert.deepEqual(request.lights, [KEY, fill], 'every light, with its type and id');
     assert.equal('light' in request, false, 'lights replace the scene\'s; light would only edit one of them');
     assert.notEqual(request.lights[0], KEY, 'a copy');
     assert.equal(request.response, 'json');
-    assert.deepEqual(request.compare, { mode: 'one-bounce-unoccluded', spp: 8 });
+    assert.deepEqual(request.compare, { mode: 'one-bounce-unoccluded', noise_target: 0.05, spp: 1024 },
+        'a noise target with the spp only the cap');
     assert.deepEqual(request.size, [128, 107]);
     assert.equal(validateCompareRequest(request, RENDER_REQUEST_SCHEMA), null);
     assert.equal(validateCompareRequest({ ...request, compare: { mode: 'nope' } }, RENDER_REQUEST_SCHEMA).where, '/compare/mode');
+    assert.equal(validateCompareRequest({ ...request, compare: { ...request.compare, noise_target: 0.6 } },
+        RENDER_REQUEST_SCHEMA).where, '/compare/noise_target', 'the schema caps the noise target at 0.5');
+    assert.equal(validateCompareRequest({ ...request, compare: { ...request.compare, noise_target: 0 } },
+        RENDER_REQUEST_SCHEMA).where, '/compare/noise_target');
+    // Above the server's limit is the server's to refuse (400 at /compare/spp): the schema has no maximum.
+    assert.equal(validateCompareRequest({ ...request, compare: { ...request.compare, spp: 4096 } }, RENDER_REQUEST_SCHEMA), null);
+    assert.equal(referenceLabel(request), 'one-bounce-unoccluded, to 5 % noise, at most 1024 spp, 128×107');
     assert.equal(validateCompareRequest({ ...request, response: 'xml' }, RENDER_REQUEST_SCHEMA).where, '/response');
     assert.equal(viewKey({ ...request, size: [64, 64], compare: { mode: 'path', spp: 1 } }), viewKey(request),
         'the view key ignores size and reference settings');
@@ -384,25 +393,119 @@ test('the accuracy request is the view on screen, small, and valid for POST /api
     assert.equal('inner_cone_deg' in requestLight({ ...KEY, inner_cone_deg: 70 }), false,
         'an inner cone wider than the outer one is left to the server');
     const noLights = buildCompareRequest({ scene: 'builtin:cornell', technique: 'none', camera: HOME, lights: [], frameSize: [64, 64],
-        maxSide: 64, mode: 'direct', spp: 1 });
+        maxSide: 64, mode: 'direct', noiseTarget: 0.05, maxSpp: 1024 });
     assert.deepEqual(noLights.lights, [], 'no lights is a view too');
+    assert.deepEqual(noLights.compare, { mode: 'direct', spp: 1024 }, 'a direct reference is exact: no noise target');
+    assert.equal(referenceLabel(noLights), 'direct, 64×64');
     assert.equal(validateCompareRequest(noLights, RENDER_REQUEST_SCHEMA), null);
     const single = buildCompareRequest({ scene: 'builtin:cornell', technique: 'none', camera: HOME, light: v1, frameSize: [64, 64],
-        maxSide: 64, mode: 'direct', spp: 1 });
+        maxSide: 64, mode: 'path', noiseTarget: 0.2, maxSpp: 16 });
+    assert.deepEqual(single.compare, { mode: 'path', noise_target: 0.2, spp: 16 });
+    assert.equal(referenceLabel(single), 'path, to 20 % noise, at most 16 spp, 64×64');
+    assert.equal(referenceLabel({ size: [64, 64], compare: { mode: 'path', spp: 8 } }), 'path, 8 spp, 64×64',
+        'a fixed sample count');
     assert.deepEqual(single.light, v1, 'a server without a light list gets its one light');
     assert.equal(validateCompareRequest(single, RENDER_REQUEST_SCHEMA), null);
     assert.ok(canCompare('builtin:cornell'));
     assert.ok(!canCompare('upload:x.glb'), 'uploads are not reachable through the HTTP API');
 });
 
-test('comparison metrics and the difference image', () => {
+test('saved accuracy settings: a noise target and an spp cap; an older page\'s fixed spp is dropped', () => {
+    const defaults = { noiseTarget: DEFAULT_COMPARE.noiseTarget, maxSpp: DEFAULT_COMPARE.maxSpp };
+    assert.deepEqual(defaults, { noiseTarget: 0.1, maxSpp: 1024 }, '10 % of the indirect light, the server\'s limit');
+    assert.deepEqual(compareSettings({}), defaults);
+    assert.deepEqual(compareSettings(undefined), defaults);
+    assert.deepEqual(compareSettings({ compareSpp: 8, compareMode: 'path' }), defaults,
+        'the old reference spp is not taken as the cap (8 spp would never reach the target)');
+    assert.deepEqual(compareSettings({ compareNoiseTarget: 0.1, compareMaxSpp: 256 }), { noiseTarget: 0.1, maxSpp: 256 });
+    assert.deepEqual(compareSettings({ compareNoiseTarget: 0.001, compareMaxSpp: 1e9 }), { noiseTarget: 0.01, maxSpp: 4096 },
+        'clamped to the controls\' ranges');
+    assert.deepEqual(compareSettings({ compareNoiseTarget: 'x', compareMaxSpp: -3 }), defaults);
+    assert.deepEqual(compareSettings({ compareNoiseTarget: null, compareMaxSpp: null }), defaults);
+});
+
+// A POST /api/render answer's stats.compare (PROTOCOL.md): noise, corrected errors, indirect and direct.
+const COMPARE = {
+    relative_rmse: 0.129, relative_rmse_corrected: 0.124, reference_noise: 0.035, rmse: 0.02, psnr_db: 27.46,
+    max_abs_error: 0.9, ssim: 0.91234, flip: 0.08123, pixels: 13696,
+    indirect: { relative_rmse: 0.240, relative_rmse_corrected: 0.222, rmse: 0.01, reference_noise: 0.095, mean_ratio: 0.9962,
+        pixels: 13696 },
+    direct: { relative_rmse: 0.121, rmse: 0.02, psnr_db: 28, ssim: 0.93, flip: 0.07, pixels: 13696, reference_noise: 0,
+        reference: { mode: 'direct', spp: 1, key: 'k2' } },
+    reference: { mode: 'one-bounce-unoccluded', spp: 575, seconds: 0.171, key: 'k1', cache_hit: false,
+        noise_target: { value: 0.1, of: 'indirect' } },
+};
+
+test('comparison metrics: corrected errors beside the reference\'s noise, indirect light and direct pass', () => {
+    const f = formatCompare(COMPARE);
+    assert.equal(f.indirect, '22.2 % (reference noise 9.5 %)', 'the corrected indirect error, not the raw 24.0 %');
+    assert.equal(f.image, '12.4 % (noise 3.5 %)');
+    assert.equal(f.direct, '12.1 %');
+    assert.equal(f.indirectEnergy, '0.996 × the reference\'s');
+    assert.equal(f.psnr, '27.5 dB');
+    assert.equal(f.ssim, '0.9123');
+    assert.equal(f.reference, 'one-bounce-unoccluded, 575 spp (stopped at 10 % noise), 0.17 s');
+    assert.equal(f.overlay, 'indirect error 22.2 % ±9.5 % noise');
+    assert.equal(f.relRmse, '22.2 %', 'the headline is the indirect light\'s');
+    assert.ok(f.corrected);
+    assert.match(f.hint, /corrected for the reference's own noise; indirect = each side less its own direct light/);
+    assert.deepEqual(f.rows.map(([k]) => k), ['indirect light error', 'indirect energy', 'whole image', 'direct pass',
+        'PSNR', 'SSIM', 'FLIP', 'reference']);
+    assert.deepEqual(f.rows[0], ['indirect light error', '22.2 % (reference noise 9.5 %)']);
+
+    // The cap (or the server's time limit) came first: the noise reached says so.
+    const capped = formatCompare({ ...COMPARE, indirect: { ...COMPARE.indirect, reference_noise: 0.072 },
+        reference: { ...COMPARE.reference, spp: 1024, noise_target: { value: 0.05, of: 'indirect' }, cache_hit: true } });
+    assert.equal(capped.reference, 'one-bounce-unoccluded, 1024 spp (5 % noise not reached: 7.2 %), 0.17 s, cached');
+    const ofImage = formatCompare({ ...COMPARE, reference: { ...COMPARE.reference, noise_target: { value: 0.05, of: 'image' } } });
+    assert.match(ofImage.reference, /575 spp \(stopped at 5 % noise\)/, 'a target of the image is checked against the image\'s noise');
+    assert.equal(formatCompare({ ...COMPARE, reference: { ...COMPARE.reference, noise_target: undefined } }).reference,
+        'one-bounce-unoccluded, 575 spp, 0.17 s', 'a fixed sample count');
+
+    // Noise unknown (a reference without variance): the figures as measured, and said so.
+    const unknown = formatCompare({ ...COMPARE, reference_noise: null, relative_rmse_corrected: 0.129,
+        indirect: { ...COMPARE.indirect, reference_noise: null, relative_rmse_corrected: 0.240 } });
+    assert.equal(unknown.indirect, '24.0 % (reference noise –)');
+    assert.equal(unknown.image, '12.9 % (noise –)');
+    assert.equal(unknown.overlay, 'indirect error 24.0 %');
+    assert.ok(!unknown.corrected);
+    assert.match(unknown.hint, /as measured/);
+    assert.match(unknown.reference, /575 spp \(to 10 % noise\)/);
+
+    // A direct reference: nothing to split, exact.
+    const direct = formatCompare({ relative_rmse: 0.05, relative_rmse_corrected: 0.05, reference_noise: 0, ssim: 0.99,
+        reference: { mode: 'direct', spp: 1, seconds: 0.01 } });
+    assert.deepEqual(direct.rows.map(([k]) => k), ['whole image', 'PSNR', 'SSIM', 'FLIP', 'reference']);
+    assert.equal(direct.image, '5.0 % (noise 0 %)');
+    assert.equal(direct.overlay, 'image error 5.0 % ±0 % noise');
+    assert.doesNotMatch(direct.hint, /indirect/);
+});
+
+test('comparison metrics of an older server: what it sends, "–" for the rest', () => {
     const f = formatCompare({ relative_rmse: 0.0431, psnr_db: 31.25, ssim: 0.95, flip: 0.0812,
         reference: { mode: 'one-bounce-unoccluded', spp: 8, seconds: 1.234, cache_hit: false } });
-    assert.equal(f.relRmse, '4.31 %');
+    assert.equal(f.relRmse, '4.3 %');
+    assert.equal(f.image, '4.3 % (noise –)');
+    assert.equal(f.indirect, '–');
+    assert.equal(f.indirectEnergy, '–');
+    assert.equal(f.direct, '–');
     assert.equal(f.psnr, '31.3 dB');
     assert.equal(f.reference, 'one-bounce-unoccluded, 8 spp, 1.23 s');
+    assert.equal(f.overlay, 'image error 4.3 %');
+    assert.ok(!f.corrected);
+    assert.deepEqual(f.rows.slice(0, 4), [['indirect light error', '–'], ['indirect energy', '–'],
+        ['whole image', '4.3 % (noise –)'], ['direct pass', '–']]);
     assert.equal(formatCompare({ relative_rmse: Number.MAX_VALUE }).relRmse, '–', 'undefined relative RMSE');
+    assert.equal(formatCompare({ relative_rmse: 0.1, relative_rmse_corrected: Number.MAX_VALUE, reference_noise: 0.5 }).image,
+        '– (noise 50.0 %)', 'undefined corrected error: the noise swamps the signal');
+    assert.equal(formatCompare({ reference: {} }).image, '– (noise –)');
     assert.equal(formatCompare(null), null);
+    assert.equal(percent(0.0043), '0.43 %', 'two decimals below 1 %');
+    assert.equal(percent(0), '0 %');
+    assert.equal(percent(undefined), '–');
+});
+
+test('the difference image', () => {
     const a = new Uint8ClampedArray([10, 20, 30, 255, 0, 0, 0, 255]);
     const b = new Uint8ClampedArray([12, 20, 10, 0, 0, 0, 100, 255]);
     const d = diffImage(a, b, 4);

@@ -45,7 +45,8 @@ std::size_t kneeOfFront(const std::vector<TradeoffPoint>& front) {
     return best;
 }
 
-PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs, double errorTolerance) {
+PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs, double errorTolerance,
+                           double finalBudgetMs) {
     PresetChoice c;
     if (front.empty()) return c;
     const double tolerance = std::isfinite(errorTolerance) ? std::max(errorTolerance, 0.0) : 0.0;
@@ -55,11 +56,18 @@ PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budge
             if (front[i].error <= front[last].error + tolerance) return i;
         return last;
     };
-    c.final = fastestEqualTo(front.size() - 1);
+    // The most accurate point the final budget affords (the fastest point when none fits).
+    std::size_t mostAccurate = front.size() - 1;
+    if (finalBudgetMs > 0) {
+        mostAccurate = 0;
+        for (std::size_t i = 0; i < front.size(); ++i)
+            if (front[i].timeMs <= finalBudgetMs) mostAccurate = i;
+    }
+    c.final = fastestEqualTo(mostAccurate);
     c.interactive = 0;
     for (std::size_t i = 0; i < front.size(); ++i)
         if (front[i].timeMs <= budgetMs) c.interactive = i;
-    c.interactive = fastestEqualTo(c.interactive);
+    c.interactive = std::min(fastestEqualTo(c.interactive), c.final); // never past final: steps only go up
     c.balanced = std::clamp(kneeOfFront(front), c.interactive, c.final);
     return c;
 }

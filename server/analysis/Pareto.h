@@ -33,8 +33,10 @@ struct PresetChoice {
 /// that fast); final: the most accurate point; balanced: the knee, moved into [interactive, final] so
 /// the three never go backwards in time. Errors within `errorTolerance` (the measurement's noise, in
 /// the error's units) of a more accurate point count as equal, and of equals the fastest is chosen: a
-/// difference the reference cannot resolve never buys a slower preset.
+/// difference the reference cannot resolve never buys a slower preset. With finalBudgetMs > 0, final is
+/// the most accurate point with time <= finalBudgetMs (what a service can afford to refine to; the
+/// fastest point when none is that fast).
 PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs,
-                           double errorTolerance = 0);
+                           double errorTolerance = 0, double finalBudgetMs = 0);
 
 } // namespace gis

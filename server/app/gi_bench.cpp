@@ -407,6 +407,7 @@ int table(const std::vector<std::string>& args) {
         if (!f) throw gis::InputError(jsonPath, "cannot open for writing");
         f << nlohmann::json({{"scene", sceneName},
                              {"size", {width, height}},
+                             {"reference_spp", refs.empty() ? 0 : refs.front().spp},
                              {"reference_spp_max", ro.spp},
                              {"reference_noise_target", ro.noiseTarget},
                              {"rows", rows}})

@@ -14,6 +14,7 @@
 
 #include "core/Error.h"
 #include "core/Log.h"
+#include "frame/Presets.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
 #include "net/ServerOptions.h"
@@ -52,6 +53,20 @@ int run(int argc, char** argv) {
     gis::ServerConfig& config = parsed.config;
     if (config.clientDir.empty()) config.clientDir = GIS_DEFAULT_CLIENT_DIR;
     if (config.glName.empty()) config.session.backend = gis::gl::defaultBackend();
+    // The default technique is measured, not chosen by hand (presets/presets.json, docs/accuracy.md).
+    if (!config.techniqueGiven) {
+        try {
+            const std::string measured =
+                gis::presetDefaultTechnique(gis::loadPresets(gis::defaultPresetsPath()));
+            if (!measured.empty()) {
+                gis::findTechnique(measured, "default_technique");
+                config.session.technique = measured;
+            }
+        } catch (const gis::InputError& e) {
+            gis::logWarn(std::string("gi-server: no default technique from the presets (") + e.what() +
+                         "); using " + config.session.technique);
+        }
+    }
     // Fail at start, not at the first connection.
     gis::findTechnique(config.session.technique, "--technique");
     (void)gis::loadScene(config.session.scene);

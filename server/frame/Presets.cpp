@@ -55,6 +55,14 @@ void checkName(const std::string& name) {
 
 } // namespace
 
+std::string presetDefaultTechnique(const nlohmann::json& presets) {
+    if (!presets.is_object()) return {};
+    const auto it = presets.find("default_technique");
+    if (it == presets.end() || !it->is_object()) return {};
+    const auto name = it->find("name");
+    return name != it->end() && name->is_string() ? name->get<std::string>() : std::string();
+}
+
 nlohmann::json presetParams(const nlohmann::json& presets, const std::string& technique,
                             const std::string& name) {
     checkName(name);

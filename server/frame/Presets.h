@@ -36,4 +36,8 @@ void applyPreset(FrameState& state, const nlohmann::json& presets, const std::st
 /// Same, from defaultPresetsPath().
 void applyPreset(FrameState& state, const std::string& name);
 
+/// The file's "default_technique": {"name": TECH, "reason": ...} (gi-bench report: the technique whose
+/// interactive preset has the lowest error within the interactive budget); "" when absent.
+std::string presetDefaultTechnique(const nlohmann::json& presets);
+
 } // namespace gis

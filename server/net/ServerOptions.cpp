@@ -114,10 +114,14 @@ std::vector<ServerOption> buildOptions() {
         t.push_back(o);
     }
     {
-        ServerOption o{"--technique", "GI_TECHNIQUE", "NAME", "default technique (default rsm_gather)"};
+        ServerOption o{
+            "--technique", "GI_TECHNIQUE", "NAME",
+            "default technique (default: the presets file's default_technique, the most accurate "
+            "within the interactive budget as measured by gi-bench report; rsm_gather without one)"};
         o.set = [](ServerConfig& c, const std::string& v) {
             findTechnique(v, "--technique");
             c.session.technique = v;
+            c.techniqueGiven = true;
         };
         o.show = [](const ServerConfig& c) { return c.session.technique; };
         t.push_back(o);

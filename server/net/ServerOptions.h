@@ -18,6 +18,7 @@ struct ServerConfig {
     int port = 8080;                       ///< [1, 65535]
     std::string clientDir;                 ///< directory served at /
     SessionConfig session;                 ///< defaults for every new session
+    bool techniqueGiven = false;           ///< --technique / GI_TECHNIQUE set it (else the presets' default)
     int jpegQuality = 85;                  ///< default stream quality for JPEG/WebP [1, 100]
     int maxSessions = 8;                   ///< more are refused with 'busy'
     int renderSlots = 2;                   ///< renders at once across sessions and the HTTP API

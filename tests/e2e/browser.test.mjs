@@ -31,6 +31,8 @@ let browser = null;
 let context = null;
 let page = null;
 const pageErrors = [];
+// Console errors a test provokes on purpose (Chromium logs an HTTP error status as one), while it runs.
+const expectedConsoleErrors = new Set();
 
 function url(suffix = '') {
     return `http://127.0.0.1:${server.port}/${suffix}`;
@@ -128,7 +130,8 @@ before(async () => {
     page.on('pageerror', (e) => pageErrors.push(e.message));
     page.on('console', (m) => {
         // Chromium logs each refused connection attempt while the server restarts: expected.
-        if (m.type() === 'error' && !/WebSocket connection to .* failed/.test(m.text())) pageErrors.push(`console: ${m.text()}`);
+        if (m.type() === 'error' && !/WebSocket connection to .* failed/.test(m.text())
+            && ![...expectedConsoleErrors].some((re) => re.test(m.text()))) pageErrors.push(`console: ${m.text()}`);
     });
 });
 
@@ -369,12 +372,58 @@ test('the light gizmo and Ctrl-drag move and aim the spotlight', async () => {
 test('the accuracy view measures the view against the CPU reference', async (t) => {
     const frame = await page.evaluate(() => window.giClient.lastFrame);
     await until('a frame after the light reset', (f) => window.giClient.lastFrame > f, frame);
+    // Every text the progress line shows, however short the measurement.
+    await page.evaluate(() => {
+        const el = document.querySelector('.compare-progress-text');
+        window.compareProgress = [];
+        new MutationObserver(() => el.textContent && window.compareProgress.push(el.textContent))
+            .observe(el, { childList: true, characterData: true, subtree: true });
+    });
+    const isRender = (r) => r.method() === 'POST' && new URL(r.url()).pathname.endsWith('/api/render');
+    const sentRequest = page.waitForRequest(isRender);
     await control('compare-run', 'button').click();
-    const rmse = await until('stats.compare from POST /api/render', () => window.giClient.compare?.relative_rmse, null, 60000);
+    const body = JSON.parse((await sentRequest).postData());
+    assert.deepEqual(body.compare, { mode: 'one-bounce-unoccluded', noise_target: 0.1, spp: 1024 },
+        'the reference stops at 10 % noise of its indirect light; the spp is only the cap');
+    const compare = await until('stats.compare from POST /api/render', () => {
+        const c = window.giClient.compare;
+        return c?.relative_rmse !== undefined && c;
+    }, null, 60000);
+    const rmse = compare.relative_rmse;
     assert.ok(rmse > 0 && rmse < 1, `relative RMSE ${rmse}`);
-    t.diagnostic(`relative RMSE of rsm_gather (vpl_grid 6) vs one-bounce-unoccluded: ${(100 * rmse).toFixed(2)} %`);
-    assert.match(await page.locator('#ov-accuracy').textContent(), /rel\. RMSE \d+\.\d\d % vs one-bounce-unoccluded/);
-    assert.match(await page.locator('[data-block="compare-result"]').textContent(), /relative RMSE.*PSNR.*SSIM/);
+    assert.ok(compare.reference_noise > 0 && compare.relative_rmse_corrected <= rmse + 1e-9,
+        `whole image: corrected ${compare.relative_rmse_corrected} <= measured ${rmse}, noise ${compare.reference_noise}`);
+    const ind = compare.indirect;
+    assert.ok(ind, 'the indirect light is measured on its own');
+    assert.ok(ind.reference_noise > 0 && ind.reference_noise < 0.5, `indirect reference noise ${ind.reference_noise}`);
+    assert.ok(ind.relative_rmse_corrected >= 0 && ind.relative_rmse_corrected <= ind.relative_rmse + 1e-9,
+        `indirect: corrected ${ind.relative_rmse_corrected} <= measured ${ind.relative_rmse}`);
+    assert.ok(ind.mean_ratio > 0, `indirect mean ratio ${ind.mean_ratio}`);
+    assert.ok(Number.isFinite(compare.direct?.relative_rmse), 'the direct pass is measured too');
+    assert.deepEqual(compare.reference.noise_target, { value: 0.1, of: 'indirect' });
+    assert.ok(compare.reference.spp >= 1 && compare.reference.spp <= 1024, `reference spp ${compare.reference.spp}`);
+    const pct = (v) => (100 * v).toFixed(2);
+    t.diagnostic(`rsm_gather (vpl_grid 6) vs one-bounce-unoccluded, ${compare.reference.spp} spp: indirect `
+        + `${pct(ind.relative_rmse_corrected)} % corrected (measured ${pct(ind.relative_rmse)} %, reference noise `
+        + `${pct(ind.reference_noise)} %, mean ratio ${ind.mean_ratio.toFixed(3)}); whole image `
+        + `${pct(compare.relative_rmse_corrected)} % (measured ${pct(rmse)} %, noise ${pct(compare.reference_noise)} %)`);
+    const progress = await page.evaluate(() => window.compareProgress);
+    assert.match(progress[0] ?? '',
+        /^rendering the reference \(one-bounce-unoccluded, to 10 % noise, at most 1024 spp, \d+×\d+\): \d+\.\d s$/,
+        `progress: ${progress[0]}`);
+    const n = '\\d+(\\.\\d+)? %';
+    assert.match(await page.locator('#ov-accuracy').textContent(),
+        new RegExp(`^indirect error ${n} ±${n} noise vs one-bounce-unoccluded`));
+    const result = await page.locator('[data-block="compare-result"]').textContent();
+    assert.match(result, new RegExp(`indirect light error\\s*${n} \\(reference noise ${n}\\)`), result);
+    assert.match(result, new RegExp(`whole image\\s*${n} \\(noise ${n}\\)`), result);
+    assert.match(result, new RegExp(`direct pass\\s*${n}`), result);
+    assert.match(result, /PSNR.*SSIM.*FLIP/);
+    assert.match(result,
+        /reference\s*one-bounce-unoccluded, \d+ spp \((stopped at 10 % noise|10 % noise not reached: [\d.]+ %)\)/, result);
+    assert.match(result, /frame time.*measured in/);
+    assert.match(await page.locator('[data-block="compare-hint"]').textContent(),
+        /corrected for the reference's own noise; indirect = each side less its own direct light/);
     await control('compare-view', 'select').selectOption({ label: 'reference' });
     assert.ok(await page.locator('#compare-view').isVisible(), 'the reference layer is shown');
     assert.match(await page.locator('#layer-label').textContent(), /CPU reference \(one-bounce-unoccluded/);
@@ -383,6 +432,29 @@ test('the accuracy view measures the view against the CPU reference', async (t) 
     assert.match(await page.locator('#layer-label').textContent(), /\|API render − reference\|/);
     await control('compare-view', 'select').selectOption({ label: 'live stream' });
     assert.ok(!(await page.locator('#compare-view').isVisible()), 'back to the stream');
+
+    // The controls reach the request; a cap above the server's limit is the server's 400, shown as such.
+    await control('compare-noise', 'input').fill('10');
+    await control('compare-noise', 'input').press('Enter');
+    await control('compare-max-spp', 'input').fill('2000');
+    await control('compare-max-spp', 'input').press('Enter');
+    const refusedLog = /^Failed to load resource: the server responded with a status of 400/;
+    expectedConsoleErrors.add(refusedLog);
+    try {
+        const refused = page.waitForRequest(isRender);
+        await control('compare-run', 'button').click();
+        assert.deepEqual(JSON.parse((await refused).postData()).compare,
+            { mode: 'one-bounce-unoccluded', noise_target: 0.1, spp: 2000 }, 'the controls\' values');
+        await until('the refusal in the Accuracy section', () => /Failed: .*at \/compare\/spp.*limit of 1024/
+            .test(document.querySelector('[data-block="compare-result"]').textContent));
+        assert.ok(await page.locator('[data-block="compare-hint"]').isHidden(), 'no reading hint without figures');
+    } finally {
+        await control('compare-noise', 'input').fill('10');
+        await control('compare-noise', 'input').press('Enter');
+        await control('compare-max-spp', 'input').fill('1024');
+        await control('compare-max-spp', 'input').press('Enter');
+        expectedConsoleErrors.delete(refusedLog);
+    }
 });
 
 test('a point light added in the Light panel is rendered, and removing it takes it out again', async () => {

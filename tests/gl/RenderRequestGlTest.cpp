@@ -152,12 +152,12 @@ TEST(RenderRequestGl, CompareAddsMetrics) {
 // and the direct pass are measured apart.
 TEST(RenderRequestGl, CompareSplitsIndirectLightAndReportsTheNoise) {
     if (!gis::renderJobsCanCompare()) GTEST_SKIP() << "built without the reference layer";
-    gis::RenderJob job = gis::parseRenderRequest(
-        {{"scene", "builtin:cornell"},
-         {"technique", "rsm_gather"},
-         {"params", {{"vpl_grid", 8}}},
-         {"size", {32, 32}},
-         {"compare", {{"mode", "one-bounce-unoccluded"}, {"noise_target", 0.1}}}});
+    gis::RenderJob job =
+        gis::parseRenderRequest({{"scene", "builtin:cornell"},
+                                 {"technique", "rsm_gather"},
+                                 {"params", {{"vpl_grid", 8}}},
+                                 {"size", {32, 32}},
+                                 {"compare", {{"mode", "one-bounce-unoccluded"}, {"noise_target", 0.1}}}});
     EXPECT_EQ(job.compare->spp, gis::RenderLimits{}.maxReferenceSpp); // the target decides, up to the cap
     const nlohmann::json compare = execute(job).stats["compare"];
     std::printf("%s\n", compare.dump().c_str());

@@ -57,6 +57,11 @@ TEST(Pareto, PresetsIgnoreDifferencesWithinTheNoise) {
     // A tolerance below every gap changes nothing; a non-finite one is treated as none.
     EXPECT_EQ(gis::choosePresets(front, 100, 0.0005).final, 4u);
     EXPECT_EQ(gis::choosePresets(front, 100, std::nan("")).final, 4u);
+    // A final budget: the most accurate point within it, of equals the fastest.
+    EXPECT_EQ(gis::choosePresets(front, 100, 0, 500).final, 3u);
+    EXPECT_EQ(gis::choosePresets(front, 100, 0.0025, 500).final, 2u);
+    EXPECT_EQ(gis::choosePresets(front, 100, 0, 5).final, 0u); // none fits: the fastest
+    EXPECT_LE(gis::choosePresets(front, 100, 0, 5).interactive, gis::choosePresets(front, 100, 0, 5).final);
 }
 
 gis::ParamTable table() {
