@@ -36,7 +36,7 @@ def main():
              "(radiance about 100 against a mean of 0.06), whose exact positions differ by a pixel between "
              "the rasteriser and the ray tracer; SSIM and FLIP, on the tone-mapped image, follow what the "
              "effects change.", "",
-             "![Error against frame time, builtin:gallery](images/accuracy_gallery.png)", "",
+             "![Error against frame time, builtin:gallery](images/nondiffuse_gallery.png)", "",
              "| # | configuration | frame ms | GPU ms | rel. RMSE | SSIM | FLIP |", "|---|---|---|---|---|---|---|"]
     points = []
     for i, r in enumerate(rows):

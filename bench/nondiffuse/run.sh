@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Error against time of the non-diffuse effects (docs/nondiffuse.md) on builtin:gallery: one
 # `gi-bench table` run (every configuration timed side by side against one cached CPU reference),
-# then the plot docs/images/accuracy_gallery.png and the table between the nondiffuse markers of
+# then the plot docs/images/nondiffuse_gallery.png and the table between the nondiffuse markers of
 # docs/accuracy.md (gi-bench report keeps that block when it regenerates the file).
 #
 #   bench/nondiffuse/run.sh [BUILD_DIR]      (default build/release; about 5 minutes on 2 cores)
@@ -48,4 +48,4 @@ for c in "${configs[@]}"; do args+=(--config "$c"); done
     --json "$OUT/table.json" | tee "$OUT/table.txt"
 
 python3 "$ROOT/bench/nondiffuse/report.py" "$OUT/table.json" "$ROOT/docs/accuracy.md" \
-    "$ROOT/docs/images/accuracy_gallery.png" "$SIZE" "$SPP"
+    "$ROOT/docs/images/nondiffuse_gallery.png" "$SIZE" "$SPP"

@@ -44,7 +44,7 @@ own direct light), relative RMSE corrected for the reference's noise; "image" us
 exceeds a fifth of the smallest error the table reports.
 
 Presets, per technique, from the front of the points measured in every scene (mean frame time and
-mean error over the scenes): interactive = the most accurate front point at most --budget-ms (the
+geometric-mean error over the scenes): interactive = the most accurate front point at most --budget-ms (the
 fastest point when none is), final = the most accurate point, balanced = the front's knee in
 log-log space (kept between the two). Errors within the references' mean noise of a more
 accurate point count as equal, and of equals the fastest is chosen.
@@ -158,8 +158,10 @@ Data load(const ReportOptions& o) {
         d.width = d.rows.front()["size"][0];
         d.height = d.rows.front()["size"][1];
     }
+    // One line per command that added to the folder (BenchSweep.cpp).
     std::ifstream c(o.in + "/sweep-command.txt");
-    std::getline(c, d.sweepCommand);
+    for (std::string command; std::getline(c, command);)
+        if (!command.empty()) d.sweepCommand += (d.sweepCommand.empty() ? "" : "\n") + command;
     std::ifstream refs(o.in + "/references.jsonl");
     while (std::getline(refs, line)) {
         json r = json::parse(line, nullptr, false);
@@ -270,23 +272,26 @@ struct PresetRow {
     double timeMs = 0, error = 0;
 };
 
-/// The noise of the error axis: each scene's reference noise for the metric, averaged over the scenes
-/// (0 when no scene's is known).
+/// The noise of the error axis: each scene's reference noise for the metric, their geometric mean over
+/// the scenes, like the errors (0 when no scene's is known).
 double meanMetricNoise(const Data& d) {
-    double sum = 0;
+    double sumLog = 0;
     int n = 0;
     for (const auto& s : d.scenes)
         if (auto it = d.references.find(s); it != d.references.end()) {
             const json& v = it->second[gIndirectMetric ? "indirect_noise" : "noise"];
-            if (v.is_number()) {
-                sum += v.get<double>();
+            if (v.is_number() && v.get<double>() > 0) {
+                sumLog += std::log(v.get<double>());
                 ++n;
             }
         }
-    return n ? sum / n : 0.0;
+    return n ? std::exp(sumLog / n) : 0.0;
 }
 
-/// Presets per technique from the front of the mean time and error over the scenes.
+/// Presets per technique from the front of the mean time and the geometric-mean error over the scenes:
+/// relative errors of different scenes differ by large factors (a scene whose reference holds effects no
+/// technique renders has errors far above 1), and a geometric mean weighs equal ratios alike, so such a
+/// scene scales every point equally instead of deciding the ranking.
 std::vector<PresetRow> choose(const Data& d, double budgetMs, double finalMs, json& file) {
     std::vector<PresetRow> out;
     json techs = json::object();
@@ -305,10 +310,12 @@ std::vector<PresetRow> choose(const Data& d, double budgetMs, double finalMs, js
             const auto& rs = byParams[k];
             if (rs.size() != d.scenes.size()) continue; // compare only points every scene measured
             TradeoffPoint p;
+            double sumLogError = 0;
             for (const json* r : rs) {
                 p.timeMs += (*r)["frame_ms"].get<double>() / static_cast<double>(rs.size());
-                p.error += err(*r) / static_cast<double>(rs.size());
+                sumLogError += std::log(err(*r)); // err() >= 1e-6
             }
+            p.error = std::exp(sumLogError / static_cast<double>(rs.size()));
             pts.push_back(p);
             rep.push_back(rs.front());
         }
@@ -351,9 +358,10 @@ std::vector<PresetRow> choose(const Data& d, double budgetMs, double finalMs, js
     if (best) {
         file["default_technique"] = {
             {"name", best->technique},
-            {"reason", "its interactive preset (" + best->changes + ") has the lowest mean " + metricName() +
-                           ", " + fmt(best->error, 4) + ", of the interactive presets within " +
-                           fmt(budgetMs, 0) + " ms at the sweep size (" + fmt(best->timeMs) + " ms)"}};
+            {"reason", "its interactive preset (" + best->changes + ") has the lowest geometric-mean " +
+                           metricName() + ", " + fmt(best->error, 4) +
+                           ", of the interactive presets within " + fmt(budgetMs, 0) +
+                           " ms at the sweep size (" + fmt(best->timeMs) + " ms)"}};
     }
     return out;
 }
@@ -431,10 +439,7 @@ int report(const std::vector<std::string>& args) {
        << reportCommand << "\n```\n\n";
     md << "Measured at " << d.width << "x" << d.height << " on " << glName << " (" << d.rows.size()
        << " points). Error is against the CPU reference `" << referenceMode << "`"
-       << (refSpp.empty()
-               ? ""
-               : " (" + refSpp +
-                     " spp for the first scene; each scene's count and noise are given with its table)")
+       << (refSpp.empty() ? "" : " (each scene's samples per pixel and noise are given with its table)")
        << ". The fronts and presets use the " << metricName()
        << (gIndirectMetric
                ? " (each side's total less its own direct light, so that a better shadow map does not pass "
@@ -526,6 +531,12 @@ int report(const std::vector<std::string>& args) {
             }
         }
         md << "\n";
+        if (std::isfinite(smallest) && smallest > 1)
+            md << "**Every point's error exceeds 1 here:** the reference holds light that no technique "
+                  "renders (on "
+                  "`builtin:gallery`, the spotlight's caustics off near-mirror lobes, which the non-diffuse "
+                  "section "
+                  "leaves out of its reference), so this scene scales every technique's error alike.\n\n";
         if (noise >= 0 && std::isfinite(smallest) && noise > smallest / 5)
             md << "**The reference's noise (" << fmt(noise, 4)
                << ") is more than a fifth of the smallest error "
@@ -540,12 +551,13 @@ int report(const std::vector<std::string>& args) {
                     "fronts (docs/accuracy.md); each preset lists only the parameters that differ "
                     "from the technique's defaults."},
         {"generated_by", {d.sweepCommand, reportCommand}},
-        {"rule", "interactive: most accurate front point with mean frame time <= " + fmt(o.budgetMs, 0) +
-                     " ms at the sweep size (else the fastest); balanced: the knee of the front in "
-                     "log-log space; final: the most accurate point with mean frame time <= " +
-                     fmt(o.finalMs, 0) +
-                     " ms (0: no limit); means over the scenes; errors within "
-                     "the references' noise count as equal and the fastest of equals is chosen"},
+        {"rule",
+         "interactive: most accurate front point with mean frame time <= " + fmt(o.budgetMs, 0) +
+             " ms at the sweep size (else the fastest); balanced: the knee of the front in "
+             "log-log space; final: the most accurate point with mean frame time <= " +
+             fmt(o.finalMs, 0) +
+             " ms (0: no limit); mean frame time and geometric-mean error over the scenes; errors within "
+             "the references' noise count as equal and the fastest of equals is chosen"},
         {"metric", metricName()},
         {"sweep", {{"scenes", d.scenes}, {"size", {d.width, d.height}}}}};
     const auto presets = choose(d, o.budgetMs, o.finalMs, presetFile);
@@ -556,9 +568,12 @@ int report(const std::vector<std::string>& args) {
        << "`" << rel(o.presets, o.out)
        << "` holds three presets per technique, chosen from the measured fronts, not by hand. Per technique, "
           "the "
-          "points measured in every scene are averaged over the scenes (frame time and error) and "
+          "points measured in every scene are averaged over the scenes (the mean frame time and the "
+          "geometric "
+          "mean of the error, so that a scene whose errors are all large scales every point alike instead of "
+          "deciding the ranking) and "
           "their "
-          "Pareto front is taken; errors within the references' mean noise ("
+          "Pareto front is taken; errors within the references' noise (its geometric mean, "
        << fmt(meanMetricNoise(d), 4)
        << ") of a more accurate point count as equal, and of equals the fastest is chosen; then "
           "**interactive** is the most accurate front point with a mean frame "
@@ -584,7 +599,7 @@ int report(const std::vector<std::string>& args) {
           "any "
           "`--param`; they are the steps gi-server's adaptive quality moves between "
           "(`docs/interactive.md`).\n\n"
-          "| technique | preset | parameters | mean frame ms | mean "
+          "| technique | preset | parameters | mean frame ms | geometric-mean "
        << metricName() << " |\n|---|---|---|---|---|\n";
     for (const auto& p : presets)
         md << "| " << p.technique << " | " << p.name << " | " << p.changes << " | " << fmt(p.timeMs) << " | "

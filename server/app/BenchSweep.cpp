@@ -322,7 +322,12 @@ int sweep(const std::vector<std::string>& args) {
         // The command is kept so the report can print how to regenerate it.
         std::string cmd = "gi-bench sweep";
         for (const auto& a : args) cmd += " " + a;
-        std::ofstream(o.out + "/sweep-command.txt") << cmd << "\n";
+        // Every distinct command that added to this folder, in order (a denser pass over one knob
+        // adds to an earlier sweep), so the report can print them all.
+        std::ifstream previous(o.out + "/sweep-command.txt");
+        bool known = false;
+        for (std::string line; std::getline(previous, line);) known |= line == cmd;
+        if (!known) std::ofstream(o.out + "/sweep-command.txt", std::ios::app) << cmd << "\n";
     }
     const bool newCsv = !std::filesystem::exists(csvPath);
     std::ofstream jsonl(jsonlPath, std::ios::app), csv(csvPath, std::ios::app);

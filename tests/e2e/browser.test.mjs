@@ -17,7 +17,7 @@ import assert from 'node:assert/strict';
 import { copyFileSync, existsSync, mkdirSync, readFileSync, statSync } from 'node:fs';
 import path from 'node:path';
 
-import { REPO, SERVER, ServerProcess, makeGlb } from './helpers.mjs';
+import { REPO, SERVER, ServerProcess, makeGlb, presetsFileWith } from './helpers.mjs';
 
 const CHROMIUM = process.env.GI_CHROMIUM ?? '/usr/bin/chromium';
 const ARTIFACTS = path.resolve(process.env.GI_TEST_ARTIFACTS ?? path.join(path.dirname(path.dirname(SERVER)), 'test-artifacts'));
@@ -108,8 +108,11 @@ const near = (a, b, eps) => a.every((v, i) => Math.abs(v - b[i]) <= eps);
 before(async () => {
     mkdirSync(ARTIFACTS, { recursive: true });
     // Technique none first: adaptive refinement of it is cheap; the tests pick rsm_gather themselves.
+    // rsm_gather's interactive preset sets min_distance 1/3 (the default is 0.1) whatever the latest
+    // measurement chose: the "Reset parameters" test tells the preset's value from the default's.
     server = await ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'none',
-        '--client-dir', path.join(REPO, 'client'), '--max-size', '400x400', '--resume-grace', '5']);
+        '--client-dir', path.join(REPO, 'client'), '--max-size', '400x400', '--resume-grace', '5'],
+    { env: { GI_PRESETS: presetsFileWith({ rsm_gather: { interactive: { min_distance: 1 / 3 } } }) } });
     if (!existsSync(CHROMIUM)) {
         throw new Error(`Chromium not found at ${CHROMIUM}: the browser tests need it (deploy/install-deps.sh installs `
             + 'Debian\'s chromium; GI_CHROMIUM names another)');

@@ -2,6 +2,8 @@
 // WebSocket, make HTTP requests. Not a test file itself (node --test runs *.test.mjs only).
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import os from 'node:os';
 import http from 'node:http';
 import net from 'node:net';
 import path from 'node:path';
@@ -17,6 +19,24 @@ export const FRAME_TIMEOUT_MS = 15000;
 export const REPLY_TIMEOUT_MS = 5000;
 
 export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+/**
+ * A presets file (for GI_PRESETS) that is the committed presets/presets.json with `overrides`
+ * ({technique: {preset: {param: value}}}) merged in, so a test that depends on what a preset sets
+ * does not depend on what the latest measurement chose. Returns its path.
+ */
+export function presetsFileWith(overrides) {
+    const presets = JSON.parse(readFileSync(path.join(REPO, 'presets/presets.json'), 'utf8'));
+    for (const [technique, named] of Object.entries(overrides)) {
+        presets.techniques[technique] ??= {};
+        for (const [name, params] of Object.entries(named)) {
+            presets.techniques[technique][name] = { ...(presets.techniques[technique][name] ?? {}), ...params };
+        }
+    }
+    const file = path.join(mkdtempSync(path.join(os.tmpdir(), 'gi-presets-')), 'presets.json');
+    writeFileSync(file, JSON.stringify(presets));
+    return file;
+}
 
 /**
  * Tests whose connections are closed (code 1000) when each test ends, and which remember whether any
@@ -78,8 +98,9 @@ export function httpRequest(port, pathname, { method = 'GET', headers = {}, body
  * for failure reports. restart() stops it and starts it again on the same port.
  */
 export class ServerProcess {
-    constructor(args, { port = 0 } = {}) {
+    constructor(args, { port = 0, env = {} } = {}) {
         this.args = args;
+        this.env = env;
         this.log = '';
         this.port = port;
         this.proc = null;
@@ -117,7 +138,7 @@ export class ServerProcess {
     async launch() {
         if (!this.port) this.port = await freePort();
         this.proc = spawn(SERVER, ['--host', '127.0.0.1', '--port', String(this.port), ...this.args],
-            { stdio: ['ignore', 'pipe', 'pipe'] });
+            { stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, ...this.env } });
         const collect = (chunk) => {
             this.log += chunk.toString();
             if (this.log.length > 200000) this.log = this.log.slice(-100000);

@@ -30,7 +30,7 @@ import zlib from 'node:zlib';
 import WebSocket from 'ws';
 
 import { SUBPROTOCOL } from '../../client/protocol.js';
-import { Client, isPng, makeGlb, ServerProcess, sleep, testGroup } from './helpers.mjs';
+import { Client, isPng, makeGlb, presetsFileWith, ServerProcess, sleep, testGroup } from './helpers.mjs';
 
 const TOKEN = 'secret';
 const SMALL = ['--scene', 'builtin:cornell', '--technique', 'none', '--size', '32x32', '--settle-ms', '0'];
@@ -52,8 +52,9 @@ before(async () => {
         ServerProcess.start([...SMALL, '--max-message-bytes', '1048576', '--hello-timeout', '2',
             '--request-timeout', '2', '--upload-dir', uploadDir]),
         ServerProcess.start([...SMALL, '--token', TOKEN, '--max-pending-per-ip', '8']),
+        // A final preset far over the refinement budget, whatever the latest measurement chose.
         ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'rsm_gather', '--size', '128x128',
-            '--refine-budget-ms', '500']),
+            '--refine-budget-ms', '500'], { env: { GI_PRESETS: presetsFileWith({ rsm_gather: { final: { vpl_grid: 256 } } }) } }),
     ]);
     Object.assign(servers, { main, strict, isolation });
 });
@@ -573,9 +574,9 @@ check('isolation: a viewer\'s snapshot does not stall the controller\'s interact
     const snapshotMs = Date.now() - started;
     console.log(`# isolation: interactive frame ${frame.stats.frame} after ${interactiveMs} ms; `
         + `snapshot ${snap.stats.size.join('x')} (${snap.stats.quality}) after ${snapshotMs} ms`);
-    // rsm_gather's final preset gathers 65,536 VPLs: about 10 s at 128x128 on llvmpipe, far over the
-    // 500 ms budget. The snapshot takes the best step that fits instead, and the controller's answer
-    // never waits behind it.
+    // rsm_gather's final preset (this server's presets file) gathers 65,536 VPLs: about 10 s at 128x128
+    // on llvmpipe, far over the 500 ms budget. The snapshot takes the best step that fits instead, and
+    // the controller's answer never waits behind it.
     assert.notEqual(snap.stats.quality, 'final', 'the snapshot did not render the over-budget final step');
     assert.equal(snap.stats.size.join('x'), '128x128', 'a snapshot is full size');
     assert.ok(interactiveMs <= 3000, `interactive frame after ${interactiveMs} ms`);
