@@ -121,10 +121,12 @@ async function pressLatency(key) {
 async function measureScene(scene, technique, params) {
     await page.evaluate(({ scene, technique, params }) => {
         window.giClient.send?.({ type: 'scene', name: scene });
-        window.giClient.send?.({ type: 'technique', name: technique });
+        // No technique: the server's default (presets/presets.json's measured default_technique).
+        if (technique) window.giClient.send?.({ type: 'technique', name: technique });
         if (params) window.giClient.send?.({ type: 'params', values: params });
     }, { scene, technique, params });
     await sleep(1500);
+    technique ??= await page.evaluate(() => window.giClient.lastStats?.technique ?? null);
     // Orbit: hold the left arrow.
     const orbitStart = Date.now();
     await page.keyboard.down('ArrowLeft');
@@ -177,7 +179,7 @@ async function duringRefinement(scene, technique, params) {
 
 const report = { viewport, machine: process.env.GI_BENCH_MACHINE ?? null, scenes: [], refinement: [] };
 for (const scene of scenes) {
-    const r = await measureScene(scene, 'rsm_gather');
+    const r = await measureScene(scene, null);
     report.scenes.push(r);
     console.log(JSON.stringify(r));
 }

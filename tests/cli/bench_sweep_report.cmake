@@ -46,6 +46,14 @@ list(LENGTH again nAgain)
 if(NOT OUT MATCHES "measured 0 new points" OR NOT nAgain EQUAL 3)
     message(FATAL_ERROR "a new reference should re-measure the 3 errors only:\n${OUT}\n${ERR}")
 endif()
+# A reference noisier than a fifth of the smallest error is rendered again (up to --spp), and the errors
+# are measured again against it.
+run_ok(${BENCH} sweep --scenes builtin:cornell-empty --size 32x32 --techniques rsm_gather --max-points 2
+       --frames 1 --spp 2048 --noise-target 0.3 --cache-dir ${WORK}/cache --out ${WORK}/refine)
+if(NOT ERR MATCHES "is above a fifth of the smallest error [0-9.]+: rendering it again to"
+   OR NOT ERR MATCHES "error measured again against this reference")
+    message(FATAL_ERROR "the noisy reference was not refined:\n${OUT}\n${ERR}")
+endif()
 run_ok(${BENCH} report --in ${WORK}/sweep --out ${WORK}/docs/accuracy.md --presets ${WORK}/presets.json)
 file(READ ${WORK}/docs/accuracy.md md)
 foreach(expect "\\| technique \\| points \\| front point \\|" "\\| rsm_gather \\| 2 \\| defaults \\|"
