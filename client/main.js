@@ -26,7 +26,8 @@ import {
     DEFAULT_PIXEL_BUDGET, PIXEL_BUDGETS, budgetLine, budgetViewport, frameTargetOptions, frameTargetSupported,
     normalizeFrameTarget, normalizePixelBudget,
 } from './budget.js';
-import { restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
+import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
+import { enqueueFrame, patchPlacement } from './frames.js';
 import { PassChart } from './chart.js';
 import { LightGizmo } from './gizmo.js';
 import {
@@ -160,7 +161,7 @@ const state = {
     lastDrawn: null, // {frame, width, height, stats}
     framesDrawn: 0,
     decoding: false,
-    pending: null, // the newest frame that arrived while another was decoding
+    pending: [], // frames that arrived while another was decoding (frames.js: the newest whole frame, then patches)
     snapshotWanted: false, // a snapshot was asked for and has not arrived yet
     rttMs: null,
     decodeMs: null, // createImageBitmap time of the last frame
@@ -374,7 +375,9 @@ function sendParamsNow(values) {
 
 /** hello for this page: a viewer names the view token, a controller its viewport and a resume token if it has one. */
 function buildHello() {
-    const common = { client: CLIENT_NAME, token: page.token, codecs: CODECS, max_in_flight: MAX_IN_FLIGHT };
+    // Patches (regions of a refining image) where this page's schema copy has the field.
+    const patches = CLIENT_SCHEMAS.hello?.properties?.patches ? true : undefined;
+    const common = { client: CLIENT_NAME, token: page.token, codecs: CODECS, max_in_flight: MAX_IN_FLIGHT, patches };
     if (state.viewer) return helloMsg({ ...common, view: page.view });
     const { size, dpr } = currentViewport();
     lastSize = `${size[0]}x${size[1]}@${dpr}`;
@@ -407,7 +410,7 @@ function sendQuality() {
 
 function handleOpen() {
     state.statsByFrame.clear();
-    state.pending = null;
+    state.pending = [];
     state.snapshotWanted = false;
     latency.reset();
     watch.reset();
@@ -431,6 +434,7 @@ function snapshotSession() {
     return sessionSnapshot({
         scene: state.scene, technique: state.technique, params: state.params, explicit: state.explicit,
         camera: camera.toCamera(), adaptive: techniqueGui.model.adaptive,
+        lights: state.lightList ? state.lights : undefined,
     });
 }
 
@@ -558,6 +562,7 @@ function restoreSession(saved, welcome) {
     if (plan.technique) restored.push(plan.technique);
     const count = Object.keys(plan.params).length;
     if (count) restored.push(`${count} parameter${count === 1 ? '' : 's'}`);
+    if (plan.lights.length) restored.push('the lights');
     if (plan.camera) restored.push('the camera');
     if (quality) restored.push(quality);
     const list = restored.length > 1 ? `${restored.slice(0, -1).join(', ')} and ${restored.at(-1)}` : restored[0];
@@ -576,6 +581,10 @@ function sendRestoreMessages(messages) {
             showTechnique(msg.name);
         } else if (msg.type === 'params') {
             sendParamsNow(msg.values);
+        } else if (msg.type === 'light') {
+            changeLight(msg.light, msg.id);
+        } else if (msg.type === 'light_add' || msg.type === 'light_remove') {
+            if (steer(msg)) state.lightOps.push(msg.type === 'light_add' ? 'add' : 'remove');
         } else if (msg.type === 'camera') {
             camera.set(msg);
             cameraGui.update();
@@ -636,7 +645,10 @@ function applyServerState(s) {
     const pending = state.restoreAfterScene;
     if (pending && s.scene === pending.scene) {
         state.restoreAfterScene = null;
-        sendRestoreMessages(pending.messages);
+        // The scene's own lights are known now: the user's changes to them go too.
+        const lights = Array.isArray(pending.saved?.lights) && Array.isArray(s.lights)
+            ? lightRestoreMessages(pending.saved.lights, s.lights) : [];
+        sendRestoreMessages([...lights, ...pending.messages]);
     }
 }
 
@@ -673,10 +685,11 @@ function handleBinary(buffer) {
     }
     const frame = { header, buffer, entry, arrivedAt, socket: connection.socket };
     if (state.decoding) {
-        // At most one decode in flight: keep only the newest frame that waits, and acknowledge
-        // the one it replaces so its slot frees.
-        if (state.pending) acknowledge(state.pending);
-        state.pending = frame;
+        // At most one decode in flight: a whole frame replaces those that wait (acknowledged so
+        // their slots free), a patch waits its turn.
+        const { queue, dropped } = enqueueFrame(state.pending, frame);
+        dropped.forEach(acknowledge);
+        state.pending = queue;
         return;
     }
     decodeAndDraw(frame);
@@ -692,11 +705,25 @@ async function decodeAndDraw(frame) {
         const bitmap = await createImageBitmap(new Blob([payload], { type: CODEC_MIME[header.codec] }));
         const decodeMs = performance.now() - started;
         if (frame.socket === connection.socket) {
-            if (ui.canvas.width !== header.width || ui.canvas.height !== header.height) {
-                ui.canvas.width = header.width;
-                ui.canvas.height = header.height;
+            const patch = patchPlacement(frame.entry?.stats, header);
+            if (patch) {
+                // A region of a refining image: the picture so far, stretched to the image's size,
+                // under it.
+                if (ui.canvas.width !== patch.width || ui.canvas.height !== patch.height) {
+                    const before = await createImageBitmap(ui.canvas);
+                    ui.canvas.width = patch.width;
+                    ui.canvas.height = patch.height;
+                    ctx.drawImage(before, 0, 0, patch.width, patch.height);
+                    before.close();
+                }
+                ctx.drawImage(bitmap, patch.x, patch.y);
+            } else {
+                if (ui.canvas.width !== header.width || ui.canvas.height !== header.height) {
+                    ui.canvas.width = header.width;
+                    ui.canvas.height = header.height;
+                }
+                ctx.drawImage(bitmap, 0, 0, header.width, header.height);
             }
-            ctx.drawImage(bitmap, 0, 0, header.width, header.height);
             recordDraw(frame, decodeMs, buffer.byteLength);
         }
         bitmap.close();
@@ -706,8 +733,7 @@ async function decodeAndDraw(frame) {
         // Acknowledge even a frame that failed to decode, else the server would wait forever.
         acknowledge(frame);
         state.decoding = false;
-        const next = state.pending;
-        state.pending = null;
+        const next = state.pending.shift();
         if (next) decodeAndDraw(next);
     }
 }

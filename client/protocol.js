@@ -28,7 +28,7 @@ export const MAX_DPR = 4;
 // Message builders
 
 const HELLO_FIELDS = ['client', 'token', 'resume', 'view', 'codecs', 'quality', 'max_in_flight', 'adaptive', 'size', 'dpr',
-    'frame_target_ms'];
+    'frame_target_ms', 'patches'];
 
 /** The opening message; only the fields given (not undefined) are sent, so the server's defaults apply to the rest. */
 export function helloMsg(fields = {}) {

@@ -3,7 +3,8 @@
 // reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms, the
 // steps' VPL counts and the most VPL parts a tile was split into.
 // usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--technique T]
-//        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"]
+//        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"] [--whole 1]
+// --whole 1 asks for whole images instead of patches (as a client that does not draw patches).
 import { spawn } from 'node:child_process';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -11,12 +12,12 @@ import WebSocket from 'ws';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const opts = { server: path.join(root, 'build/ci/bin/gi-server'), technique: '', params: '', seconds: 15,
-    'server-args': '' };
+    'server-args': '', whole: 0 };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
     const key = argv[i].replace(/^--/, '');
     if (key === 'help') {
-        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"]');
+        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1]');
         process.exit(0);
     }
     if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
@@ -35,7 +36,9 @@ let stats = null;
 const tiles = [];
 const progress = [];
 ws.on('open', () => {
-    ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2 }));
+    ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2, codecs: ['webp', 'jpeg'],
+        // As the web client: patches (the regions pasted since the last send) unless --whole 1.
+        patches: !opts.whole }));
     if (opts.technique) ws.send(JSON.stringify({ type: 'technique', name: opts.technique }));
     if (opts.params) ws.send(JSON.stringify({ type: 'params', values: JSON.parse(opts.params) }));
 });
@@ -48,16 +51,19 @@ ws.on('message', (data, isBinary) => {
     }
     ws.send(JSON.stringify({ type: 'ack', frame: data.readUInt32LE(4) }));
     if (stats?.refine) {
-        tiles.push({ ms: stats.frame_ms, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
+        tiles.push({ ms: stats.frame_ms, encodeMs: stats.encode_ms ?? 0, bytes: stats.bytes ?? 0, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
             parts: stats.refine.vpl_parts ?? 1, index: tiles.length, tile: stats.tile?.size,
             passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(2)])) });
     }
 });
 setTimeout(() => {
     const ms = tiles.map((t) => t.ms).sort((a, b) => a - b);
-    const p = (q) => (ms.length ? +ms[Math.min(ms.length - 1, Math.floor(q * ms.length))].toFixed(1) : null);
+    const p = (q, v = ms) => (v.length ? +v[Math.min(v.length - 1, Math.floor(q * v.length))].toFixed(1) : null);
+    const enc = tiles.map((t) => t.encodeMs).sort((a, b) => a - b);
+    const bytes = tiles.map((t) => t.bytes).sort((a, b) => a - b);
     console.log(JSON.stringify({ technique: opts.technique || 'default', params: opts.params || null,
         tiles_sent: ms.length, tile_ms: { p50: p(0.5), p95: p(0.95), max: p(1) },
+        encode_ms: { p50: p(0.5, enc), p95: p(0.95, enc), max: p(1, enc) }, bytes_p50: p(0.5, bytes),
         balanced_vpls: tiles.filter((t) => t.step === 'balanced').at(-1)?.vpls ?? null,
         final_vpls: tiles.filter((t) => t.step === 'final').at(-1)?.vpls ?? null,
         vpl_parts_max: Math.max(1, ...tiles.map((t) => t.parts)),

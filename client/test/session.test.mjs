@@ -5,7 +5,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 
-import { restoreMessages, restorePlan, sessionSnapshot } from '../restore.js';
+import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from '../restore.js';
 import { MessageStack, noticeFor } from '../messages.js';
 import { checkTypedNumber, orderedProperties, rangeText, resetPlan } from '../params.js';
 import { OrbitCamera, boundsSphere, fitDistance, withOrbitTarget } from '../camera.js';
@@ -40,7 +40,7 @@ test('a new session gets the scene, technique, explicit parameters and camera of
     assert.deepEqual(saved.params, { vpl_grid: 6, exposure: 0.5 }, 'only the explicit values');
     const plan = restorePlan(saved, WELCOME);
     assert.deepEqual(plan, { scene: 'builtin:sponza', technique: 'rsm_gather', params: { vpl_grid: 6, exposure: 0.5 },
-        camera: CAMERA, adaptive: false, notes: [] });
+        lights: [], camera: CAMERA, adaptive: false, notes: [] });
     const messages = restoreMessages(plan);
     assert.deepEqual(messages.map((m) => m.type), ['technique', 'params', 'camera'], 'after the scene, in this order');
     for (const msg of messages) assert.equal(validateClientMessage(msg, CLIENT_SCHEMAS), null, JSON.stringify(msg));
@@ -62,6 +62,39 @@ test('what the new session already has, or cannot have, is not sent', () => {
     assert.match(upload.notes[1], /technique gone/);
     assert.match(upload.notes[2], /vpl_grid = 999/);
     assert.match(restorePlan({ scene: 'file:old.glb' }, WELCOME).notes[0], /no longer offers file:old\.glb/);
+});
+
+const SPOT = { id: 'light0', name: 'key', type: 'spot', position: [0, 2, 0], direction: [0, -1, 0], intensity: 8,
+    color: [1, 1, 1], range: 0, cone_deg: 40, inner_cone_deg: 30, enabled: true };
+const FILL = { id: 'light1', name: 'fill', type: 'point', position: [1, 1, 1], intensity: 2, color: [1, 1, 1], range: 0,
+    enabled: true };
+
+test('the lights of the lost session are restored: edits, lights removed and lights added', () => {
+    const added = { id: 'light2', name: 'sun', type: 'directional', direction: [0, -1, 0.2], intensity: 3,
+        color: [1, 0.9, 0.8], enabled: true };
+    const saved = [{ ...SPOT, intensity: 20, color: [1, 0, 0] }, added]; // the fill was removed, a sun added
+    const messages = lightRestoreMessages(saved, [SPOT, FILL]);
+    assert.deepEqual(messages.map((m) => m.type), ['light_remove', 'light', 'light_add']);
+    assert.deepEqual(messages[0], { type: 'light_remove', id: 'light1' });
+    assert.deepEqual(messages[1], { type: 'light', id: 'light0', light: { intensity: 20, color: [1, 0, 0] } },
+        'only the fields that differ');
+    assert.equal(messages[2].light.type, 'directional');
+    assert.equal(messages[2].light.id, undefined, 'the server gives an added light its id');
+    for (const msg of messages) assert.equal(validateClientMessage(msg, CLIENT_SCHEMAS), null, JSON.stringify(msg));
+    assert.deepEqual(lightRestoreMessages([SPOT, FILL], [SPOT, FILL]), [], 'nothing changed, nothing sent');
+
+    // Through the plan: on the same scene the light messages come before the camera.
+    const welcome = { ...WELCOME, state: { ...WELCOME.state, lights: [SPOT, FILL] } };
+    const plan = restorePlan(sessionSnapshot({ scene: 'builtin:cornell', technique: 'none', camera: CAMERA,
+        lights: saved }), welcome);
+    assert.deepEqual(restoreMessages(plan).map((m) => m.type), ['light_remove', 'light', 'light_add', 'camera']);
+    // A server that lists no lights (protocol 1) cannot take them: said, not sent.
+    const old = restorePlan(sessionSnapshot({ scene: 'builtin:cornell', technique: 'none', lights: saved }), WELCOME);
+    assert.deepEqual(old.lights, []);
+    assert.match(old.notes[0], /lights/);
+    // A scene loaded first: its lights are diffed when its state arrives (main.js), not in the plan.
+    const other = restorePlan(sessionSnapshot({ scene: 'builtin:sponza', technique: 'none', lights: saved }), welcome);
+    assert.deepEqual(other.lights, []);
 });
 
 // ---- toasts and notices -----------------------------------------------------------------------------

@@ -60,6 +60,34 @@ void pasteTile(std::vector<std::uint8_t>& canvas, int fullWidth, int fullHeight,
     }
 }
 
+TileRect clipToImage(const TileRect& rect, int width, int height) {
+    const int x0 = std::clamp(rect.x, 0, std::max(0, width)), y0 = std::clamp(rect.y, 0, std::max(0, height));
+    const int x1 = std::clamp(rect.x + std::max(0, rect.width), x0, std::max(0, width));
+    const int y1 = std::clamp(rect.y + std::max(0, rect.height), y0, std::max(0, height));
+    return {x0, y0, x1 - x0, y1 - y0};
+}
+
+TileRect unite(const TileRect& a, const TileRect& b) {
+    const bool aEmpty = a.width <= 0 || a.height <= 0, bEmpty = b.width <= 0 || b.height <= 0;
+    if (aEmpty) return b;
+    if (bEmpty) return a;
+    const int x0 = std::min(a.x, b.x), y0 = std::min(a.y, b.y);
+    const int x1 = std::max(a.x + a.width, b.x + b.width), y1 = std::max(a.y + a.height, b.y + b.height);
+    return {x0, y0, x1 - x0, y1 - y0};
+}
+
+std::vector<std::uint8_t> cropRgba8(const std::vector<std::uint8_t>& canvas, int width, int height,
+                                    const TileRect& rect) {
+    const TileRect r = clipToImage(rect, width, height);
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(r.width) * r.height * 4);
+    if (canvas.size() < static_cast<std::size_t>(width) * height * 4) return {};
+    for (int y = 0; y < r.height; ++y)
+        std::copy_n(canvas.begin() + ((static_cast<std::ptrdiff_t>(r.y) + y) * width + r.x) * 4,
+                    static_cast<std::ptrdiff_t>(r.width) * 4,
+                    out.begin() + static_cast<std::ptrdiff_t>(y) * r.width * 4);
+    return out;
+}
+
 std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
                                       int width, int height) {
     std::vector<std::uint8_t> out(static_cast<std::size_t>(width) * height * 4, 0);

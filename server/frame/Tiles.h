@@ -39,6 +39,15 @@ void pasteTile(std::vector<std::uint8_t>& canvas, int fullWidth, int fullHeight,
 std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
                                       int width, int height);
 
+/// The part of `rect` inside a width x height image (empty when none is).
+TileRect clipToImage(const TileRect& rect, int width, int height);
+/// The smallest rectangle holding both (an empty one adds nothing).
+TileRect unite(const TileRect& a, const TileRect& b);
+/// The pixels of `rect` (inside the image) copied out of `canvas` (width x height RGBA8): the region
+/// of the image a patch frame sends.
+std::vector<std::uint8_t> cropRgba8(const std::vector<std::uint8_t>& canvas, int width, int height,
+                                    const TileRect& rect);
+
 /// The order and sizes of one step's tiles: square tiles in reading order, each at the first cell
 /// (align x align px) not yet covered. Each next() asks for about `pixels` pixels (from measured
 /// slice times); the side is kept while the request stays within a factor 1.6 of its area, since

@@ -1007,9 +1007,10 @@ struct WsServer::Impl {
         return w;
     }
 
-    std::shared_ptr<ClientLink> makeLink(ClientRole role, int maxInFlight) {
+    std::shared_ptr<ClientLink> makeLink(ClientRole role, int maxInFlight, bool acceptsPatches) {
         lws_context* ctx = context;
-        return std::make_shared<ClientLink>(role, maxInFlight, [ctx] { lws_cancel_service(ctx); });
+        return std::make_shared<ClientLink>(
+            role, maxInFlight, [ctx] { lws_cancel_service(ctx); }, 64, acceptsPatches);
     }
 
     void onHello(Connection& c, const nlohmann::json& hello) {
@@ -1041,6 +1042,7 @@ struct WsServer::Impl {
             return;
         }
         const int maxInFlight = hello.value("max_in_flight", 1);
+        const bool acceptsPatches = hello.value("patches", false);
         StreamOptions stream;
         stream.quality = hello.value("quality", config.jpegQuality);
         stream.adaptive = hello.value("adaptive", true);
@@ -1058,7 +1060,7 @@ struct WsServer::Impl {
                 closeWith(c, {"busy", "this session has its maximum of viewers", "", "hello"}, 1013);
                 return;
             }
-            c.link = makeLink(ClientRole::Viewer, maxInFlight);
+            c.link = makeLink(ClientRole::Viewer, maxInFlight, acceptsPatches);
             c.entry = entry;
             c.helloDone = true;
             settle(c.wsi);
@@ -1125,7 +1127,7 @@ struct WsServer::Impl {
                 sendError(c, e);
             }
         }
-        c.link = makeLink(ClientRole::Controller, maxInFlight);
+        c.link = makeLink(ClientRole::Controller, maxInFlight, acceptsPatches);
         c.entry = entry;
         c.helloDone = true;
         settle(c.wsi);

@@ -9,9 +9,10 @@ const char* roleName(ClientRole role) {
     return role == ClientRole::Controller ? "controller" : "viewer";
 }
 
-ClientLink::ClientLink(ClientRole role, int maxInFlight, Wake wake, std::size_t maxQueuedText)
-    : mRole(role), mMaxInFlight(std::clamp(maxInFlight, 1, 4)), mMaxQueuedText(maxQueuedText),
-      mWake(std::move(wake)) {}
+ClientLink::ClientLink(ClientRole role, int maxInFlight, Wake wake, std::size_t maxQueuedText,
+                       bool acceptsPatches)
+    : mRole(role), mMaxInFlight(std::clamp(maxInFlight, 1, 4)), mAcceptsPatches(acceptsPatches),
+      mMaxQueuedText(maxQueuedText), mWake(std::move(wake)) {}
 
 bool ClientLink::pushText(std::string text) {
     Wake wake;
@@ -32,15 +33,17 @@ bool ClientLink::pushText(std::string text) {
 }
 
 bool ClientLink::offerFrame(std::uint32_t id, std::string stats, std::shared_ptr<const std::string> frame,
-                            bool bypassWindow) {
+                            bool bypassWindow, bool patch) {
     assert(id != 0 && frame);
+    assert(!patch || mAcceptsPatches);
     Wake wake;
     {
         std::lock_guard lock(mMutex);
         if (mClosed) return false;
         // A frame whose stats are still queued has not reached the client: the new one replaces it.
-        // A pair whose stats already left must be completed, so only whole pairs are removed.
-        for (auto it = mQueue.begin(); it != mQueue.end();) {
+        // A pair whose stats already left must be completed, so only whole pairs are removed. A
+        // patch replaces nothing: it is drawn over what came before it.
+        for (auto it = mQueue.begin(); !patch && it != mQueue.end();) {
             if (it->frameHead && it->replaceable) {
                 const std::uint32_t stale = it->frame;
                 it = mQueue.erase(it);
@@ -56,8 +59,8 @@ bool ClientLink::offerFrame(std::uint32_t id, std::string stats, std::shared_ptr
             return false;
         }
         mQueue.push_back(
-            {false, std::make_shared<const std::string>(std::move(stats)), id, true, !bypassWindow});
-        mQueue.push_back({true, std::move(frame), id, false, false});
+            {false, std::make_shared<const std::string>(std::move(stats)), id, true, !bypassWindow, patch});
+        mQueue.push_back({true, std::move(frame), id, false, false, patch});
         if (!bypassWindow) mInFlight.insert(id);
         mNewestOffered = std::max(mNewestOffered, id);
         ++mOffered;

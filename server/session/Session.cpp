@@ -196,7 +196,12 @@ void Session::attach(const std::shared_ptr<ClientLink>& link, const StreamOption
             markInput();
         } else {
             mViewers.push_back(link);
-            if (mLastFrame.bytes) {
+            // Patches sent since the last whole frame would be missing from this viewer's image: the
+            // worker sends the current one whole instead (replaying the old one would fill the
+            // viewer's window and crowd it out).
+            if (mPatchedSinceLastFrame) {
+                mWholeFrameWanted = true;
+            } else if (mLastFrame.bytes) {
                 nlohmann::json stats = mLastFrame.stats;
                 stats["viewers"] = mViewers.size();
                 stats["dropped_frames"] = 0;
@@ -235,6 +240,7 @@ std::vector<std::shared_ptr<ClientLink>> Session::clients() const {
 }
 
 void Session::markInput() {
+    if (!mDirty) mPendingSince = Clock::now();
     mDirty = true;
     mNextStep = Step::Interactive;
     mLastInput = Clock::now();
@@ -390,6 +396,10 @@ void Session::broadcastText(const nlohmann::json& msg) {
 bool Session::readyLocked(Clock::time_point now) const {
     if (!mSnapshotFor.expired()) return true;
     if (!mController || mController->windowFull()) return false;
+    return mWholeFrameWanted || stepReadyLocked(now);
+}
+
+bool Session::stepReadyLocked(Clock::time_point now) const {
     if (mDirty) return true;
     if (!mStream.adaptive || mNextStep == Step::Done || mNextStep == Step::Interactive) return false;
     return mNextStep != Step::Balanced ||
@@ -405,6 +415,9 @@ struct Session::Worker {
     /// The last image sent to the controller (RGBA8): the canvas a tiled step starts from.
     std::vector<std::uint8_t> lastImage;
     int lastWidth = 0, lastHeight = 0;
+    /// Its stats and step: what a whole image sent again (Session::mWholeFrameWanted) carries.
+    nlohmann::json lastStats;
+    std::string lastQuality;
 };
 
 int Session::frameTargetMs(const StreamOptions& stream) const {
@@ -425,14 +438,37 @@ void Session::recordRefineCost(const std::string& sceneName, const FrameState& s
 
 bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int width, int height,
                       nlohmann::json stats, const std::string& quality, const StreamOptions& stream,
-                      const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec) {
+                      const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec,
+                      const TileRect* patch) {
     const ImageCodec codec = snapshotFor ? snapshotCodec : stream.codec;
+    std::vector<std::shared_ptr<ClientLink>> targets;
+    if (snapshotFor)
+        targets.push_back(snapshotFor);
+    else
+        targets = clients();
+    // A patch goes out only where every client draws patches and none has missed one: encoding the
+    // whole canvas of a large view took 50-70 ms a tile send, time that input waited behind.
+    std::optional<TileRect> region;
+    if (patch && !snapshotFor && !targets.empty() &&
+        std::all_of(targets.begin(), targets.end(), [](const auto& c) { return c->acceptsPatches(); })) {
+        std::lock_guard lock(mMutex);
+        if (!mWholeFrameWanted) region = clipToImage(*patch, width, height);
+    }
+    if (region && (region->width <= 0 || region->height <= 0)) region.reset();
+    if (!region && !snapshotFor) {
+        std::lock_guard lock(mMutex);
+        mWholeFrameWanted = false;
+    }
+    const int sentWidth = region ? region->width : width, sentHeight = region ? region->height : height;
     Stopwatch encodeClock;
     std::vector<std::uint8_t> encoded;
     try {
+        const std::vector<std::uint8_t> cropped =
+            region ? cropRgba8(rgba, width, height, *region) : std::vector<std::uint8_t>();
+        const std::uint8_t* pixels = region ? cropped.data() : rgba.data();
         encoded = snapshotFor && codec == ImageCodec::Webp
-                      ? encodeWebpLossless(rgba.data(), width, height)
-                      : encodeImage(codec, rgba.data(), width, height, stream.quality);
+                      ? encodeWebpLossless(pixels, sentWidth, sentHeight)
+                      : encodeImage(codec, pixels, sentWidth, sentHeight, stream.quality);
     } catch (const std::exception& e) {
         fail(std::string("the frame could not be encoded: ") + e.what());
         return false;
@@ -440,7 +476,7 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     const double encodeMs = encodeClock.elapsedMs();
     const std::uint32_t frameId = ++w.frameId;
     ++mFramesRendered;
-    std::vector<std::uint8_t> message = makeFrameMessage(frameId, width, height, codec, encoded);
+    std::vector<std::uint8_t> message = makeFrameMessage(frameId, sentWidth, sentHeight, codec, encoded);
     auto shared = std::make_shared<const std::string>(message.begin(), message.end());
 
     stats["type"] = "stats";
@@ -452,6 +488,11 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     stats["bytes"] = shared->size();
     stats["codec"] = codecName(codec);
     stats["scene"] = mSceneName.empty() ? w.scene->name : mSceneName;
+    if (region) {
+        stats["patch"] = {
+            {"x", region->x}, {"y", region->y}, {"width", region->width}, {"height", region->height}};
+        stats["size"] = {width, height};
+    }
 
     FrameReport report;
     report.quality = quality;
@@ -463,30 +504,39 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     if (stats.contains("passes"))
         for (const auto& p : stats["passes"])
             report.passMs.emplace_back(p.value("name", ""), p.value("gpu_ms", 0.0));
-    std::vector<std::shared_ptr<ClientLink>> targets;
-    if (snapshotFor)
-        targets.push_back(snapshotFor);
-    else
-        targets = clients();
     const std::size_t viewers = viewerCount();
+    bool patchMissed = false;
     for (const auto& client : targets) {
         stats["viewers"] = viewers;
         stats["dropped_frames"] = client->droppedFrames();
-        if (client->offerFrame(frameId, stats.dump(), shared, snapshotFor != nullptr))
+        if (client->offerFrame(frameId, stats.dump(), shared, snapshotFor != nullptr, region.has_value())) {
             ++report.delivered;
-        else
+        } else {
             ++report.dropped;
+            patchMissed = patchMissed || region.has_value();
+        }
     }
     FrameObserver onFrame;
     {
         std::lock_guard lock(mMutex);
         onFrame = mOnFrame;
-        if (!snapshotFor) mLastFrame = {frameId, stats, shared};
+        if (patchMissed) mWholeFrameWanted = true;
+        if (!snapshotFor) {
+            if (region) {
+                mPatchedSinceLastFrame = true;
+            } else {
+                mLastFrame = {frameId, stats, shared};
+                mPatchedSinceLastFrame = false;
+            }
+        }
     }
     if (!snapshotFor) {
         w.lastImage = rgba;
         w.lastWidth = width;
         w.lastHeight = height;
+        w.lastStats = stats;
+        w.lastStats.erase("patch");
+        w.lastQuality = quality;
     }
     if (onFrame) onFrame(report);
     return true;
@@ -550,6 +600,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     Stopwatch stepClock;
     Stopwatch sinceSend;
     bool sentOnce = false;
+    TileRect unsent; // the canvas's pixels pasted since the last send
     double renderedMs = 0.0;
     // VPL parts: tiles of kPartTileSide^2 inner pixels (their fixed costs stay small beside the VPLs'),
     // as many parts as make one fit 80 % of a slice; `partsFloor` rises when a part overran, and the
@@ -599,6 +650,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
             slowestPartMs = std::max(slowestPartMs, rendered.renderMs);
             renderedMs += rendered.renderMs;
             pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
+            unsent = unite(unsent, clipToImage(rect, full.width, full.height));
 
             // Input waits: its frame goes first, the unsent tiles are not worth encoding.
             const double share = shareBefore + (shareAfter - shareBefore) * (part + 1) / parts;
@@ -642,9 +694,12 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
                                {"complete", last},
                                {"vpl_parts", parts},
                                {"vpl_parts_done", part + 1}};
+            // Only the tiles pasted since the last send; a client whose image has another size (the
+            // interactive frame's) stretches it to the full size first, as the canvas here was.
             if (!deliver(w, canvas, full.width, full.height, std::move(stats), stepLabel, stream, nullptr,
-                         ImageCodec::Png))
+                         ImageCodec::Png, &unsent))
                 return RefineResult::Failed;
+            unsent = {};
             sentOnce = true;
             sinceSend = Stopwatch();
         }
@@ -734,18 +789,36 @@ void Session::workerMain() {
         StreamOptions stream;
         std::shared_ptr<ClientLink> snapshotFor;
         ImageCodec snapshotCodec = ImageCodec::Png;
-        int step = -1; // -1: fixed; else Step
+        int step = -1;                                   // -1: fixed; else Step
+        std::optional<Clock::time_point> answersInputOf; // the input this frame answers arrived then
+        double inputWaitMs = 0.0, windowWaitMs = 0.0;
         {
             std::unique_lock lock(mMutex);
+            std::optional<Clock::time_point> windowWaitFrom;
             while (!mStop) {
                 const auto now = Clock::now();
                 if (readyLocked(now)) break;
+                if (mDirty && mController && mController->windowFull() && !windowWaitFrom)
+                    windowWaitFrom = now;
                 if (mStream.adaptive && mNextStep == Step::Balanced && !mDirty && mController)
                     mCv.wait_until(lock, mLastInput + std::chrono::milliseconds(mConfig.limits.settleMs));
                 else
                     mCv.wait(lock);
             }
             if (mStop) break;
+            // A viewer joined after patches and nothing else is to render: the last image again, whole.
+            if (mWholeFrameWanted && mSnapshotFor.expired() && !stepReadyLocked(Clock::now())) {
+                const StreamOptions current = mStream;
+                lock.unlock();
+                if (w.lastImage.empty()) {
+                    std::lock_guard relock(mMutex);
+                    mWholeFrameWanted = false;
+                } else if (!deliver(w, w.lastImage, w.lastWidth, w.lastHeight, w.lastStats, w.lastQuality,
+                                    current, nullptr, ImageCodec::Png)) {
+                    break;
+                }
+                continue;
+            }
             // A viewer's snapshot waits while the controller has input to answer: viewers never delay
             // the controller by more than the frame already rendering.
             const bool controllerWaits = mDirty && mController && !mController->windowFull();
@@ -762,6 +835,11 @@ void Session::workerMain() {
                 mNextStep = Step::Done;
             } else if (mDirty) {
                 mDirty = false;
+                answersInputOf = mPendingSince;
+                inputWaitMs = std::chrono::duration<double, std::milli>(Clock::now() - mPendingSince).count();
+                if (windowWaitFrom)
+                    windowWaitMs =
+                        std::chrono::duration<double, std::milli>(Clock::now() - *windowWaitFrom).count();
                 step = static_cast<int>(Step::Interactive);
                 mNextStep = Step::Balanced;
             } else {
@@ -984,6 +1062,14 @@ void Session::workerMain() {
         stats["scale"] = scale;
         stats["queue_ms"] = queueMs;
         if (!budgetJson.is_null()) stats["budget"] = budgetJson;
+        if (answersInputOf)
+            // How long the input waited for the worker (a tile or an unacknowledged frame ahead of
+            // it), and from its arrival to the frame about to be encoded.
+            stats["input"] = {
+                {"wait_ms", inputWaitMs},
+                {"window_wait_ms", windowWaitMs},
+                {"rendered_ms",
+                 std::chrono::duration<double, std::milli>(Clock::now() - *answersInputOf).count()}};
         const double frameMs = frame.stats.value("frame_ms", 0.0);
         const double techniqueMs = frame.stats.value("technique_ms", 0.0);
         if (!deliver(w, frame.rgba8, frame.width, frame.height, std::move(stats), stepName(step), stream,

@@ -33,6 +33,8 @@
 
 namespace gis {
 
+struct TileRect;
+
 class RenderGate;
 
 /// Server-wide limits a session enforces (protocol `welcome.limits`).
@@ -143,9 +145,13 @@ private:
     struct Worker;
     /// Encodes and offers one image to the clients (or to the snapshot's), with its stats; false when
     /// the encoder failed (the session has failed then).
+    /// `patch` (a refinement step's canvas): send only that region where every client draws
+    /// patches and none has missed one (else the whole image); the canvas stays the image that
+    /// later steps and a joining viewer start from.
     bool deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int width, int height,
                  nlohmann::json stats, const std::string& quality, const StreamOptions& stream,
-                 const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec);
+                 const std::shared_ptr<ClientLink>& snapshotFor, ImageCodec snapshotCodec,
+                 const TileRect* patch = nullptr);
     /// Renders a balanced or final step in tiles of about limits.sliceMs each, sending the image as
     /// it fills in; a technique with VPL parts (TechniqueInfo::vplParts) renders a tile too slow for
     /// one slice as several parts of its VPLs, sending the tile as its parts add up. Returns at the
@@ -166,6 +172,8 @@ private:
     nlohmann::json stateJsonLocked() const;
     void markInput(); // requires mMutex
     bool readyLocked(std::chrono::steady_clock::time_point now) const;
+    /// Input, or an adaptive step due (readyLocked less snapshots and whole images sent again).
+    bool stepReadyLocked(std::chrono::steady_clock::time_point now) const;
     void workerMain();
     void broadcastText(const nlohmann::json& msg);
     void fail(const std::string& reason);
@@ -194,13 +202,20 @@ private:
     bool mDirty = true;
     Step mNextStep = Step::Done;
     std::chrono::steady_clock::time_point mLastInput = std::chrono::steady_clock::now();
+    /// When the oldest input not yet answered arrived (set as mDirty turns true): stats.input.
+    std::chrono::steady_clock::time_point mPendingSince = std::chrono::steady_clock::now();
     std::weak_ptr<ClientLink> mSnapshotFor;
     ImageCodec mSnapshotCodec = ImageCodec::Png;
     struct LastFrame {
         std::uint32_t id = 0;
         nlohmann::json stats;
         std::shared_ptr<const std::string> bytes;
-    } mLastFrame; ///< replayed to a viewer that joins a still view
+    } mLastFrame; ///< replayed to a viewer that joins a still view (whole frames only)
+    /// Patches were sent since mLastFrame: a viewer that joins needs the whole image again.
+    bool mPatchedSinceLastFrame = false;
+    /// The next image goes out whole (a client missed a patch, or a viewer joined after patches);
+    /// when the worker is idle it sends the last image again.
+    bool mWholeFrameWanted = false;
     std::shared_ptr<ClientLink> mController;
     std::vector<std::shared_ptr<ClientLink>> mViewers;
     struct StepCost {

@@ -292,7 +292,7 @@ test('the frame-time target is offered, sent with quality and kept; interactive 
 test('refinement fills the image in tile by tile and the overlay shows step, share and time left', async () => {
     await withAdaptive(async () => {
         await page.evaluate(() => {
-            window.seenRefine = { texts: [], kinds: [], stats: [] };
+            window.seenRefine = { texts: [], kinds: [], stats: [], patches: 0 };
             const line = document.getElementById('ov-refine');
             new MutationObserver(() => {
                 if (line.hidden) return;
@@ -301,7 +301,10 @@ test('refinement fills the image in tile by tile and the overlay shows step, sha
             }).observe(line, { subtree: true, childList: true, characterData: true, attributes: true });
             setInterval(() => {
                 const r = window.giClient.lastStats?.refine;
-                if (r && window.seenRefine.stats.at(-1) !== r) window.seenRefine.stats.push(r);
+                if (r && window.seenRefine.stats.at(-1) !== r) {
+                    window.seenRefine.stats.push(r);
+                    if (window.giClient.lastStats.patch) window.seenRefine.patches += 1;
+                }
             }, 20);
         });
         await drag();
@@ -316,6 +319,11 @@ test('refinement fills the image in tile by tile and the overlay shows step, sha
         assert.ok(seen.texts.some((t) => /^refining (balanced|final) · \d+ %/.test(t)), seen.texts.join(' | '));
         const last = seen.texts.at(-1);
         assert.match(last, /refined: final quality|skipped (balanced|final): ./, 'the end is said, a skip with its reason');
+        // The page asks for patches: refinement frames are regions drawn over the image at its full size.
+        assert.ok(seen.patches > 0, 'refinement frames came as patches');
+        const sizes = await page.evaluate(() => ({ canvas: [document.querySelector('#view').width,
+            document.querySelector('#view').height], stats: window.giClient.lastStats.size }));
+        assert.deepEqual(sizes.canvas, sizes.stats, 'the canvas has the refined image\'s size');
     });
 });
 
@@ -791,6 +799,12 @@ test('an expired view link explains itself, is not retried and offers a session 
 });
 
 test('the page reconnects after the server restarts, counting down, and restores the session', async () => {
+    // A light of the user's own, which the new session must get again.
+    const lightsBefore = await page.evaluate(() => window.giClient.lights.length);
+    await control('light-add-type', 'select').selectOption('point');
+    await control('light-add', 'button').click();
+    await until('the added point light', (n) => window.giClient.lights.length === n + 1
+        && window.giClient.lights.some((l) => l.type === 'point'), lightsBefore);
     const welcomes = await page.evaluate(() => window.giClient.welcomes);
     const frames = await page.evaluate(() => window.giClient.framesDrawn);
     const before = await page.evaluate(() => ({
@@ -823,8 +837,13 @@ test('the page reconnects after the server restarts, counting down, and restores
         return s?.technique === 'rsm_gather' && s.params.vpl_grid === 6 && s.quality === 'fixed' && window.giClient.camera;
     }, null, 30000);
     assert.ok(near(restored.position, before.camera.position, 1e-4), `camera restored: ${restored.position}`);
+    await until('the added light restored and rendered', (n) => {
+        const l = window.giClient.lastStats?.lighting;
+        const point = window.giClient.lights.find((x) => x.type === 'point');
+        return window.giClient.lights.length === n + 1 && point && l?.rendered?.some((r) => r.id === point.id);
+    }, lightsBefore, 30000);
     await until('the restore is said', () => [...document.querySelectorAll('.message')]
-        .some((m) => /^New session: restored rsm_gather, \d+ parameters?, the camera and fixed quality\./
+        .some((m) => /^New session: restored rsm_gather, \d+ parameters?, the lights, the camera and fixed quality\./
             .test(m.textContent)));
 });
 

@@ -8,6 +8,7 @@ import http from 'node:http';
 import net from 'node:net';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { inflateSync } from 'node:zlib';
 import WebSocket from 'ws';
 
 import { helloMsg, parseFrameHeader, SUBPROTOCOL } from '../../client/protocol.js';
@@ -339,7 +340,9 @@ export class Client {
             const { binary } = await this.inbox.next((m) => m.binary !== undefined, `${what}: binary frame`, REPLY_TIMEOUT_MS);
             const header = parseFrameHeader(binary);
             assert.equal(header.frame, stats.frame, `${what}: frame id in the header equals stats.frame`);
-            assert.deepEqual([header.width, header.height], stats.size, `${what}: header size equals stats.size`);
+            // A patch (asked for with hello.patches) is a region of the stats.size image.
+            const expected = stats.patch ? [stats.patch.width, stats.patch.height] : stats.size;
+            assert.deepEqual([header.width, header.height], expected, `${what}: header size equals stats.size or the patch's`);
             const frame = { stats, header, payload: binary.subarray(header.payloadOffset) };
             if (match(stats, frame)) return frame;
         }
@@ -394,6 +397,52 @@ export class Client {
         this.ws.terminate();
         return this.closeCode;
     }
+}
+
+/**
+ * Decodes an 8-bit RGB or RGBA PNG (what the server writes) to {width, height, rgba}; throws on
+ * anything else. Enough for tests that compare pixels.
+ */
+export function decodePng(bytes) {
+    assert.ok(isPng(bytes), 'a PNG signature');
+    let width = 0, height = 0, channels = 0;
+    const idat = [];
+    for (let at = 8; at + 8 <= bytes.length;) {
+        const length = bytes.readUInt32BE(at);
+        const type = bytes.toString('latin1', at + 4, at + 8);
+        const data = bytes.subarray(at + 8, at + 8 + length);
+        if (type === 'IHDR') {
+            width = data.readUInt32BE(0);
+            height = data.readUInt32BE(4);
+            assert.equal(data[8], 8, 'PNG bit depth 8');
+            channels = { 2: 3, 6: 4 }[data[9]];
+            assert.ok(channels, `PNG colour type ${data[9]} (RGB or RGBA expected)`);
+            assert.equal(data[12], 0, 'PNG not interlaced');
+        } else if (type === 'IDAT') {
+            idat.push(data);
+        }
+        at += 12 + length;
+    }
+    const raw = inflateSync(Buffer.concat(idat));
+    const stride = width * channels;
+    const pixels = Buffer.alloc(stride * height);
+    for (let y = 0; y < height; y++) {
+        const filter = raw[y * (stride + 1)];
+        const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+        for (let i = 0; i < stride; i++) {
+            const a = i >= channels ? pixels[y * stride + i - channels] : 0;
+            const b = y > 0 ? pixels[(y - 1) * stride + i] : 0;
+            const c = y > 0 && i >= channels ? pixels[(y - 1) * stride + i - channels] : 0;
+            const p = a + b - c;
+            const pa = Math.abs(p - a), pb = Math.abs(p - b), pc = Math.abs(p - c);
+            const predictor = [0, a, b, (a + b) >> 1, pa <= pb && pa <= pc ? a : pb <= pc ? b : c][filter];
+            assert.ok(predictor !== undefined, `PNG filter ${filter}`);
+            pixels[y * stride + i] = (line[i] + predictor) & 0xff;
+        }
+    }
+    const rgba = Buffer.alloc(width * height * 4, 255);
+    for (let k = 0; k < width * height; k++) pixels.copy(rgba, k * 4, k * channels, k * channels + channels);
+    return { width, height, rgba };
 }
 
 export function isPng(bytes) {

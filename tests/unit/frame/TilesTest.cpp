@@ -110,5 +110,33 @@ TEST(Tiles, ResizeKeepsFlatImagesFlat) {
     EXPECT_EQ(resizeRgba8({}, 0, 0, 4, 4), std::vector<std::uint8_t>(64, 0));
 }
 
+TEST(Tiles, RectanglesClipUniteAndCrop) {
+    const TileRect clipped = clipToImage({8, 4, 4, 4}, 10, 6);
+    EXPECT_EQ(clipped.x, 8);
+    EXPECT_EQ(clipped.y, 4);
+    EXPECT_EQ(clipped.width, 2);
+    EXPECT_EQ(clipped.height, 2);
+    const TileRect outside = clipToImage({12, 1, 4, 4}, 10, 6);
+    EXPECT_EQ(outside.width * outside.height, 0);
+    const TileRect u = unite({}, {2, 3, 4, 1});
+    EXPECT_EQ(u.x, 2);
+    EXPECT_EQ(u.width, 4);
+    const TileRect both = unite(u, {0, 5, 1, 1});
+    EXPECT_EQ(both.x, 0);
+    EXPECT_EQ(both.y, 3);
+    EXPECT_EQ(both.width, 6);
+    EXPECT_EQ(both.height, 3);
+
+    std::vector<std::uint8_t> canvas(10 * 6 * 4);
+    for (int y = 0; y < 6; ++y)
+        for (int x = 0; x < 10; ++x) canvas[(y * 10 + x) * 4] = static_cast<std::uint8_t>(10 * y + x);
+    const auto crop = cropRgba8(canvas, 10, 6, {8, 4, 4, 4}); // clipped to 2 x 2
+    ASSERT_EQ(crop.size(), 2u * 2u * 4u);
+    EXPECT_EQ(crop[0], 48);
+    EXPECT_EQ(crop[4], 49);
+    EXPECT_EQ(crop[8], 58);
+    EXPECT_EQ(crop[12], 59);
+}
+
 } // namespace
 } // namespace gis

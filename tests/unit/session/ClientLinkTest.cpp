@@ -86,3 +86,20 @@ TEST(ClientLink, AcksOfFramesNeverOfferedAreRefused) {
     EXPECT_EQ(link.inFlight(), 0u);
     EXPECT_EQ(link.newestOffered(), 1u);
 }
+
+TEST(ClientLink, PatchesAreNeverReplacedButAWholeFrameReplacesThem) {
+    gis::ClientLink link(gis::ClientRole::Controller, 4, nullptr, 64, /*acceptsPatches=*/true);
+    EXPECT_TRUE(link.acceptsPatches());
+    link.offerFrame(1, "s1", bytes("f1"));              // whole
+    link.offerFrame(2, "p2", bytes("g2"), false, true); // a patch over frame 1: both stay
+    link.offerFrame(3, "p3", bytes("g3"), false, true); // and over patch 2
+    EXPECT_EQ(drain(link),
+              (std::vector<std::string>{"txt:s1", "bin:f1", "txt:p2", "bin:g2", "txt:p3", "bin:g3"}));
+    EXPECT_EQ(link.droppedFrames(), 0u);
+    link.ack(3);
+    link.offerFrame(4, "p4", bytes("g4"), false, true);
+    link.offerFrame(5, "s5", bytes("f5")); // a whole frame supersedes the unsent patch
+    EXPECT_EQ(drain(link), (std::vector<std::string>{"txt:s5", "bin:f5"}));
+    EXPECT_EQ(link.droppedFrames(), 1u);
+    EXPECT_FALSE(gis::ClientLink(gis::ClientRole::Viewer, 1, nullptr).acceptsPatches());
+}
