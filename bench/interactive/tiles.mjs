@@ -2,7 +2,7 @@
 // client with a 960x800 view, optionally sets a technique and parameters, leaves the view still and
 // reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms, the
 // steps' VPL counts and the most VPL parts a tile was split into.
-// usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--technique T]
+// usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--scene builtin:NAME] [--technique T]
 //        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"] [--whole 1]
 // --whole 1 asks for whole images instead of patches (as a client that does not draw patches).
 import { spawn } from 'node:child_process';
@@ -12,12 +12,12 @@ import WebSocket from 'ws';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const opts = { server: path.join(root, 'build/ci/bin/gi-server'), technique: '', params: '', seconds: 15,
-    'server-args': '', whole: 0 };
+    'server-args': '', whole: 0, scene: '' };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
     const key = argv[i].replace(/^--/, '');
     if (key === 'help') {
-        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1]');
+        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1]');
         process.exit(0);
     }
     if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
@@ -39,6 +39,7 @@ ws.on('open', () => {
     ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2, codecs: ['webp', 'jpeg'],
         // As the web client: patches (the regions pasted since the last send) unless --whole 1.
         patches: !opts.whole }));
+    if (opts.scene) ws.send(JSON.stringify({ type: 'scene', name: opts.scene }));
     if (opts.technique) ws.send(JSON.stringify({ type: 'technique', name: opts.technique }));
     if (opts.params) ws.send(JSON.stringify({ type: 'params', values: JSON.parse(opts.params) }));
 });

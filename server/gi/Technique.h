@@ -56,6 +56,9 @@ struct FrameInputs {
     bool glossy = false;
     float glossyMinRoughness = 0.35f;
     bool lightEnabled = true;
+    /// The light views (shadow maps, RSMs) are the previous frame's, unchanged: what a technique
+    /// derived from them alone (the extracted VPLs) still holds.
+    bool lightViewsReused = false;
     const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
     /// Draws the scene's triangles (world-space positions at attribute 0) with `program` bound,
     /// `instances` times; techniques see geometry only through this (VPL shadow maps).

@@ -460,6 +460,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     in.glossy = nonDiffuse.glossy;
     in.glossyMinRoughness = fp.getFloat("glossy_split");
     in.lightEnabled = lightOn;
+    in.lightViewsReused = reuseLights;
     in.frame = &u;
     in.drawGeometry = [this](const gl::Program& program, int instances) {
         mSceneGpu->draw(program, nullptr, instances);

@@ -99,11 +99,14 @@ TEST(TilesGl, ReusedLightViewsRenderTheSameFrame) {
     const FrameOutput a = fresh.render(s), b = reusing.render(s);
     EXPECT_EQ(counter(b, "light_views_reused"), 6.0); // the point light's six faces
     EXPECT_EQ(counter(a, "light_views_reused"), 0.0);
+    EXPECT_EQ(counter(b, "vpls_reused"), 1.0); // and the VPLs extracted from them
+    EXPECT_EQ(counter(a, "vpls_reused"), 0.0);
     EXPECT_EQ(a.rgba8, b.rgba8);
-    // A moved light renders its views again.
+    // A moved light renders its views again, and extracts its VPLs again.
     s.lights[0].light.position += glm::vec3(0.0f, -0.2f, 0.0f);
     const FrameOutput c = reusing.render(s), d = fresh.render(s);
     EXPECT_EQ(counter(c, "light_views_reused"), 0.0);
+    EXPECT_EQ(counter(c, "vpls_reused"), 0.0);
     EXPECT_EQ(c.rgba8, d.rgba8);
 }
 

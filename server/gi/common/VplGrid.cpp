@@ -85,6 +85,15 @@ std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int
 int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Counters& counters) {
     const int views = in.lightEnabled ? in.lightViews : 0;
     const std::vector<int> sides = splitVplGrid(grid, in.viewFlux, views, in.rsmSize);
+    // The VPLs depend on the RSMs and the split alone: unchanged light views (an orbit, the tiles
+    // and VPL parts of a refinement step) keep the last extraction. With several views it cost
+    // 16 ms of a 25 ms VPL part on cornell-colored at 960 x 800.
+    if (in.lightViewsReused && mExtracted && sides == mExtractedSides && in.rsmSize == mExtractedRsmSize) {
+        counters["vpl_count"] = mCount;
+        counters["vpls_reused"] = 1;
+        return mCount;
+    }
+    mExtracted = false;
     mCount = 0;
     for (int side : sides) mCount += side * side;
     counters["vpl_count"] = mCount;
@@ -111,6 +120,9 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
         offset += side * side;
     }
     pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    mExtracted = true;
+    mExtractedSides = sides;
+    mExtractedRsmSize = in.rsmSize;
     return mCount;
 }
 

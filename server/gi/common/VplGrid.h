@@ -103,6 +103,10 @@ private:
     gl::Buffer mPartVpls; ///< the prepared part's VPLs (preparePart)
     int mCount = 0;
     int mPartCount = 0;
+    /// What the buffer holds: the sides and RSM size of the last extraction (valid when mExtracted).
+    bool mExtracted = false;
+    std::vector<int> mExtractedSides;
+    int mExtractedRsmSize = 0;
 };
 
 } // namespace gis
