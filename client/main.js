@@ -706,7 +706,10 @@ async function decodeAndDraw(frame) {
         const decodeMs = performance.now() - started;
         if (frame.socket === connection.socket) {
             const patch = patchPlacement(frame.entry?.stats, header);
-            if (patch) {
+            if (frame.entry?.stats?.patch && !patch) {
+                // Drawn as a whole frame it would stretch a region over the view.
+                showMessage(`Frame ${header.frame}: a patch outside its image was not drawn.`);
+            } else if (patch) {
                 // A region of a refining image: the picture so far, stretched to the image's size,
                 // under it.
                 if (ui.canvas.width !== patch.width || ui.canvas.height !== patch.height) {

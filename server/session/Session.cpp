@@ -520,7 +520,13 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     {
         std::lock_guard lock(mMutex);
         onFrame = mOnFrame;
-        if (patchMissed) mWholeFrameWanted = true;
+        // A viewer that joined while this patch was encoded has neither it nor (attach saw no patch
+        // yet) a reason to get the image whole: it needs one like a client that missed a patch.
+        const bool joinedMeanwhile =
+            region && std::any_of(mViewers.begin(), mViewers.end(), [&](const auto& v) {
+                return std::find(targets.begin(), targets.end(), v) == targets.end();
+            });
+        if (patchMissed || joinedMeanwhile) mWholeFrameWanted = true;
         if (!snapshotFor) {
             if (region) {
                 mPatchedSinceLastFrame = true;

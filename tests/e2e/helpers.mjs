@@ -400,8 +400,8 @@ export class Client {
 }
 
 /**
- * Decodes an 8-bit RGB or RGBA PNG (what the server writes) to {width, height, rgba}; throws on
- * anything else. Enough for tests that compare pixels.
+ * Decodes an 8-bit non-interlaced PNG (what the server writes) to {width, height, channels, pixels
+ * (the file's channels), rgba (every pixel as RGBA8)}; fails the test on anything else.
  */
 export function decodePng(bytes) {
     assert.ok(isPng(bytes), 'a PNG signature');
@@ -415,8 +415,8 @@ export function decodePng(bytes) {
             width = data.readUInt32BE(0);
             height = data.readUInt32BE(4);
             assert.equal(data[8], 8, 'PNG bit depth 8');
-            channels = { 2: 3, 6: 4 }[data[9]];
-            assert.ok(channels, `PNG colour type ${data[9]} (RGB or RGBA expected)`);
+            channels = { 0: 1, 2: 3, 4: 2, 6: 4 }[data[9]];
+            assert.ok(channels, `PNG colour type ${data[9]} (grey, RGB, grey-alpha or RGBA expected)`);
             assert.equal(data[12], 0, 'PNG not interlaced');
         } else if (type === 'IDAT') {
             idat.push(data);
@@ -441,8 +441,15 @@ export function decodePng(bytes) {
         }
     }
     const rgba = Buffer.alloc(width * height * 4, 255);
-    for (let k = 0; k < width * height; k++) pixels.copy(rgba, k * 4, k * channels, k * channels + channels);
-    return { width, height, rgba };
+    for (let k = 0; k < width * height; k++) {
+        const px = pixels.subarray(k * channels, (k + 1) * channels);
+        const grey = channels < 3;
+        rgba[k * 4] = px[0];
+        rgba[k * 4 + 1] = grey ? px[0] : px[1];
+        rgba[k * 4 + 2] = grey ? px[0] : px[2];
+        if (channels === 2 || channels === 4) rgba[k * 4 + 3] = px[channels - 1];
+    }
+    return { width, height, channels, pixels, rgba };
 }
 
 export function isPng(bytes) {

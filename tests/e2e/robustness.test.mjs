@@ -15,9 +15,8 @@
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import path from 'node:path';
-import zlib from 'node:zlib';
 
-import { Client, REPO, ServerProcess, testGroup } from './helpers.mjs';
+import { Client, decodePng, REPO, ServerProcess, testGroup } from './helpers.mjs';
 
 const SIZE = [16, 16]; // the smallest size every entry point accepts
 let server = null;
@@ -130,51 +129,6 @@ function assertFiniteStats(stats, what) {
             if (key in p) assert.ok(Number.isFinite(p[key]), `${what}: pass ${p.name} ${key} ${p[key]}`);
         }
     }
-}
-
-/** Decodes an 8-bit non-interlaced PNG (what the server writes) to {width, height, channels, pixels}. */
-function decodePng(bytes) {
-    let offset = 8;
-    let width = 0, height = 0, channels = 0;
-    const idat = [];
-    while (offset < bytes.length) {
-        const length = bytes.readUInt32BE(offset);
-        const type = bytes.toString('latin1', offset + 4, offset + 8);
-        const data = bytes.subarray(offset + 8, offset + 8 + length);
-        if (type === 'IHDR') {
-            width = data.readUInt32BE(0);
-            height = data.readUInt32BE(4);
-            assert.equal(data[8], 8, 'PNG bit depth 8');
-            channels = { 0: 1, 2: 3, 4: 2, 6: 4 }[data[9]];
-            assert.equal(data[12], 0, 'PNG not interlaced');
-        } else if (type === 'IDAT') {
-            idat.push(data);
-        }
-        offset += 12 + length;
-    }
-    const raw = zlib.inflateSync(Buffer.concat(idat));
-    const stride = width * channels;
-    const pixels = Buffer.alloc(stride * height);
-    for (let y = 0; y < height; ++y) {
-        const filter = raw[y * (stride + 1)];
-        const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
-        for (let x = 0; x < stride; ++x) {
-            const a = x >= channels ? pixels[y * stride + x - channels] : 0;
-            const b = y > 0 ? pixels[(y - 1) * stride + x] : 0;
-            const c = x >= channels && y > 0 ? pixels[(y - 1) * stride + x - channels] : 0;
-            let v = line[x];
-            if (filter === 1) v += a;
-            else if (filter === 2) v += b;
-            else if (filter === 3) v += (a + b) >> 1;
-            else if (filter === 4) {
-                const p = a + b - c;
-                const pa = Math.abs(p - a), pb = Math.abs(p - b), pc = Math.abs(p - c);
-                v += pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
-            }
-            pixels[y * stride + x] = v & 0xff;
-        }
-    }
-    return { width, height, channels, pixels };
 }
 
 async function render(body) {
