@@ -4,7 +4,8 @@
 // steps' VPL counts and the most VPL parts a tile was split into.
 // usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--scene builtin:NAME] [--technique T]
 //        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"] [--whole 1]
-// --whole 1 asks for whole images instead of patches (as a client that does not draw patches).
+// --whole 1 asks for whole images instead of patches (as a client that does not draw patches); --verbose 1
+// prints every tile sent (step, parts, size, ms, passes). Steps that completed are reported with their time.
 import { spawn } from 'node:child_process';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -12,12 +13,12 @@ import WebSocket from 'ws';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const opts = { server: path.join(root, 'build/ci/bin/gi-server'), technique: '', params: '', seconds: 15,
-    'server-args': '', whole: 0, scene: '' };
+    'server-args': '', whole: 0, scene: '', verbose: 0 };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
     const key = argv[i].replace(/^--/, '');
     if (key === 'help') {
-        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1]');
+        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1] [--verbose 1]');
         process.exit(0);
     }
     if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
@@ -35,6 +36,7 @@ const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
 let stats = null;
 const tiles = [];
 const progress = [];
+const stepsDone = [];
 ws.on('open', () => {
     ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2, codecs: ['webp', 'jpeg'],
         // As the web client: patches (the regions pasted since the last send) unless --whole 1.
@@ -52,6 +54,10 @@ ws.on('message', (data, isBinary) => {
     }
     ws.send(JSON.stringify({ type: 'ack', frame: data.readUInt32LE(4) }));
     if (stats?.refine) {
+        if (stats.refine.complete) stepsDone.push({ step: stats.quality, ms: Math.round(stats.refine.elapsed_ms) });
+        if (opts.verbose) console.log(JSON.stringify({ step: stats.quality, share: +stats.refine.share.toFixed(3),
+            parts: `${stats.refine.vpl_parts_done}/${stats.refine.vpl_parts}`, tile: stats.tile?.size, ms: +stats.frame_ms.toFixed(1),
+            passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(1)])) }));
         tiles.push({ ms: stats.frame_ms, encodeMs: stats.encode_ms ?? 0, bytes: stats.bytes ?? 0, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
             parts: stats.refine.vpl_parts ?? 1, index: tiles.length, tile: stats.tile?.size,
             passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(2)])) });
@@ -70,7 +76,7 @@ setTimeout(() => {
         vpl_parts_max: Math.max(1, ...tiles.map((t) => t.parts)),
         slowest_tile: tiles.length ? (({ passes, ...t }) => t)(tiles.reduce((a, b) => (b.ms > a.ms ? b : a))) : null,
         last_tile: tiles.length ? { ms: tiles.at(-1).ms, parts: tiles.at(-1).parts, passes: tiles.at(-1).passes } : null,
-        progress }));
+        steps_done: stepsDone, progress }));
     ws.close(1000);
     server.kill('SIGINT');
     process.exit(0);

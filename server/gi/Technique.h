@@ -68,6 +68,9 @@ struct FrameInputs {
     /// vplParts is vplPart, their light scaled by vplParts. 1 part: every VPL.
     int vplPart = 0;
     int vplParts = 1;
+    /// A later VPL part of the image the previous frame rendered (same size, window, camera and
+    /// parameters): what a technique derived from the G-buffer alone (the eye hierarchy) still holds.
+    bool sameImageAsLastPart = false;
 
     /// The resource `name`, or nullptr when the frame did not produce it.
     const gl::Texture* find(const std::string& name) const {

@@ -339,8 +339,21 @@ void FrameRenderer::composite(int width, int height, const gl::Texture* indirect
     mResources.publish("linear", "composite", mLinear);
 }
 
-const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const gl::Texture& part,
-                                                 Counters& counters) {
+std::array<int, 7> FrameRenderer::partKey(const FrameState& state) {
+    return {state.width,        state.height,           state.window.x,
+            state.window.y,     state.window.fullWidth, state.window.fullHeight,
+            state.vplPart.count};
+}
+
+bool FrameRenderer::followsLastPart(const FrameState& state, const glm::mat4& viewProj) const {
+    const PartAverage& a = mPartAverage;
+    return state.vplPart.index > 0 && a.averaged == state.vplPart.index && a.width == state.width &&
+           a.height == state.height && partKey(state) == a.key && viewProj == a.viewProj &&
+           state.techniqueParams.toJson() == a.techniqueParams;
+}
+
+const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const glm::mat4& viewProj,
+                                                 const gl::Texture& part, Counters& counters) {
     PartAverage& a = mPartAverage;
     if (a.width != state.width || a.height != state.height) {
         a.mean = gl::Texture::create2D(GL_RGBA32F, state.width, state.height);
@@ -349,13 +362,12 @@ const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const 
         a.height = state.height;
         a.averaged = 0;
     }
-    const std::array<int, 7> key{state.width,        state.height,           state.window.x,
-                                 state.window.y,     state.window.fullWidth, state.window.fullHeight,
-                                 state.vplPart.count};
     // Part 0 starts a mean; so does a part that does not follow the ones in it (another image, or a
     // part left out), which then shows the parts it has rather than mixing two images.
-    if (state.vplPart.index == 0 || key != a.key || a.averaged != state.vplPart.index) a.averaged = 0;
-    a.key = key;
+    if (!followsLastPart(state, viewProj)) a.averaged = 0;
+    a.key = partKey(state);
+    a.viewProj = viewProj;
+    a.techniqueParams = state.techniqueParams.toJson();
     {
         gl::Pass pass(mTimer, "vpl_part_average");
         pass.target(a.fbo, state.width, state.height)
@@ -472,6 +484,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     if (vplParts) {
         in.vplParts = state.vplPart.count;
         in.vplPart = std::clamp(state.vplPart.index, 0, state.vplPart.count - 1);
+        in.sameImageAsLastPart = followsLastPart(state, u.viewProj);
+        if (in.sameImageAsLastPart) counters["vpl_part_same_image"] = 1;
     }
     const size_t techniqueFirstPass = mTimer.passCount();
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
@@ -479,7 +493,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     const gl::Texture* indirect = mTechnique->indirect();
-    if (indirect && vplParts) indirect = &averageVplPart(state, *indirect, counters);
+    if (indirect && vplParts) indirect = &averageVplPart(state, u.viewProj, *indirect, counters);
     if (indirect)
         mResources.publish("indirect", "technique", *indirect);
     else

@@ -89,7 +89,11 @@ private:
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
     /// Folds one VPL part's indirect light into the running mean of the parts before it
     /// (FrameState::VplPart) and returns that mean.
-    const gl::Texture& averageVplPart(const FrameState& state, const gl::Texture& part, Counters& counters);
+    const gl::Texture& averageVplPart(const FrameState& state, const glm::mat4& viewProj,
+                                      const gl::Texture& part, Counters& counters);
+    static std::array<int, 7> partKey(const FrameState& state);
+    /// Whether `state` is the next VPL part of the image whose parts are in the mean.
+    bool followsLastPart(const FrameState& state, const glm::mat4& viewProj) const;
 
     std::shared_ptr<const Scene> mScene;
     std::unique_ptr<SceneGpu> mSceneGpu;
@@ -147,6 +151,9 @@ private:
         int averaged = 0; ///< parts in the mean
         /// What the parts in the mean rendered: a part adds to them only with the same image.
         std::array<int, 7> key{};
+        /// The camera and technique parameters of the parts in the mean.
+        glm::mat4 viewProj{0.0f};
+        nlohmann::json techniqueParams;
     } mPartAverage;
 
     Reflections mReflections;

@@ -20,6 +20,7 @@
 #include "scene/SceneLoader.h"
 #include "session/FrameBudget.h"
 #include "session/RenderGate.h"
+#include "session/VplPartPlanner.h"
 #if GIS_HAVE_EFFECTS
 #include "effects/EffectPlan.h"
 #endif
@@ -34,8 +35,9 @@ using Clock = std::chrono::steady_clock;
 constexpr int kTileAlign = 16;
 constexpr int kMinTileSide = 16;
 constexpr int kSnapshotBudgetMs = 5000;
-// Tiles whose VPLs render in parts (FrameState::VplPart): 64 x 64 inner pixels, so that a part's fixed
-// costs (G-buffer, direct light, composite, read-back) stay small beside its share of the VPLs; at
+// Tiles whose VPLs render in parts (FrameState::VplPart): at most 64 x 64 inner pixels or twice the
+// guard band (so the guard is not most of what a part renders), fewer when a part's fixed work
+// (G-buffer, direct light, composite, read-back) would fill the slice (session/VplPartPlanner.h); at
 // most 4096 parts (each at least one VPL).
 constexpr int kPartTileSide = 64;
 constexpr int kMaxVplParts = 4096;
@@ -608,11 +610,16 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     bool sentOnce = false;
     TileRect unsent; // the canvas's pixels pasted since the last send
     double renderedMs = 0.0;
-    // VPL parts: tiles of kPartTileSide^2 inner pixels (their fixed costs stay small beside the VPLs'),
-    // as many parts as make one fit 80 % of a slice; `partsFloor` rises when a part overran, and the
-    // tile shrinks when even the most parts overran.
-    int partsFloor = 1;
-    double partTilePixels = double(kPartTileSide) * kPartTileSide;
+    // VPL parts: tiles of partSide^2 inner pixels (smaller when a part's fixed work alone would fill
+    // most of a slice), in as many parts as the parts measured so far say fit 70 % of a slice. The
+    // planner counts rendered pixels, the guard band included.
+    VplPartPlanner::Limits partLimits;
+    partLimits.targetMs = 0.7 * sliceMs;
+    const int partSide = std::max(kPartTileSide, 2 * guard);
+    partLimits.tilePixels = double(partSide + 2 * guard) * (partSide + 2 * guard);
+    partLimits.minTilePixels = double(kMinTileSide + 2 * guard) * (kMinTileSide + 2 * guard);
+    partLimits.maxParts = kMaxVplParts;
+    VplPartPlanner partPlanner(partLimits);
     int maxPartsUsed = 1;
     progress("refining", 0.0, rate > 0.0 ? rate * fullPixels : 0.0,
              "the view is still: rendering the " + stepLabel + " step in tiles of about " +
@@ -629,11 +636,10 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const double sizingRate = renderedMs > 0.0 ? rate : 3.0 * rate;
         double pixels = rate > 0.0 ? sliceMs / sizingRate : double(kMinTileSide) * kMinTileSide;
         int parts = 1;
-        if (splittable && rate > 0.0 && (pixels < partTilePixels || partsFloor > 1)) {
-            const double wanted = std::ceil(sizingRate * partTilePixels / (0.8 * sliceMs));
-            parts = static_cast<int>(std::clamp(std::max(wanted, double(partsFloor)), 2.0,
-                                                std::min(double(vpls), double(kMaxVplParts))));
-            pixels = partTilePixels;
+        if (splittable && rate > 0.0 && pixels < partLimits.tilePixels) {
+            const VplPartPlan partPlan = partPlanner.plan(vpls, sizingRate);
+            parts = partPlan.parts;
+            pixels = partPlan.pixels;
         }
         // The guard band is rendered too: ask for fewer inner pixels so the whole tile fits the slice.
         const double side = std::sqrt(std::max(pixels, 1.0));
@@ -643,7 +649,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const double shareAfter = plan.shareDone();
         const FrameState tile = tileState(full, rect, guard);
         const double tilePixels = static_cast<double>(tile.width) * tile.height;
-        double tileMs = 0.0, slowestPartMs = 0.0;
+        double tileMs = 0.0;
         for (int part = 0; part < parts; ++part) {
             if (part > 0 && inputPending()) return abandoned();
             FrameState piece = tile;
@@ -653,7 +659,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
                 return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
             const FrameOutput& frame = rendered.frame;
             tileMs += rendered.renderMs;
-            slowestPartMs = std::max(slowestPartMs, rendered.renderMs);
+            if (splittable) partPlanner.record(tilePixels, parts, rendered.renderMs);
             renderedMs += rendered.renderMs;
             pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
             unsent = unite(unsent, clipToImage(rect, full.width, full.height));
@@ -714,17 +720,6 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         // A slow tile counts at once (tiles must not overrun); a cheap one (mostly background) lowers
         // the estimate by at most a fifth, since the next one may cover geometry.
         rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
-        if (parts > 1 && slowestPartMs > sliceMs) {
-            // A part overran: more parts next time (as if a part's cost were all VPLs), and once the
-            // parts are at their limit, a smaller tile.
-            const double more = std::ceil(parts * slowestPartMs / (0.8 * sliceMs));
-            if (more > std::min(double(vpls), double(kMaxVplParts)))
-                partTilePixels = std::max(double(kMinTileSide) * kMinTileSide,
-                                          partTilePixels * 0.8 * sliceMs / slowestPartMs);
-            partsFloor = static_cast<int>(std::min(more, double(kMaxVplParts)));
-        } else if (parts > 1 && slowestPartMs < 0.4 * sliceMs && partsFloor > 1) {
-            partsFloor = std::max(1, partsFloor / 2);
-        }
         // A smallest tile over the slice that cannot split its VPLs: its cost is mostly per VPL (each
         // batch of them is a draw), so the step starts again with the VPLs this measurement allows
         // (workerMain caps them).

@@ -137,6 +137,12 @@ double maxRelativeDifference(const std::vector<float>& a, const std::vector<floa
     return worst / peak;
 }
 
+bool hasPass(const FrameOutput& f, const std::string& name) {
+    for (const auto& pass : f.stats.at("passes"))
+        if (pass.at("name") == name) return true;
+    return false;
+}
+
 // VPL parts (FrameState::VplPart): the running mean of the parts of one image ends at the image of
 // every VPL, its first parts differ from it, and parts of another image or out of order start again.
 TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
@@ -159,6 +165,11 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
             const FrameOutput out = renderer.render(part, true);
             EXPECT_EQ(counter(out, "vpl_parts_averaged"), p + 1.0) << info.name;
             EXPECT_EQ(counter(out, "vpl_parts"), parts) << info.name;
+            // Parts after the first keep what the G-buffer alone decides (the eye hierarchy's mipmap).
+            EXPECT_EQ(counter(out, "vpl_part_same_image"), p > 0 ? 1.0 : 0.0) << info.name;
+            if (info.eyeHierarchy) {
+                EXPECT_EQ(hasPass(out, "eye_mipmap"), p == 0) << info.name << " part " << p;
+            }
             errors.push_back(maxRelativeDifference(out.linear, whole.linear));
         }
         std::printf("[vpl parts] %-16s 144 VPLs in %d parts: max relative difference after part 1 %.3g, "
@@ -188,6 +199,18 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
     FrameState stray = full;
     stray.vplPart = {2, 3};
     EXPECT_EQ(counter(renderer.render(stray), "vpl_parts_averaged"), 1.0);
+
+    // The next part seen from elsewhere is another image: a new mean, nothing kept from the last part.
+    FrameState multires = stateFor(scene, "multires_gather", 96, 80);
+    multires.vplPart = {0, 3};
+    renderer.render(multires);
+    FrameState moved = multires;
+    moved.vplPart = {1, 3};
+    moved.camera.position += glm::vec3(0.05f, 0.0f, 0.0f);
+    const FrameOutput movedPart = renderer.render(moved);
+    EXPECT_EQ(counter(movedPart, "vpl_parts_averaged"), 1.0);
+    EXPECT_EQ(counter(movedPart, "vpl_part_same_image"), 0.0);
+    EXPECT_TRUE(hasPass(movedPart, "eye_mipmap"));
 
     // Bias compensation filters the sum: no parts, every part renders the whole set.
     FrameState compensated = full;

@@ -167,11 +167,7 @@ void EyeHierarchy::bindUniforms() const {
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_EYE, mUbo.id());
 }
 
-void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer) {
-    ensureLayout(in.width, in.height, params.getInt("coarsest_size"));
-    uploadUniforms(params);
-    bindUniforms();
-
+void EyeHierarchy::buildGeometryLevels(const FrameInputs& in, gl::PassTimer& timer) {
     {
         gl::Pass pass(timer, "eye_mipmap");
         pass.target(mGeoFbo, mAtlasWidth, mAtlasHeight);
@@ -198,6 +194,21 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
                 .viewport(mWidth, 0, mAtlasWidth - mWidth, mAtlasHeight) // the level column only
                 .drawFullscreen(mEmptyVao);
         }
+    }
+}
+
+void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer) {
+    const bool sameLayout =
+        mWidth == in.width && mHeight == in.height && mCoarsest == params.getInt("coarsest_size");
+    ensureLayout(in.width, in.height, params.getInt("coarsest_size"));
+    uploadUniforms(params);
+    bindUniforms();
+
+    // A later VPL part of the same image: the G-buffer, so the mipmap and the refinement flags, are the
+    // previous part's (the receivers' stencil below is reset with the illumination target each time).
+    if (!(in.sameImageAsLastPart && sameLayout && mBuilt)) {
+        buildGeometryLevels(in, timer);
+        mBuilt = true;
     }
 
     gl::Pass pass(timer, "stencil_setup");

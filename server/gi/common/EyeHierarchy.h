@@ -57,6 +57,8 @@ public:
 
     /// Builds the mipmaps and flags ("eye_mipmap"), marks the receivers in the stencil
     /// ("stencil_setup") and clears the illumination atlas.
+    /// A later VPL part of the same image (FrameInputs::sameImageAsLastPart) keeps the mipmaps and
+    /// flags of the part before.
     void build(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer);
     /// Reads back the receiver count per level (synchronises) and writes the counters
     /// receivers_total, receivers_l<k> and receiver_fraction (receivers / covered pixels).
@@ -92,6 +94,8 @@ public:
     std::vector<std::array<int, 3>> readReceiverSet() const;
 
 private:
+    /// The geometry mipmaps and the refinement flags over the G-buffer ("eye_mipmap", "refine_flags").
+    void buildGeometryLevels(const FrameInputs& in, gl::PassTimer& timer);
     void uploadUniforms(const ParamSet& params);
 
     struct ReduceProgram {
@@ -130,6 +134,7 @@ private:
     gl::Buffer mUbo, mCounts;
     std::vector<EyeLevel> mLevels;
     int mWidth = 0, mHeight = 0, mCoarsest = 0, mAtlasWidth = 0, mAtlasHeight = 0;
+    bool mBuilt = false; ///< the mipmaps and flags were built for the current layout
     gl::Texture mGeoPosition, mGeoNormal, mGeoAlbedo, mDepthInfo, mNormalMin, mNormalMax, mFlags, mDiscFlags;
     gl::Texture mIllumination, mStencil, mReconstructed;
     gl::Framebuffer mGeoFbo, mFlagsFbo, mIllumFbo, mReconFbo;
