@@ -21,6 +21,7 @@
 #include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "scene/Geometry.h"
+#include "scene/GltfPreflight.h"
 #include "scene/SceneLoader.h"
 
 namespace gis {
@@ -29,8 +30,6 @@ namespace {
 constexpr const char* kLightsExtension = "KHR_lights_punctual";
 constexpr const char* kEmissiveStrengthExtension = "KHR_materials_emissive_strength";
 constexpr const char* kSpecularExtension = "KHR_materials_specular";
-// Quantized attributes are just non-float component types, which the accessor reader handles.
-constexpr const char* kQuantizationExtension = "KHR_mesh_quantization";
 constexpr int kNotConverted = -2;
 
 /// tinygltf joins several messages with newlines; an InputError reads best as one line.
@@ -328,10 +327,11 @@ private:
     [[noreturn]] void fail(const std::string& message) const { throw InputError(mPath, message); }
     void warn(const std::string& message) const { logWarn("scene: " + mPath + ": " + message); }
 
+    // preflightGltfJson refused these already, with advice; a model built another way is checked too.
     void checkRequiredExtensions() const {
+        const auto& readable = gltfReadableExtensions();
         for (const auto& ext : mModel.extensionsRequired)
-            if (ext != kLightsExtension && ext != kEmissiveStrengthExtension &&
-                ext != kQuantizationExtension && ext != kSpecularExtension)
+            if (std::find(readable.begin(), readable.end(), ext) == readable.end())
                 fail("unsupported required extension '" + ext + "'");
     }
 
@@ -761,6 +761,8 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
         throw InputError(name, "malformed JSON: arrays and objects nested deeper than " +
                                    std::to_string(kMaxGltfJsonDepth) + " levels (at byte " +
                                    std::to_string(*at) + " of the JSON)");
+    // Version, required extensions and dangling references, said with their JSON path.
+    preflightGltfJson(json, name);
 
     tinygltf::TinyGLTF parser;
     parser.SetFsCallbacks(

@@ -128,7 +128,126 @@ TEST(GltfErrors, UnsupportedRequiredExtension) {
     b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_draco_mesh_compression"};
     b.doc["extensionsRequired"] = {"KHR_lights_punctual", "KHR_draco_mesh_compression"};
     expectInputError(b.writeGltf(dir, "draco.gltf"),
-                     {"unsupported required extension 'KHR_draco_mesh_compression'"});
+                     {"unsupported required extension 'KHR_draco_mesh_compression'", "Draco-compressed",
+                      "export it without mesh compression"});
+    b.doc["extensionsRequired"] = {"KHR_texture_basisu"};
+    expectInputError(b.writeGltf(dir, "ktx2.gltf"),
+                     {"unsupported required extension 'KHR_texture_basisu'", "KTX2", "PNG or JPEG"});
+    b.doc["extensionsRequired"] = {"EXT_meshopt_compression"};
+    expectInputError(b.writeGlb(dir, "meshopt.glb"), {"'EXT_meshopt_compression'", "meshopt-compressed"});
+    b.doc["extensionsRequired"] = {"KHR_materials_volume_future"};
+    expectInputError(b.writeGlb(dir, "other.glb"), {"'KHR_materials_volume_future'",
+                                                    "it reads KHR_lights_punctual", "KHR_mesh_quantization"});
+}
+
+// A Draco primitive without uncompressed data is refused by its extension even when the file does not
+// list it as required (the parser said "accessor[0] invalid bufferView").
+TEST(GltfErrors, DracoPrimitiveWithoutFallbackNamesTheExtension) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode("squeezed");
+    b.doc["accessors"][0].erase("bufferView");
+    b.doc["meshes"][0]["primitives"][0]["extensions"] = {
+        {"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
+    b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    b.setScene({tri});
+    expectInputError(b.writeGlb(dir, "draco_used.glb"),
+                     {"meshes[0].primitives[0].attributes.POSITION", "'KHR_draco_mesh_compression'",
+                      "without mesh compression"});
+}
+
+TEST(GltfErrors, VersionOtherThanTwoIsRefused) {
+    TempDir dir;
+    GltfBuilder b;
+    b.setScene({b.addTriangleNode()});
+    b.doc["asset"]["version"] = "3.0";
+    expectInputError(b.writeGltf(dir, "v3.gltf"), {"asset.version is \"3.0\"", "glTF 2.x only"});
+    b.doc["asset"]["version"] = "1.0";
+    expectInputError(b.writeGlb(dir, "v1.glb"), {"asset.version is \"1.0\"", "1-to-2"});
+    b.doc["asset"]["version"] = 2;
+    expectInputError(b.writeGltf(dir, "number.gltf"), {"asset.version must be a string"});
+    b.doc["asset"]["version"] = "2.1";
+    b.doc["asset"]["minVersion"] = "2.1";
+    expectInputError(b.writeGltf(dir, "min.gltf"), {"asset.minVersion is \"2.1\""});
+    b.doc["asset"].erase("minVersion");
+    EXPECT_NO_THROW(loadGltf(b.writeGltf(dir, "minor.gltf"))) << "2.1 is still glTF 2";
+    b.doc.erase("asset");
+    expectInputError(b.writeGltf(dir, "noasset.gltf"), {"asset.version is missing"});
+}
+
+TEST(GltfErrors, DanglingReferencesAreRefusedWithTheirPath) {
+    TempDir dir;
+    struct Case {
+        const char* name;
+        std::function<void(GltfBuilder&)> damage;
+        std::vector<std::string> fragments;
+    };
+    const std::vector<Case> cases = {
+        {"texture_source",
+         [](GltfBuilder& b) {
+             b.doc["images"] = nlohmann::json::array({{{"uri", "data:image/png;base64,"}}});
+             b.doc["textures"] = nlohmann::json::array({{{"source", 3}}});
+         },
+         {"textures[0].source: image 3 does not exist (the file has 1)", "export it again"}},
+        {"texture_sampler",
+         [](GltfBuilder& b) {
+             b.doc["textures"] = nlohmann::json::array({{{"sampler", 0}}});
+         },
+         {"textures[0].sampler: sampler 0 does not exist (the file has none)"}},
+        {"material_texture",
+         [](GltfBuilder& b) {
+             b.doc["materials"] = nlohmann::json::array({{{"normalTexture", {{"index", 2}}}}});
+         },
+         {"materials[0].normalTexture.index: texture 2 does not exist"}},
+        {"base_color_texture",
+         [](GltfBuilder& b) {
+             b.doc["materials"] =
+                 nlohmann::json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", -1}}}}}}});
+         },
+         {"materials[0].pbrMetallicRoughness.baseColorTexture.index: texture -1 does not exist"}},
+        {"primitive_material",
+         [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["material"] = 5; },
+         {"meshes[0].primitives[0].material: material 5 does not exist"}},
+        {"attribute",
+         [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 9; },
+         {"meshes[0].primitives[0].attributes.NORMAL: accessor 9 does not exist"}},
+        {"node_mesh",
+         [](GltfBuilder& b) { b.doc["nodes"][0]["mesh"] = 4; },
+         {"nodes[0].mesh: mesh 4 does not exist"}},
+        {"node_child",
+         [](GltfBuilder& b) { b.doc["nodes"][0]["children"] = {7}; },
+         {"nodes[0].children[0]: node 7 does not exist"}},
+        {"scene_node",
+         [](GltfBuilder& b) {
+             b.doc["scenes"][0]["nodes"] = {0, 12};
+         },
+         {"scenes[0].nodes[1]: node 12 does not exist"}},
+        {"default_scene", [](GltfBuilder& b) { b.doc["scene"] = 2; }, {"scene: scene 2 does not exist"}},
+        {"node_light",
+         [](GltfBuilder& b) {
+             b.doc["nodes"][0]["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}};
+         },
+         {"nodes[0].extensions.KHR_lights_punctual.light: light 0 does not exist"}},
+        {"buffer_view",
+         [](GltfBuilder& b) { b.doc["accessors"][0]["bufferView"] = 40; },
+         {"accessors[0].bufferView: buffer view 40 does not exist"}},
+        {"not_an_index",
+         [](GltfBuilder& b) { b.doc["nodes"][0]["camera"] = "front"; },
+         {"nodes[0].camera must be an index into cameras"}},
+        {"not_an_array",
+         [](GltfBuilder& b) {
+             b.doc["materials"] = {{"name", "x"}};
+         },
+         {"materials must be an array"}},
+    };
+    for (const Case& c : cases) {
+        GltfBuilder b;
+        b.setScene({b.addTriangleNode()});
+        c.damage(b);
+        SCOPED_TRACE(c.name);
+        expectInputError(b.writeGltf(dir, std::string(c.name) + ".gltf"), c.fragments);
+        expectInputError(b.writeGlb(dir, std::string(c.name) + ".glb"), c.fragments);
+    }
 }
 
 TEST(GltfErrors, SparseAccessor) {
@@ -171,7 +290,8 @@ TEST(GltfErrors, MissingMaterialAndNodeCycle) {
         const int tri = b.addTriangleNode("mat");
         b.doc["meshes"][0]["primitives"][0]["material"] = 5;
         b.setScene({tri});
-        expectInputError(b.writeGltf(dir, "material.gltf"), {"mesh 'mat'", "material 5 does not exist"});
+        expectInputError(b.writeGltf(dir, "material.gltf"),
+                         {"meshes[0].primitives[0].material", "material 5 does not exist"});
     }
     {
         GltfBuilder b;
