@@ -636,7 +636,8 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const double sizingRate = renderedMs > 0.0 ? rate : 3.0 * rate;
         double pixels = rate > 0.0 ? sliceMs / sizingRate : double(kMinTileSide) * kMinTileSide;
         int parts = 1;
-        if (splittable && rate > 0.0 && pixels < partLimits.tilePixels) {
+        const bool planned = splittable && rate > 0.0 && pixels < partLimits.tilePixels;
+        if (planned) {
             const VplPartPlan partPlan = partPlanner.plan(vpls, sizingRate);
             parts = partPlan.parts;
             pixels = partPlan.pixels;
@@ -659,7 +660,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
                 return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
             const FrameOutput& frame = rendered.frame;
             tileMs += rendered.renderMs;
-            if (splittable) partPlanner.record(tilePixels, parts, rendered.renderMs);
+            if (planned) partPlanner.record(tilePixels, parts, rendered.renderMs);
             renderedMs += rendered.renderMs;
             pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
             unsent = unite(unsent, clipToImage(rect, full.width, full.height));
