@@ -11,6 +11,8 @@ find_package(glm CONFIG REQUIRED)
 find_package(nlohmann_json 3 CONFIG REQUIRED)
 find_package(TinyGLTF CONFIG REQUIRED)                 # shared lib: never define TINYGLTF_IMPLEMENTATION
 pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)    # libstb-dev: image headers read before decoding
+find_package(draco CONFIG REQUIRED)                    # libdraco-dev: KHR_draco_mesh_compression
+find_package(meshoptimizer CONFIG REQUIRED)            # libmeshoptimizer-dev: EXT_meshopt_compression
 find_package(libjpeg-turbo CONFIG REQUIRED)
 find_package(PNG REQUIRED)
 find_package(libwebsockets CONFIG REQUIRED)

@@ -14,6 +14,8 @@ PACKAGES=(
     # scene, math, JSON, images
     # (openimageio-tools: OIIO's CMake config names its command-line tools)
     libglm-dev nlohmann-json3-dev libtinygltf-dev libstb-dev libopenimageio-dev
+    # compressed glTF: Draco and meshopt decoding
+    libdraco-dev libmeshoptimizer-dev
     openimageio-tools libturbojpeg0-dev libwebp-dev libpng-dev
     # reference renderer
     libembree-dev libtbb-dev

@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/Base64.h"
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Log.h"
@@ -202,19 +203,7 @@ nlohmann::json techniquesJson() {
 }
 
 std::string base64(const std::vector<std::uint8_t>& data) {
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    out.reserve((data.size() + 2) / 3 * 4);
-    for (std::size_t i = 0; i < data.size(); i += 3) {
-        const std::uint32_t n = (std::uint32_t(data[i]) << 16) |
-                                (i + 1 < data.size() ? data[i + 1] << 8 : 0) |
-                                (i + 2 < data.size() ? data[i + 2] : 0);
-        out += table[(n >> 18) & 63];
-        out += table[(n >> 12) & 63];
-        out += i + 1 < data.size() ? table[(n >> 6) & 63] : '=';
-        out += i + 2 < data.size() ? table[n & 63] : '=';
-    }
-    return out;
+    return base64Encode(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
 }
 
 /// One HTTP response, written in two writable callbacks: headers, then the body.

@@ -21,6 +21,7 @@
 #include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "scene/Geometry.h"
+#include "scene/GltfDecompress.h"
 #include "scene/GltfPreflight.h"
 #include "scene/SceneLoader.h"
 
@@ -719,6 +720,21 @@ private:
     int mDefaultMaterial = -1;
 };
 
+/// A URI's %XX escapes decoded, as tinygltf decodes them before joining the path.
+std::string percentDecoded(const std::string& uri) {
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+            std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+            out += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
 /// tinygltf reports a short GLB only as "Invalid glTF binary."; say what is wrong instead. Returns the
 /// JSON chunk for the depth check.
 std::string_view glbJsonChunk(const std::string& bytes, const std::string& name) {
@@ -761,8 +777,30 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
         throw InputError(name, "malformed JSON: arrays and objects nested deeper than " +
                                    std::to_string(kMaxGltfJsonDepth) + " levels (at byte " +
                                    std::to_string(*at) + " of the JSON)");
+    // Draco and meshopt data decoded into plain accessors, which is all tinygltf reads.
+    std::string_view checkedJson = json;
+    auto spend = [&](std::uint64_t n, const std::string& what) {
+        if (!context.spend(n, what)) throw InputError(name, context.refusal);
+        return true;
+    };
+    // External buffers with compressed data, through the same sandbox as tinygltf's reads.
+    auto readExternal = [&](const std::string& uri) {
+        std::vector<unsigned char> data;
+        std::string err;
+        if (!sandboxReadFile(&data, &err, context.baseDir + "/" + percentDecoded(uri), &context))
+            throw InputError(name, !context.refusal.empty() ? context.refusal
+                                   : !err.empty()           ? err
+                                                            : "cannot read '" + validUtf8(uri) + "'");
+        return std::string(data.begin(), data.end());
+    };
+    const auto decompressed = decompressGltf(bytes, binary, json, name, spend, readExternal);
+    if (decompressed) {
+        for (const auto& what : decompressed->decoded) logInfo("scene: " + name + ": decoded " + what);
+        bytes = decompressed->bytes;
+        checkedJson = binary ? glbJsonChunk(bytes, name) : std::string_view(bytes);
+    }
     // Version, required extensions and dangling references, said with their JSON path.
-    preflightGltfJson(json, name);
+    preflightGltfJson(checkedJson, name);
 
     tinygltf::TinyGLTF parser;
     parser.SetFsCallbacks(

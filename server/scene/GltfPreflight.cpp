@@ -13,12 +13,6 @@ using Json = nlohmann::json;
 
 // What to do about an extension the loader cannot read, for the ones users meet most.
 std::string adviceFor(const std::string& extension) {
-    if (extension == "KHR_draco_mesh_compression")
-        return "its meshes are Draco-compressed, which this service does not decode: export it without mesh "
-               "compression (in Blender's glTF exporter, leave Compression unticked)";
-    if (extension == "EXT_meshopt_compression" || extension == "KHR_meshopt_compression")
-        return "its buffers are meshopt-compressed, which this service does not decode: export it without "
-               "meshopt compression (for gltfpack, leave out -c and -cc)";
     if (extension == "KHR_texture_basisu")
         return "its textures are KTX2/Basis Universal, which this service does not decode: export it with "
                "PNG or JPEG textures";
@@ -38,7 +32,6 @@ public:
     void run() {
         checkVersion();
         checkRequiredExtensions();
-        checkCompressedPrimitives();
         checkReferences();
     }
 
@@ -89,41 +82,6 @@ private:
             if (std::find(readable.begin(), readable.end(), ext) == readable.end())
                 fail("unsupported required extension '" + ext + "': " + adviceFor(ext));
         }
-    }
-
-    // A Draco primitive whose accessors have no uncompressed data, even where the file forgot to list
-    // the extension as required, would otherwise read as zeros or fail as "invalid bufferView".
-    void checkCompressedPrimitives() const {
-        const Json* meshes = array("meshes");
-        if (!meshes) return;
-        for (std::size_t m = 0; m < meshes->size(); ++m) {
-            const Json* primitives = member((*meshes)[m], "primitives");
-            if (!primitives || !primitives->is_array()) continue;
-            for (std::size_t p = 0; p < primitives->size(); ++p) {
-                const Json* extensions = member((*primitives)[p], "extensions");
-                if (!extensions || !extensions->is_object() ||
-                    !extensions->contains("KHR_draco_mesh_compression"))
-                    continue;
-                const Json* attributes = member((*primitives)[p], "attributes");
-                if (!attributes || !attributes->is_object()) continue;
-                for (const auto& [semantic, index] : attributes->items()) {
-                    if (!hasUncompressedData(index))
-                        fail("meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) +
-                             "].attributes." + semantic +
-                             ": unsupported extension 'KHR_draco_mesh_compression': " +
-                             adviceFor("KHR_draco_mesh_compression"));
-                }
-            }
-        }
-    }
-
-    bool hasUncompressedData(const Json& accessorIndex) const {
-        const Json* accessors = array("accessors");
-        if (!accessors || !accessorIndex.is_number_integer()) return true; // reported as a reference
-        const auto i = accessorIndex.get<long long>();
-        if (i < 0 || i >= static_cast<long long>(accessors->size())) return true;
-        const Json& accessor = (*accessors)[static_cast<std::size_t>(i)];
-        return accessor.is_object() && accessor.contains("bufferView");
     }
 
     // ---- references ------------------------------------------------------------------------------

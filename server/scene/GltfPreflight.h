@@ -3,8 +3,9 @@
 // what to do, rather than with a parser message about a consequence:
 //   - `asset.version` (and `asset.minVersion`) must be 2.x: glTF 1.0 and any later major version are
 //     refused;
-//   - every extension in `extensionsRequired` must be one the loader reads (gltfReadableExtensions);
-//     compressed geometry and textures get advice on how to export without them;
+//   - every extension in `extensionsRequired` must be one the loader reads (gltfReadableExtensions;
+//     Draco and meshopt are decoded before this check, scene/GltfDecompress.h); compressed textures
+//     get advice on how to export without them;
 //   - every index into another array (scene nodes, node children, meshes, cameras, lights,
 //     primitive attributes, indices and materials, material textures, texture images and samplers,
 //     accessor and image buffer views, buffer view buffers) must name an element that exists.

@@ -1,6 +1,9 @@
 // Files made by another tool (Blender's glTF exporter, tests/data/corpus/generate.py) render lit and
 // finite through the whole pipeline: those without lights get the default rig (frame/DefaultLighting.h)
 // and say so in the stats; point_lamps.glb is lit by its own two point lamps and sun.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -51,6 +54,31 @@ TEST(Corpus, BlenderExportsRenderLit) {
             // Black before the default light (and before point and sun lamps rendered): the direct
             // light alone must now show the model.
             EXPECT_GT(meanRadiance(f), 1e-3) << "the frame is black";
+        }
+    }
+}
+
+// The compressed copies (tests/data/corpus/compress.sh: glTF Transform's Draco, gltfpack's meshopt)
+// render as their originals, up to the encoders' quantization.
+TEST(Corpus, CompressedCopiesRenderAsTheirOriginals) {
+    for (const char* name : {"suzanne", "textured_box"}) {
+        const std::string dir = std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/";
+        const FrameOutput original = renderScene(dir + name + ".glb", "rsm_gather", 64, 64);
+        for (const char* kind : {"_draco", "_meshopt"}) {
+            SCOPED_TRACE(std::string(name) + kind);
+            const FrameOutput compressed = renderScene(dir + name + kind + ".glb", "rsm_gather", 64, 64);
+            ASSERT_EQ(compressed.linear.size(), original.linear.size());
+            double squaredError = 0, squaredValue = 0;
+            for (size_t i = 0; i < original.linear.size(); ++i) {
+                if (i % 4 == 3) continue;
+                const double d = compressed.linear[i] - original.linear[i];
+                squaredError += d * d;
+                squaredValue += double(original.linear[i]) * original.linear[i];
+            }
+            const double relativeRmse = std::sqrt(squaredError / std::max(squaredValue, 1e-30));
+            std::printf("[corpus] %s%s against %s.glb: relative RMSE %.4f\n", name, kind, name, relativeRmse);
+            EXPECT_EQ(gis::test::badValues(compressed), 0u);
+            EXPECT_LT(relativeRmse, 0.05);
         }
     }
 }

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Regenerates the compressed copies of the Blender exports with other tools' encoders (not run by the
+# tests; the outputs are committed): Draco with glTF Transform's CLI (npm @gltf-transform/cli, in a
+# scratch folder outside the repository) and meshopt with Debian's gltfpack (apt-get install gltfpack).
+#   suzanne_draco.glb, textured_box_draco.glb     gltf-transform draco (14-bit positions by default)
+#   suzanne_meshopt.glb                           gltfpack -c (meshopt, quantized: KHR_mesh_quantization)
+#   textured_box_meshopt.glb                      gltfpack -cc -noq (meshopt with filters, float data)
+# usage: tests/data/corpus/compress.sh [SCRATCH_DIR]
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+scratch="${1:-/tmp/gis-gltf-transform}"
+mkdir -p "$scratch"
+if [[ ! -x "$scratch/node_modules/.bin/gltf-transform" ]]; then
+    (cd "$scratch" && npm init -y >/dev/null && npm install --no-audit --no-fund @gltf-transform/cli@4 >/dev/null)
+fi
+for name in suzanne textured_box; do
+    "$scratch/node_modules/.bin/gltf-transform" draco "$here/$name.glb" "$here/${name}_draco.glb"
+done
+gltfpack -i "$here/suzanne.glb" -o "$here/suzanne_meshopt.glb" -c
+gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_meshopt.glb" -cc -noq
