@@ -14,9 +14,9 @@ PACKAGES=(
     # scene, math, JSON, images
     # (openimageio-tools: OIIO's CMake config names its command-line tools)
     libglm-dev nlohmann-json3-dev libtinygltf-dev libstb-dev libopenimageio-dev
+    openimageio-tools libturbojpeg0-dev libwebp-dev libpng-dev
     # compressed glTF: Draco and meshopt decoding
     libdraco-dev libmeshoptimizer-dev
-    openimageio-tools libturbojpeg0-dev libwebp-dev libpng-dev
     # reference renderer
     libembree-dev libtbb-dev
     # network
