@@ -27,6 +27,7 @@ import {
     normalizeFrameTarget, normalizePixelBudget,
 } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
+import { notShownLines, notShownSummary } from './scene-notes.js';
 import { enqueueFrame, patchPlacement } from './frames.js';
 import { PassChart } from './chart.js';
 import { LightGizmo } from './gizmo.js';
@@ -796,6 +797,7 @@ function recordDraw(frame, decodeMs, frameBytes) {
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
     sceneGui.showPlan(stats?.plan, stats?.nondiffuse);
+    sceneGui.showNotShown(stats?.not_shown);
     noteDefaultLighting(stats?.lighting);
     lightGui.showLighting(stats?.lighting ?? state.lighting);
     statsGui.showDetails(stats);
@@ -1030,6 +1032,13 @@ const sceneGui = (() => {
     const effectsCtl = describe(gui.add(model, 'autoEffects').name('plan effects'), 'auto-effects',
         'effects = auto: the server measures which lighting effects this view needs and switches the rest off');
     effectsCtl.onChange((on) => queueParams({ effects: on ? 'auto' : 'manual' }));
+    // What the file asks for and is not shown (stats.not_shown): hidden while there is nothing.
+    const notes = addBlock(gui, block('div', 'not-shown block'));
+    notes.dataset.block = 'not-shown';
+    notes.hidden = true;
+    const notesSummary = notes.appendChild(block('p', 'not-shown-summary'));
+    const notesList = notes.appendChild(block('ul', 'not-shown-list'));
+    let lastNotesKey = '';
     const planFolder = gui.addFolder('effect plan');
     planFolder.domElement.dataset.folder = 'plan';
     const plan = addBlock(planFolder, block('div', 'plan block'));
@@ -1065,6 +1074,19 @@ const sceneGui = (() => {
          * renderer's own non-diffuse decisions (stats.nondiffuse: "on: reason" / "off: reason") are
          * listed, since they run whatever the mode.
          */
+        showNotShown(notShown) {
+            const lines = notShownLines(notShown);
+            const key = JSON.stringify(lines);
+            if (key === lastNotesKey) return;
+            lastNotesKey = key;
+            notes.hidden = lines.length === 0;
+            notesSummary.textContent = notShownSummary(lines);
+            notesList.replaceChildren(...lines.map((line) => {
+                const li = block('li', 'not-shown-item', line.text);
+                li.dataset.feature = line.feature;
+                return li;
+            }));
+        },
         showPlan(p, nondiffuse) {
             const key = `${state.params.effects}:${JSON.stringify(p ?? null)}:${JSON.stringify(nondiffuse ?? null)}`;
             if (key === lastPlanKey) return;

@@ -8,6 +8,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 import { DRAG_TOOLS, OrbitCamera, gestureFor, keyMotion } from '../camera.js';
+import { notShownLines, notShownSummary } from '../scene-notes.js';
 import {
     aimAt, aimLight, containRect, dragToWorld, gizmoAnchor, gizmoHandles, gizmoKinds, gizmoLabels, moveLight, projectPoint,
     safeDirection, viewBasis,
@@ -553,4 +554,20 @@ test('the import map points at vendored files that npm ci put in place', () => {
     const problems = checkVendor();
     assert.deepEqual(problems, [], `client/vendor/ is not ready: ${problems.join('; ')}`);
     for (const [, , name] of VENDOR_FILES) assert.ok(existsSync(path.join(CLIENT_DIR, 'vendor', name)));
+});
+
+test('not shown: the file\'s unshown features as lines, malformed entries left out', () => {
+    assert.deepEqual(notShownLines(undefined), []);
+    assert.deepEqual(notShownLines({ feature: 'x' }), []);
+    const lines = notShownLines([
+        { feature: 'KHR_materials_clearcoat', detail: "1 material ('Paint'): clear coat is not rendered" },
+        { feature: 'normalTexture' },
+        null,
+        { feature: 'alphaMode MASK', detail: 'cutouts render opaque' },
+    ]);
+    assert.deepEqual(lines.map((l) => l.feature), ['KHR_materials_clearcoat', 'alphaMode MASK']);
+    assert.equal(lines[0].text, "KHR_materials_clearcoat: 1 material ('Paint'): clear coat is not rendered");
+    assert.equal(notShownSummary([]), '');
+    assert.match(notShownSummary(lines), /2 features this renderer does not show/);
+    assert.match(notShownSummary(lines.slice(0, 1)), /1 feature this renderer/);
 });

@@ -560,6 +560,12 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
     out.stats["lighting"] = lightingStats(state, lightSet, viewFlux);
+    if (!mScene->notShown.empty()) {
+        nlohmann::json notShown = nlohmann::json::array();
+        for (const NotShown& n : mScene->notShown)
+            notShown.push_back({{"feature", n.feature}, {"detail", n.detail}});
+        out.stats["not_shown"] = std::move(notShown);
+    }
     return out;
 }
 

@@ -3,6 +3,8 @@
 // transforms, extensions) is checked here before any byte is read, so a hostile file yields an
 // InputError naming the file and the offending object instead of a crash.
 #include <algorithm>
+#include <functional>
+#include <map>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -31,6 +33,7 @@ namespace {
 constexpr const char* kLightsExtension = "KHR_lights_punctual";
 constexpr const char* kEmissiveStrengthExtension = "KHR_materials_emissive_strength";
 constexpr const char* kSpecularExtension = "KHR_materials_specular";
+constexpr const char* kTextureTransformExtension = "KHR_texture_transform";
 constexpr int kNotConverted = -2;
 
 /// tinygltf joins several messages with newlines; an InputError reads best as one line.
@@ -316,6 +319,7 @@ public:
     Scene read() {
         checkRequiredExtensions();
         readMaterials();
+        collectNotShown();
         for (int root : rootNodes()) visitNode(root, glm::mat4(1.0f));
         mScene.name = mPath;
         mScene.updateBounds();
@@ -481,6 +485,168 @@ private:
         }
     }
 
+    // ---- texture coordinates -------------------------------------------------------------------
+
+    struct BaseColorUv {
+        int set = 0;                        ///< TEXCOORD_<set>
+        std::optional<glm::mat3> transform; ///< KHR_texture_transform, uv' = (T R S) (u, v, 1)
+    };
+
+    static double numberOr(const tinygltf::Value& object, const char* key, double fallback) {
+        if (!object.Has(key) || !object.Get(key).IsNumber()) return fallback;
+        const double v = object.Get(key).GetNumberAsDouble();
+        return std::isfinite(v) ? v : fallback;
+    }
+
+    static glm::vec2 pairOr(const tinygltf::Value& object, const char* key, glm::vec2 fallback) {
+        if (!object.Has(key)) return fallback;
+        const tinygltf::Value& a = object.Get(key);
+        if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber())
+            return fallback;
+        const glm::vec2 v(a.Get(0).GetNumberAsDouble(), a.Get(1).GetNumberAsDouble());
+        return std::isfinite(v.x) && std::isfinite(v.y) ? v : fallback;
+    }
+
+    BaseColorUv baseColorUv(int material) const {
+        BaseColorUv uv;
+        if (material < 0 || material >= static_cast<int>(mModel.materials.size())) return uv;
+        const tinygltf::TextureInfo& info =
+            mModel.materials[static_cast<std::size_t>(material)].pbrMetallicRoughness.baseColorTexture;
+        if (info.index < 0) return uv;
+        uv.set = std::max(0, info.texCoord);
+        const auto ext = info.extensions.find(kTextureTransformExtension);
+        if (ext == info.extensions.end() || !ext->second.IsObject()) return uv;
+        const tinygltf::Value& t = ext->second;
+        if (t.Has("texCoord") && t.Get("texCoord").IsInt())
+            uv.set = std::max(0, t.Get("texCoord").GetNumberAsInt());
+        const glm::vec2 offset = pairOr(t, "offset", glm::vec2(0.0f));
+        const glm::vec2 scale = pairOr(t, "scale", glm::vec2(1.0f));
+        const auto rotation = static_cast<float>(numberOr(t, "rotation", 0.0));
+        // Column-major as the extension's own GLSL: translation * rotation * scale.
+        const glm::mat3 translate(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1);
+        const glm::mat3 rotate(std::cos(rotation), std::sin(rotation), 0, -std::sin(rotation),
+                               std::cos(rotation), 0, 0, 0, 1);
+        const glm::mat3 scaling(scale.x, 0, 0, 0, scale.y, 0, 0, 0, 1);
+        uv.transform = translate * rotate * scaling;
+        return uv;
+    }
+
+    // ---- what the file asks for and the renderer does not show -----------------------------------
+
+    /// "3 materials ('a', 'b', 'c')", at most three names.
+    static std::string namedCount(const std::vector<std::string>& names, const char* kind) {
+        std::string text = std::to_string(names.size()) + " " + kind + (names.size() == 1 ? "" : "s") + " (";
+        for (std::size_t i = 0; i < names.size() && i < 3; ++i) text += (i ? ", '" : "'") + names[i] + "'";
+        if (names.size() > 3) text += ", ...";
+        return text + ")";
+    }
+
+    static std::string extensionEffect(const std::string& name) {
+        static const std::map<std::string, std::string> effects = {
+            {"KHR_materials_clearcoat", "clear coat is not rendered: the base layer shows alone"},
+            {"KHR_materials_transmission", "transmission is not rendered: the surfaces are opaque"},
+            {"KHR_materials_volume", "volumes (thickness, attenuation) are not rendered"},
+            {"KHR_materials_sheen", "sheen is not rendered"},
+            {"KHR_materials_ior", "the index of refraction is not used: dielectrics reflect 4 % head-on"},
+            {"KHR_materials_iridescence", "iridescence is not rendered"},
+            {"KHR_materials_anisotropy", "anisotropy is not rendered: highlights are round"},
+            {"KHR_materials_dispersion", "dispersion is not rendered"},
+            {"KHR_materials_unlit", "unlit materials are lit like the others"},
+            {"KHR_materials_variants", "only each primitive's default material is shown"},
+            {"KHR_materials_pbrSpecularGlossiness",
+             "specular-glossiness materials show their metallic-roughness values (often the defaults)"},
+            {"EXT_mesh_gpu_instancing", "instances are not drawn: each instanced mesh appears once"},
+            {"KHR_animation_pointer", "animations are not played"},
+        };
+        const auto found = effects.find(name);
+        return found != effects.end() ? found->second
+                                      : "the extension is not read: what it adds is not shown";
+    }
+
+    static bool textureInfoUses(const tinygltf::ExtensionMap& extensions, const std::string& name) {
+        return extensions.find(name) != extensions.end();
+    }
+
+    void collectNotShown() {
+        std::vector<NotShown>& out = mScene.notShown;
+        const auto& readable = gltfReadableExtensions();
+        // Optional extensions (a required one the loader cannot read was refused): who uses them.
+        for (const std::string& ext : mModel.extensionsUsed) {
+            if (std::find(readable.begin(), readable.end(), ext) != readable.end()) continue;
+            // Fallback images stand in for compressed textures: those show.
+            if (ext == "KHR_texture_basisu" || ext == "EXT_texture_webp" || ext == "EXT_texture_avif")
+                continue;
+            std::vector<std::string> materials, nodes;
+            for (std::size_t i = 0; i < mModel.materials.size(); ++i) {
+                const tinygltf::Material& m = mModel.materials[i];
+                const bool uses =
+                    m.extensions.count(ext) ||
+                    textureInfoUses(m.pbrMetallicRoughness.baseColorTexture.extensions, ext) ||
+                    textureInfoUses(m.pbrMetallicRoughness.metallicRoughnessTexture.extensions, ext) ||
+                    textureInfoUses(m.normalTexture.extensions, ext) ||
+                    textureInfoUses(m.occlusionTexture.extensions, ext) ||
+                    textureInfoUses(m.emissiveTexture.extensions, ext);
+                if (uses) materials.push_back(nameOr(m.name, "material", static_cast<int>(i)));
+            }
+            for (std::size_t i = 0; i < mModel.nodes.size(); ++i)
+                if (mModel.nodes[i].extensions.count(ext))
+                    nodes.push_back(nameOr(mModel.nodes[i].name, "node", static_cast<int>(i)));
+            std::string where;
+            if (!materials.empty())
+                where = namedCount(materials, "material") + ": ";
+            else if (!nodes.empty())
+                where = namedCount(nodes, "node") + ": ";
+            out.push_back({ext, where + extensionEffect(ext)});
+        }
+        // Core material features the renderer does not read yet.
+        struct Feature {
+            const char* name;
+            const char* effect;
+            std::function<bool(const tinygltf::Material&)> uses;
+        };
+        const Feature features[] = {
+            {"metallicRoughnessTexture",
+             "metallic-roughness textures are not applied: the factors hold everywhere",
+             [](const tinygltf::Material& m) {
+                 return m.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
+             }},
+            {"normalTexture", "normal maps are not applied: the geometry's own normals are shaded",
+             [](const tinygltf::Material& m) { return m.normalTexture.index >= 0; }},
+            {"occlusionTexture",
+             "occlusion maps are not applied (the techniques compute their own occlusion)",
+             [](const tinygltf::Material& m) { return m.occlusionTexture.index >= 0; }},
+            {"emissiveTexture", "emissive textures are not applied: the emissive factor glows uniformly",
+             [](const tinygltf::Material& m) { return m.emissiveTexture.index >= 0; }},
+            {"alphaMode MASK", "alpha cutouts are not applied: the cut-out parts render opaque",
+             [](const tinygltf::Material& m) { return m.alphaMode == "MASK"; }},
+            {"alphaMode BLEND", "transparency is not rendered: the surfaces render opaque",
+             [](const tinygltf::Material& m) { return m.alphaMode == "BLEND"; }},
+        };
+        for (const Feature& f : features) {
+            std::vector<std::string> names;
+            for (std::size_t i = 0; i < mModel.materials.size(); ++i)
+                if (f.uses(mModel.materials[i]))
+                    names.push_back(nameOr(mModel.materials[i].name, "material", static_cast<int>(i)));
+            if (!names.empty()) out.push_back({f.name, namedCount(names, "material") + ": " + f.effect});
+        }
+        std::vector<std::string> coloured;
+        for (std::size_t i = 0; i < mModel.meshes.size(); ++i)
+            for (const auto& primitive : mModel.meshes[i].primitives)
+                if (primitive.attributes.count("COLOR_0")) {
+                    coloured.push_back(nameOr(mModel.meshes[i].name, "mesh", static_cast<int>(i)));
+                    break;
+                }
+        if (!coloured.empty())
+            out.push_back({"COLOR_0", namedCount(coloured, "mesh") + ": vertex colours are not applied"});
+        if (!mModel.animations.empty())
+            out.push_back({"animations", std::to_string(mModel.animations.size()) +
+                                             " animation(s) are not played: the nodes' rest pose is shown"});
+        if (!mModel.skins.empty())
+            out.push_back({"skins", std::to_string(mModel.skins.size()) +
+                                        " skin(s) are not applied: skinned meshes show in their bind pose"});
+        for (const NotShown& n : out) warn("not shown: " + n.feature + ": " + n.detail);
+    }
+
     int defaultMaterial() {
         if (mDefaultMaterial < 0) {
             mScene.materials.push_back(Material{.name = "default"});
@@ -592,8 +758,19 @@ private:
         mesh.positions = readVectors<3>(positionAccessor, TINYGLTF_TYPE_VEC3, context + " POSITION");
         if (const int a = attribute("NORMAL"); a >= 0)
             mesh.normals = readVectors<3>(a, TINYGLTF_TYPE_VEC3, context + " NORMAL");
-        if (const int a = attribute("TEXCOORD_0"); a >= 0)
-            mesh.texcoords = readVectors<2>(a, TINYGLTF_TYPE_VEC2, context + " TEXCOORD_0");
+        // The base colour texture is the one the renderer samples: its UV set and its
+        // KHR_texture_transform are baked into the mesh's texture coordinates.
+        const BaseColorUv uv = baseColorUv(prim.material);
+        const std::string uvName = "TEXCOORD_" + std::to_string(uv.set);
+        if (const int a = attribute(uvName.c_str()); a >= 0) {
+            mesh.texcoords = readVectors<2>(a, TINYGLTF_TYPE_VEC2, context + " " + uvName);
+        } else if (const int first = attribute("TEXCOORD_0"); first >= 0) {
+            warn(context + ": the base colour texture reads " + uvName +
+                 ", which the primitive lacks; TEXCOORD_0 is used");
+            mesh.texcoords = readVectors<2>(first, TINYGLTF_TYPE_VEC2, context + " TEXCOORD_0");
+        }
+        if (uv.transform)
+            for (glm::vec2& t : mesh.texcoords) t = glm::vec2(*uv.transform * glm::vec3(t, 1.0f));
         if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
             fail(context + ": NORMAL has " + std::to_string(mesh.normals.size()) + " elements, POSITION " +
                  std::to_string(mesh.positions.size()));

@@ -250,8 +250,10 @@ private:
 const std::vector<std::string>& gltfReadableExtensions() {
     // KHR_mesh_quantization: quantized attributes are non-float component types, which the accessor
     // reader handles.
+    // KHR_texture_transform: applied to the base colour texture, the one the renderer samples.
     static const std::vector<std::string> names = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                                   "KHR_materials_specular", "KHR_mesh_quantization"};
+                                                   "KHR_materials_specular", "KHR_mesh_quantization",
+                                                   "KHR_texture_transform"};
     return names;
 }
 

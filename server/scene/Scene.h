@@ -34,7 +34,7 @@ struct Material {
     /// materials built in code are Lambertian unless they ask for a specular lobe; glTF files get the
     /// glTF default 1 from the loader. The reflection model is scene/Brdf.h.
     float specular = 0.0f;
-    glm::vec3 emissive{0.0f};  ///< linear RGB radiance scale (glTF emissiveFactor)
+    glm::vec3 emissive{0.0f}; ///< linear RGB radiance scale (glTF emissiveFactor)
 };
 
 /// One triangle list in world space. Every vertex attribute array has positions.size() entries.
@@ -78,6 +78,13 @@ struct Bounds {
     float radius() const { return 0.5f * glm::length(max - min); }
 };
 
+/// Something the file asks for that the renderer does not show, said to the user rather than left out
+/// silently (stats.not_shown): a glTF extension or a core material feature, where, and what shows instead.
+struct NotShown {
+    std::string feature; ///< "KHR_materials_clearcoat", "normalTexture", "alphaMode MASK", ...
+    std::string detail;  ///< "3 materials ('Paint', 'Glass', 'Trim'): normal maps are not applied ..."
+};
+
 struct Scene {
     std::string name; ///< "builtin:cornell" or the file path it came from
     std::vector<Mesh> meshes;
@@ -86,6 +93,7 @@ struct Scene {
     std::vector<Light> lights;
     std::vector<Camera> cameras; ///< never empty after loading (a framing camera is added)
     Bounds bounds;
+    std::vector<NotShown> notShown; ///< what the file uses and the renderer does not show
 
     std::size_t triangleCount() const;
     /// Recomputes bounds from all mesh positions.

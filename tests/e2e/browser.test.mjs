@@ -509,7 +509,7 @@ test('a point light added in the Light panel is rendered, and removing it takes 
 });
 
 test('a .glb dropped on the view is uploaded with progress and shown', async () => {
-    const glb = makeGlb().toString('base64');
+    const glb = makeGlb({ clearcoat: true }).toString('base64');
     const transfer = await page.evaluateHandle((b64) => {
         const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
         const dt = new DataTransfer();
@@ -526,8 +526,13 @@ test('a .glb dropped on the view is uploaded with progress and shown', async () 
     assert.equal((await page.evaluate(() => window.giClient.lastStats.lighting)).source, 'default');
     await until('the default lighting is explained', () => [...document.querySelectorAll('.message')]
         .some((m) => m.textContent.startsWith('Default lighting: the scene has no lights')));
+    // Its clear coat is not rendered, and the Scene section says so.
+    await until('the unshown clear coat is listed', () => !document.querySelector('[data-block="not-shown"]').hidden
+        && document.querySelector('.not-shown-item[data-feature="KHR_materials_clearcoat"]')?.textContent
+            .includes("1 material ('clay'): clear coat is not rendered"));
     await control('scene', 'select').selectOption('builtin:cornell');
     await until('back on the Cornell box', () => window.giClient.lastStats?.scene === 'builtin:cornell');
+    await until('nothing is listed for the Cornell box', () => document.querySelector('[data-block="not-shown"]').hidden);
 });
 
 test('the orbit target sits at the model; "Frame the model" fits it; Reset camera returns to the scene camera',

@@ -464,7 +464,7 @@ export function isJpeg(bytes) {
  * A small binary glTF (.glb) for upload tests: a floor and a box, positions and normals, one
  * material, no light and no camera: the server adds its framing camera and default key light.
  */
-export function makeGlb() {
+export function makeGlb({ clearcoat = false } = {}) {
     const positions = [];
     const normals = [];
     const quad = (corners, normal) => {
@@ -490,7 +490,10 @@ export function makeGlb() {
         scenes: [{ nodes: [0] }],
         nodes: [{ mesh: 0 }],
         meshes: [{ primitives: [{ attributes: { POSITION: 0, NORMAL: 1 }, material: 0 }] }],
-        materials: [{ pbrMetallicRoughness: { baseColorFactor: [0.8, 0.6, 0.4, 1], metallicFactor: 0 } }],
+        materials: [{ name: 'clay', pbrMetallicRoughness: { baseColorFactor: [0.8, 0.6, 0.4, 1], metallicFactor: 0 },
+            // An optional extension the renderer does not show (stats.not_shown lists it).
+            ...(clearcoat ? { extensions: { KHR_materials_clearcoat: { clearcoatFactor: 1 } } } : {}) }],
+        ...(clearcoat ? { extensionsUsed: ['KHR_materials_clearcoat'] } : {}),
         buffers: [{ byteLength: bin.length }],
         bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: bin.length / 2 },
             { buffer: 0, byteOffset: bin.length / 2, byteLength: bin.length / 2 }],

@@ -58,13 +58,16 @@ TEST(Corpus, BlenderExportsRenderLit) {
     }
 }
 
-// The compressed copies (tests/data/corpus/compress.sh: glTF Transform's Draco, gltfpack's meshopt)
-// render as their originals, up to the encoders' quantization.
+// The compressed copies (tests/data/corpus/compress.sh: glTF Transform's Draco, gltfpack's meshopt and
+// quantization) render as their originals, up to the encoders' quantization.
 TEST(Corpus, CompressedCopiesRenderAsTheirOriginals) {
     for (const char* name : {"suzanne", "textured_box"}) {
         const std::string dir = std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/";
         const FrameOutput original = renderScene(dir + name + ".glb", "rsm_gather", 64, 64);
-        for (const char* kind : {"_draco", "_meshopt"}) {
+        // _quantized: gltfpack's default output, whose texture coordinates are dequantized by
+        // KHR_texture_transform (the box only).
+        for (const char* kind : {"_draco", "_meshopt", "_quantized"}) {
+            if (std::string(kind) == "_quantized" && std::string(name) != "textured_box") continue;
             SCOPED_TRACE(std::string(name) + kind);
             const FrameOutput compressed = renderScene(dir + name + kind + ".glb", "rsm_gather", 64, 64);
             ASSERT_EQ(compressed.linear.size(), original.linear.size());

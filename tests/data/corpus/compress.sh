@@ -5,6 +5,7 @@
 #   suzanne_draco.glb, textured_box_draco.glb     gltf-transform draco (14-bit positions by default)
 #   suzanne_meshopt.glb                           gltfpack -c (meshopt, quantized: KHR_mesh_quantization)
 #   textured_box_meshopt.glb                      gltfpack -cc -noq (meshopt with filters, float data)
+#   textured_box_quantized.glb                    gltfpack (quantized; UVs dequantized by KHR_texture_transform)
 # usage: tests/data/corpus/compress.sh [SCRATCH_DIR]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -18,3 +19,4 @@ for name in suzanne textured_box; do
 done
 gltfpack -i "$here/suzanne.glb" -o "$here/suzanne_meshopt.glb" -c
 gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_meshopt.glb" -cc -noq
+gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_quantized.glb"

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <map>
 
 #include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
@@ -257,6 +258,83 @@ TEST(GltfLoader, MaterialFactorsEmissiveStrengthAndBaseColorTexture) {
     EXPECT_EQ(t.width, 2);
     EXPECT_EQ(t.height, 1);
     EXPECT_EQ(t.rgba, (std::vector<std::uint8_t>{255, 0, 0, 255, 0, 255, 0, 255}));
+}
+
+// What a file asks for and the renderer does not show is listed (Scene::notShown, stats.not_shown),
+// naming the materials, meshes or nodes; a file the renderer shows whole lists nothing.
+TEST(GltfLoader, FeaturesTheRendererDoesNotShowAreListed) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode("leaves");
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 0; // the positions, as colours
+    b.doc["textures"] = {nlohmann::json::object()};
+    b.doc["materials"] = {{{"name", "foliage"},
+                           {"alphaMode", "MASK"},
+                           {"normalTexture", {{"index", 0}}},
+                           {"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}}}}}},
+                          {{"name", "bark"}, {"normalTexture", {{"index", 0}}}}};
+    b.doc["nodes"][tri]["extensions"] = {
+        {"EXT_mesh_gpu_instancing", {{"attributes", nlohmann::json::object()}}}};
+    b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "EXT_mesh_gpu_instancing", "KHR_lights_punctual"};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "unshown.glb"));
+    std::map<std::string, std::string> listed;
+    for (const NotShown& n : s.notShown) listed[n.feature] = n.detail;
+    EXPECT_EQ(listed.size(), 5u) << "clearcoat, instancing, normal maps, MASK, vertex colours";
+    EXPECT_EQ(listed["KHR_materials_clearcoat"],
+              "1 material ('foliage'): clear coat is not rendered: the base layer shows alone");
+    EXPECT_NE(listed["EXT_mesh_gpu_instancing"].find("1 node ('node 0')"), std::string::npos)
+        << listed["EXT_mesh_gpu_instancing"];
+    EXPECT_NE(listed["normalTexture"].find("2 materials ('foliage', 'bark')"), std::string::npos);
+    EXPECT_NE(listed["alphaMode MASK"].find("render opaque"), std::string::npos);
+    EXPECT_NE(listed["COLOR_0"].find("1 mesh ('leaves')"), std::string::npos);
+    EXPECT_FALSE(listed.count("KHR_lights_punctual")) << "read, so shown";
+
+    GltfBuilder plain;
+    plain.setScene({plain.addTriangleNode()});
+    EXPECT_TRUE(loadGltf(plain.writeGlb(dir, "plain.glb")).notShown.empty());
+}
+
+// The base colour texture's UV set and KHR_texture_transform (offset, rotation, scale: T R S as the
+// extension defines them) are baked into the mesh's texture coordinates.
+TEST(GltfLoader, BaseColorTextureTransformAndUvSetAreApplied) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    const int uv0 = b.addAccessor(b.addView(std::vector<float>{9, 9, 9, 9, 9, 9}), test::kFloat, 3, "VEC2");
+    const int uv1 = b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 0, 0, 1}), test::kFloat, 3, "VEC2");
+    b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv0;
+    b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = uv1;
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    const double quarterTurn = glm::half_pi<double>();
+    b.doc["materials"] = {{{"pbrMetallicRoughness",
+                            {{"baseColorTexture",
+                              {{"index", 0},
+                               {"texCoord", 0},
+                               {"extensions",
+                                {{"KHR_texture_transform",
+                                  {{"offset", {0.5, 0.25}},
+                                   {"rotation", quarterTurn},
+                                   {"scale", {2.0, 3.0}},
+                                   {"texCoord", 1}}}}}}}}}}};
+    b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+    b.doc["extensionsRequired"] = {"KHR_texture_transform"};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "transform.glb"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    const auto& t = s.meshes[0].texcoords;
+    ASSERT_EQ(t.size(), 3u);
+    // TEXCOORD_1 (the transform's texCoord overrides the textureInfo's 0): (0,0), (1,0), (0,1) scaled
+    // to (0,0), (2,0), (0,3), turned a quarter counter-clockwise to (0,0), (0,2), (-3,0), then offset.
+    const glm::vec2 expected[] = {{0.5f, 0.25f}, {0.5f, 2.25f}, {-2.5f, 0.25f}};
+    for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(t[i].x, expected[i].x, 1e-5f) << i;
+        EXPECT_NEAR(t[i].y, expected[i].y, 1e-5f) << i;
+    }
+    EXPECT_TRUE(s.notShown.empty()) << s.notShown.front().feature;
 }
 
 TEST(GltfLoader, SpecularFactorDefaultsToGltfsDielectricAndReadsTheExtension) {
