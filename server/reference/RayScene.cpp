@@ -1,13 +1,16 @@
 // Embree 3 scene for the reference renderer. Geometry is copied into Embree-owned buffers once; the
 // scene is committed with RTC_SCENE_FLAG_ROBUST (watertight triangle test, so rays do not leak through
 // shared edges of the grid walls) and RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION (the all-hits query
-// installs its collector through the intersect context, plain queries pay nothing).
+// installs its collector through the intersect context, plain queries pay nothing). Meshes whose
+// material cuts out (alpha MASK, BLEND approximated) get a geometry filter that rejects hits where
+// the base colour's alpha is below the cutoff, for intersection and occlusion rays alike.
 #include "reference/RayScene.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include <embree3/rtcore.h>
@@ -21,6 +24,7 @@ struct LinearTexture {
     int width = 0;
     int height = 0;
     std::vector<glm::vec3> texels; ///< linear RGB (sRGB decoded per texel, as GL's sRGB sampler does)
+    std::vector<float> alpha;      ///< linear alpha in [0, 1] (not sRGB-encoded)
 };
 
 float srgbToLinear(std::uint8_t v) {
@@ -39,9 +43,12 @@ int wrapIndex(int i, int n) {
     return m < 0 ? m + n : m;
 }
 
-/// Bilinear, wrap-repeat lookup; texel centres at (i + 0.5) / size like GL.
-glm::vec3 sampleBilinear(const LinearTexture& tex, glm::vec2 uv) {
-    if (tex.width <= 0 || tex.height <= 0) return glm::vec3(1.0f);
+/// Bilinear, wrap-repeat lookup of `values` (one per texel); texel centres at (i + 0.5) / size like GL.
+template <typename T>
+T bilinear(const LinearTexture& tex, const std::vector<T>& values, glm::vec2 uv, T fallback) {
+    if (tex.width <= 0 || tex.height <= 0 ||
+        values.size() < static_cast<size_t>(tex.width) * static_cast<size_t>(tex.height))
+        return fallback;
     for (int i = 0; i < 2; ++i) {
         if (!std::isfinite(uv[i])) uv[i] = 0.0f;
         uv[i] -= std::floor(uv[i]); // keeps huge coordinates from overflowing the int conversion
@@ -54,11 +61,54 @@ glm::vec3 sampleBilinear(const LinearTexture& tex, glm::vec2 uv) {
     auto at = [&](int xi, int yi) {
         const auto idx = static_cast<size_t>(wrapIndex(yi, tex.height)) * static_cast<size_t>(tex.width) +
                          static_cast<size_t>(wrapIndex(xi, tex.width));
-        return tex.texels[idx];
+        return values[idx];
     };
-    const glm::vec3 top = glm::mix(at(x0, y0), at(x0 + 1, y0), fx);
-    const glm::vec3 bottom = glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
+    const T top = glm::mix(at(x0, y0), at(x0 + 1, y0), fx);
+    const T bottom = glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
     return glm::mix(top, bottom, fy);
+}
+
+glm::vec3 sampleBilinear(const LinearTexture& tex, glm::vec2 uv) {
+    return bilinear(tex, tex.texels, uv, glm::vec3(1.0f));
+}
+
+/// A mesh whose material cuts out (Material::cutsOut): what its Embree filter reads.
+struct CutoutGeometry {
+    const Mesh* mesh = nullptr;
+    const LinearTexture* texture = nullptr; ///< the base colour texture, or none
+    float alphaFactor = 1.0f;
+    float cutoff = 0.5f;
+
+    /// material.glsl's materialCutOut() at barycentrics (u, v) of triangle `prim`.
+    bool cutsOut(unsigned prim, float u, float v) const {
+        float alpha = alphaFactor;
+        if (texture) {
+            glm::vec2 uv(0.0f); // GL feeds (0, 0) to meshes without texcoords
+            const size_t base = static_cast<size_t>(prim) * 3;
+            if (base + 2 < mesh->indices.size() && !mesh->positions.empty() &&
+                mesh->texcoords.size() == mesh->positions.size()) {
+                const auto last = static_cast<std::uint32_t>(mesh->positions.size() - 1);
+                const std::uint32_t i0 = std::min(mesh->indices[base], last),
+                                    i1 = std::min(mesh->indices[base + 1], last),
+                                    i2 = std::min(mesh->indices[base + 2], last);
+                uv = (1.0f - u - v) * mesh->texcoords[i0] + u * mesh->texcoords[i1] + v * mesh->texcoords[i2];
+            }
+            alpha *= bilinear(*texture, texture->alpha, uv, 1.0f);
+        }
+        return !(alpha >= cutoff); // NaN cuts out, as in the shader
+    }
+};
+
+// Embree geometry filter (intersect and occluded) of a cut-out mesh: a hit where the material's alpha is
+// below its cutoff is no hit, so rays and shadow rays pass through the cut-out parts.
+void cutoutFilter(const RTCFilterFunctionNArguments* args) {
+    const auto* geometry = static_cast<const CutoutGeometry*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        if (geometry->cutsOut(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i)))
+            args->valid[i] = 0;
+    }
 }
 
 struct CollectContext {
@@ -111,6 +161,7 @@ struct RayScene::Impl {
     Scene source;                    // copied: the renderer must not depend on the caller's lifetime
     std::vector<int> meshOfGeometry; // Embree geometry id -> index into source.meshes
     std::vector<LinearTexture> textures;
+    std::vector<std::unique_ptr<CutoutGeometry>> cutouts; // the filters' user data (stable addresses)
 
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
@@ -126,6 +177,26 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
     m.scene = rtcNewScene(m.device);
     rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
+
+    // One sRGB decode table: textures are decoded to linear once, then filtered in linear space.
+    std::array<float, 256> decode{};
+    for (int i = 0; i < 256; ++i) decode[static_cast<size_t>(i)] = srgbToLinear(static_cast<std::uint8_t>(i));
+    for (const TextureImage& img : m.source.textures) {
+        LinearTexture t;
+        const size_t count =
+            static_cast<size_t>(std::max(img.width, 0)) * static_cast<size_t>(std::max(img.height, 0));
+        if (count > 0 && img.rgba.size() >= count * 4) {
+            t.width = img.width;
+            t.height = img.height;
+            t.texels.resize(count);
+            for (size_t i = 0; i < count; ++i)
+                t.texels[i] = {decode[img.rgba[4 * i]], decode[img.rgba[4 * i + 1]],
+                               decode[img.rgba[4 * i + 2]]};
+            t.alpha.resize(count);
+            for (size_t i = 0; i < count; ++i) t.alpha[i] = static_cast<float>(img.rgba[4 * i + 3]) / 255.0f;
+        }
+        m.textures.push_back(std::move(t));
+    }
 
     for (size_t mi = 0; mi < m.source.meshes.size(); ++mi) {
         const Mesh& mesh = m.source.meshes[mi];
@@ -146,6 +217,22 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
         for (size_t i = 0; i < triangles * 3; ++i)
             indices[i] =
                 std::min<std::uint32_t>(mesh.indices[i], vertexCount - 1); // validated; belt and braces
+        if (mesh.material >= 0 && static_cast<size_t>(mesh.material) < m.source.materials.size()) {
+            const Material& mat = m.source.materials[static_cast<size_t>(mesh.material)];
+            if (mat.cutsOut()) {
+                auto cut = std::make_unique<CutoutGeometry>();
+                cut->mesh = &mesh;
+                if (mat.baseColorTexture >= 0 &&
+                    static_cast<size_t>(mat.baseColorTexture) < m.textures.size())
+                    cut->texture = &m.textures[static_cast<size_t>(mat.baseColorTexture)];
+                cut->alphaFactor = mat.baseColor.a;
+                cut->cutoff = mat.cutoff();
+                rtcSetGeometryUserData(geom, cut.get());
+                rtcSetGeometryIntersectFilterFunction(geom, cutoutFilter);
+                rtcSetGeometryOccludedFilterFunction(geom, cutoutFilter);
+                m.cutouts.push_back(std::move(cut));
+            }
+        }
         rtcCommitGeometry(geom);
         const unsigned id = rtcAttachGeometry(m.scene, geom);
         rtcReleaseGeometry(geom);
@@ -155,24 +242,6 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
     rtcCommitScene(m.scene);
     if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
         throw Error("reference: Embree failed to build the scene");
-
-    // One sRGB decode table: textures are decoded to linear once, then filtered in linear space.
-    std::array<float, 256> decode{};
-    for (int i = 0; i < 256; ++i) decode[static_cast<size_t>(i)] = srgbToLinear(static_cast<std::uint8_t>(i));
-    for (const TextureImage& img : m.source.textures) {
-        LinearTexture t;
-        const size_t count =
-            static_cast<size_t>(std::max(img.width, 0)) * static_cast<size_t>(std::max(img.height, 0));
-        if (count > 0 && img.rgba.size() >= count * 4) {
-            t.width = img.width;
-            t.height = img.height;
-            t.texels.resize(count);
-            for (size_t i = 0; i < count; ++i)
-                t.texels[i] = {decode[img.rgba[4 * i]], decode[img.rgba[4 * i + 1]],
-                               decode[img.rgba[4 * i + 2]]};
-        }
-        m.textures.push_back(std::move(t));
-    }
 
     // Far enough to clear float rounding of positions anywhere in the scene (coordinates up to
     // |centre| + radius carry a relative error of ~1e-7), small enough not to skip real geometry in

@@ -22,7 +22,8 @@ namespace reference {
 // 2: non-diffuse materials (scene/Brdf.h: metallic, roughness, specular) and the frame parameters
 // specular_lobe and effect_specular.
 // 3: every light, range windows.
-constexpr const char* kKeyVersion = "gis-reference-4"; // 4: the pixel means' variance, the noise target
+// 4: the pixel means' variance, the noise target; 5: materials' alpha cutouts
+constexpr const char* kKeyVersion = "gis-reference-5";
 
 std::string sceneDigest(const Scene& scene) {
     Hasher h;
@@ -46,6 +47,8 @@ std::string sceneDigest(const Scene& scene) {
         h.value(m.roughness);
         h.value(m.specular);
         h.value(m.emissive);
+        h.value(static_cast<int>(m.alphaMode));
+        h.value(m.alphaCutoff);
     }
     h.value(scene.textures.size());
     for (const TextureImage& t : scene.textures) {

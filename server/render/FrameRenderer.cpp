@@ -123,21 +123,25 @@ void writeLightUniforms(const LightSetModel& set, shader::LightUniforms& u) {
     u.counts = glm::ivec4(lights, views, 0, 0);
 }
 
-FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
+FrameRenderer::MeshPass FrameRenderer::buildMeshPass(const char* fragment, MeshMaterials materials,
+                                                     bool cutout) {
     const gl::ShaderStage meshVert{GL_VERTEX_SHADER, "render/mesh.vert"};
+    std::vector<std::pair<std::string, std::string>> defines;
+    if (cutout) defines.emplace_back("GIS_ALPHA_CUTOUT", "1");
+    MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}, defines), {}, {}};
+    p.view = p.program.location("uView");
+    // A cut-out shadow map reads the base colour's alpha: it needs the materials too.
+    if (materials != MeshMaterials::None || cutout)
+        p.materials = MaterialSlots::of(p.program, materials == MeshMaterials::All);
+    return p;
+}
+
+FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
     // The shadow map draws depth only: its program reads no material.
-    enum class Materials { None, Used, All };
-    auto meshPass = [&](const char* fragment, Materials materials) {
-        MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}), {}, {}};
-        p.view = p.program.location("uView");
-        if (materials != Materials::None)
-            p.materials = MaterialSlots::of(p.program, materials == Materials::All);
-        return p;
-    };
-    mShadowPass = meshPass("render/shadow.frag", Materials::None);
-    mRsmPass = meshPass("render/rsm.frag", Materials::Used);
-    mGBufferPass = meshPass("render/gbuffer.frag", Materials::All);
+    mShadowPass = buildMeshPass("render/shadow.frag", MeshMaterials::None, false);
+    mRsmPass = buildMeshPass("render/rsm.frag", MeshMaterials::Used, false);
+    mGBufferPass = buildMeshPass("render/gbuffer.frag", MeshMaterials::All, false);
     mDirectPass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
     const gl::Program& d = mDirectPass.program;
     mDirectPass.position = d.textureUnit("gPosition");
@@ -175,6 +179,13 @@ FrameRenderer::~FrameRenderer() = default;
 void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
     GIS_ASSERT(scene != nullptr);
     mSceneGpu = std::make_unique<SceneGpu>(*scene);
+    mSceneCutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
+                                [](const Material& m) { return m.cutsOut(); });
+    if (mSceneCutsOut && !mCutoutPasses)
+        mCutoutPasses = std::make_unique<CutoutPasses>(
+            CutoutPasses{buildMeshPass("render/shadow.frag", MeshMaterials::None, true),
+                         buildMeshPass("render/rsm.frag", MeshMaterials::Used, true),
+                         buildMeshPass("render/gbuffer.frag", MeshMaterials::All, true)});
     mScene = std::move(scene);
     mLightPassesValid = false;
 }
@@ -251,8 +262,9 @@ void FrameRenderer::renderShadowMaps(int views) {
             .clearDepth();
         if (v >= views) continue;
         layer.polygonOffset(2.0f, 4.0f);
-        layer.use(mShadowPass.program).set(mShadowPass.view, v);
-        mSceneGpu->draw(mShadowPass.program, nullptr);
+        const MeshPass& shadow = shadowPass();
+        layer.use(shadow.program).set(shadow.view, v);
+        mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr);
     }
     mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
 }
@@ -266,8 +278,9 @@ void FrameRenderer::renderRsms(int views) {
             .clearColor(4)
             .clearDepth();
         if (v >= views) continue;
-        layer.use(mRsmPass.program).set(mRsmPass.view, v);
-        mSceneGpu->draw(mRsmPass.program, &mRsmPass.materials);
+        const MeshPass& rsm = rsmPass();
+        layer.use(rsm.program).set(rsm.view, v);
+        mSceneGpu->draw(rsm.program, &rsm.materials);
     }
     mResources.publish("lights.rsm.position", "rsm", mRsmPosition);
     mResources.publish("lights.rsm.normal", "rsm", mRsmNormal);
@@ -298,8 +311,9 @@ std::vector<double> FrameRenderer::readViewFlux(int views) const {
 void FrameRenderer::renderGBuffer(int width, int height) {
     gl::Pass pass(mTimer, "gbuffer");
     pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
-    pass.use(mGBufferPass.program).set(mGBufferPass.view, -1);
-    mSceneGpu->draw(mGBufferPass.program, &mGBufferPass.materials);
+    const MeshPass& gbuffer = gbufferPass();
+    pass.use(gbuffer.program).set(gbuffer.view, -1);
+    mSceneGpu->draw(gbuffer.program, &gbuffer.materials);
     mResources.publish("gbuffer.position", "gbuffer", mGPosition);
     mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
     mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);

@@ -106,7 +106,21 @@ private:
         gl::UniformLocation view;
         MaterialSlots materials;
     };
+    /// Which material uniforms a mesh pass reads: none (depth only), those it uses, or all of them
+    /// (the G-buffer, where a missing one is a misspelling).
+    enum class MeshMaterials { None, Used, All };
+    static MeshPass buildMeshPass(const char* fragment, MeshMaterials materials, bool cutout);
     MeshPass mShadowPass, mRsmPass, mGBufferPass;
+    /// The same passes built with GIS_ALPHA_CUTOUT, for scenes with cut-out materials (built with
+    /// the first such scene; discarding fragments costs the others their early depth test).
+    struct CutoutPasses {
+        MeshPass shadow, rsm, gbuffer;
+    };
+    std::unique_ptr<CutoutPasses> mCutoutPasses;
+    bool mSceneCutsOut = false;
+    const MeshPass& shadowPass() const { return mSceneCutsOut ? mCutoutPasses->shadow : mShadowPass; }
+    const MeshPass& rsmPass() const { return mSceneCutsOut ? mCutoutPasses->rsm : mRsmPass; }
+    const MeshPass& gbufferPass() const { return mSceneCutsOut ? mCutoutPasses->gbuffer : mGBufferPass; }
     struct DirectPass {
         gl::Program program;
         gl::TextureUnit position, normal, albedo, emissive, shadow, specular;

@@ -25,8 +25,11 @@ const gl::Texture& ReflectionInputs::get(const std::string& name) const {
 
 ForwardProgram ForwardProgram::build() {
     ForwardProgram f;
+    // Cutouts always: reflections are drawn far less often than the eye and light views, so one
+    // program serves every scene (opaque materials set a negative cutoff and never discard).
     f.program = gl::Program::build(
-        {{GL_VERTEX_SHADER, "render/forward.vert"}, {GL_FRAGMENT_SHADER, "render/forward.frag"}});
+        {{GL_VERTEX_SHADER, "render/forward.vert"}, {GL_FRAGMENT_SHADER, "render/forward.frag"}},
+        {{"GIS_ALPHA_CUTOUT", "1"}});
     f.viewProj = f.program.location("uViewProj");
     f.clipPlane = f.program.location("uClipPlane");
     f.eye = f.program.location("uEye");

@@ -97,6 +97,7 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     m.hasTexture = slot("uHasTexture");
     m.metalRoughSpec = slot("uMetalRoughSpec");
     m.mirrorId = slot("uMirrorId");
+    if (program.declares("uAlphaCutoff")) m.alphaCutoff = program.optionalLocation("uAlphaCutoff");
     if (complete || program.has("uBaseColorTex")) m.baseColorTexture = program.textureUnit("uBaseColorTex");
     return m;
 }
@@ -112,6 +113,7 @@ void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int inst
             glUniform4f(s.baseColor.location, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
             glUniform3f(s.metalRoughSpec.location, m.metallic, m.roughness, m.specular);
             glUniform1i(s.mirrorId.location, d.surfaceId);
+            glUniform1f(s.alphaCutoff.location, m.cutsOut() ? m.cutoff() : -1.0f);
             glUniform3f(s.emissive.location, m.emissive.r, m.emissive.g, m.emissive.b);
             const bool textured =
                 m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());

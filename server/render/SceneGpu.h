@@ -14,6 +14,7 @@ namespace gis {
 /// where the program is built, so the draw loop looks nothing up.
 struct MaterialSlots {
     gl::UniformLocation baseColor, emissive, hasTexture, metalRoughSpec, mirrorId;
+    gl::UniformLocation alphaCutoff; ///< only in programs built with GIS_ALPHA_CUTOUT
     gl::TextureUnit baseColorTexture;
     /// `program`'s slots. With `complete`, every one must be active (the G-buffer's program, which
     /// reads them all: a misspelt name in material.glsl fails there); otherwise the ones a program

@@ -481,6 +481,11 @@ private:
             }
             if (pbr.baseColorTexture.index >= 0)
                 m.baseColorTexture = convertTexture(pbr.baseColorTexture.index, "material '" + m.name + "'");
+            if (src.alphaMode == "MASK") m.alphaMode = Material::Alpha::Mask;
+            if (src.alphaMode == "BLEND") m.alphaMode = Material::Alpha::Blend;
+            m.alphaCutoff = std::isfinite(src.alphaCutoff)
+                                ? std::clamp(static_cast<float>(src.alphaCutoff), 0.0f, 1.0f)
+                                : 0.5f;
             mScene.materials.push_back(std::move(m));
         }
     }
@@ -617,9 +622,8 @@ private:
              [](const tinygltf::Material& m) { return m.occlusionTexture.index >= 0; }},
             {"emissiveTexture", "emissive textures are not applied: the emissive factor glows uniformly",
              [](const tinygltf::Material& m) { return m.emissiveTexture.index >= 0; }},
-            {"alphaMode MASK", "alpha cutouts are not applied: the cut-out parts render opaque",
-             [](const tinygltf::Material& m) { return m.alphaMode == "MASK"; }},
-            {"alphaMode BLEND", "transparency is not rendered: the surfaces render opaque",
+            {"alphaMode BLEND",
+             "transparency is approximated as a cutout: alpha below 0.5 is cut out, the rest renders opaque",
              [](const tinygltf::Material& m) { return m.alphaMode == "BLEND"; }},
         };
         for (const Feature& f : features) {

@@ -35,6 +35,15 @@ struct Material {
     /// glTF default 1 from the loader. The reflection model is scene/Brdf.h.
     float specular = 0.0f;
     glm::vec3 emissive{0.0f}; ///< linear RGB radiance scale (glTF emissiveFactor)
+    /// glTF alphaMode. MASK cuts out where the base colour's alpha (factor times texture) is below
+    /// alphaCutoff, in every pass (G-buffer, shadow maps, RSMs, reflections) and in the reference.
+    /// BLEND is approximated as a cutout at 0.5: half-transparent surfaces are either opaque or gone
+    /// (docs/scenes.md).
+    enum class Alpha { Opaque, Mask, Blend } alphaMode = Alpha::Opaque;
+    float alphaCutoff = 0.5f; ///< [0, 1], MASK only
+    /// Whether some of the surface may be cut out, and below which alpha.
+    bool cutsOut() const { return alphaMode != Alpha::Opaque; }
+    float cutoff() const { return alphaMode == Alpha::Blend ? 0.5f : alphaCutoff; }
 };
 
 /// One triangle list in world space. Every vertex attribute array has positions.size() entries.

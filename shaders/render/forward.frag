@@ -17,6 +17,7 @@ layout(location = 1) out vec4 outPosition; // xyz world position (m), w = 1 cove
 layout(location = 2) out vec4 outMirror;   // x planar-mirror index + 1 (0 none); only mirrored views attach it
 
 void main() {
+    CUT_OUT(vTexcoord);
     vec3 toEye = uEye - vWorldPos;
     float e2 = dot(toEye, toEye);
     vec3 v = e2 > 1e-20 ? toEye * inversesqrt(e2) : vec3(0.0, 1.0, 0.0);

@@ -14,6 +14,7 @@ layout(location = 3) out vec4 outEmissive; // rgb emitted radiance
 layout(location = 4) out vec4 outSpecular; // rgb F0, a perceptual roughness (render/brdf.glsl)
 
 void main() {
+    CUT_OUT(vTexcoord);
     vec3 toEye = gFrame.cameraPos.xyz - vWorldPos;
     vec3 n = safeNormal(vNormal, vWorldPos, toEye);
     outPosition = vec4(vWorldPos, 1.0);

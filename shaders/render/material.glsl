@@ -6,6 +6,22 @@ uniform vec3 uMetalRoughSpec; // x metallic, y perceptual roughness, z specular 
 uniform int uMirrorId;        // reflector id (SceneGpu::setSurfaceIds): mirror k + 1, local probe -(k + 1), 0 none
 layout(binding = 0) uniform sampler2D uBaseColorTex; // sRGB texture, decoded by the sampler
 
+// Alpha cutouts (glTF alphaMode MASK, and BLEND approximated at 0.5: scene/Scene.h Material). Only
+// programs built with GIS_ALPHA_CUTOUT (for scenes that have such materials) discard, so that the
+// others keep early depth tests.
+#ifdef GIS_ALPHA_CUTOUT
+uniform float uAlphaCutoff; // cut out below this alpha (base colour factor x texture); < 0: opaque
+bool materialCutOut(vec2 uv) {
+    if (uAlphaCutoff < 0.0) return false;
+    float alpha = uBaseColor.a;
+    if (uHasTexture == 1) alpha *= texture(uBaseColorTex, uv).a;
+    return !(alpha >= uAlphaCutoff); // NaN alpha cuts out
+}
+#define CUT_OUT(uv) if (materialCutOut(uv)) discard
+#else
+#define CUT_OUT(uv)
+#endif
+
 vec3 materialBaseColor(vec2 uv) {
     vec4 c = uBaseColor;
     if (uHasTexture == 1) c *= texture(uBaseColorTex, uv);

@@ -20,6 +20,7 @@ layout(location = 2) out vec4 outFlux;     // rgb diffusely reflected flux of th
 layout(location = 3) out vec4 outSpecular; // rgb F0, a perceptual roughness (glossy VPLs)
 
 void main() {
+    CUT_OUT(vTexcoord);
     int light = lightOfView(uView);
     vec3 l, irradiance;
     float dist;

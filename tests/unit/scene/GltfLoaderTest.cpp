@@ -270,7 +270,7 @@ TEST(GltfLoader, FeaturesTheRendererDoesNotShowAreListed) {
     b.doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 0; // the positions, as colours
     b.doc["textures"] = {nlohmann::json::object()};
     b.doc["materials"] = {{{"name", "foliage"},
-                           {"alphaMode", "MASK"},
+                           {"alphaMode", "BLEND"},
                            {"normalTexture", {{"index", 0}}},
                            {"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}}}}}},
                           {{"name", "bark"}, {"normalTexture", {{"index", 0}}}}};
@@ -281,13 +281,15 @@ TEST(GltfLoader, FeaturesTheRendererDoesNotShowAreListed) {
     const Scene s = loadGltf(b.writeGlb(dir, "unshown.glb"));
     std::map<std::string, std::string> listed;
     for (const NotShown& n : s.notShown) listed[n.feature] = n.detail;
-    EXPECT_EQ(listed.size(), 5u) << "clearcoat, instancing, normal maps, MASK, vertex colours";
+    EXPECT_EQ(listed.size(), 5u) << "clearcoat, instancing, normal maps, BLEND, vertex colours";
     EXPECT_EQ(listed["KHR_materials_clearcoat"],
               "1 material ('foliage'): clear coat is not rendered: the base layer shows alone");
     EXPECT_NE(listed["EXT_mesh_gpu_instancing"].find("1 node ('node 0')"), std::string::npos)
         << listed["EXT_mesh_gpu_instancing"];
     EXPECT_NE(listed["normalTexture"].find("2 materials ('foliage', 'bark')"), std::string::npos);
-    EXPECT_NE(listed["alphaMode MASK"].find("render opaque"), std::string::npos);
+    EXPECT_NE(listed["alphaMode BLEND"].find("approximated as a cutout"), std::string::npos);
+    EXPECT_EQ(s.materials[0].alphaMode, Material::Alpha::Blend);
+    EXPECT_FLOAT_EQ(s.materials[0].cutoff(), 0.5f);
     EXPECT_NE(listed["COLOR_0"].find("1 mesh ('leaves')"), std::string::npos);
     EXPECT_FALSE(listed.count("KHR_lights_punctual")) << "read, so shown";
 

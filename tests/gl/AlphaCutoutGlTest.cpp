@@ -1,0 +1,113 @@
+// Alpha cutouts (glTF alphaMode MASK; BLEND approximated at 0.5): a red card half cut out by its
+// texture's alpha, over a floor, under a slanted sun. The GL frame (G-buffer and shadow map cut out)
+// agrees with the CPU reference (its rays pass through the cut-out half) as closely as the same scene
+// with an opaque card does, and both differ from the opaque card's frames where the cutout shows the
+// floor and lets the sun through.
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "GlTestSupport.h"
+#include "frame/FrameState.h"
+#include "reference/ReferenceRenderer.h"
+#include "render/FrameRenderer.h"
+#include "scene/SceneLoader.h"
+
+using namespace gis;
+
+namespace {
+
+Mesh quad(const std::string& name, float y, float half, int material) {
+    Mesh m;
+    m.name = name;
+    m.positions = {{-half, y, -half}, {half, y, -half}, {half, y, half}, {-half, y, half}};
+    m.normals.assign(4, glm::vec3(0.0f, 1.0f, 0.0f));
+    m.texcoords = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
+    m.indices = {0, 2, 1, 0, 3, 2};
+    m.material = material;
+    return m;
+}
+
+Scene cardScene(Material::Alpha mode) {
+    Scene s;
+    s.name = "card";
+    s.meshes = {quad("floor", 0.0f, 1.0f, 0), quad("card", 0.5f, 0.5f, 1)};
+    s.materials = {
+        Material{.name = "floor", .baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)},
+        Material{.name = "card", .baseColor = glm::vec4(0.9f, 0.1f, 0.1f, 1.0f), .baseColorTexture = 0}};
+    s.materials[1].alphaMode = mode;
+    s.materials[1].alphaCutoff = 0.5f;
+    // 8 x 1 texels: alpha 0 on the left half of the card (u < 0.5), 1 on the right.
+    TextureImage t;
+    t.width = 8;
+    t.height = 1;
+    t.name = "half";
+    for (int x = 0; x < 8; ++x)
+        t.rgba.insert(t.rgba.end(), {255, 255, 255, static_cast<std::uint8_t>(x < 4 ? 0 : 255)});
+    s.textures = {t};
+    Light sun;
+    sun.name = "sun";
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(glm::vec3(0.35f, -1.0f, 0.15f));
+    sun.intensity = 3.0f;
+    s.lights = {sun};
+    Camera c;
+    c.name = "above";
+    c.position = {0.0f, 2.6f, 1.6f};
+    c.target = {0.0f, 0.2f, 0.0f};
+    c.yfovRadians = 0.9f;
+    c.znear = 0.05f;
+    c.zfar = 20.0f;
+    s.cameras = {c};
+    s.updateBounds();
+    finalizeScene(s, "card");
+    return s;
+}
+
+struct Frames {
+    FrameOutput gl;
+    std::vector<float> reference; // RGB
+};
+
+Frames render(Material::Alpha mode) {
+    test::sharedContext();
+    const Scene scene = cardScene(mode);
+    FrameRenderer renderer;
+    renderer.setScene(std::make_shared<const Scene>(scene));
+    FrameState state = makeFrameState(scene, "none");
+    state.width = 64;
+    state.height = 64;
+    state.frameParams.set("shadow_map_size", 1024);
+    Frames f;
+    f.gl = renderer.render(state, true);
+    ReferenceRenderer reference(scene);
+    f.reference = reference.render(state, {.mode = "direct", .spp = 16, .seed = 3, .jitter = true}).rgb;
+    return f;
+}
+
+} // namespace
+
+TEST(AlphaCutout, MaskedCardMatchesTheReferenceInEveryPass) {
+    const Frames opaque = render(Material::Alpha::Opaque);
+    const Frames masked = render(Material::Alpha::Mask);
+    const Frames blended = render(Material::Alpha::Blend);
+    const size_t pixels = 64 * 64;
+    const double opaqueError = test::relativeRmseOf(opaque.gl.linear, 4, opaque.reference, 3, pixels);
+    const double maskedError = test::relativeRmseOf(masked.gl.linear, 4, masked.reference, 3, pixels);
+    const double glChange = test::relativeRmseOf(masked.gl.linear, 4, opaque.gl.linear, 4, pixels);
+    const double referenceChange = test::relativeRmseOf(masked.reference, 3, opaque.reference, 3, pixels);
+    std::printf("[cutout] GL against the reference (direct, 16 spp): opaque card %.4f, masked card %.4f; "
+                "masked against opaque: GL %.3f, reference %.3f\n",
+                opaqueError, maskedError, glChange, referenceChange);
+    EXPECT_EQ(test::badValues(masked.gl), 0u);
+    // The cutout changes the image (the floor shows through and is lit through it) ...
+    EXPECT_GT(glChange, 0.1);
+    EXPECT_GT(referenceChange, 0.1);
+    // ... the same way on both sides: GL stays as close to the reference as with an opaque card.
+    EXPECT_LT(maskedError, std::max(0.08, 1.5 * opaqueError));
+    // BLEND is approximated by a cutout at 0.5: this texture's alpha is 0 or 1, so it renders the same.
+    EXPECT_LT(test::relativeRmseOf(blended.gl.linear, 4, masked.gl.linear, 4, pixels), 1e-6);
+    EXPECT_LT(test::relativeRmseOf(blended.reference, 3, masked.reference, 3, pixels), 1e-6);
+}
