@@ -4,7 +4,8 @@
 // performance.now()), so node's test runner checks it.
 
 /** How long "done", "abandoned" and "skipped" stay up. */
-export const FLASH_MS = Object.freeze({ done: 3000, abandoned: 4000, skipped: 8000 });
+// A load's line stays until the load ends (`loaded` or `load_failed` replaces it), up to two minutes.
+export const FLASH_MS = Object.freeze({ done: 3000, abandoned: 4000, skipped: 8000, loading: 120000, loaded: 4000 });
 // A figure this much older than pending input is stale even while frames are not late.
 export const STALE_AFTER_MS = 2000;
 // The frame target when the server names none (protocol 1 and older protocol 2 servers).
@@ -72,6 +73,18 @@ export class RefineTracker {
             this.flash = { kind: 'abandoned', text: `refinement abandoned${reason ? `: ${reason}` : ' (input)'}`,
                 until: now + FLASH_MS.abandoned };
             break;
+        case 'loading':
+            // A scene load: no refinement runs meanwhile; it says what is loading until it ends.
+            this.current = null;
+            this.flash = { kind: 'loading', text: reason || 'loading the scene', until: now + FLASH_MS.loading };
+            break;
+        case 'loaded':
+            this.flash = { kind: 'loaded', text: reason || 'scene loaded', until: now + FLASH_MS.loaded };
+            break;
+        case 'load_failed':
+            // The error message that follows says why.
+            if (this.flash?.kind === 'loading') this.flash = null;
+            break;
         case 'skipped':
             // A step is skipped between steps: nothing runs until the next 'refining'.
             this.current = null;
@@ -95,7 +108,8 @@ export class RefineTracker {
     }
 
     /**
-     * What to show at `now`: null, or {kind: 'refining' | 'done' | 'abandoned' | 'skipped', text,
+     * What to show at `now`: null, or {kind: 'refining' | 'done' | 'abandoned' | 'skipped' | 'loading' |
+     * 'loaded', text,
      * share (0..1, refining only)}. The time left counts down between messages.
      */
     view(now) {
@@ -173,6 +187,6 @@ export class InputWatch {
  */
 export function busyText({ lateMs = null, refine = null }) {
     if (lateMs !== null) return `rendering… ${formatSeconds(lateMs)}`;
-    if (refine?.kind === 'refining') return refine.text;
+    if (refine?.kind === 'refining' || refine?.kind === 'loading') return refine.text;
     return null;
 }

@@ -228,3 +228,18 @@ test('the reconnect countdown counts whole seconds, tenths below one', () => {
     assert.equal(formatCountdown(500), '0.5 s');
     assert.equal(formatCountdown(-20), '0.0 s');
 });
+
+test('a scene load shows while it runs, then what it cost; a failed one leaves the error to say why', () => {
+    const r = new RefineTracker();
+    r.message({ type: 'progress', state: 'loading', step: 'scene', reason: 'loading upload:city.glb (48.0 MiB)' }, 0);
+    assert.deepEqual(r.view(10), { kind: 'loading', text: 'loading upload:city.glb (48.0 MiB)', share: null });
+    assert.equal(busyText({ refine: r.view(10) }), 'loading upload:city.glb (48.0 MiB)');
+    assert.equal(r.view(60000).kind, 'loading', 'a long load stays up');
+    r.message({ type: 'progress', state: 'loaded', step: 'scene', reason: 'loaded upload:city.glb: 2000 triangles in 900 ms' }, 61000);
+    assert.equal(r.view(61010).kind, 'loaded');
+    assert.match(r.view(61010).text, /2000 triangles in 900 ms/);
+    assert.equal(r.view(61000 + FLASH_MS.loaded + 1), null);
+    r.message({ type: 'progress', state: 'loading', step: 'scene', reason: 'loading upload:bad.glb' }, 70000);
+    r.message({ type: 'progress', state: 'load_failed', step: 'scene', reason: 'could not load upload:bad.glb' }, 70100);
+    assert.equal(r.view(70200), null);
+});

@@ -1,6 +1,7 @@
 #include "session/Session.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -41,6 +42,12 @@ constexpr int kSnapshotBudgetMs = 5000;
 // most 4096 parts (each at least one VPL).
 constexpr int kPartTileSide = 64;
 constexpr int kMaxVplParts = 4096;
+
+std::string mebibytes(std::uintmax_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+    return text;
+}
 
 const char* stepName(int step) {
     static const char* names[] = {"interactive", "balanced", "final"};
@@ -132,6 +139,7 @@ nlohmann::json Session::stateJsonLocked() const {
             {"lights", lightsJson(mDesired)},
             {"lighting", {{"source", mDesired.lightSource}, {"note", mDesired.lightNote}}},
             {"scene_camera", cameraJson(mSceneCamera)},
+            {"load", mSceneLoad.is_null() ? nlohmann::json(nullptr) : mSceneLoad},
             {"bounds",
              {{"min", {mScene->bounds.min.x, mScene->bounds.min.y, mScene->bounds.min.z}},
               {"max", {mScene->bounds.max.x, mScene->bounds.max.y, mScene->bounds.max.z}}}}};
@@ -855,15 +863,48 @@ void Session::workerMain() {
             try {
                 const std::string path =
                     mCatalog ? mCatalog->resolve(sceneRequest, mUploadDir) : sceneRequest;
-                Stopwatch loadClock;
-                auto next =
-                    mScenes->get(path, mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{});
                 std::error_code sizeError;
                 const auto bytes = std::filesystem::file_size(path, sizeError);
+                const std::string sizeText = sizeError ? std::string() : " (" + mebibytes(bytes) + ")";
+                // The client shows that a load is under way (a large file takes seconds) and what
+                // it cost; the scene cache answers at once for a scene another session holds.
+                broadcastText({{"type", "progress"},
+                               {"state", "loading"},
+                               {"step", "scene"},
+                               {"share", 0.0},
+                               {"eta_ms", 0.0},
+                               {"reason", "loading " + validUtf8(sceneRequest) + sizeText}});
+                Stopwatch loadClock;
+                std::shared_ptr<const Scene> next;
+                try {
+                    next = mScenes->get(path,
+                                        mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{});
+                } catch (...) {
+                    broadcastText({{"type", "progress"},
+                                   {"state", "load_failed"},
+                                   {"step", "scene"},
+                                   {"share", 0.0},
+                                   {"eta_ms", 0.0},
+                                   {"reason", "could not load " + validUtf8(sceneRequest)}});
+                    throw;
+                }
+                const double loadMs = loadClock.elapsedMs();
                 logInfo("session " + mId + ": scene " + validUtf8(sceneRequest) + " loaded (" +
                         (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
                         std::to_string(next->triangleCount()) + " triangles, " +
-                        std::to_string(static_cast<long>(loadClock.elapsedMs())) + " ms)");
+                        std::to_string(static_cast<long>(loadMs)) + " ms)");
+                broadcastText({{"type", "progress"},
+                               {"state", "loaded"},
+                               {"step", "scene"},
+                               {"share", 1.0},
+                               {"eta_ms", 0.0},
+                               {"reason", "loaded " + validUtf8(sceneRequest) + sizeText + ": " +
+                                              std::to_string(next->triangleCount()) + " triangles in " +
+                                              std::to_string(std::lround(loadMs)) + " ms"}});
+                const nlohmann::json loadInfo = {
+                    {"ms", loadMs},
+                    {"bytes", sizeError ? nlohmann::json(nullptr) : nlohmann::json(bytes)},
+                    {"triangles", next->triangleCount()}};
                 w.renderer->setScene(next);
                 w.scene = next;
                 nlohmann::json stateMsg;
@@ -877,6 +918,7 @@ void Session::workerMain() {
                     mDesired.lightNote = fresh.lightNote;
                     mScene = next;
                     mSceneName = sceneRequest;
+                    mSceneLoad = loadInfo;
                     stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
                 }
                 broadcastText(stateMsg);

@@ -196,6 +196,7 @@ private:
     Camera mSceneCamera; ///< the scene's own camera (state.scene_camera: what "reset camera" returns to)
     nlohmann::json mExplicit = nlohmann::json::object(); ///< parameters the client set (win over presets)
     std::string mSceneName;
+    nlohmann::json mSceneLoad; ///< the last scene load's {ms, bytes, triangles} (state.load); null before one
     std::shared_ptr<const Scene> mScene;
     std::string mSceneRequest;
     StreamOptions mStream;

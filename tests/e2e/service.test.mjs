@@ -204,8 +204,15 @@ check('every client message type has its effect', async (t) => {
 
     await t.test('scene loads the scene and sends a state message', async () => {
         client.send({ type: 'scene', name: 'builtin:cornell-empty' });
+        // The load says it starts and what it cost, before the state.
+        const loading = await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+        assert.equal(loading.step, 'scene');
+        assert.match(loading.reason, /^loading builtin:cornell-empty/);
+        const loaded = await client.inbox.next((m) => m.type === 'progress' && m.state === 'loaded', 'progress loaded', 15000);
+        assert.match(loaded.reason, /^loaded builtin:cornell-empty.*: \d+ triangles in \d+ ms$/);
         const state = await client.inbox.nextOfType('state', 'state after scene', 15000);
         assert.equal(state.state?.scene, 'builtin:cornell-empty', 'state.scene');
+        assert.ok(state.state.load?.triangles > 0 && state.state.load.ms >= 0, 'state.load: what the load cost');
         assert.ok(Array.isArray(state.state?.camera?.position), 'state carries the reset camera');
         last = await client.frame('frame of the new scene', (s) => s.scene === 'builtin:cornell-empty');
         await client.expectError({ type: 'scene', name: 'builtin:no-such-scene' }, 'unknown_scene');
