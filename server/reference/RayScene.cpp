@@ -189,9 +189,13 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
             t.width = img.width;
             t.height = img.height;
             t.texels.resize(count);
+            // Colour is sRGB-decoded per texel as GL's sRGB sampler does; data textures stay linear.
+            const auto channel = [&](std::uint8_t v) {
+                return img.srgb ? decode[v] : static_cast<float>(v) / 255.0f;
+            };
             for (size_t i = 0; i < count; ++i)
-                t.texels[i] = {decode[img.rgba[4 * i]], decode[img.rgba[4 * i + 1]],
-                               decode[img.rgba[4 * i + 2]]};
+                t.texels[i] = {channel(img.rgba[4 * i]), channel(img.rgba[4 * i + 1]),
+                               channel(img.rgba[4 * i + 2])};
             t.alpha.resize(count);
             for (size_t i = 0; i < count; ++i) t.alpha[i] = static_cast<float>(img.rgba[4 * i + 3]) / 255.0f;
         }
@@ -332,10 +336,24 @@ SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const g
         // materialBaseColor() / materialAlbedo() / materialF0() of material.glsl, via scene/Brdf.h.
         const glm::vec3 baseColour = glm::clamp(sanitizePositive(c), 0.0f, 1.0f);
         const auto finiteOr = [](float v, float fallback) { return std::isfinite(v) ? v : fallback; };
-        h.surface = brdf::surfaceFrom(baseColour, finiteOr(mat.metallic, 0.0f), finiteOr(mat.roughness, 1.0f),
-                                      finiteOr(mat.specular, 0.0f));
+        const auto texture = [&](int index) -> const LinearTexture* {
+            return index >= 0 && static_cast<size_t>(index) < m.textures.size()
+                       ? &m.textures[static_cast<size_t>(index)]
+                       : nullptr;
+        };
+        // materialMetalRoughSpec() and materialEmissive() of material.glsl.
+        float metallic = finiteOr(mat.metallic, 0.0f), roughness = finiteOr(mat.roughness, 1.0f);
+        if (const LinearTexture* mr = texture(mat.metallicRoughnessTexture)) {
+            const glm::vec3 t = sampleBilinear(*mr, uv);
+            metallic *= t.b;
+            roughness *= t.g;
+        }
+        h.surface = brdf::surfaceFrom(baseColour, std::clamp(metallic, 0.0f, 1.0f),
+                                      std::clamp(roughness, 0.0f, 1.0f), finiteOr(mat.specular, 0.0f));
         h.albedo = h.surface.diffuse; // == base when F0 = 0 (metallic 0, specular 0)
-        h.emission = sanitizePositive(mat.emissive);
+        glm::vec3 emission = mat.emissive;
+        if (const LinearTexture* e = texture(mat.emissiveTexture)) emission *= sampleBilinear(*e, uv);
+        h.emission = sanitizePositive(emission);
     }
     return h;
 }

@@ -22,7 +22,8 @@ namespace reference {
 // 2: non-diffuse materials (scene/Brdf.h: metallic, roughness, specular) and the frame parameters
 // specular_lobe and effect_specular.
 // 3: every light, range windows.
-// 4: the pixel means' variance, the noise target; 5: materials' alpha cutouts
+// 4: the pixel means' variance, the noise target; 5: materials' alpha cutouts, metallic-roughness and
+// emissive textures
 constexpr const char* kKeyVersion = "gis-reference-5";
 
 std::string sceneDigest(const Scene& scene) {
@@ -49,11 +50,14 @@ std::string sceneDigest(const Scene& scene) {
         h.value(m.emissive);
         h.value(static_cast<int>(m.alphaMode));
         h.value(m.alphaCutoff);
+        h.value(m.metallicRoughnessTexture);
+        h.value(m.emissiveTexture);
     }
     h.value(scene.textures.size());
     for (const TextureImage& t : scene.textures) {
         h.value(t.width);
         h.value(t.height);
+        h.value(t.srgb);
         h.value(t.rgba.size());
         h.bytes(t.rgba.data(), t.rgba.size());
     }

@@ -69,7 +69,9 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     for (const TextureImage& image : scene.textures) {
         int levels =
             1 + static_cast<int>(std::floor(std::log2(std::max(std::max(image.width, image.height), 1))));
-        gl::Texture t = gl::Texture::create2D(GL_SRGB8_ALPHA8, image.width, image.height, levels);
+        // Colour is sRGB-encoded (the sampler decodes it); metallic-roughness data is linear.
+        gl::Texture t =
+            gl::Texture::create2D(image.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, image.width, image.height, levels);
         glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
                             image.rgba.data());
         glGenerateTextureMipmap(t.id());
@@ -98,7 +100,17 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     m.metalRoughSpec = slot("uMetalRoughSpec");
     m.mirrorId = slot("uMirrorId");
     if (program.declares("uAlphaCutoff")) m.alphaCutoff = program.optionalLocation("uAlphaCutoff");
-    if (complete || program.has("uBaseColorTex")) m.baseColorTexture = program.textureUnit("uBaseColorTex");
+    m.hasMetalRoughTexture = slot("uHasMetalRoughTex");
+    m.hasEmissiveTexture = slot("uHasEmissiveTex");
+    // A sampler the program leaves unused gets no unit (kNoUnit): binding to unit 0 would replace the
+    // base colour texture.
+    auto unit = [&](const char* name) {
+        if (complete) return program.textureUnit(name);
+        return program.declares(name) ? program.optionalTextureUnit(name) : gl::TextureUnit{gl::kNoUnit};
+    };
+    m.baseColorTexture = unit("uBaseColorTex");
+    m.metalRoughTexture = unit("uMetalRoughTex");
+    m.emissiveTexture = unit("uEmissiveTex");
     return m;
 }
 
@@ -115,12 +127,16 @@ void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int inst
             glUniform1i(s.mirrorId.location, d.surfaceId);
             glUniform1f(s.alphaCutoff.location, m.cutsOut() ? m.cutoff() : -1.0f);
             glUniform3f(s.emissive.location, m.emissive.r, m.emissive.g, m.emissive.b);
-            const bool textured =
-                m.baseColorTexture >= 0 && m.baseColorTexture < static_cast<int>(mTextures.size());
-            glUniform1i(s.hasTexture.location, textured ? 1 : 0);
-            if (textured)
-                glBindTextureUnit(s.baseColorTexture.unit,
-                                  mTextures[static_cast<size_t>(m.baseColorTexture)].id());
+            // Each texture the material has, on its unit; a unit the program does not sample is skipped.
+            auto bind = [&](int texture, gl::UniformLocation has, const gl::TextureUnit& unit) {
+                const bool present = texture >= 0 && texture < static_cast<int>(mTextures.size());
+                glUniform1i(has.location, present ? 1 : 0);
+                if (present && unit.unit != gl::kNoUnit)
+                    glBindTextureUnit(unit.unit, mTextures[static_cast<size_t>(texture)].id());
+            };
+            bind(m.baseColorTexture, s.hasTexture, s.baseColorTexture);
+            bind(m.metallicRoughnessTexture, s.hasMetalRoughTexture, s.metalRoughTexture);
+            bind(m.emissiveTexture, s.hasEmissiveTexture, s.emissiveTexture);
         }
         glDrawElementsInstancedBaseVertex(
             GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,

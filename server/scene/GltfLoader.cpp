@@ -314,7 +314,8 @@ class GltfReader {
 public:
     GltfReader(const tinygltf::Model& model, LoadContext& context)
         : mModel(model), mPath(context.name), mContext(context),
-          mImageTexture(model.images.size(), kNotConverted), mOnPath(model.nodes.size(), false) {}
+          mImageTexture(model.images.size(), kNotConverted),
+          mLinearImageTexture(model.images.size(), kNotConverted), mOnPath(model.nodes.size(), false) {}
 
     Scene read() {
         checkRequiredExtensions();
@@ -479,8 +480,14 @@ private:
                 const double f = spec->second.Get("specularFactor").GetNumberAsDouble();
                 m.specular = std::isfinite(f) ? std::clamp(static_cast<float>(f), 0.0f, 1.0f) : 1.0f;
             }
+            const std::string where = "material '" + m.name + "'";
             if (pbr.baseColorTexture.index >= 0)
-                m.baseColorTexture = convertTexture(pbr.baseColorTexture.index, "material '" + m.name + "'");
+                m.baseColorTexture = convertTexture(pbr.baseColorTexture.index, where);
+            if (pbr.metallicRoughnessTexture.index >= 0)
+                m.metallicRoughnessTexture =
+                    convertTexture(pbr.metallicRoughnessTexture.index, where + " metallic-roughness", false);
+            if (src.emissiveTexture.index >= 0)
+                m.emissiveTexture = convertTexture(src.emissiveTexture.index, where + " emissive");
             if (src.alphaMode == "MASK") m.alphaMode = Material::Alpha::Mask;
             if (src.alphaMode == "BLEND") m.alphaMode = Material::Alpha::Blend;
             m.alphaCutoff = std::isfinite(src.alphaCutoff)
@@ -515,8 +522,14 @@ private:
     BaseColorUv baseColorUv(int material) const {
         BaseColorUv uv;
         if (material < 0 || material >= static_cast<int>(mModel.materials.size())) return uv;
-        const tinygltf::TextureInfo& info =
-            mModel.materials[static_cast<std::size_t>(material)].pbrMetallicRoughness.baseColorTexture;
+        // The base colour texture's coordinates, else those of the first other texture the renderer
+        // samples (every one of them is mapped with one set: stats.not_shown says when they differ).
+        const tinygltf::Material& m = mModel.materials[static_cast<std::size_t>(material)];
+        const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture.index >= 0
+                                                ? m.pbrMetallicRoughness.baseColorTexture
+                                            : m.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0
+                                                ? m.pbrMetallicRoughness.metallicRoughnessTexture
+                                                : m.emissiveTexture;
         if (info.index < 0) return uv;
         uv.set = std::max(0, info.texCoord);
         const auto ext = info.extensions.find(kTextureTransformExtension);
@@ -610,18 +623,27 @@ private:
             std::function<bool(const tinygltf::Material&)> uses;
         };
         const Feature features[] = {
-            {"metallicRoughnessTexture",
-             "metallic-roughness textures are not applied: the factors hold everywhere",
-             [](const tinygltf::Material& m) {
-                 return m.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
-             }},
             {"normalTexture", "normal maps are not applied: the geometry's own normals are shaded",
              [](const tinygltf::Material& m) { return m.normalTexture.index >= 0; }},
             {"occlusionTexture",
              "occlusion maps are not applied (the techniques compute their own occlusion)",
              [](const tinygltf::Material& m) { return m.occlusionTexture.index >= 0; }},
-            {"emissiveTexture", "emissive textures are not applied: the emissive factor glows uniformly",
-             [](const tinygltf::Material& m) { return m.emissiveTexture.index >= 0; }},
+            {"texture coordinates",
+             "the metallic-roughness or emissive texture asks for another UV set or transform than the base "
+             "colour texture: all are mapped with the base colour's",
+             [](const tinygltf::Material& m) {
+                 const auto& base = m.pbrMetallicRoughness.baseColorTexture;
+                 auto differs = [&](const tinygltf::TextureInfo& other) {
+                     if (other.index < 0 || base.index < 0) return false;
+                     const auto a = base.extensions.find(kTextureTransformExtension);
+                     const auto b = other.extensions.find(kTextureTransformExtension);
+                     const bool aHas = a != base.extensions.end(), bHas = b != other.extensions.end();
+                     return other.texCoord != base.texCoord || aHas != bHas ||
+                            (aHas && bHas && !(a->second == b->second));
+                 };
+                 return differs(m.pbrMetallicRoughness.metallicRoughnessTexture) ||
+                        differs(m.emissiveTexture);
+             }},
             {"alphaMode BLEND",
              "transparency is approximated as a cutout: alpha below 0.5 is cut out, the rest renders opaque",
              [](const tinygltf::Material& m) { return m.alphaMode == "BLEND"; }},
@@ -659,7 +681,9 @@ private:
         return mDefaultMaterial;
     }
 
-    int convertTexture(int textureIndex, const std::string& context) {
+    /// `srgb`: colour (base colour, emissive); false: linear data (metallic-roughness). One glTF image
+    /// used both ways becomes two textures.
+    int convertTexture(int textureIndex, const std::string& context, bool srgb = true) {
         if (textureIndex >= static_cast<int>(mModel.textures.size()))
             fail(context + ": texture " + std::to_string(textureIndex) + " does not exist");
         const int source = mModel.textures[static_cast<std::size_t>(textureIndex)].source;
@@ -667,8 +691,11 @@ private:
             warn(context + ": texture " + std::to_string(textureIndex) + " has no usable image; ignored");
             return -1;
         }
-        int& cached = mImageTexture[static_cast<std::size_t>(source)];
-        if (cached == kNotConverted) cached = convertImage(source, context);
+        int& cached = (srgb ? mImageTexture : mLinearImageTexture)[static_cast<std::size_t>(source)];
+        if (cached == kNotConverted) {
+            cached = convertImage(source, context);
+            if (cached >= 0) mScene.textures[static_cast<std::size_t>(cached)].srgb = srgb;
+        }
         return cached;
     }
 
@@ -896,8 +923,9 @@ private:
     const std::string& mPath;
     LoadContext& mContext;
     Scene mScene;
-    std::vector<int> mImageTexture; ///< glTF image -> Scene::textures index, kNotConverted, or -1
-    std::vector<bool> mOnPath;      ///< nodes on the current root-to-node path, to reject cycles
+    std::vector<int> mImageTexture;       ///< glTF image -> Scene::textures index, kNotConverted, or -1
+    std::vector<int> mLinearImageTexture; ///< the same for images read as linear data
+    std::vector<bool> mOnPath;            ///< nodes on the current root-to-node path, to reject cycles
     int mDefaultMaterial = -1;
 };
 

@@ -15,12 +15,14 @@
 
 namespace gis {
 
-/// RGBA8 image, rows top to bottom, sRGB-encoded colour as stored in the source file.
+/// RGBA8 image, rows top to bottom, as stored in the source file: sRGB-encoded colour (base colour,
+/// emissive) or linear data (metallic-roughness), as `srgb` says.
 struct TextureImage {
     int width = 0;
     int height = 0;
     std::vector<std::uint8_t> rgba; ///< width * height * 4 bytes
     std::string name;               ///< for messages only
+    bool srgb = true;               ///< colour, decoded to linear when sampled; false: linear data
 };
 
 /// glTF metallic-roughness material, reduced to what the pipeline reads.
@@ -35,6 +37,11 @@ struct Material {
     /// glTF default 1 from the loader. The reflection model is scene/Brdf.h.
     float specular = 0.0f;
     glm::vec3 emissive{0.0f}; ///< linear RGB radiance scale (glTF emissiveFactor)
+    /// glTF metallicRoughnessTexture (linear; blue scales metallic, green roughness) and
+    /// emissiveTexture (sRGB; scales emissive): indices into Scene::textures, -1 for none. Both use
+    /// the base colour texture's coordinates (the loader bakes that texture's UV set and transform).
+    int metallicRoughnessTexture = -1;
+    int emissiveTexture = -1;
     /// glTF alphaMode. MASK cuts out where the base colour's alpha (factor times texture) is below
     /// alphaCutoff, in every pass (G-buffer, shadow maps, RSMs, reflections) and in the reference.
     /// BLEND is approximated as a cutout at 0.5: half-transparent surfaces are either opaque or gone

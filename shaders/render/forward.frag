@@ -22,9 +22,8 @@ void main() {
     float e2 = dot(toEye, toEye);
     vec3 v = e2 > 1e-20 ? toEye * inversesqrt(e2) : vec3(0.0, 1.0, 0.0);
     vec3 n = safeNormal(vNormal, vWorldPos, v);
-    vec3 base = materialBaseColor(vTexcoord);
-    vec4 spec = vec4(materialF0(base), clamp(uMetalRoughSpec.y, 0.0, 1.0));
-    vec3 radiance = max(sanitize(uEmissive), vec3(0.0)) +
+    vec4 spec = materialSpecular(vTexcoord);
+    vec3 radiance = max(sanitize(materialEmissive(vTexcoord)), vec3(0.0)) +
                     lightsReflected(vWorldPos, n, materialAlbedo(vTexcoord), spec, v, gFrame.shadingInfo.z > 0.5);
     outRadiance = vec4(max(sanitize(radiance), vec3(0.0)), 1.0);
     outPosition = vec4(vWorldPos, 1.0);

@@ -20,6 +20,6 @@ void main() {
     outPosition = vec4(vWorldPos, 1.0);
     outNormal = vec4(n, float(uMirrorId)); // w: reflector id (mirror k + 1, local probe -(k + 1), 0)
     outAlbedo = vec4(materialAlbedo(vTexcoord), 1.0);
-    outSpecular = vec4(materialF0(materialBaseColor(vTexcoord)), clamp(uMetalRoughSpec.y, 0.0, 1.0));
-    outEmissive = vec4(max(sanitize(uEmissive), vec3(0.0)), 1.0);
+    outSpecular = materialSpecular(vTexcoord);
+    outEmissive = vec4(max(sanitize(materialEmissive(vTexcoord)), vec3(0.0)), 1.0);
 }

@@ -5,6 +5,29 @@ uniform int uHasTexture;      // 1 when uBaseColorTex holds the base colour text
 uniform vec3 uMetalRoughSpec; // x metallic, y perceptual roughness, z specular factor; all [0, 1]
 uniform int uMirrorId;        // reflector id (SceneGpu::setSurfaceIds): mirror k + 1, local probe -(k + 1), 0 none
 layout(binding = 0) uniform sampler2D uBaseColorTex; // sRGB texture, decoded by the sampler
+// glTF metallicRoughnessTexture (linear: b scales metallic, g roughness) and emissiveTexture (sRGB),
+// on the base colour texture's coordinates; unit 1 and 2.
+uniform int uHasMetalRoughTex;
+uniform int uHasEmissiveTex;
+layout(binding = 1) uniform sampler2D uMetalRoughTex;
+layout(binding = 2) uniform sampler2D uEmissiveTex;
+
+// x metallic, y perceptual roughness, z specular factor; each in [0, 1].
+vec3 materialMetalRoughSpec(vec2 uv) {
+    vec3 m = uMetalRoughSpec;
+    if (uHasMetalRoughTex == 1) {
+        vec4 t = texture(uMetalRoughTex, uv);
+        m.x *= t.b;
+        m.y *= t.g;
+    }
+    return clamp(m, 0.0, 1.0);
+}
+
+vec3 materialEmissive(vec2 uv) {
+    vec3 e = uEmissive;
+    if (uHasEmissiveTex == 1) e *= texture(uEmissiveTex, uv).rgb;
+    return e;
+}
 
 // Alpha cutouts (glTF alphaMode MASK, and BLEND approximated at 0.5: scene/Scene.h Material). Only
 // programs built with GIS_ALPHA_CUTOUT (for scenes that have such materials) discard, so that the
@@ -28,19 +51,25 @@ vec3 materialBaseColor(vec2 uv) {
     return clamp(c.rgb, 0.0, 1.0);
 }
 
-// scene/Brdf.h's surfaceFrom(): F0 = mix(0.04 s, base, metal).
-vec3 materialF0(vec3 base) {
-    float metal = clamp(uMetalRoughSpec.x, 0.0, 1.0);
-    return mix(vec3(0.04 * clamp(uMetalRoughSpec.z, 0.0, 1.0)), base, metal);
+// scene/Brdf.h's surfaceFrom(): F0 = mix(0.04 s, base, metal); `mrs` from materialMetalRoughSpec().
+vec3 materialF0(vec3 base, vec3 mrs) {
+    return mix(vec3(0.04 * mrs.z), base, mrs.x);
 }
 
 // The diffuse albedo rho_d = base (1 - metal) (1 - Favg): what every technique multiplies by.
 vec3 materialAlbedo(vec2 uv) {
     vec3 base = materialBaseColor(uv);
-    vec3 f0 = materialF0(base);
+    vec3 mrs = materialMetalRoughSpec(uv);
+    vec3 f0 = materialF0(base, mrs);
     float f90 = clamp(50.0 * 0.33 * (f0.r + f0.g + f0.b), 0.0, 1.0);
     vec3 favg = f0 + (vec3(f90) - f0) * (1.0 / 21.0);
-    return base * (1.0 - clamp(uMetalRoughSpec.x, 0.0, 1.0)) * (vec3(1.0) - favg);
+    return base * (1.0 - mrs.x) * (vec3(1.0) - favg);
+}
+
+// F0 and perceptual roughness (the G-buffer's and RSM's specular target).
+vec4 materialSpecular(vec2 uv) {
+    vec3 mrs = materialMetalRoughSpec(uv);
+    return vec4(materialF0(materialBaseColor(uv), mrs), mrs.y);
 }
 
 // A unit normal facing the viewer; falls back to the geometric normal when the interpolated one

@@ -38,5 +38,5 @@ void main() {
     outFlux = vec4(sanitize(arriving * albedo), isBad(areaPerp) ? 0.0 : max(areaPerp, 0.0));
     outPosition = vec4(vWorldPos, 1.0);
     outNormal = vec4(n, 0.0);
-    outSpecular = vec4(materialF0(materialBaseColor(vTexcoord)), clamp(uMetalRoughSpec.y, 0.0, 1.0));
+    outSpecular = materialSpecular(vTexcoord);
 }

@@ -339,6 +339,32 @@ TEST(GltfLoader, BaseColorTextureTransformAndUvSetAreApplied) {
     EXPECT_TRUE(s.notShown.empty()) << s.notShown.front().feature;
 }
 
+// Metallic-roughness textures are linear data, base colour and emissive textures sRGB colour: one image
+// used both ways becomes two textures, flagged accordingly.
+TEST(GltfLoader, MetallicRoughnessAndEmissiveTexturesAreRead) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["materials"] = {
+        {{"pbrMetallicRoughness",
+          {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 0}}}}},
+         {"emissiveTexture", {{"index", 0}}},
+         {"emissiveFactor", {1.0, 1.0, 1.0}}}};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "maps.glb"));
+    const Material& m = s.materials[0];
+    ASSERT_EQ(s.textures.size(), 2u);
+    EXPECT_EQ(m.baseColorTexture, m.emissiveTexture) << "both colour: one texture";
+    EXPECT_NE(m.metallicRoughnessTexture, m.baseColorTexture);
+    EXPECT_TRUE(s.textures[static_cast<size_t>(m.baseColorTexture)].srgb);
+    EXPECT_FALSE(s.textures[static_cast<size_t>(m.metallicRoughnessTexture)].srgb);
+    EXPECT_EQ(s.textures[0].rgba, s.textures[1].rgba);
+    for (const NotShown& n : s.notShown) ADD_FAILURE() << "listed as not shown: " << n.feature;
+}
+
 TEST(GltfLoader, SpecularFactorDefaultsToGltfsDielectricAndReadsTheExtension) {
     TempDir dir;
     GltfBuilder b;

@@ -1,9 +1,13 @@
+// Material maps against the CPU reference on a small scene built here: alpha cutouts, and the
+// metallic-roughness and emissive textures.
+//
 // Alpha cutouts (glTF alphaMode MASK; BLEND approximated at 0.5): a red card half cut out by its
 // texture's alpha, over a floor, under a slanted sun. The GL frame (G-buffer and shadow map cut out)
 // agrees with the CPU reference (its rays pass through the cut-out half) as closely as the same scene
 // with an opaque card does, and both differ from the opaque card's frames where the cutout shows the
 // floor and lets the sun through.
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <memory>
 
@@ -71,9 +75,8 @@ struct Frames {
     std::vector<float> reference; // RGB
 };
 
-Frames render(Material::Alpha mode) {
+Frames renderScene(const Scene& scene) {
     test::sharedContext();
-    const Scene scene = cardScene(mode);
     FrameRenderer renderer;
     renderer.setScene(std::make_shared<const Scene>(scene));
     FrameState state = makeFrameState(scene, "none");
@@ -87,7 +90,65 @@ Frames render(Material::Alpha mode) {
     return f;
 }
 
+Frames render(Material::Alpha mode) {
+    return renderScene(cardScene(mode));
+}
+
+TextureImage halves(const std::string& name, std::array<std::uint8_t, 4> left,
+                    std::array<std::uint8_t, 4> right, bool srgb) {
+    TextureImage t;
+    t.width = 8;
+    t.height = 1;
+    t.name = name;
+    t.srgb = srgb;
+    for (int x = 0; x < 8; ++x) {
+        const auto& c = x < 4 ? left : right;
+        t.rgba.insert(t.rgba.end(), c.begin(), c.end());
+    }
+    return t;
+}
+
+// The card opaque and grey; `maps`: its left half metallic (blue 255) and smooth (green 80), its right
+// half dielectric and rough, and an emissive texture lit on the right half only.
+Scene mappedScene(bool maps) {
+    Scene s = cardScene(Material::Alpha::Opaque);
+    Material& card = s.materials[1];
+    card.baseColor = glm::vec4(0.7f, 0.6f, 0.3f, 1.0f);
+    card.baseColorTexture = -1;
+    card.metallic = 1.0f;
+    card.roughness = 1.0f;
+    card.specular = 1.0f;
+    card.emissive = glm::vec3(0.6f, 0.3f, 0.1f);
+    if (maps) {
+        s.textures = {halves("metal-rough", {0, 80, 255, 255}, {0, 255, 0, 255}, false),
+                      halves("glow", {0, 0, 0, 255}, {255, 255, 255, 255}, true)};
+        card.metallicRoughnessTexture = 0;
+        card.emissiveTexture = 1;
+    }
+    return s;
+}
+
 } // namespace
+
+TEST(MaterialMaps, MetallicRoughnessAndEmissiveTexturesMatchTheReference) {
+    const Frames plain = renderScene(mappedScene(false));
+    const Frames mapped = renderScene(mappedScene(true));
+    const size_t pixels = 64 * 64;
+    const double plainError = test::relativeRmseOf(plain.gl.linear, 4, plain.reference, 3, pixels);
+    const double mappedError = test::relativeRmseOf(mapped.gl.linear, 4, mapped.reference, 3, pixels);
+    const double glChange = test::relativeRmseOf(mapped.gl.linear, 4, plain.gl.linear, 4, pixels);
+    const double referenceChange = test::relativeRmseOf(mapped.reference, 3, plain.reference, 3, pixels);
+    std::printf("[maps] GL against the reference (direct, 16 spp): factors only %.4f, with the maps %.4f; "
+                "maps against factors: GL %.3f, reference %.3f\n",
+                plainError, mappedError, glChange, referenceChange);
+    EXPECT_EQ(test::badValues(mapped.gl), 0u);
+    EXPECT_GT(glChange, 0.1);
+    EXPECT_GT(referenceChange, 0.1);
+    EXPECT_NEAR(glChange, referenceChange, 0.25 * referenceChange) << "the maps change both sides alike";
+    EXPECT_LT(mappedError, std::max(0.1, 1.5 * plainError));
+}
+
+namespace {} // namespace
 
 TEST(AlphaCutout, MaskedCardMatchesTheReferenceInEveryPass) {
     const Frames opaque = render(Material::Alpha::Opaque);
