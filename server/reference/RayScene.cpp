@@ -351,6 +351,27 @@ SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const g
         h.surface = brdf::surfaceFrom(baseColour, std::clamp(metallic, 0.0f, 1.0f),
                                       std::clamp(roughness, 0.0f, 1.0f), finiteOr(mat.specular, 0.0f));
         h.albedo = h.surface.diffuse; // == base when F0 = 0 (metallic 0, specular 0)
+        // materialNormal() of material.glsl: the map perturbs the mesh's own (interpolated) normal in
+        // the tangent frame; the integrator turns the result to the viewer's side as GL does.
+        if (const LinearTexture* map = texture(mat.normalTexture);
+            map && mesh.tangents.size() == mesh.positions.size()) {
+            const glm::vec4 tangent =
+                w0 * mesh.tangents[i0] + w1 * mesh.tangents[i1] + w2 * mesh.tangents[i2];
+            const glm::vec3 n = h.shadingNormal;
+            glm::vec3 t = glm::vec3(tangent) - n * glm::dot(n, glm::vec3(tangent));
+            const float t2 = glm::dot(t, t);
+            if (t2 > 1e-12f && std::isfinite(t2)) {
+                t /= std::sqrt(t2);
+                const glm::vec3 b = glm::cross(n, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+                glm::vec3 mapped = sampleBilinear(*map, uv) * 2.0f - 1.0f;
+                const float scale = std::isfinite(mat.normalScale) ? mat.normalScale : 1.0f;
+                mapped.x *= scale;
+                mapped.y *= scale;
+                const glm::vec3 r = t * mapped.x + b * mapped.y + n * mapped.z;
+                const float r2 = glm::dot(r, r);
+                if (r2 > 1e-12f && std::isfinite(r2)) h.shadingNormal = r / std::sqrt(r2);
+            }
+        }
         glm::vec3 emission = mat.emissive;
         if (const LinearTexture* e = texture(mat.emissiveTexture)) emission *= sampleBilinear(*e, uv);
         h.emission = sanitizePositive(emission);

@@ -22,8 +22,8 @@ namespace reference {
 // 2: non-diffuse materials (scene/Brdf.h: metallic, roughness, specular) and the frame parameters
 // specular_lobe and effect_specular.
 // 3: every light, range windows.
-// 4: the pixel means' variance, the noise target; 5: materials' alpha cutouts, metallic-roughness and
-// emissive textures
+// 4: the pixel means' variance, the noise target; 5: materials' alpha cutouts, metallic-roughness,
+// emissive and normal textures
 constexpr const char* kKeyVersion = "gis-reference-5";
 
 std::string sceneDigest(const Scene& scene) {
@@ -36,6 +36,8 @@ std::string sceneDigest(const Scene& scene) {
         h.bytes(m.normals.data(), m.normals.size() * sizeof(glm::vec3));
         h.value(m.texcoords.size());
         h.bytes(m.texcoords.data(), m.texcoords.size() * sizeof(glm::vec2));
+        h.value(m.tangents.size());
+        h.bytes(m.tangents.data(), m.tangents.size() * sizeof(glm::vec4));
         h.value(m.indices.size());
         h.bytes(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
         h.value(m.material);
@@ -52,6 +54,8 @@ std::string sceneDigest(const Scene& scene) {
         h.value(m.alphaCutoff);
         h.value(m.metallicRoughnessTexture);
         h.value(m.emissiveTexture);
+        h.value(m.normalTexture);
+        h.value(m.normalScale);
     }
     h.value(scene.textures.size());
     for (const TextureImage& t : scene.textures) {

@@ -12,8 +12,9 @@ struct Vertex {
     float position[3];
     float normal[3];
     float texcoord[2];
+    float tangent[4]; ///< Mesh::tangents; zero where the mesh has none (no normal map)
 };
-static_assert(sizeof(Vertex) == 32);
+static_assert(sizeof(Vertex) == 48);
 } // namespace
 
 SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
@@ -40,6 +41,8 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
                 v.texcoord[0] = mesh.texcoords[i].x;
                 v.texcoord[1] = mesh.texcoords[i].y;
             }
+            if (i < mesh.tangents.size())
+                for (int c = 0; c < 4; ++c) v.tangent[c] = mesh.tangents[i][c];
             vertices.push_back(v);
         }
         indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
@@ -57,10 +60,10 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     const GLuint vao = mVao.id();
     glVertexArrayVertexBuffer(vao, 0, mVertices.id(), 0, sizeof(Vertex));
     glVertexArrayElementBuffer(vao, mIndices.id());
-    const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal),
-                               offsetof(Vertex, texcoord)};
-    const GLint sizes[3] = {3, 3, 2};
-    for (GLuint a = 0; a < 3; ++a) {
+    const GLuint offsets[4] = {offsetof(Vertex, position), offsetof(Vertex, normal),
+                               offsetof(Vertex, texcoord), offsetof(Vertex, tangent)};
+    const GLint sizes[4] = {3, 3, 2, 4};
+    for (GLuint a = 0; a < 4; ++a) {
         glEnableVertexArrayAttrib(vao, a);
         glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
         glVertexArrayAttribBinding(vao, a, 0);
@@ -111,6 +114,9 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     m.baseColorTexture = unit("uBaseColorTex");
     m.metalRoughTexture = unit("uMetalRoughTex");
     m.emissiveTexture = unit("uEmissiveTex");
+    m.normalTexture = unit("uNormalTex");
+    m.hasNormalTexture = slot("uHasNormalTex");
+    m.normalScale = slot("uNormalScale");
     return m;
 }
 
@@ -137,6 +143,8 @@ void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int inst
             bind(m.baseColorTexture, s.hasTexture, s.baseColorTexture);
             bind(m.metallicRoughnessTexture, s.hasMetalRoughTexture, s.metalRoughTexture);
             bind(m.emissiveTexture, s.hasEmissiveTexture, s.emissiveTexture);
+            bind(m.normalTexture, s.hasNormalTexture, s.normalTexture);
+            glUniform1f(s.normalScale.location, std::isfinite(m.normalScale) ? m.normalScale : 1.0f);
         }
         glDrawElementsInstancedBaseVertex(
             GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,

@@ -488,6 +488,12 @@ private:
                     convertTexture(pbr.metallicRoughnessTexture.index, where + " metallic-roughness", false);
             if (src.emissiveTexture.index >= 0)
                 m.emissiveTexture = convertTexture(src.emissiveTexture.index, where + " emissive");
+            if (src.normalTexture.index >= 0) {
+                m.normalTexture = convertTexture(src.normalTexture.index, where + " normal", false);
+                m.normalScale = std::isfinite(src.normalTexture.scale)
+                                    ? static_cast<float>(src.normalTexture.scale)
+                                    : 1.0f;
+            }
             if (src.alphaMode == "MASK") m.alphaMode = Material::Alpha::Mask;
             if (src.alphaMode == "BLEND") m.alphaMode = Material::Alpha::Blend;
             m.alphaCutoff = std::isfinite(src.alphaCutoff)
@@ -519,21 +525,30 @@ private:
         return std::isfinite(v.x) && std::isfinite(v.y) ? v : fallback;
     }
 
+    /// What decides a texture's coordinates: textureInfo and normalTextureInfo alike.
+    struct UvSource {
+        int index = -1;
+        int texCoord = 0;
+        const tinygltf::ExtensionMap* extensions = nullptr;
+    };
+    template <typename Info> static UvSource uvSource(const Info& info) {
+        return {info.index, info.texCoord, &info.extensions};
+    }
+
     BaseColorUv baseColorUv(int material) const {
         BaseColorUv uv;
         if (material < 0 || material >= static_cast<int>(mModel.materials.size())) return uv;
         // The base colour texture's coordinates, else those of the first other texture the renderer
         // samples (every one of them is mapped with one set: stats.not_shown says when they differ).
         const tinygltf::Material& m = mModel.materials[static_cast<std::size_t>(material)];
-        const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture.index >= 0
-                                                ? m.pbrMetallicRoughness.baseColorTexture
-                                            : m.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0
-                                                ? m.pbrMetallicRoughness.metallicRoughnessTexture
-                                                : m.emissiveTexture;
+        UvSource info = uvSource(m.pbrMetallicRoughness.baseColorTexture);
+        for (const UvSource& other : {uvSource(m.pbrMetallicRoughness.metallicRoughnessTexture),
+                                      uvSource(m.emissiveTexture), uvSource(m.normalTexture)})
+            if (info.index < 0) info = other;
         if (info.index < 0) return uv;
         uv.set = std::max(0, info.texCoord);
-        const auto ext = info.extensions.find(kTextureTransformExtension);
-        if (ext == info.extensions.end() || !ext->second.IsObject()) return uv;
+        const auto ext = info.extensions->find(kTextureTransformExtension);
+        if (ext == info.extensions->end() || !ext->second.IsObject()) return uv;
         const tinygltf::Value& t = ext->second;
         if (t.Has("texCoord") && t.Get("texCoord").IsInt())
             uv.set = std::max(0, t.Get("texCoord").GetNumberAsInt());
@@ -623,26 +638,25 @@ private:
             std::function<bool(const tinygltf::Material&)> uses;
         };
         const Feature features[] = {
-            {"normalTexture", "normal maps are not applied: the geometry's own normals are shaded",
-             [](const tinygltf::Material& m) { return m.normalTexture.index >= 0; }},
             {"occlusionTexture",
              "occlusion maps are not applied (the techniques compute their own occlusion)",
              [](const tinygltf::Material& m) { return m.occlusionTexture.index >= 0; }},
             {"texture coordinates",
-             "the metallic-roughness or emissive texture asks for another UV set or transform than the base "
+             "the metallic-roughness, emissive or normal texture asks for another UV set or transform than "
+             "the base "
              "colour texture: all are mapped with the base colour's",
              [](const tinygltf::Material& m) {
-                 const auto& base = m.pbrMetallicRoughness.baseColorTexture;
-                 auto differs = [&](const tinygltf::TextureInfo& other) {
+                 const UvSource base = uvSource(m.pbrMetallicRoughness.baseColorTexture);
+                 auto differs = [&](const UvSource& other) {
                      if (other.index < 0 || base.index < 0) return false;
-                     const auto a = base.extensions.find(kTextureTransformExtension);
-                     const auto b = other.extensions.find(kTextureTransformExtension);
-                     const bool aHas = a != base.extensions.end(), bHas = b != other.extensions.end();
+                     const auto a = base.extensions->find(kTextureTransformExtension);
+                     const auto b = other.extensions->find(kTextureTransformExtension);
+                     const bool aHas = a != base.extensions->end(), bHas = b != other.extensions->end();
                      return other.texCoord != base.texCoord || aHas != bHas ||
                             (aHas && bHas && !(a->second == b->second));
                  };
-                 return differs(m.pbrMetallicRoughness.metallicRoughnessTexture) ||
-                        differs(m.emissiveTexture);
+                 return differs(uvSource(m.pbrMetallicRoughness.metallicRoughnessTexture)) ||
+                        differs(uvSource(m.emissiveTexture)) || differs(uvSource(m.normalTexture));
              }},
             {"alphaMode BLEND",
              "transparency is approximated as a cutout: alpha below 0.5 is cut out, the rest renders opaque",

@@ -42,6 +42,9 @@ struct Material {
     /// the base colour texture's coordinates (the loader bakes that texture's UV set and transform).
     int metallicRoughnessTexture = -1;
     int emissiveTexture = -1;
+    /// glTF normalTexture (linear, tangent space: rgb * 2 - 1) and its scale (applied to x and y).
+    int normalTexture = -1;
+    float normalScale = 1.0f;
     /// glTF alphaMode. MASK cuts out where the base colour's alpha (factor times texture) is below
     /// alphaCutoff, in every pass (G-buffer, shadow maps, RSMs, reflections) and in the reference.
     /// BLEND is approximated as a cutout at 0.5: half-transparent surfaces are either opaque or gone
@@ -60,7 +63,11 @@ struct Mesh {
     std::vector<glm::vec3> normals;     ///< unit length; generated when the source has none
     std::vector<glm::vec2> texcoords;   ///< empty when the source has none
     std::vector<std::uint32_t> indices; ///< triangle list, 3 per triangle, all < positions.size()
-    int material = 0;                   ///< index into Scene::materials
+    /// xyz: unit tangent along +u, w: the bitangent's sign (b = w cross(n, t)); generated from the
+    /// texture coordinates for meshes whose material has a normal map, empty otherwise. A zero
+    /// tangent (no usable texture coordinates there) leaves the normal unmapped.
+    std::vector<glm::vec4> tangents;
+    int material = 0; ///< index into Scene::materials
 };
 
 enum class LightType { Spot, Point, Directional };

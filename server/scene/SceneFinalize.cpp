@@ -66,6 +66,40 @@ void repairNormals(Mesh& mesh) {
         if (bad[i] && !fixed[i]) mesh.normals[i] = kUp;
 }
 
+// Per-vertex tangents from the texture coordinates (each triangle's dP/du, summed by area as the
+// normals are, then made orthogonal to the normal); w is the bitangent's handedness. Vertices on no
+// usable triangle get a zero tangent, which leaves their normal unmapped.
+void generateTangents(Mesh& mesh) {
+    const std::size_t n = mesh.positions.size();
+    if (mesh.texcoords.size() != n || mesh.normals.size() != n) return;
+    std::vector<glm::vec3> tangent(n, glm::vec3(0.0f)), bitangent(n, glm::vec3(0.0f));
+    forEachValidTriangle(mesh, [&](std::uint32_t i0, std::uint32_t i1, std::uint32_t i2) {
+        const glm::vec3 e1 = mesh.positions[i1] - mesh.positions[i0],
+                        e2 = mesh.positions[i2] - mesh.positions[i0];
+        const glm::vec2 d1 = mesh.texcoords[i1] - mesh.texcoords[i0],
+                        d2 = mesh.texcoords[i2] - mesh.texcoords[i0];
+        const float det = d1.x * d2.y - d2.x * d1.y;
+        if (!(std::fabs(det) > 1e-20f)) return; // degenerate mapping
+        const glm::vec3 t = (e1 * d2.y - e2 * d1.y) / det, b = (e2 * d1.x - e1 * d2.x) / det;
+        if (!isFinite(t) || !isFinite(b)) return;
+        // Weighted by the triangle's area (|cross| of its edges), as the normals.
+        const float area = glm::length(glm::cross(e1, e2));
+        const float scale = area / std::max(glm::length(t), 1e-30f);
+        for (std::uint32_t i : {i0, i1, i2}) {
+            tangent[i] += t * scale;
+            bitangent[i] += b * scale;
+        }
+    });
+    mesh.tangents.assign(n, glm::vec4(0.0f));
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 nrm = mesh.normals[i];
+        const glm::vec3 t = safeNormalize(tangent[i] - nrm * glm::dot(nrm, tangent[i]), glm::vec3(0.0f));
+        if (t == glm::vec3(0.0f)) continue;
+        const float w = glm::dot(glm::cross(nrm, t), bitangent[i]) < 0.0f ? -1.0f : 1.0f;
+        mesh.tangents[i] = glm::vec4(t, w);
+    }
+}
+
 Camera framingCamera(const Bounds& bounds) {
     const float radius = std::max(bounds.radius(), 1e-3f);
     const float distance = radius / std::sin(0.5f * kFramingFov);
@@ -86,6 +120,11 @@ void finalizeScene(Scene& scene, const std::string& where) {
     for (auto& mesh : scene.meshes) {
         if (mesh.normals.empty()) generateNormals(mesh);
         repairNormals(mesh);
+    }
+    for (auto& mesh : scene.meshes) {
+        const bool mapped = mesh.material >= 0 && mesh.material < static_cast<int>(scene.materials.size()) &&
+                            scene.materials[static_cast<std::size_t>(mesh.material)].normalTexture >= 0;
+        if (mapped && mesh.tangents.empty()) generateTangents(mesh);
     }
     if (scene.materials.empty()) scene.materials.push_back(Material{.name = "default"});
     scene.updateBounds();

@@ -83,6 +83,13 @@ private:
         }
         for (std::size_t k = 0; k < m.texcoords.size(); ++k)
             if (!isFinite(m.texcoords[k])) fail(what + ": texcoord " + std::to_string(k) + " is not finite");
+        if (!m.tangents.empty() && m.tangents.size() != n)
+            fail(what + ": has " + std::to_string(m.tangents.size()) + " tangents for " + std::to_string(n) +
+                 " positions");
+        for (std::size_t k = 0; k < m.tangents.size(); ++k)
+            if (!std::isfinite(m.tangents[k].x) || !std::isfinite(m.tangents[k].y) ||
+                !std::isfinite(m.tangents[k].z) || !std::isfinite(m.tangents[k].w))
+                fail(what + ": tangent " + std::to_string(k) + " is not finite");
         if (m.material < 0 || m.material >= static_cast<int>(mScene.materials.size()))
             fail(what + ": material " + std::to_string(m.material) + " does not exist (" +
                  std::to_string(mScene.materials.size()) + " materials)");

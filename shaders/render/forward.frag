@@ -9,6 +9,7 @@
 in vec3 vWorldPos;
 in vec3 vNormal;
 in vec2 vTexcoord;
+in vec4 vTangent;
 
 uniform vec3 uEye; // the viewpoint (m): probe centre or mirrored camera
 
@@ -22,6 +23,7 @@ void main() {
     float e2 = dot(toEye, toEye);
     vec3 v = e2 > 1e-20 ? toEye * inversesqrt(e2) : vec3(0.0, 1.0, 0.0);
     vec3 n = safeNormal(vNormal, vWorldPos, v);
+    n = materialNormal(n, vNormal, vTangent, vTexcoord);
     vec4 spec = materialSpecular(vTexcoord);
     vec3 radiance = max(sanitize(materialEmissive(vTexcoord)), vec3(0.0)) +
                     lightsReflected(vWorldPos, n, materialAlbedo(vTexcoord), spec, v, gFrame.shadingInfo.z > 0.5);

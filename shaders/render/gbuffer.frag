@@ -6,6 +6,7 @@
 in vec3 vWorldPos;
 in vec3 vNormal;
 in vec2 vTexcoord;
+in vec4 vTangent;
 
 layout(location = 0) out vec4 outPosition; // xyz world (m), w = 1 covered
 layout(location = 1) out vec4 outNormal;   // xyz unit normal facing the camera
@@ -17,6 +18,7 @@ void main() {
     CUT_OUT(vTexcoord);
     vec3 toEye = gFrame.cameraPos.xyz - vWorldPos;
     vec3 n = safeNormal(vNormal, vWorldPos, toEye);
+    n = materialNormal(n, vNormal, vTangent, vTexcoord);
     outPosition = vec4(vWorldPos, 1.0);
     outNormal = vec4(n, float(uMirrorId)); // w: reflector id (mirror k + 1, local probe -(k + 1), 0)
     outAlbedo = vec4(materialAlbedo(vTexcoord), 1.0);

@@ -12,6 +12,31 @@ uniform int uHasEmissiveTex;
 layout(binding = 1) uniform sampler2D uMetalRoughTex;
 layout(binding = 2) uniform sampler2D uEmissiveTex;
 
+// glTF normalTexture (linear, tangent space: rgb * 2 - 1, x and y scaled by uNormalScale), unit 3.
+uniform int uHasNormalTex;
+uniform float uNormalScale;
+layout(binding = 3) uniform sampler2D uNormalTex;
+
+// The shading normal with the normal map applied. `n` is the unit normal already turned to face the
+// viewer (safeNormal), `interpolated` the mesh's own normal before that: the map perturbs the mesh's
+// side and the result is turned as n was, as the reference does (reference/RayScene.cpp). Unchanged
+// without a map or a usable tangent.
+vec3 materialNormal(vec3 n, vec3 interpolated, vec4 tangent, vec2 uv) {
+    if (uHasNormalTex != 1) return n;
+    float side = dot(n, interpolated) < 0.0 ? -1.0 : 1.0;
+    vec3 base = side * n;
+    vec3 t = tangent.xyz - base * dot(base, tangent.xyz);
+    float t2 = dot(t, t);
+    if (!(t2 > 1e-12)) return n;
+    t *= inversesqrt(t2);
+    vec3 b = cross(base, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 m = texture(uNormalTex, uv).xyz * 2.0 - 1.0;
+    m.xy *= uNormalScale;
+    vec3 r = t * m.x + b * m.y + base * m.z;
+    float r2 = dot(r, r);
+    return r2 > 1e-12 && !isnan(r2) ? side * r * inversesqrt(r2) : n;
+}
+
 // x metallic, y perceptual roughness, z specular factor; each in [0, 1].
 vec3 materialMetalRoughSpec(vec2 uv) {
     vec3 m = uMetalRoughSpec;

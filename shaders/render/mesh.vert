@@ -4,6 +4,7 @@
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inTexcoord;
+layout(location = 3) in vec4 inTangent; // xyz tangent, w bitangent sign; zero without a normal map
 
 // -1: eye camera; v >= 0: light view v (shadow map and RSM layer v)
 uniform int uView;
@@ -11,10 +12,12 @@ uniform int uView;
 out vec3 vWorldPos;
 out vec3 vNormal;
 out vec2 vTexcoord;
+out vec4 vTangent;
 
 void main() {
     vWorldPos = inPosition;
     vNormal = inNormal;
     vTexcoord = inTexcoord;
+    vTangent = inTangent;
     gl_Position = (uView < 0 ? gFrame.viewProj : gLights.views[uView].viewProj) * vec4(inPosition, 1.0);
 }

@@ -11,6 +11,7 @@
 in vec3 vWorldPos;
 in vec3 vNormal;
 in vec2 vTexcoord;
+in vec4 vTangent;
 
 uniform int uView; // the light view this layer belongs to (mesh.vert's selector)
 
@@ -26,6 +27,7 @@ void main() {
     float dist;
     bool defined = lightIncidence(light, vWorldPos, l, dist, irradiance);
     vec3 n = safeNormal(vNormal, vWorldPos, l);
+    n = materialNormal(n, vNormal, vTangent, vTexcoord);
 
     float measure = rsmTexelMeasure(uView, gl_FragCoord.xy);
     bool ortho = gLights.views[uView].info.x > 0.5;

@@ -130,6 +130,42 @@ Scene mappedScene(bool maps) {
 
 } // namespace
 
+// The card opaque and white; `mapped`: its left half's normal map tilts the normal 35 degrees along
+// +u (tangent space (0.57, 0, 0.82)), its right half is flat (0, 0, 1).
+Scene normalScene(bool mapped) {
+    Scene s = cardScene(Material::Alpha::Opaque);
+    Material& card = s.materials[1];
+    card.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+    card.baseColorTexture = -1;
+    if (mapped) {
+        s.textures = {halves("normals", {200, 128, 232, 255}, {128, 128, 255, 255}, false)};
+        card.normalTexture = 0;
+        card.normalScale = 1.0f;
+        finalizeScene(s, "card"); // tangents for the mapped card
+    }
+    return s;
+}
+
+TEST(MaterialMaps, NormalMapMatchesTheReference) {
+    const Frames flat = renderScene(normalScene(false));
+    const Scene scene = normalScene(true);
+    ASSERT_EQ(scene.meshes[1].tangents.size(), scene.meshes[1].positions.size());
+    EXPECT_NEAR(scene.meshes[1].tangents[0].x, 1.0f, 1e-5f) << "+u runs along +x on the card";
+    const Frames mapped = renderScene(scene);
+    const size_t pixels = 64 * 64;
+    const double flatError = test::relativeRmseOf(flat.gl.linear, 4, flat.reference, 3, pixels);
+    const double mappedError = test::relativeRmseOf(mapped.gl.linear, 4, mapped.reference, 3, pixels);
+    const double glChange = test::relativeRmseOf(mapped.gl.linear, 4, flat.gl.linear, 4, pixels);
+    const double referenceChange = test::relativeRmseOf(mapped.reference, 3, flat.reference, 3, pixels);
+    std::printf("[normal map] GL against the reference (direct, 16 spp): flat %.4f, mapped %.4f; mapped "
+                "against flat: GL %.3f, reference %.3f\n",
+                flatError, mappedError, glChange, referenceChange);
+    EXPECT_EQ(test::badValues(mapped.gl), 0u);
+    EXPECT_GT(glChange, 0.03);
+    EXPECT_NEAR(glChange, referenceChange, 0.3 * referenceChange) << "the map changes both sides alike";
+    EXPECT_LT(mappedError, std::max(0.1, 1.5 * flatError));
+}
+
 TEST(MaterialMaps, MetallicRoughnessAndEmissiveTexturesMatchTheReference) {
     const Frames plain = renderScene(mappedScene(false));
     const Frames mapped = renderScene(mappedScene(true));

@@ -271,9 +271,9 @@ TEST(GltfLoader, FeaturesTheRendererDoesNotShowAreListed) {
     b.doc["textures"] = {nlohmann::json::object()};
     b.doc["materials"] = {{{"name", "foliage"},
                            {"alphaMode", "BLEND"},
-                           {"normalTexture", {{"index", 0}}},
+                           {"occlusionTexture", {{"index", 0}}},
                            {"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}}}}}},
-                          {{"name", "bark"}, {"normalTexture", {{"index", 0}}}}};
+                          {{"name", "bark"}, {"occlusionTexture", {{"index", 0}}}}};
     b.doc["nodes"][tri]["extensions"] = {
         {"EXT_mesh_gpu_instancing", {{"attributes", nlohmann::json::object()}}}};
     b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "EXT_mesh_gpu_instancing", "KHR_lights_punctual"};
@@ -281,12 +281,12 @@ TEST(GltfLoader, FeaturesTheRendererDoesNotShowAreListed) {
     const Scene s = loadGltf(b.writeGlb(dir, "unshown.glb"));
     std::map<std::string, std::string> listed;
     for (const NotShown& n : s.notShown) listed[n.feature] = n.detail;
-    EXPECT_EQ(listed.size(), 5u) << "clearcoat, instancing, normal maps, BLEND, vertex colours";
+    EXPECT_EQ(listed.size(), 5u) << "clearcoat, instancing, occlusion maps, BLEND, vertex colours";
     EXPECT_EQ(listed["KHR_materials_clearcoat"],
               "1 material ('foliage'): clear coat is not rendered: the base layer shows alone");
     EXPECT_NE(listed["EXT_mesh_gpu_instancing"].find("1 node ('node 0')"), std::string::npos)
         << listed["EXT_mesh_gpu_instancing"];
-    EXPECT_NE(listed["normalTexture"].find("2 materials ('foliage', 'bark')"), std::string::npos);
+    EXPECT_NE(listed["occlusionTexture"].find("2 materials ('foliage', 'bark')"), std::string::npos);
     EXPECT_NE(listed["alphaMode BLEND"].find("approximated as a cutout"), std::string::npos);
     EXPECT_EQ(s.materials[0].alphaMode, Material::Alpha::Blend);
     EXPECT_FLOAT_EQ(s.materials[0].cutoff(), 0.5f);
@@ -363,6 +363,38 @@ TEST(GltfLoader, MetallicRoughnessAndEmissiveTexturesAreRead) {
     EXPECT_FALSE(s.textures[static_cast<size_t>(m.metallicRoughnessTexture)].srgb);
     EXPECT_EQ(s.textures[0].rgba, s.textures[1].rgba);
     for (const NotShown& n : s.notShown) ADD_FAILURE() << "listed as not shown: " << n.feature;
+    EXPECT_TRUE(s.meshes[0].tangents.empty()) << "no normal map, no tangents";
+}
+
+// A normal map gets tangents generated from the texture coordinates: unit, orthogonal to the normal,
+// along +u, with the bitangent's handedness.
+TEST(GltfLoader, NormalMapGetsTangentsAlongU) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode(); // (0,0,0), (1,0,0), (0,0,-1), facing +y
+    // u along +x, v along -z (so that +v runs toward the third vertex).
+    const int uv = b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 0, 0, 1}), test::kFloat, 3, "VEC2");
+    b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv;
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["materials"] = {{{"normalTexture", {{"index", 0}, {"scale", 0.5}}}}};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "normal.glb"));
+    const Material& m = s.materials[0];
+    ASSERT_GE(m.normalTexture, 0);
+    EXPECT_FALSE(s.textures[static_cast<size_t>(m.normalTexture)].srgb);
+    EXPECT_FLOAT_EQ(m.normalScale, 0.5f);
+    const Mesh& mesh = s.meshes[0];
+    ASSERT_EQ(mesh.tangents.size(), 3u);
+    for (const glm::vec4& t : mesh.tangents) {
+        EXPECT_NEAR(t.x, 1.0f, 1e-5f);
+        EXPECT_NEAR(t.y, 0.0f, 1e-5f);
+        EXPECT_NEAR(t.z, 0.0f, 1e-5f);
+        // b = w cross(n, t) = w cross(+y, +x) = -w z must run along +v, i.e. -z: w = +1.
+        EXPECT_EQ(t.w, 1.0f);
+    }
+    EXPECT_TRUE(s.notShown.empty());
 }
 
 TEST(GltfLoader, SpecularFactorDefaultsToGltfsDielectricAndReadsTheExtension) {
