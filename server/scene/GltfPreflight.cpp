@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "scene/GltfDecompress.h"
 
 namespace gis {
 namespace {
@@ -19,9 +20,10 @@ std::string adviceFor(const std::string& extension) {
     if (extension == "EXT_texture_webp" || extension == "EXT_texture_avif")
         return "its textures need " + extension +
                ", which this service does not decode: export it with PNG or JPEG textures";
-    std::string readable;
+    std::string readable, decoded;
     for (const auto& name : gltfReadableExtensions()) readable += (readable.empty() ? "" : ", ") + name;
-    return "this service does not read it (it reads " + readable +
+    for (const auto& name : gltfDecodedExtensions()) decoded += (decoded.empty() ? "" : ", ") + name;
+    return "this service does not read it (it reads " + readable + " and decodes " + decoded +
            "): export the file without it, or as a plain glTF 2.0 file";
 }
 
