@@ -82,6 +82,13 @@ struct CutoutGeometry {
     /// material.glsl's materialCutOut() at barycentrics (u, v) of triangle `prim`.
     bool cutsOut(unsigned prim, float u, float v) const {
         float alpha = alphaFactor;
+        const size_t first = static_cast<size_t>(prim) * 3;
+        if (mesh->colors.size() == mesh->positions.size() && first + 2 < mesh->indices.size()) {
+            const auto last = static_cast<std::uint32_t>(mesh->positions.size() - 1);
+            alpha *= (1.0f - u - v) * mesh->colors[std::min(mesh->indices[first], last)].w +
+                     u * mesh->colors[std::min(mesh->indices[first + 1], last)].w +
+                     v * mesh->colors[std::min(mesh->indices[first + 2], last)].w;
+        }
         if (texture) {
             glm::vec2 uv(0.0f); // GL feeds (0, 0) to meshes without texcoords
             const size_t base = static_cast<size_t>(prim) * 3;
@@ -331,6 +338,8 @@ SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const g
     if (mesh.material >= 0 && static_cast<size_t>(mesh.material) < m.source.materials.size()) {
         const Material& mat = m.source.materials[static_cast<size_t>(mesh.material)];
         glm::vec3 c(mat.baseColor);
+        if (mesh.colors.size() == mesh.positions.size()) // COLOR_0, as vColor in material.glsl
+            c *= glm::vec3(w0 * mesh.colors[i0] + w1 * mesh.colors[i1] + w2 * mesh.colors[i2]);
         if (mat.baseColorTexture >= 0 && static_cast<size_t>(mat.baseColorTexture) < m.textures.size())
             c *= sampleBilinear(m.textures[static_cast<size_t>(mat.baseColorTexture)], uv);
         // materialBaseColor() / materialAlbedo() / materialF0() of material.glsl, via scene/Brdf.h.

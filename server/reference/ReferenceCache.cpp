@@ -23,7 +23,7 @@ namespace reference {
 // specular_lobe and effect_specular.
 // 3: every light, range windows.
 // 4: the pixel means' variance, the noise target; 5: materials' alpha cutouts, metallic-roughness,
-// emissive and normal textures
+// emissive and normal textures, vertex colours
 constexpr const char* kKeyVersion = "gis-reference-5";
 
 std::string sceneDigest(const Scene& scene) {
@@ -36,6 +36,8 @@ std::string sceneDigest(const Scene& scene) {
         h.bytes(m.normals.data(), m.normals.size() * sizeof(glm::vec3));
         h.value(m.texcoords.size());
         h.bytes(m.texcoords.data(), m.texcoords.size() * sizeof(glm::vec2));
+        h.value(m.colors.size());
+        h.bytes(m.colors.data(), m.colors.size() * sizeof(glm::vec4));
         h.value(m.tangents.size());
         h.bytes(m.tangents.data(), m.tangents.size() * sizeof(glm::vec4));
         h.value(m.indices.size());

@@ -13,8 +13,9 @@ struct Vertex {
     float normal[3];
     float texcoord[2];
     float tangent[4]; ///< Mesh::tangents; zero where the mesh has none (no normal map)
+    float color[4];   ///< Mesh::colors; white where the mesh has none
 };
-static_assert(sizeof(Vertex) == 48);
+static_assert(sizeof(Vertex) == 64);
 } // namespace
 
 SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
@@ -27,6 +28,7 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         d.baseVertex = static_cast<GLint>(vertices.size());
         d.material = mesh.material;
         d.mesh = static_cast<int>(&mesh - scene.meshes.data());
+        d.colored = !mesh.colors.empty();
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
             v.position[0] = mesh.positions[i].x;
@@ -43,6 +45,7 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
             }
             if (i < mesh.tangents.size())
                 for (int c = 0; c < 4; ++c) v.tangent[c] = mesh.tangents[i][c];
+            for (int c = 0; c < 4; ++c) v.color[c] = i < mesh.colors.size() ? mesh.colors[i][c] : 1.0f;
             vertices.push_back(v);
         }
         indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
@@ -60,10 +63,11 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     const GLuint vao = mVao.id();
     glVertexArrayVertexBuffer(vao, 0, mVertices.id(), 0, sizeof(Vertex));
     glVertexArrayElementBuffer(vao, mIndices.id());
-    const GLuint offsets[4] = {offsetof(Vertex, position), offsetof(Vertex, normal),
-                               offsetof(Vertex, texcoord), offsetof(Vertex, tangent)};
-    const GLint sizes[4] = {3, 3, 2, 4};
-    for (GLuint a = 0; a < 4; ++a) {
+    const GLuint offsets[5] = {offsetof(Vertex, position), offsetof(Vertex, normal),
+                               offsetof(Vertex, texcoord), offsetof(Vertex, tangent),
+                               offsetof(Vertex, color)};
+    const GLint sizes[5] = {3, 3, 2, 4, 4};
+    for (GLuint a = 0; a < 5; ++a) {
         glEnableVertexArrayAttrib(vao, a);
         glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
         glVertexArrayAttribBinding(vao, a, 0);
@@ -117,6 +121,7 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     m.normalTexture = unit("uNormalTex");
     m.hasNormalTexture = slot("uHasNormalTex");
     m.normalScale = slot("uNormalScale");
+    m.hasVertexColor = slot("uHasVertexColor");
     return m;
 }
 
@@ -131,6 +136,7 @@ void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int inst
             glUniform4f(s.baseColor.location, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
             glUniform3f(s.metalRoughSpec.location, m.metallic, m.roughness, m.specular);
             glUniform1i(s.mirrorId.location, d.surfaceId);
+            glUniform1i(s.hasVertexColor.location, d.colored ? 1 : 0);
             glUniform1f(s.alphaCutoff.location, m.cutsOut() ? m.cutoff() : -1.0f);
             glUniform3f(s.emissive.location, m.emissive.r, m.emissive.g, m.emissive.b);
             // Each texture the material has, on its unit; a unit the program does not sample is skipped.

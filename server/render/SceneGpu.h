@@ -15,7 +15,8 @@ namespace gis {
 struct MaterialSlots {
     gl::UniformLocation baseColor, emissive, hasTexture, metalRoughSpec, mirrorId;
     gl::UniformLocation alphaCutoff; ///< only in programs built with GIS_ALPHA_CUTOUT
-    gl::UniformLocation hasMetalRoughTexture, hasEmissiveTexture, hasNormalTexture, normalScale;
+    gl::UniformLocation hasMetalRoughTexture, hasEmissiveTexture, hasNormalTexture, normalScale,
+        hasVertexColor;
     gl::TextureUnit baseColorTexture{gl::kNoUnit}, metalRoughTexture{gl::kNoUnit},
         emissiveTexture{gl::kNoUnit}, normalTexture{gl::kNoUnit};
     /// `program`'s slots. With `complete`, every one must be active (the G-buffer's program, which
@@ -45,8 +46,9 @@ private:
         GLsizei indexCount = 0;
         GLint baseVertex = 0;
         int material = 0;
-        int mesh = 0;      ///< index into Scene::meshes
-        int surfaceId = 0; ///< reflector id (setSurfaceIds)
+        int mesh = 0;         ///< index into Scene::meshes
+        int surfaceId = 0;    ///< reflector id (setSurfaceIds)
+        bool colored = false; ///< the mesh has COLOR_0 (uHasVertexColor)
     };
     gl::Buffer mVertices;
     gl::Buffer mIndices;

@@ -669,15 +669,6 @@ private:
                     names.push_back(nameOr(mModel.materials[i].name, "material", static_cast<int>(i)));
             if (!names.empty()) out.push_back({f.name, namedCount(names, "material") + ": " + f.effect});
         }
-        std::vector<std::string> coloured;
-        for (std::size_t i = 0; i < mModel.meshes.size(); ++i)
-            for (const auto& primitive : mModel.meshes[i].primitives)
-                if (primitive.attributes.count("COLOR_0")) {
-                    coloured.push_back(nameOr(mModel.meshes[i].name, "mesh", static_cast<int>(i)));
-                    break;
-                }
-        if (!coloured.empty())
-            out.push_back({"COLOR_0", namedCount(coloured, "mesh") + ": vertex colours are not applied"});
         if (!mModel.animations.empty())
             out.push_back({"animations", std::to_string(mModel.animations.size()) +
                                              " animation(s) are not played: the nodes' rest pose is shown"});
@@ -816,6 +807,20 @@ private:
         }
         if (uv.transform)
             for (glm::vec2& t : mesh.texcoords) t = glm::vec2(*uv.transform * glm::vec3(t, 1.0f));
+        if (const int a = attribute("COLOR_0"); a >= 0) {
+            const auto& accessor = mModel.accessors[static_cast<std::size_t>(a)];
+            if (accessor.type == TINYGLTF_TYPE_VEC3) {
+                for (const glm::vec3& c : readVectors<3>(a, TINYGLTF_TYPE_VEC3, context + " COLOR_0"))
+                    mesh.colors.push_back(glm::vec4(c, 1.0f));
+            } else {
+                mesh.colors = readVectors<4>(a, TINYGLTF_TYPE_VEC4, context + " COLOR_0");
+            }
+            for (glm::vec4& c : mesh.colors)
+                for (int k = 0; k < 4; ++k) c[k] = std::isfinite(c[k]) ? std::clamp(c[k], 0.0f, 1.0f) : 1.0f;
+            if (mesh.colors.size() != mesh.positions.size())
+                fail(context + ": COLOR_0 has " + std::to_string(mesh.colors.size()) +
+                     " elements, POSITION " + std::to_string(mesh.positions.size()));
+        }
         if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
             fail(context + ": NORMAL has " + std::to_string(mesh.normals.size()) + " elements, POSITION " +
                  std::to_string(mesh.positions.size()));
@@ -852,7 +857,8 @@ private:
         // Instances are flattened: a small file can name one mesh a million times through its nodes.
         const std::uint64_t bytes =
             mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
-            mesh.texcoords.size() * sizeof(glm::vec2) + mesh.indices.size() * sizeof(std::uint32_t);
+            mesh.texcoords.size() * sizeof(glm::vec2) + mesh.colors.size() * sizeof(glm::vec4) +
+            mesh.indices.size() * sizeof(std::uint32_t);
         if (!mContext.spend(bytes, context)) fail(mContext.refusal);
         mScene.meshes.push_back(std::move(mesh));
     }

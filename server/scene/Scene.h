@@ -67,6 +67,9 @@ struct Mesh {
     /// texture coordinates for meshes whose material has a normal map, empty otherwise. A zero
     /// tangent (no usable texture coordinates there) leaves the normal unmapped.
     std::vector<glm::vec4> tangents;
+    /// glTF COLOR_0, linear RGBA in [0, 1] (alpha 1 for RGB sources): multiplies the base colour (and
+    /// its alpha, for cutouts). Empty when the source has none.
+    std::vector<glm::vec4> colors;
     int material = 0; ///< index into Scene::materials
 };
 

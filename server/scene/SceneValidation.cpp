@@ -83,6 +83,14 @@ private:
         }
         for (std::size_t k = 0; k < m.texcoords.size(); ++k)
             if (!isFinite(m.texcoords[k])) fail(what + ": texcoord " + std::to_string(k) + " is not finite");
+        if (!m.colors.empty() && m.colors.size() != n)
+            fail(what + ": has " + std::to_string(m.colors.size()) + " colours for " + std::to_string(n) +
+                 " positions");
+        for (std::size_t k = 0; k < m.colors.size(); ++k)
+            if (!(m.colors[k].x >= 0.0f && m.colors[k].x <= 1.0f && m.colors[k].y >= 0.0f &&
+                  m.colors[k].y <= 1.0f && m.colors[k].z >= 0.0f && m.colors[k].z <= 1.0f &&
+                  m.colors[k].w >= 0.0f && m.colors[k].w <= 1.0f))
+                fail(what + ": colour " + std::to_string(k) + " is not in [0, 1]");
         if (!m.tangents.empty() && m.tangents.size() != n)
             fail(what + ": has " + std::to_string(m.tangents.size()) + " tangents for " + std::to_string(n) +
                  " positions");

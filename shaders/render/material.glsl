@@ -5,6 +5,13 @@ uniform int uHasTexture;      // 1 when uBaseColorTex holds the base colour text
 uniform vec3 uMetalRoughSpec; // x metallic, y perceptual roughness, z specular factor; all [0, 1]
 uniform int uMirrorId;        // reflector id (SceneGpu::setSurfaceIds): mirror k + 1, local probe -(k + 1), 0 none
 layout(binding = 0) uniform sampler2D uBaseColorTex; // sRGB texture, decoded by the sampler
+in vec4 vColor; // the mesh's COLOR_0 (linear RGBA): multiplies the base colour where uHasVertexColor is 1
+uniform int uHasVertexColor;
+// The base colour factor times the vertex colour, where the mesh has one (others skip the multiply,
+// which is not exact in every interpolation of a constant white).
+vec4 materialFactor() {
+    return uHasVertexColor == 1 ? uBaseColor * vColor : uBaseColor;
+}
 // glTF metallicRoughnessTexture (linear: b scales metallic, g roughness) and emissiveTexture (sRGB),
 // on the base colour texture's coordinates; unit 1 and 2.
 uniform int uHasMetalRoughTex;
@@ -61,7 +68,7 @@ vec3 materialEmissive(vec2 uv) {
 uniform float uAlphaCutoff; // cut out below this alpha (base colour factor x texture); < 0: opaque
 bool materialCutOut(vec2 uv) {
     if (uAlphaCutoff < 0.0) return false;
-    float alpha = uBaseColor.a;
+    float alpha = materialFactor().a;
     if (uHasTexture == 1) alpha *= texture(uBaseColorTex, uv).a;
     return !(alpha >= uAlphaCutoff); // NaN alpha cuts out
 }
@@ -71,7 +78,7 @@ bool materialCutOut(vec2 uv) {
 #endif
 
 vec3 materialBaseColor(vec2 uv) {
-    vec4 c = uBaseColor;
+    vec4 c = materialFactor();
     if (uHasTexture == 1) c *= texture(uBaseColorTex, uv);
     return clamp(c.rgb, 0.0, 1.0);
 }

@@ -5,6 +5,7 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inTexcoord;
 layout(location = 3) in vec4 inTangent; // xyz tangent, w bitangent sign; zero without a normal map
+layout(location = 4) in vec4 inColor;   // COLOR_0, linear RGBA; white without one
 
 // -1: eye camera; v >= 0: light view v (shadow map and RSM layer v)
 uniform int uView;
@@ -13,11 +14,13 @@ out vec3 vWorldPos;
 out vec3 vNormal;
 out vec2 vTexcoord;
 out vec4 vTangent;
+out vec4 vColor;
 
 void main() {
     vWorldPos = inPosition;
     vNormal = inNormal;
     vTexcoord = inTexcoord;
     vTangent = inTangent;
+    vColor = inColor;
     gl_Position = (uView < 0 ? gFrame.viewProj : gLights.views[uView].viewProj) * vec4(inPosition, 1.0);
 }

@@ -166,6 +166,29 @@ TEST(MaterialMaps, NormalMapMatchesTheReference) {
     EXPECT_LT(mappedError, std::max(0.1, 1.5 * flatError));
 }
 
+// COLOR_0: the card's vertices red on its left edge, blue on its right, multiplying its white base.
+TEST(MaterialMaps, VertexColoursMatchTheReference) {
+    const Frames plain = renderScene(normalScene(false));
+    Scene scene = normalScene(false);
+    scene.meshes[1].colors = {{1.0f, 0.1f, 0.1f, 1.0f},
+                              {0.1f, 0.1f, 1.0f, 1.0f},
+                              {0.1f, 0.1f, 1.0f, 1.0f},
+                              {1.0f, 0.1f, 0.1f, 1.0f}};
+    const Frames coloured = renderScene(scene);
+    const size_t pixels = 64 * 64;
+    const double error = test::relativeRmseOf(coloured.gl.linear, 4, coloured.reference, 3, pixels);
+    const double plainError = test::relativeRmseOf(plain.gl.linear, 4, plain.reference, 3, pixels);
+    const double glChange = test::relativeRmseOf(coloured.gl.linear, 4, plain.gl.linear, 4, pixels);
+    const double referenceChange = test::relativeRmseOf(coloured.reference, 3, plain.reference, 3, pixels);
+    std::printf(
+        "[vertex colours] GL against the reference: %.4f (white %.4f); coloured against white: GL %.3f, "
+        "reference %.3f\n",
+        error, plainError, glChange, referenceChange);
+    EXPECT_GT(glChange, 0.1);
+    EXPECT_NEAR(glChange, referenceChange, 0.25 * referenceChange);
+    EXPECT_LT(error, std::max(0.1, 1.5 * plainError));
+}
+
 TEST(MaterialMaps, MetallicRoughnessAndEmissiveTexturesMatchTheReference) {
     const Frames plain = renderScene(mappedScene(false));
     const Frames mapped = renderScene(mappedScene(true));
