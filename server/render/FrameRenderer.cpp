@@ -186,6 +186,10 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
             CutoutPasses{buildMeshPass("render/shadow.frag", MeshMaterials::None, true),
                          buildMeshPass("render/rsm.frag", MeshMaterials::Used, true),
                          buildMeshPass("render/gbuffer.frag", MeshMaterials::All, true)});
+    // The scene's stats.not_shown, built once: every frame carries it.
+    mNotShown = nlohmann::json::array();
+    for (const NotShown& n : scene->notShown)
+        mNotShown.push_back({{"feature", n.feature}, {"detail", n.detail}});
     mScene = std::move(scene);
     mLightPassesValid = false;
 }
@@ -367,7 +371,8 @@ bool FrameRenderer::followsLastPart(const FrameState& state, const glm::mat4& vi
 }
 
 const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const glm::mat4& viewProj,
-                                                 const gl::Texture& part, Counters& counters) {
+                                                 bool followsLast, const gl::Texture& part,
+                                                 Counters& counters) {
     PartAverage& a = mPartAverage;
     if (a.width != state.width || a.height != state.height) {
         a.mean = gl::Texture::create2D(GL_RGBA32F, state.width, state.height);
@@ -378,7 +383,7 @@ const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const 
     }
     // Part 0 starts a mean; so does a part that does not follow the ones in it (another image, or a
     // part left out), which then shows the parts it has rather than mixing two images.
-    if (!followsLastPart(state, viewProj)) a.averaged = 0;
+    if (!followsLast) a.averaged = 0;
     a.key = partKey(state);
     a.viewProj = viewProj;
     a.techniqueParams = state.techniqueParams.toJson();
@@ -495,11 +500,13 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     const TechniqueInfo& techniqueInfo = findTechniqueInfo(state.technique);
     const bool vplParts =
         state.vplPart.active() && techniqueInfo.vplParts && techniqueInfo.vplParts(state.techniqueParams);
+    // Decided before the part joins the mean (averageVplPart records it as the last part).
+    const bool followsLast = vplParts && followsLastPart(state, u.viewProj);
     if (vplParts) {
         in.vplParts = state.vplPart.count;
         in.vplPart = std::clamp(state.vplPart.index, 0, state.vplPart.count - 1);
-        in.sameImageAsLastPart = followsLastPart(state, u.viewProj);
-        if (in.sameImageAsLastPart) counters["vpl_part_same_image"] = 1;
+        in.sameImageAsLastPart = followsLast;
+        if (followsLast) counters["vpl_part_same_image"] = 1;
     }
     const size_t techniqueFirstPass = mTimer.passCount();
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
@@ -507,7 +514,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     const gl::Texture* indirect = mTechnique->indirect();
-    if (indirect && vplParts) indirect = &averageVplPart(state, u.viewProj, *indirect, counters);
+    if (indirect && vplParts) indirect = &averageVplPart(state, u.viewProj, followsLast, *indirect, counters);
     if (indirect)
         mResources.publish("indirect", "technique", *indirect);
     else
@@ -574,12 +581,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
     out.stats["lighting"] = lightingStats(state, lightSet, viewFlux);
-    if (!mScene->notShown.empty()) {
-        nlohmann::json notShown = nlohmann::json::array();
-        for (const NotShown& n : mScene->notShown)
-            notShown.push_back({{"feature", n.feature}, {"detail", n.detail}});
-        out.stats["not_shown"] = std::move(notShown);
-    }
+    if (!mNotShown.empty()) out.stats["not_shown"] = mNotShown;
     return out;
 }
 

@@ -88,14 +88,15 @@ private:
     void renderDirect();
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
     /// Folds one VPL part's indirect light into the running mean of the parts before it
-    /// (FrameState::VplPart) and returns that mean.
-    const gl::Texture& averageVplPart(const FrameState& state, const glm::mat4& viewProj,
+    /// (FrameState::VplPart) and returns that mean; `followsLast`: followsLastPart() before this part.
+    const gl::Texture& averageVplPart(const FrameState& state, const glm::mat4& viewProj, bool followsLast,
                                       const gl::Texture& part, Counters& counters);
     static std::array<int, 7> partKey(const FrameState& state);
     /// Whether `state` is the next VPL part of the image whose parts are in the mean.
     bool followsLastPart(const FrameState& state, const glm::mat4& viewProj) const;
 
     std::shared_ptr<const Scene> mScene;
+    nlohmann::json mNotShown; ///< stats.not_shown of mScene (an empty array: nothing to say)
     std::unique_ptr<SceneGpu> mSceneGpu;
     gl::PassTimer mTimer;
     FrameResources mResources;

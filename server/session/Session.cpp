@@ -585,14 +585,22 @@ Session::RenderStatus Session::renderAdmitted(Worker& w, const FrameState& state
     return RenderStatus::Ok;
 }
 
+void Session::broadcastProgress(const char* state, const std::string& step, double share, double etaMs,
+                                const std::string& reason) {
+    broadcastText({{"type", "progress"},
+                   {"state", state},
+                   {"step", step},
+                   {"share", share},
+                   {"eta_ms", etaMs},
+                   {"reason", reason}});
+}
+
 Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, int step,
                                              const StreamOptions& stream, const std::string& note) {
     const std::string stepLabel = stepName(step);
     const double fullPixels = static_cast<double>(full.width) * full.height;
     auto progress = [&](const char* state, double share, double etaMs, const std::string& reason) {
-        nlohmann::json msg = {{"type", "progress"}, {"state", state},  {"step", stepLabel},
-                              {"share", share},     {"eta_ms", etaMs}, {"reason", reason}};
-        broadcastText(msg);
+        broadcastProgress(state, stepLabel, share, etaMs, reason);
     };
     const int sliceMs = std::max(5, mConfig.limits.sliceMs);
     const long vpls = std::max(1L, vplEstimate(full));
@@ -868,24 +876,16 @@ void Session::workerMain() {
                 const std::string sizeText = sizeError ? std::string() : " (" + mebibytes(bytes) + ")";
                 // The client shows that a load is under way (a large file takes seconds) and what
                 // it cost; the scene cache answers at once for a scene another session holds.
-                broadcastText({{"type", "progress"},
-                               {"state", "loading"},
-                               {"step", "scene"},
-                               {"share", 0.0},
-                               {"eta_ms", 0.0},
-                               {"reason", "loading " + validUtf8(sceneRequest) + sizeText}});
+                broadcastProgress("loading", "scene", 0.0, 0.0,
+                                  "loading " + validUtf8(sceneRequest) + sizeText);
                 Stopwatch loadClock;
                 std::shared_ptr<const Scene> next;
                 try {
                     next = mScenes->get(path,
                                         mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{});
                 } catch (...) {
-                    broadcastText({{"type", "progress"},
-                                   {"state", "load_failed"},
-                                   {"step", "scene"},
-                                   {"share", 0.0},
-                                   {"eta_ms", 0.0},
-                                   {"reason", "could not load " + validUtf8(sceneRequest)}});
+                    broadcastProgress("load_failed", "scene", 0.0, 0.0,
+                                      "could not load " + validUtf8(sceneRequest));
                     throw;
                 }
                 const double loadMs = loadClock.elapsedMs();
@@ -893,14 +893,10 @@ void Session::workerMain() {
                         (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
                         std::to_string(next->triangleCount()) + " triangles, " +
                         std::to_string(static_cast<long>(loadMs)) + " ms)");
-                broadcastText({{"type", "progress"},
-                               {"state", "loaded"},
-                               {"step", "scene"},
-                               {"share", 1.0},
-                               {"eta_ms", 0.0},
-                               {"reason", "loaded " + validUtf8(sceneRequest) + sizeText + ": " +
-                                              std::to_string(next->triangleCount()) + " triangles in " +
-                                              std::to_string(std::lround(loadMs)) + " ms"}});
+                broadcastProgress("loaded", "scene", 1.0, 0.0,
+                                  "loaded " + validUtf8(sceneRequest) + sizeText + ": " +
+                                      std::to_string(next->triangleCount()) + " triangles in " +
+                                      std::to_string(std::lround(loadMs)) + " ms");
                 const nlohmann::json loadInfo = {
                     {"ms", loadMs},
                     {"bytes", sizeError ? nlohmann::json(nullptr) : nlohmann::json(bytes)},
@@ -1036,12 +1032,7 @@ void Session::workerMain() {
                     if (capped && info.limitVpls)
                         why = "at most " + std::to_string(std::max(0L, static_cast<long>(cap))) + " of " +
                               std::to_string(vpls) + " VPLs fit (" + why + "), no more than the step before";
-                    broadcastText({{"type", "progress"},
-                                   {"state", "skipped"},
-                                   {"step", stepName(step)},
-                                   {"share", 0.0},
-                                   {"eta_ms", predictedMs},
-                                   {"reason", why}});
+                    broadcastProgress("skipped", stepName(step), 0.0, predictedMs, why);
                     continue;
                 }
             }

@@ -176,6 +176,9 @@ private:
     bool stepReadyLocked(std::chrono::steady_clock::time_point now) const;
     void workerMain();
     void broadcastText(const nlohmann::json& msg);
+    /// A `progress` message (protocol/PROTOCOL.md) to every client: refinement steps and scene loads.
+    void broadcastProgress(const char* state, const std::string& step, double share, double etaMs,
+                           const std::string& reason);
     void fail(const std::string& reason);
 
     const std::string mId;

@@ -1,5 +1,7 @@
-// Material maps against the CPU reference on a small scene built here: alpha cutouts, and the
-// metallic-roughness and emissive textures.
+// Material maps against the CPU reference (direct mode, 16 jittered spp; its noise is printed beside
+// each error) on a small scene built here: alpha cutouts, metallic-roughness, emissive and normal maps
+// and vertex colours. Each test renders the card without and with the feature, and checks that GL
+// stays as close to the reference with it as without, and that the feature changes both alike.
 //
 // Alpha cutouts (glTF alphaMode MASK; BLEND approximated at 0.5): a red card half cut out by its
 // texture's alpha, over a floor, under a slanted sun. The GL frame (G-buffer and shadow map cut out)
@@ -14,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "GlTestSupport.h"
+#include "analysis/Accuracy.h"
 #include "frame/FrameState.h"
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
@@ -70,9 +73,11 @@ Scene cardScene(Material::Alpha mode) {
     return s;
 }
 
+constexpr int kSide = 64;
+
 struct Frames {
     FrameOutput gl;
-    std::vector<float> reference; // RGB
+    ReferenceImage reference; // RGB, with its pixel means' variance
 };
 
 Frames renderScene(const Scene& scene) {
@@ -80,14 +85,38 @@ Frames renderScene(const Scene& scene) {
     FrameRenderer renderer;
     renderer.setScene(std::make_shared<const Scene>(scene));
     FrameState state = makeFrameState(scene, "none");
-    state.width = 64;
-    state.height = 64;
+    state.width = kSide;
+    state.height = kSide;
     state.frameParams.set("shadow_map_size", 1024);
     Frames f;
     f.gl = renderer.render(state, true);
     ReferenceRenderer reference(scene);
-    f.reference = reference.render(state, {.mode = "direct", .spp = 16, .seed = 3, .jitter = true}).rgb;
+    f.reference = reference.render(state, {.mode = "direct", .spp = 16, .seed = 3, .jitter = true});
     return f;
+}
+
+/// The card without (`base`) and with (`variant`) a feature: GL's error against its reference, that
+/// reference's own noise, and how much the feature changes each side.
+struct Comparison {
+    double baseError, variantError, baseNoise, variantNoise, glChange, referenceChange;
+};
+
+Comparison compare(const char* label, const Frames& base, const Frames& variant) {
+    const size_t pixels = kSide * kSide;
+    const auto noise = [](const Frames& f) {
+        return relativeNoise(ImageView(f.reference.rgb, kSide, kSide, 3), f.reference.variance);
+    };
+    const Comparison c{test::relativeRmseOf(base.gl.linear, 4, base.reference.rgb, 3, pixels),
+                       test::relativeRmseOf(variant.gl.linear, 4, variant.reference.rgb, 3, pixels),
+                       noise(base),
+                       noise(variant),
+                       test::relativeRmseOf(variant.gl.linear, 4, base.gl.linear, 4, pixels),
+                       test::relativeRmseOf(variant.reference.rgb, 3, base.reference.rgb, 3, pixels)};
+    std::printf(
+        "[%s] GL against the reference (direct, 16 spp): without %.4f (reference noise %.4f), with %.4f "
+        "(noise %.4f); the feature changes GL by %.3f, the reference by %.3f\n",
+        label, c.baseError, c.baseNoise, c.variantError, c.variantNoise, c.glChange, c.referenceChange);
+    return c;
 }
 
 Frames render(Material::Alpha mode) {
@@ -128,8 +157,6 @@ Scene mappedScene(bool maps) {
     return s;
 }
 
-} // namespace
-
 // The card opaque and white; `mapped`: its left half's normal map tilts the normal 35 degrees along
 // +u (tangent space (0.57, 0, 0.82)), its right half is flat (0, 0, 1).
 Scene normalScene(bool mapped) {
@@ -146,24 +173,19 @@ Scene normalScene(bool mapped) {
     return s;
 }
 
+} // namespace
+
 TEST(MaterialMaps, NormalMapMatchesTheReference) {
     const Frames flat = renderScene(normalScene(false));
     const Scene scene = normalScene(true);
     ASSERT_EQ(scene.meshes[1].tangents.size(), scene.meshes[1].positions.size());
     EXPECT_NEAR(scene.meshes[1].tangents[0].x, 1.0f, 1e-5f) << "+u runs along +x on the card";
     const Frames mapped = renderScene(scene);
-    const size_t pixels = 64 * 64;
-    const double flatError = test::relativeRmseOf(flat.gl.linear, 4, flat.reference, 3, pixels);
-    const double mappedError = test::relativeRmseOf(mapped.gl.linear, 4, mapped.reference, 3, pixels);
-    const double glChange = test::relativeRmseOf(mapped.gl.linear, 4, flat.gl.linear, 4, pixels);
-    const double referenceChange = test::relativeRmseOf(mapped.reference, 3, flat.reference, 3, pixels);
-    std::printf("[normal map] GL against the reference (direct, 16 spp): flat %.4f, mapped %.4f; mapped "
-                "against flat: GL %.3f, reference %.3f\n",
-                flatError, mappedError, glChange, referenceChange);
+    const Comparison c = compare("normal map", flat, mapped);
     EXPECT_EQ(test::badValues(mapped.gl), 0u);
-    EXPECT_GT(glChange, 0.03);
-    EXPECT_NEAR(glChange, referenceChange, 0.3 * referenceChange) << "the map changes both sides alike";
-    EXPECT_LT(mappedError, std::max(0.1, 1.5 * flatError));
+    EXPECT_GT(c.glChange, 0.03);
+    EXPECT_NEAR(c.glChange, c.referenceChange, 0.3 * c.referenceChange) << "the map changes both sides alike";
+    EXPECT_LT(c.variantError, std::max(0.1, 1.5 * c.baseError));
 }
 
 // COLOR_0: the card's vertices red on its left edge, blue on its right, multiplying its white base.
@@ -174,60 +196,37 @@ TEST(MaterialMaps, VertexColoursMatchTheReference) {
                               {0.1f, 0.1f, 1.0f, 1.0f},
                               {0.1f, 0.1f, 1.0f, 1.0f},
                               {1.0f, 0.1f, 0.1f, 1.0f}};
-    const Frames coloured = renderScene(scene);
-    const size_t pixels = 64 * 64;
-    const double error = test::relativeRmseOf(coloured.gl.linear, 4, coloured.reference, 3, pixels);
-    const double plainError = test::relativeRmseOf(plain.gl.linear, 4, plain.reference, 3, pixels);
-    const double glChange = test::relativeRmseOf(coloured.gl.linear, 4, plain.gl.linear, 4, pixels);
-    const double referenceChange = test::relativeRmseOf(coloured.reference, 3, plain.reference, 3, pixels);
-    std::printf(
-        "[vertex colours] GL against the reference: %.4f (white %.4f); coloured against white: GL %.3f, "
-        "reference %.3f\n",
-        error, plainError, glChange, referenceChange);
-    EXPECT_GT(glChange, 0.1);
-    EXPECT_NEAR(glChange, referenceChange, 0.25 * referenceChange);
-    EXPECT_LT(error, std::max(0.1, 1.5 * plainError));
+    const Comparison c = compare("vertex colours", plain, renderScene(scene));
+    EXPECT_GT(c.glChange, 0.1);
+    EXPECT_NEAR(c.glChange, c.referenceChange, 0.25 * c.referenceChange);
+    EXPECT_LT(c.variantError, std::max(0.1, 1.5 * c.baseError));
 }
 
 TEST(MaterialMaps, MetallicRoughnessAndEmissiveTexturesMatchTheReference) {
     const Frames plain = renderScene(mappedScene(false));
     const Frames mapped = renderScene(mappedScene(true));
-    const size_t pixels = 64 * 64;
-    const double plainError = test::relativeRmseOf(plain.gl.linear, 4, plain.reference, 3, pixels);
-    const double mappedError = test::relativeRmseOf(mapped.gl.linear, 4, mapped.reference, 3, pixels);
-    const double glChange = test::relativeRmseOf(mapped.gl.linear, 4, plain.gl.linear, 4, pixels);
-    const double referenceChange = test::relativeRmseOf(mapped.reference, 3, plain.reference, 3, pixels);
-    std::printf("[maps] GL against the reference (direct, 16 spp): factors only %.4f, with the maps %.4f; "
-                "maps against factors: GL %.3f, reference %.3f\n",
-                plainError, mappedError, glChange, referenceChange);
+    const Comparison c = compare("maps", plain, mapped);
     EXPECT_EQ(test::badValues(mapped.gl), 0u);
-    EXPECT_GT(glChange, 0.1);
-    EXPECT_GT(referenceChange, 0.1);
-    EXPECT_NEAR(glChange, referenceChange, 0.25 * referenceChange) << "the maps change both sides alike";
-    EXPECT_LT(mappedError, std::max(0.1, 1.5 * plainError));
+    EXPECT_GT(c.glChange, 0.1);
+    EXPECT_GT(c.referenceChange, 0.1);
+    EXPECT_NEAR(c.glChange, c.referenceChange, 0.25 * c.referenceChange)
+        << "the maps change both sides alike";
+    EXPECT_LT(c.variantError, std::max(0.1, 1.5 * c.baseError));
 }
-
-namespace {} // namespace
 
 TEST(AlphaCutout, MaskedCardMatchesTheReferenceInEveryPass) {
     const Frames opaque = render(Material::Alpha::Opaque);
     const Frames masked = render(Material::Alpha::Mask);
     const Frames blended = render(Material::Alpha::Blend);
-    const size_t pixels = 64 * 64;
-    const double opaqueError = test::relativeRmseOf(opaque.gl.linear, 4, opaque.reference, 3, pixels);
-    const double maskedError = test::relativeRmseOf(masked.gl.linear, 4, masked.reference, 3, pixels);
-    const double glChange = test::relativeRmseOf(masked.gl.linear, 4, opaque.gl.linear, 4, pixels);
-    const double referenceChange = test::relativeRmseOf(masked.reference, 3, opaque.reference, 3, pixels);
-    std::printf("[cutout] GL against the reference (direct, 16 spp): opaque card %.4f, masked card %.4f; "
-                "masked against opaque: GL %.3f, reference %.3f\n",
-                opaqueError, maskedError, glChange, referenceChange);
+    const Comparison c = compare("cutout", opaque, masked);
     EXPECT_EQ(test::badValues(masked.gl), 0u);
     // The cutout changes the image (the floor shows through and is lit through it) ...
-    EXPECT_GT(glChange, 0.1);
-    EXPECT_GT(referenceChange, 0.1);
+    EXPECT_GT(c.glChange, 0.1);
+    EXPECT_GT(c.referenceChange, 0.1);
     // ... the same way on both sides: GL stays as close to the reference as with an opaque card.
-    EXPECT_LT(maskedError, std::max(0.08, 1.5 * opaqueError));
+    EXPECT_LT(c.variantError, std::max(0.08, 1.5 * c.baseError));
     // BLEND is approximated by a cutout at 0.5: this texture's alpha is 0 or 1, so it renders the same.
+    const size_t pixels = kSide * kSide;
     EXPECT_LT(test::relativeRmseOf(blended.gl.linear, 4, masked.gl.linear, 4, pixels), 1e-6);
-    EXPECT_LT(test::relativeRmseOf(blended.reference, 3, masked.reference, 3, pixels), 1e-6);
+    EXPECT_LT(test::relativeRmseOf(blended.reference.rgb, 3, masked.reference.rgb, 3, pixels), 1e-6);
 }

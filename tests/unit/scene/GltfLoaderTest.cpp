@@ -227,13 +227,18 @@ std::vector<std::uint8_t> tinyBmp() {
     return f;
 }
 
+/// Texture 0: tinyBmp() as image 0.
+void addTinyTexture(GltfBuilder& b) {
+    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
+    b.doc["textures"] = {{{"source", 0}}};
+}
+
 TEST(GltfLoader, MaterialFactorsEmissiveStrengthAndBaseColorTexture) {
     TempDir dir;
     GltfBuilder b;
     const int tri = b.addTriangleNode();
     b.doc["meshes"][0]["primitives"][0]["material"] = 0;
-    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
-    b.doc["textures"] = {{{"source", 0}}};
+    addTinyTexture(b);
     b.doc["materials"] = {
         {{"name", "paint"},
          {"pbrMetallicRoughness",
@@ -313,8 +318,7 @@ TEST(GltfLoader, BaseColorTextureTransformAndUvSetAreApplied) {
     b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv0;
     b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = uv1;
     b.doc["meshes"][0]["primitives"][0]["material"] = 0;
-    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
-    b.doc["textures"] = {{{"source", 0}}};
+    addTinyTexture(b);
     const double quarterTurn = glm::half_pi<double>();
     b.doc["materials"] = {{{"pbrMetallicRoughness",
                             {{"baseColorTexture",
@@ -350,8 +354,7 @@ TEST(GltfLoader, MetallicRoughnessAndEmissiveTexturesAreRead) {
     GltfBuilder b;
     const int tri = b.addTriangleNode();
     b.doc["meshes"][0]["primitives"][0]["material"] = 0;
-    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
-    b.doc["textures"] = {{{"source", 0}}};
+    addTinyTexture(b);
     b.doc["materials"] = {
         {{"pbrMetallicRoughness",
           {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 0}}}}},
@@ -380,8 +383,7 @@ TEST(GltfLoader, NormalMapGetsTangentsAlongU) {
     const int uv = b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 0, 0, 1}), test::kFloat, 3, "VEC2");
     b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv;
     b.doc["meshes"][0]["primitives"][0]["material"] = 0;
-    b.doc["images"] = {{{"uri", "data:image/bmp;base64," + test::base64(tinyBmp())}}};
-    b.doc["textures"] = {{{"source", 0}}};
+    addTinyTexture(b);
     b.doc["materials"] = {{{"normalTexture", {{"index", 0}, {"scale", 0.5}}}}};
     b.setScene({tri});
     const Scene s = loadGltf(b.writeGlb(dir, "normal.glb"));
