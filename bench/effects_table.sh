@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The effect plan against everything on, per built-in scene (docs/effects.md). Everything on = `ssbc`
-# (clamp_b 10, one compensation step) with vpl_shadows; the plan = the same with effects=auto.
+# (clamp_b 40, one compensation step) with vpl_shadows; the plan = the same with effects=auto.
 # Frame times: `gi-bench passes`, both configurations interleaved frame by frame (glFinish timing),
 # median of FRAMES. Relative RMSE: `gi-render --compare` against a one-bounce CPU reference at SPP
 # (cached under $GI_CACHE_DIR or ~/.cache/gi-render). Planning time is the planner's own (once per

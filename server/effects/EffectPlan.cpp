@@ -11,6 +11,7 @@
 #include "frame/LightModel.h"
 #include "frame/VplBudget.h"
 #include "gi/Catalog.h"
+#include "gi/common/ParamSpecs.h"
 #include "reference/RayScene.h"
 #include "reference/Sampling.h"
 #include "scene/SurfaceAnalysis.h"
@@ -49,9 +50,9 @@ struct Point {
     glm::vec3 p{0.0f}, n{0.0f}, ng{0.0f}, albedo{0.0f};
 };
 
-std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
+std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
     char buf[256];
-    std::snprintf(buf, sizeof buf, format, a, b, c);
+    std::snprintf(buf, sizeof buf, format, a, b, c, d);
     return buf;
 }
 
@@ -333,7 +334,8 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
     //    the unoccluded bounce the clamp min(G, b) removes.
     const TechniqueInfo& technique = findTechniqueInfo(state.technique);
     const bool hasClamp = technique.biasCompensation;
-    const double clampB = hasClamp ? state.techniqueParams.getFloat("clamp_b") : 0.0;
+    const double clampB =
+        hasClamp ? vplClampB(state.techniqueParams, scene.bounds.longestSide()) : 0.0; // 1/m^2
     double truthSq = 0.0, indirectSq = 0.0, occlusionSq = 0.0, compensationSq = 0.0;
     double pairsWeighted = 0.0, pairsOccludedWeighted = 0.0;
     int lit = 0, reached = 0;
@@ -483,8 +485,9 @@ EffectPlan planEffects(const Scene& scene, const FrameState& state, const Effect
         else if (!(clampB > 0.0))
             d.reason = "clamp_b is 0: the kernel removes nothing";
         else
-            d.reason = fmt("clamp_b %.3g removes %.2f%% (relative RMSE; threshold %.2f%%)", clampB,
-                           100.0 * d.value, 100.0 * d.threshold);
+            d.reason =
+                fmt("clamp_b %.3g (%.3g/m^2) removes %.2f%% (relative RMSE; threshold %.2f%%)",
+                    state.techniqueParams.getFloat("clamp_b"), clampB, 100.0 * d.value, 100.0 * d.threshold);
         const bool on = indirectOn && d.available && d.value > d.threshold;
         decide(std::move(d), on);
     }

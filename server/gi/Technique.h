@@ -64,6 +64,9 @@ struct FrameInputs {
     /// `instances` times; techniques see geometry only through this (VPL shadow maps).
     std::function<void(const gl::Program& program, int instances)> drawGeometry;
     float sceneExtent = 1.0f; ///< diagonal of the scene's bounds (m), > 0
+    /// Longest side of the scene's bounds (m), > 0: the unit of the scene-relative knobs
+    /// (min_distance, clamp_b; gi/common/ParamSpecs.h).
+    float sceneSize = 1.0f;
     /// One of vplParts interleaved VPL subsets (TechniqueInfo::vplParts): the VPLs whose index modulo
     /// vplParts is vplPart, their light scaled by vplParts. 1 part: every VPL.
     int vplPart = 0;

@@ -6,6 +6,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "gi/common/ParamSpecs.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/Timer.h"
@@ -497,6 +498,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         mSceneGpu->draw(program, nullptr, instances);
     };
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
+    in.sceneSize = std::max(mScene->bounds.longestSide(), kMinSceneSize);
     const TechniqueInfo& techniqueInfo = findTechniqueInfo(state.technique);
     const bool vplParts =
         state.vplPart.active() && techniqueInfo.vplParts && techniqueInfo.vplParts(state.techniqueParams);

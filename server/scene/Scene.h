@@ -102,6 +102,11 @@ struct Bounds {
     glm::vec3 max{0.0f};
     glm::vec3 center() const { return 0.5f * (min + max); }
     float radius() const { return 0.5f * glm::length(max - min); }
+    /// The longest side (m): the unit of the scene-relative knobs (gi/common/ParamSpecs.h).
+    float longestSide() const {
+        const glm::vec3 d = max - min;
+        return glm::max(d.x, glm::max(d.y, d.z));
+    }
 };
 
 /// Something the file asks for that the renderer does not show, said to the user rather than left out

@@ -108,7 +108,7 @@ const near = (a, b, eps) => a.every((v, i) => Math.abs(v - b[i]) <= eps);
 before(async () => {
     mkdirSync(ARTIFACTS, { recursive: true });
     // Technique none first: adaptive refinement of it is cheap; the tests pick rsm_gather themselves.
-    // rsm_gather's interactive preset sets min_distance 1/3 (the default is 0.1) whatever the latest
+    // rsm_gather's interactive preset sets min_distance 1/3 (the default is 0.05) whatever the latest
     // measurement chose: the "Reset parameters" test tells the preset's value from the default's.
     server = await ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'none',
         '--client-dir', path.join(REPO, 'client'), '--max-size', '400x400', '--resume-grace', '5'],
@@ -232,7 +232,7 @@ test('the parameter folders keep the schema\'s order and show whole names', asyn
 });
 
 test('"Reset parameters" sends no explicit defaults: the adaptive presets apply again', async () => {
-    // min_distance: the interactive preset of rsm_gather sets it to 1/3, the default is 0.1.
+    // min_distance: the interactive preset of rsm_gather sets it to 1/3, the default is 0.05.
     const input = control('param-min_distance', 'input');
     await input.fill('0.2');
     await input.press('Enter');
@@ -241,14 +241,14 @@ test('"Reset parameters" sends no explicit defaults: the adaptive presets apply 
     await control('reset-params', 'button').click();
     await until('the defaults rendered', () => {
         const p = window.giClient.lastStats?.params;
-        return p?.vpl_grid === 16 && Math.abs(p.min_distance - 0.1) < 1e-9 && window.giClient.lastStats.quality === 'fixed';
+        return p?.vpl_grid === 16 && Math.abs(p.min_distance - 0.05) < 1e-9 && window.giClient.lastStats.quality === 'fixed';
     });
     const messages = await sent();
     assert.ok(messages.some((m) => m.type === 'technique' && m.name === 'rsm_gather'),
         `the technique again, which makes the server forget explicit values: ${JSON.stringify(messages)}`);
     assert.ok(!messages.some((m) => m.type === 'params' && ('vpl_grid' in m.values || 'min_distance' in m.values)),
         `no technique parameter sent explicitly: ${JSON.stringify(messages)}`);
-    assert.equal(await input.inputValue(), '0.1', 'the panel shows the default');
+    assert.equal(await input.inputValue(), '0.05', 'the panel shows the default');
     await withAdaptive(async () => {
         await drag();
         await until('an interactive frame with the preset\'s min_distance', () => {

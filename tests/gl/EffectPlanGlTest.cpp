@@ -22,7 +22,7 @@ struct Pair {
     FrameState plannedState;
 };
 
-/// Everything on: `ssbc` (clamp_b 10, one compensation step) with VPL visibility.
+/// Everything on: `ssbc` (clamp_b 40, one compensation step) with VPL visibility.
 Pair renderBoth(const std::string& sceneName) {
     const nlohmann::json everything = {{"vpl_shadows", true}};
     Pair p;

@@ -85,7 +85,7 @@ TEST(VplShadows, StableWithCompensationAndExtremes) {
               nlohmann::json{
                   {"vpl_grid", 6}, {"vpl_shadows", true}, {"vpl_shadow_bias", 0.5}, {"vpl_shadow_size", 16}},
               nlohmann::json{
-                  {"vpl_grid", 6}, {"vpl_shadows", true}, {"ssbc_iterations", 1}, {"clamp_b", 10.0}}}) {
+                  {"vpl_grid", 6}, {"vpl_shadows", true}, {"ssbc_iterations", 1}, {"clamp_b", 40.0}}}) {
             // 65k triangles x 6 faces x VPLs: one configuration of the dense scene is enough.
             if (std::string(scene) == "builtin:cornell-dense" && p.contains("vpl_shadow_size")) continue;
             const FrameOutput f = renderScene(scene, "rsm_gather", 63, 47, p);

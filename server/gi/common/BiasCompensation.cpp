@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/common/ParamSpecs.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
@@ -20,12 +21,6 @@ int groupsFor(int n) {
 }
 
 } // namespace
-
-float vplInverseClampB(const ParamSet& params) {
-    if (!params.has("clamp_b")) return 0.0f;
-    const double b = params.getFloat("clamp_b");
-    return b > 0.0 && std::isfinite(b) ? static_cast<float>(1.0 / b) : 0.0f;
-}
 
 BiasCompensation::BiasCompensation() {
     BaseProgram& base = mBase;
@@ -154,7 +149,7 @@ void BiasCompensation::apply(const FrameInputs& in, const ParamSet& params, cons
                              gl::PassTimer& timer, Counters& counters) {
     if (!params.has("ssbc_iterations")) return;
     const int iterations = std::clamp(params.getInt("ssbc_iterations"), 0, kMaxIterations);
-    const double b = params.getFloat("clamp_b");
+    const double b = vplClampB(params, in.sceneSize); // 1/m^2
     counters["ssbc_energy_added"] = 0;
     if (iterations == 0 || !(b > 0.0) || !std::isfinite(b) || !in.frame || !in.find("direct") ||
         !in.find("gbuffer.position") || !in.find("gbuffer.normal") || !in.find("gbuffer.albedo") ||

@@ -32,7 +32,8 @@
 //   - visibility inside r is ignored (as in 002); only on-screen surfaces contribute (002.6 item 1).
 //
 // Parameters (every VPL technique; biasCompensationParamSpecs):
-//   clamp_b                    K3 bound b on G, [0, 1e4] 1/m^2; 0 = off (the technique's own kernel)
+//   clamp_b                    K3 bound on G, [0, 4e4] 1/size^2 (size: the scene's longest side, so
+//                              b = clamp_b / size^2 in 1/m^2); 0 = off (the technique's own kernel)
 //   ssbc_iterations            N in [0, 3]; 0 = off (default); needs clamp_b > 0
 //   ssbc_solid_angle           refinement threshold, [0, 4] sr, default 0.08 sr (002 §4.2)
 //   ssbc_discontinuity_angle   refine discontinuous samples above this, [0, 4] sr, default 0.04
@@ -82,9 +83,6 @@ namespace gis {
 /// clamp_b, ssbc_iterations, ssbc_solid_angle, ssbc_discontinuity_angle, ssbc_grazing_angle,
 /// ssbc_input, ssbc_levels, ssbc_blur, ssbc_half_resolution; `defaultClampB` and `defaultIterations` let a
 /// preset (`ssbc`) turn them on.
-
-/// 1/b for vpl_transport.glsl's uVplInvClampB (0: clamp off).
-float vplInverseClampB(const ParamSet& params);
 
 class BiasCompensation {
 public:

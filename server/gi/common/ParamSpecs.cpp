@@ -2,6 +2,9 @@
 // panel and sweeps derive from them). GL-free: part of the technique catalog (gi/Catalog.h).
 #include "gi/common/ParamSpecs.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace gis {
 
 std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel) {
@@ -23,11 +26,12 @@ std::vector<ParamSpec> vplParamSpecs(VplKernel defaultKernel) {
          .options = {"point", "disk"}},
         {.name = "min_distance",
          .type = ParamType::Float,
-         .defaultValue = 0.1,
+         .defaultValue = 0.05,
          .min = 0.0,
-         .max = 1.0,
-         .unit = "m",
-         .help = "point kernel only: distance clamp of the 1/d^2 falloff (bounds the r->0 singularity)",
+         .max = 0.5,
+         .unit = "fraction of scene size",
+         .help = "point kernel only: distance clamp of the 1/d^2 falloff (bounds the r->0 singularity), "
+                 "relative to the longest side of the scene's bounds (0.05: 0.1 m in a 2 m room)",
          .source = "000 Fig. 13 (value not given; chosen)"},
     };
     for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
@@ -44,10 +48,12 @@ std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB, int defa
          .type = ParamType::Float,
          .defaultValue = defaultClampB,
          .min = 0.0,
-         .max = 1e4,
-         .unit = "1/m^2",
-         .help = "K3 bound b on the VPL geometry term, E = Phi/pi min(G, b) (radius 1/sqrt(b) where G > b); "
-                 "0 = off, the technique's own kernel",
+         .max = 4e4,
+         .unit = "1/scene size^2",
+         .help =
+             "K3 bound b on the VPL geometry term, E = Phi/pi min(G, b) (radius size/sqrt(b) where G > b, "
+             "size the longest side of the scene's bounds: 40 is 10/m^2 in a 2 m room); 0 = off, the "
+             "technique's own kernel",
          .source = "002 G_b (no value given; digest S.5 item 1)"},
         {.name = "ssbc_iterations",
          .type = ParamType::Int,
@@ -111,6 +117,25 @@ std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB, int defa
                  "block where all weights vanish); needs ssbc_levels >= 2",
          .source = "002 §5 (bilateral upsampling; nearest-sample fallback instead of recomputation)"},
     };
+}
+
+float vplMinDistance(const ParamSet& params, float sceneSize) {
+    if (!params.has("min_distance")) return 0.0f;
+    const double d = params.getFloat("min_distance") * std::max(sceneSize, kMinSceneSize);
+    return std::isfinite(d) ? static_cast<float>(d) : 0.0f;
+}
+
+double vplClampB(const ParamSet& params, float sceneSize) {
+    if (!params.has("clamp_b")) return 0.0;
+    const double size = std::max(sceneSize, kMinSceneSize);
+    const double b = params.getFloat("clamp_b") / (size * size);
+    return b > 0.0 && std::isfinite(b) ? b : 0.0;
+}
+
+float vplInverseClampB(const ParamSet& params, float sceneSize) {
+    const double b = vplClampB(params, sceneSize);
+    const double inv = b > 0.0 ? 1.0 / b : 0.0;
+    return std::isfinite(inv) ? static_cast<float>(inv) : 0.0f;
 }
 
 std::vector<ParamSpec> eyeHierarchyParamSpecs() {

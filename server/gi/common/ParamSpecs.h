@@ -32,7 +32,21 @@ std::vector<ParamSpec> withVplShadowParams(std::vector<ParamSpec> specs);
 /// Most bias-compensation steps (002: "1 to 3 iterations").
 inline constexpr int kMaxIterations = 3;
 
-/// `ssbc`'s K3 bound: 1/m^2, r = 1/sqrt(b) = 0.32 m (docs/ssbc.md).
-inline constexpr double kSsbcDefaultClampB = 10.0;
+/// `ssbc`'s K3 bound in 1/size^2: r = size/sqrt(40), 0.32 m in the 2 m Cornell room (docs/ssbc.md).
+inline constexpr double kSsbcDefaultClampB = 40.0;
+
+// Distance-like knobs are relative to the scene's size, the longest side of its bounds, so one value
+// gives the same image at any unit scale (a CAD export in millimetres, a terrain in kilometres): a
+// min_distance of 0.05 is 0.1 m in the 2 m Cornell room and 20 units in a 400-unit bracket. The
+// shaders take metres (scene units); these convert, with `sceneSize` the longest side in metres.
+
+/// The floor on a scene size (m) that keeps the conversions finite for an empty or flat scene.
+inline constexpr float kMinSceneSize = 1e-6f;
+/// `min_distance` (fraction of the scene size) in metres; 0 without the knob.
+float vplMinDistance(const ParamSet& params, float sceneSize);
+/// `clamp_b` (1/size^2) as K3's bound b in 1/m^2; 0 = off (or no such knob).
+double vplClampB(const ParamSet& params, float sceneSize);
+/// 1/b in m^2 for vpl_transport.glsl's uVplInvClampB; 0 = off.
+float vplInverseClampB(const ParamSet& params, float sceneSize);
 
 } // namespace gis

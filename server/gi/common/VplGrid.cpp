@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "gi/common/BiasCompensation.h"
+#include "gi/common/ParamSpecs.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
@@ -24,9 +25,9 @@ VplTransportHandles::VplTransportHandles(const gl::Program& program)
     }
 }
 
-void VplTransportHandles::set(gl::Pass& pass, const ParamSet& params, bool glossyOn, float minRoughness,
-                              const gl::Buffer* glossyData) const {
-    pass.set(invClampB, vplInverseClampB(params));
+void VplTransportHandles::set(gl::Pass& pass, const ParamSet& params, float sceneSize, bool glossyOn,
+                              float minRoughness, const gl::Buffer* glossyData) const {
+    pass.set(invClampB, vplInverseClampB(params, sceneSize));
     if (!hasGlossy) return;
     pass.set(glossy, glossyOn ? 1 : 0).set(glossyMinRoughness, minRoughness);
     if (glossyOn && glossyData) pass.buffer(glossyVpls, *glossyData);

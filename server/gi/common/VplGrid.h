@@ -46,9 +46,9 @@ struct VplTransportHandles {
     gl::UniformLocation glossy, glossyMinRoughness; ///< vpl_glossy.glsl (when built with it)
     gl::BlockBinding glossyVpls;                    ///< VplGlossyBuffer (when built with it)
     bool hasGlossy = false;
-    /// Sets the clamp from clamp_b and, with vpl_glossy.glsl, the glossy switch; binds the glossy
-    /// VPL data when `glossyOn`.
-    void set(gl::Pass& pass, const ParamSet& params, bool glossyOn, float minRoughness,
+    /// Sets the clamp from clamp_b (relative to `sceneSize`, m) and, with vpl_glossy.glsl, the glossy
+    /// switch; binds the glossy VPL data when `glossyOn`.
+    void set(gl::Pass& pass, const ParamSet& params, float sceneSize, bool glossyOn, float minRoughness,
              const gl::Buffer* glossyData) const;
 };
 

@@ -101,7 +101,7 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
                                                         params.getInt("max_depth"), params.getFloat("tau"));
             const GatherProgram& g = mGather;
             pass.use(g.program);
-            g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
+            g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
             pass.set(g.startLevel, s.startLevel)
                 .set(g.leafLevel, s.leafLevel)
                 .set(g.refineMode, static_cast<int>(s.mode))

@@ -99,7 +99,7 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
         if (mVplCount > 0) {
             const GatherProgram& g = mGather;
             pass.use(g.program);
-            g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
+            g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
             mEye.beginIlluminationPass(pass, g.eye, in, true);
             counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
                 pass.set(g.vplCount, count).set(g.vplScale, 1.0f).drawFullscreen(mEye.emptyVao());

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "gi/common/ParamSpecs.h"
+
 namespace gis {
 
 MultiresGather::GatherProgram::GatherProgram(gl::Program built)
@@ -29,8 +31,8 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
         gl::Pass pass(timer, "vpl_gather");
         if (vplCount > 0) {
             const GatherProgram& g = mGather.get(vplKernel(params));
-            pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
-            g.transport.set(pass, params, false, in.glossyMinRoughness, nullptr);
+            pass.use(g.program).set(g.minDistance, vplMinDistance(params, in.sceneSize));
+            g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
             mEye.beginIlluminationPass(pass, g.eye, in, true);
             // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.
             const int parts = std::max(1, in.vplParts);

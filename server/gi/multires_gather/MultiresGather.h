@@ -13,8 +13,8 @@
 //   5. vpl_gather: one full-screen pass per VPL batch with the stencil test; receivers sum the kernel
 //   6. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel
 //
-// Parameters: vpl_grid [1, 256] (16), kernel point|disk (disk), min_distance [0, 1] m (0.1, point
-// only); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16, depth 0.1 relative,
+// Parameters: vpl_grid [1, 256] (16), kernel point|disk (disk), min_distance [0, 0.5] of the scene's
+// size (0.05, point only); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16, depth 0.1 relative,
 // normal 0.25, diagonal on, detail_alpha 0).
 //
 // Limits: no indirect visibility; diffuse receivers; a coarse patch is lit at its mean position and

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "gi/common/ParamSpecs.h"
 #include "core/Log.h"
 #include "gl/ShaderShared.h"
 
@@ -160,11 +161,11 @@ bool MultiresSplat::glossyTransport(const ParamSet& params) const {
 void MultiresSplat::setShading(gl::Pass& pass, const ShadingHandles& h, const FrameInputs& in,
                                const ParamSet& params, bool perVpl) const {
     pass.set(h.perVpl, perVpl ? 1 : 0)
-        .set(h.minDistance, static_cast<float>(params.getFloat("min_distance")))
+        .set(h.minDistance, vplMinDistance(params, in.sceneSize))
         .set(h.phongKs, static_cast<float>(params.getFloat("phong_ks")))
         .set(h.phongExponent, static_cast<float>(params.getFloat("phong_exponent")));
     const bool glossy = perVpl && in.glossy && in.find("gbuffer.specular") != nullptr;
-    h.transport.set(pass, params, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
+    h.transport.set(pass, params, in.sceneSize, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
     if (glossy) pass.texture(h.patchSpecular, in.get("gbuffer.specular"));
 }
 

@@ -15,7 +15,7 @@
 //      geometry refinement draws it instanced once per VPL.
 //   5. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel (geometry).
 //
-// Parameters: the VPL ones (vpl_grid 16, kernel point, min_distance 0.1 m), the eye hierarchy's,
+// Parameters: the VPL ones (vpl_grid 16, kernel point, min_distance 0.05 of the scene's size), the eye hierarchy's,
 // refinement geometry|illumination, illum_threshold (radiance), phong_ks [0, 1] (0 = Lambertian),
 // phong_exponent [1, 1000], max_subsplats (list capacity; items past it are splatted unrefined and
 // counted in subsplat_capped, so an explosion degrades resolution and never overruns memory).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "gi/common/ParamSpecs.h"
 #include "gl/ShaderShared.h"
 
 namespace gis {
@@ -37,12 +38,12 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         if (vplCount > 0) {
             const GatherProgram& g = mGather.get(vplKernel(params));
             const bool glossy = in.glossy && in.find("gbuffer.specular") != nullptr;
-            pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
+            pass.use(g.program).set(g.minDistance, vplMinDistance(params, in.sceneSize));
             mShadows.bind(pass, g.shadows, in, params);
             pass.texture(g.position, in.get("gbuffer.position"))
                 .texture(g.normal, in.get("gbuffer.normal"))
                 .texture(g.albedo, in.get("gbuffer.albedo"));
-            g.transport.set(pass, params, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
+            g.transport.set(pass, params, in.sceneSize, glossy, in.glossyMinRoughness, &mVpls.glossyBuffer());
             if (glossy) pass.texture(g.specular, in.get("gbuffer.specular"));
             pass.blendAdd();
             // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.

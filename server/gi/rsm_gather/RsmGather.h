@@ -18,9 +18,10 @@
 // Parameters:
 //   vpl_grid      VPLs per side, [1, 256] (clamped to rsm_size), default 16 (256 VPLs)
 //   kernel        point (000 Eq. 2, default) or disk (001 Eq. 1: bounded, needs no clamp)
-//   min_distance  point kernel: distance clamp of the 1/d^2 falloff, [0, 1] m, default 0.1 m
+//   min_distance  point kernel: distance clamp of the 1/d^2 falloff, [0, 0.5] of the scene's size (its
+//                 longest side), default 0.05 (0.1 m in the 2 m Cornell room)
 //   clamp_b, ssbc_*  K3 clamp and bias compensation (BiasCompensation.h), off by default; the
-//                 `ssbc` preset (002) is this pipeline with clamp_b 10 and ssbc_iterations 1
+//                 `ssbc` preset (002) is this pipeline with clamp_b 40 (1/size^2) and ssbc_iterations 1
 //
 // Glossy transport (FrameInputs::glossy, docs/nondiffuse.md): VPLs and receivers on specular surfaces
 // at least glossy_split rough add their specular lobes (gi/common/vpl_glossy.glsl).

@@ -5,6 +5,7 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 
+#include "gi/common/ParamSpecs.h"
 #include "core/Error.h"
 #include "gi/common/VplGrid.h"
 #include "gi/second_order/Limits.h"
@@ -360,7 +361,7 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
             .set(p.negativeCount, mNegativeSlots)
             .set(p.candidateCount, candidates)
             .set(p.frustumSolidAngle, static_cast<float>(frustumSolidAngle))
-            .set(p.minDistance, static_cast<float>(params.getFloat("min_distance")))
+            .set(p.minDistance, vplMinDistance(params, in.sceneSize))
             .set(p.minCosView, kMinCosView);
         pass.texture(p.position, in.get("gbuffer.position")).texture(p.normal, in.get("gbuffer.normal"));
         pass.buffer(p.vpls, mVpls).buffer(p.candidates, mCandidates).buffer(p.stats, mStats);
@@ -370,10 +371,10 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
 }
 
 void SecondOrder::gather(gl::Pass& pass, const gl::Texture& position, const gl::Texture& normal,
-                         const ParamSet& params, int slots, Counters& counters) {
+                         const ParamSet& params, float sceneSize, int slots, Counters& counters) {
     const GatherProgram& g = mGather;
-    pass.use(g.program).set(g.minDistance, static_cast<float>(params.getFloat("min_distance")));
-    g.transport.set(pass, params, false, 0.0f, nullptr);
+    pass.use(g.program).set(g.minDistance, vplMinDistance(params, sceneSize));
+    g.transport.set(pass, params, sceneSize, false, 0.0f, nullptr);
     pass.texture(g.position, position).texture(g.normal, normal).buffer(g.stats, mStats);
     pass.blendAdd(); // signed sums: negative lights carry negative flux
     int first = 0;
@@ -431,7 +432,7 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
         }
         gl::Pass pass(timer, "lowres_gather");
         pass.target(mLowIrradianceFbo, lowW, lowH).clearColor(1);
-        gather(pass, mLowPosition, mLowNormal, params, slots, counters);
+        gather(pass, mLowPosition, mLowNormal, params, in.sceneSize, slots, counters);
     }
 
     GLuint flagged = 0;
@@ -456,7 +457,7 @@ void SecondOrder::execute(const FrameInputs& in, const ParamSet& params, gl::Pas
         gl::Pass pass(timer, "fixup_gather");
         pass.target(mFixupFbo, in.width, in.height).clearColor(1);
         pass.stencilTest(false).stencilFunc(GL_EQUAL, 1);
-        gather(pass, position, normal, params, slots, counters);
+        gather(pass, position, normal, params, in.sceneSize, slots, counters);
     }
 
     {

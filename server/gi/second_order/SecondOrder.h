@@ -32,7 +32,8 @@
 //                            with 0.38% relative RMSE against threshold 0; docs/second_order.md);
 //                            0 = every pixel at full resolution (no low-res pass), 2 = no fix-up
 //   lowres_factor            pixels per low-res texel side, [1, 8], default 2 (003 §3.5: 2x2)
-//   min_distance             K1 falloff clamp max(d^2, min_distance^2), [0, 1] m, default 0.1 m
+//   min_distance             K1 falloff clamp max(d^2, (min_distance size)^2), [0, 0.5] of the scene's
+//                            size (its longest side), default 0.05 (0.1 m in the 2 m Cornell room)
 //                            (003 gives none; the same default as the other point-kernel techniques)
 //
 // Counters: positive_count (accepted cone points), positive_valid (of those, on a surface),
@@ -88,9 +89,9 @@ private:
     int placeNegative(const FrameInputs& in, const ParamSet& params, int positiveCount, gl::PassTimer& timer,
                       Counters& counters);
     /// The VPL and negative-light gather into the pass's target, with `position` and `normal` as the
-    /// receivers (low-resolution or full G-buffer).
+    /// receivers (low-resolution or full G-buffer); `sceneSize` (m) scales the distance knobs.
     void gather(gl::Pass& pass, const gl::Texture& position, const gl::Texture& normal,
-                const ParamSet& params, int slots, Counters& counters);
+                const ParamSet& params, float sceneSize, int slots, Counters& counters);
 
     std::vector<ConeCache> mLightCones; ///< one per light
     ConeCache mCameraCone;

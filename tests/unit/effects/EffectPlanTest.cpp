@@ -54,7 +54,7 @@ TEST(EffectPlan, BounceOffWithBlackWalls) {
 }
 
 TEST(EffectPlan, CompensationFollowsTheClamp) {
-    const Planned tight = plan("crease", {{"clamp_b", 2.0}}), loose = plan("crease", {{"clamp_b", 1000.0}});
+    const Planned tight = plan("crease", {{"clamp_b", 8.0}}), loose = plan("crease", {{"clamp_b", 4000.0}});
     EXPECT_TRUE(decision(tight.plan, "compensation").enabled) << decision(tight.plan, "compensation").reason;
     EXPECT_FALSE(decision(loose.plan, "compensation").enabled) << decision(loose.plan, "compensation").reason;
     EXPECT_GT(decision(tight.plan, "compensation").value, decision(loose.plan, "compensation").value);
