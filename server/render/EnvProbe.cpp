@@ -220,8 +220,12 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
                 .texture(fw.shadowMap, shadowMap);
             for (int f = 0; f < 6; ++f) {
                 pass.target(m.faceFbo[f], size, size).clearColor(1).clearDepth();
-                pass.set(fw.viewProj, faceViewProj(f, probe, zNear, zFar));
-                in.sceneGpu->draw(fw.program, &fw.materials, 1, probes[p].skipMesh);
+                const glm::mat4 face = faceViewProj(f, probe, zNear, zFar);
+                pass.set(fw.viewProj, face);
+                const DrawCount drawn =
+                    in.sceneGpu->draw(fw.program, &fw.materials, 1, probes[p].skipMesh, &face);
+                counters["triangles_env"] += static_cast<double>(drawn.drawn);
+                counters["triangles_env_culled"] += static_cast<double>(drawn.culled);
             }
             m.source.generateMipmap();
         }

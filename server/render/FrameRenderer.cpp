@@ -257,9 +257,10 @@ void FrameRenderer::ensureTechnique(const std::string& name, int width, int heig
     }
 }
 
-void FrameRenderer::renderShadowMaps(int views) {
+DrawCount FrameRenderer::renderShadowMaps(int views) {
     // Depth only, with a slope-scaled offset against acne; layers without a view are cleared (lit).
     gl::Pass pass(mTimer, "shadow_map");
+    DrawCount count;
     for (int v = 0; v < mShadowLayers; ++v) {
         gl::Pass layer("shadow_map view");
         layer.target(mShadowFbos[static_cast<size_t>(v)], mShadowSize, mShadowSize)
@@ -269,13 +270,16 @@ void FrameRenderer::renderShadowMaps(int views) {
         layer.polygonOffset(2.0f, 4.0f);
         const MeshPass& shadow = shadowPass();
         layer.use(shadow.program).set(shadow.view, v);
-        mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr);
+        count += mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr, 1, -1,
+                                 &mLightBlock->views[v].viewProj);
     }
     mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
+    return count;
 }
 
-void FrameRenderer::renderRsms(int views) {
+DrawCount FrameRenderer::renderRsms(int views) {
     gl::Pass pass(mTimer, "rsm");
+    DrawCount count;
     for (int v = 0; v < mRsmLayers; ++v) {
         gl::Pass layer("rsm view");
         layer.target(mRsmFbos[static_cast<size_t>(v)], mRsmSize, mRsmSize)
@@ -285,12 +289,13 @@ void FrameRenderer::renderRsms(int views) {
         if (v >= views) continue;
         const MeshPass& rsm = rsmPass();
         layer.use(rsm.program).set(rsm.view, v);
-        mSceneGpu->draw(rsm.program, &rsm.materials);
+        count += mSceneGpu->draw(rsm.program, &rsm.materials, 1, -1, &mLightBlock->views[v].viewProj);
     }
     mResources.publish("lights.rsm.position", "rsm", mRsmPosition);
     mResources.publish("lights.rsm.normal", "rsm", mRsmNormal);
     mResources.publish("lights.rsm.flux", "rsm", mRsmFlux);
     mResources.publish("lights.rsm.specular", "rsm", mRsmSpecular);
+    return count;
 }
 
 void FrameRenderer::measureViewFlux(int views) {
@@ -313,18 +318,19 @@ std::vector<double> FrameRenderer::readViewFlux(int views) const {
     return out;
 }
 
-void FrameRenderer::renderGBuffer(int width, int height) {
+DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& viewProj) {
     gl::Pass pass(mTimer, "gbuffer");
     pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
     const MeshPass& gbuffer = gbufferPass();
     pass.use(gbuffer.program).set(gbuffer.view, -1);
-    mSceneGpu->draw(gbuffer.program, &gbuffer.materials);
+    const DrawCount count = mSceneGpu->draw(gbuffer.program, &gbuffer.materials, 1, -1, &viewProj);
     mResources.publish("gbuffer.position", "gbuffer", mGPosition);
     mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
     mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);
     mResources.publish("gbuffer.emissive", "gbuffer", mGEmissive);
     mResources.publish("gbuffer.specular", "gbuffer", mGSpecular);
     mResources.publish("gbuffer.depth", "gbuffer", mGDepth);
+    return count;
 }
 
 void FrameRenderer::renderDirect() {
@@ -442,6 +448,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     std::vector<double> viewFlux;
+    DrawCount lightDraws;
     const bool readsRsm = findTechniqueInfo(state.technique).readsRsm;
     // The light views depend on the lights, the scene and the RSM's solid-angle rule only, never on
     // the camera: with reuse on, an unchanged light block keeps last frame's maps (an orbit or the
@@ -460,11 +467,11 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
                                          {"lights.rsm.specular", &mRsmSpecular}})
                 mResources.publish(name, "rsm", *texture);
     } else {
-        renderShadowMaps(views);
+        lightDraws += renderShadowMaps(views);
     }
     // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
     if (readsRsm && !reuseLights) {
-        renderRsms(views);
+        lightDraws += renderRsms(views);
         measureViewFlux(views);
         // Several views: the VPL split needs the sums before the technique's extraction is dispatched,
         // so they are read now (a small synchronous read; the previous frame's would make a single
@@ -476,11 +483,17 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
              {"lights.rsm.position", "lights.rsm.normal", "lights.rsm.flux", "lights.rsm.specular"})
             mResources.withdraw(name);
     }
-    renderGBuffer(state.width, state.height);
+    const DrawCount eyeDraws = renderGBuffer(state.width, state.height, u.viewProj);
     renderDirect();
 
     // The technique's indirect passes read the G-buffer, the RSM and the direct light by name.
     Counters counters;
+    // Frustum culling's measure: triangles the G-buffer and the light views (shadow maps and RSMs,
+    // every view; 0 when last frame's are reused) drew and left out.
+    counters["triangles_gbuffer"] = static_cast<double>(eyeDraws.drawn);
+    counters["triangles_gbuffer_culled"] = static_cast<double>(eyeDraws.culled);
+    counters["triangles_light_views"] = static_cast<double>(lightDraws.drawn);
+    counters["triangles_light_views_culled"] = static_cast<double>(lightDraws.culled);
     FrameInputs in;
     in.width = state.width;
     in.height = state.height;

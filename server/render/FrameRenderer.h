@@ -78,13 +78,13 @@ private:
     void ensureTargets(int width, int height, int rsmSide, int shadowSide, int views);
     void ensureTechnique(const std::string& name, int width, int height);
     // The frame's stages, in order; each publishes what it writes in mResources.
-    void renderShadowMaps(int views);
-    void renderRsms(int views);
+    DrawCount renderShadowMaps(int views);
+    DrawCount renderRsms(int views);
     /// Sums the reflected flux luminance of every view's RSM on the GPU (pass "rsm_flux").
     void measureViewFlux(int views);
     /// Those sums, read back (waits for the pass); empty without views.
     std::vector<double> readViewFlux(int views) const;
-    void renderGBuffer(int width, int height);
+    DrawCount renderGBuffer(int width, int height, const glm::mat4& viewProj);
     void renderDirect();
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
     /// Folds one VPL part's indirect light into the running mean of the parts before it

@@ -284,12 +284,13 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
                 // A reflection flips the winding; culling is off in this renderer, but keep GL's notion
                 // of front faces right for anything that enables it.
                 const bool odd = (v.level % 2) == 1;
+                const glm::mat4 reflected = viewProj * v.reflect;
                 sub.frontFace(odd ? GL_CW : GL_CCW)
                     .stencilFunc(GL_EQUAL, v.stencil)
-                    .set(fw.viewProj, viewProj * v.reflect)
+                    .set(fw.viewProj, reflected)
                     .set(fw.clipPlane, glm::vec4(n, d))
                     .set(fw.eye, v.eye);
-                in.sceneGpu->draw(fw.program, &fw.materials);
+                in.sceneGpu->draw(fw.program, &fw.materials, 1, -1, &reflected);
                 previous.push_back(static_cast<int>(views.size()));
                 views.push_back(v);
             }

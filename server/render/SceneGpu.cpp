@@ -1,10 +1,12 @@
 #include "render/SceneGpu.h"
 
 #include <algorithm>
-
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include "core/Error.h"
+#include "scene/Frustum.h"
 
 namespace gis {
 namespace {
@@ -23,12 +25,29 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     std::vector<std::uint32_t> indices;
     for (const Mesh& mesh : scene.meshes) {
         Draw d;
-        d.firstIndex = static_cast<GLint>(indices.size());
-        d.indexCount = static_cast<GLsizei>(mesh.indices.size());
         d.baseVertex = static_cast<GLint>(vertices.size());
         d.material = mesh.material;
         d.mesh = static_cast<int>(&mesh - scene.meshes.data());
         d.colored = !mesh.colors.empty();
+        // Runs of consecutive triangles with their bounds (meshes are in world space). Indices were
+        // validated at load; a bad one is skipped here rather than read out of range.
+        const std::size_t meshFirst = indices.size();
+        for (std::size_t t0 = 0; t0 + 3 <= mesh.indices.size(); t0 += 3 * kChunkTriangles) {
+            const std::size_t t1 = std::min(mesh.indices.size() / 3 * 3, t0 + 3 * kChunkTriangles);
+            Draw run = d;
+            run.firstIndex = static_cast<GLint>(meshFirst + t0);
+            run.indexCount = static_cast<GLsizei>(t1 - t0);
+            glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+            for (std::size_t i = t0; i < t1; ++i) {
+                const std::uint32_t v = mesh.indices[i];
+                if (v >= mesh.positions.size()) continue;
+                lo = glm::min(lo, mesh.positions[v]);
+                hi = glm::max(hi, mesh.positions[v]);
+            }
+            run.boundsMin = lo;
+            run.boundsMax = hi;
+            if (run.indexCount > 0) mDraws.push_back(run);
+        }
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
             v.position[0] = mesh.positions[i].x;
@@ -50,7 +69,6 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         }
         indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
         mTriangles += mesh.indices.size() / 3;
-        if (d.indexCount > 0) mDraws.push_back(d);
     }
     if (vertices.empty() || indices.empty())
         throw Error("render: scene '" + scene.name + "' has no triangles");
@@ -125,12 +143,24 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     return m;
 }
 
-void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int instances, int skipMesh) const {
+DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int instances, int skipMesh,
+                         const glm::mat4* cullViewProj) const {
     // The caller has bound the program; `materials` were resolved from it.
     glBindVertexArray(mVao.id());
+    const std::optional<Frustum> frustum =
+        cullViewProj ? std::optional<Frustum>(Frustum(*cullViewProj)) : std::nullopt;
+    DrawCount count;
+    int uniformsOf = -1; // the mesh whose material uniforms are set (a mesh's runs share them)
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
-        if (materials) {
+        const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
+        if (frustum && frustum->outside(d.boundsMin, d.boundsMax)) {
+            count.culled += triangles;
+            continue;
+        }
+        count.drawn += triangles;
+        if (materials && uniformsOf != d.mesh) {
+            uniformsOf = d.mesh;
             const MaterialSlots& s = *materials;
             const Material& m = mMaterials[static_cast<size_t>(d.material)];
             glUniform4f(s.baseColor.location, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
@@ -157,6 +187,7 @@ void SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int inst
             reinterpret_cast<const void*>(static_cast<uintptr_t>(d.firstIndex) * 4), std::max(instances, 1),
             d.baseVertex);
     }
+    return count;
 }
 
 } // namespace gis

@@ -25,16 +25,34 @@ struct MaterialSlots {
     static MaterialSlots of(const gl::Program& program, bool complete = false);
 };
 
+/// Triangles one draw loop sent and left out (frustum culling's measure, per pass in the stats).
+struct DrawCount {
+    std::size_t drawn = 0, culled = 0;
+    DrawCount& operator+=(const DrawCount& o) {
+        drawn += o.drawn;
+        culled += o.culled;
+        return *this;
+    }
+};
+
 class SceneGpu {
 public:
+    /// Triangles per draw: a bigger mesh is drawn in runs of consecutive triangles, each with its own
+    /// bounds, so culling can leave out part of it.
+    static constexpr std::size_t kChunkTriangles = 16384;
+
     /// Uploads everything; throws gis::Error on GL failure (a load boundary).
     explicit SceneGpu(const Scene& scene);
     /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
     /// through `materials` (null: none, as for depth-only passes). `skipMesh` (an index into
     /// Scene::meshes) is left out: a local environment probe does not see the object it belongs to.
-    void draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
-              int skipMesh = -1) const;
+    /// With `cullViewProj` (world -> clip, the matrix the program's vertex stage applies), runs whose
+    /// bounds lie wholly outside one of its clip planes are skipped: GL would clip every triangle of
+    /// them, so the image is the same.
+    DrawCount draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
+                   int skipMesh = -1, const glm::mat4* cullViewProj = nullptr) const;
     std::size_t triangleCount() const { return mTriangles; }
+    std::size_t drawCount() const { return mDraws.size(); }
     /// The reflector id of each mesh, written by the G-buffer into the normal's w
     /// (shaders/render/gbuffer.frag): k + 1 for planar mirror k, -(k + 1) for the object of local
     /// environment probe k, 0 for none (render/Reflections).
@@ -46,9 +64,10 @@ private:
         GLsizei indexCount = 0;
         GLint baseVertex = 0;
         int material = 0;
-        int mesh = 0;         ///< index into Scene::meshes
-        int surfaceId = 0;    ///< reflector id (setSurfaceIds)
-        bool colored = false; ///< the mesh has COLOR_0 (uHasVertexColor)
+        int mesh = 0;                               ///< index into Scene::meshes
+        int surfaceId = 0;                          ///< reflector id (setSurfaceIds)
+        bool colored = false;                       ///< the mesh has COLOR_0 (uHasVertexColor)
+        glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< world space, of this run's triangles
     };
     gl::Buffer mVertices;
     gl::Buffer mIndices;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -314,11 +315,230 @@ Scene makeCrease() {
     return scene;
 }
 
+// ---- The atrium: a large scene for the triangle-count benchmarks ---------------------------------
+
+/// Appends a procedural RGBA8 texture (`texel(x, y)` gives each texel) and returns its index.
+template <typename Texel>
+int addTexture(Scene& scene, const std::string& name, int size, bool srgb, Texel texel) {
+    TextureImage image{.width = size, .height = size, .name = name, .srgb = srgb};
+    image.rgba.reserve(static_cast<std::size_t>(size) * size * 4);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::u8vec4 c = texel(x, y);
+            image.rgba.insert(image.rgba.end(), {c.r, c.g, c.b, c.a});
+        }
+    scene.textures.push_back(std::move(image));
+    return static_cast<int>(scene.textures.size()) - 1;
+}
+
+/// A small integer hash in [0, 1): texture variation without a random number generator's state.
+float hash01(int x, int y, int salt) {
+    std::uint32_t h = static_cast<std::uint32_t>(x) * 374761393u +
+                      static_cast<std::uint32_t>(y) * 668265263u +
+                      static_cast<std::uint32_t>(salt) * 2246822519u;
+    h = (h ^ (h >> 13)) * 1274126177u;
+    return static_cast<float>((h ^ (h >> 16)) & 0xffffffu) / 16777216.0f;
+}
+
+/// A surface of revolution about +Y through `base`: radius(phi, t) at height t * height, `segments`
+/// around (the seam shared) and `rings` up, open at both ends, outward-facing. Normals are left to
+/// finalizeScene (smooth, area-weighted).
+template <typename Radius>
+Mesh makeColumn(const std::string& name, int material, const glm::vec3& base, float height, int segments,
+                int rings, Radius radius) {
+    Mesh mesh{.name = name, .material = material};
+    const float twoPi = glm::two_pi<float>();
+    for (int j = 0; j <= rings; ++j)
+        for (int i = 0; i < segments; ++i) {
+            const float phi = twoPi * static_cast<float>(i) / static_cast<float>(segments);
+            const float t = static_cast<float>(j) / static_cast<float>(rings);
+            const float r = radius(phi, t);
+            mesh.positions.push_back(base + glm::vec3(r * std::cos(phi), t * height, r * std::sin(phi)));
+            mesh.texcoords.emplace_back(static_cast<float>(i) / static_cast<float>(segments), t * 4.0f);
+        }
+    const auto seg = static_cast<std::uint32_t>(segments);
+    for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(rings); ++j)
+        for (std::uint32_t i = 0; i < seg; ++i) {
+            const std::uint32_t p00 = j * seg + i, p10 = j * seg + (i + 1) % seg, p01 = p00 + seg,
+                                p11 = p10 + seg;
+            // Seen from outside, +phi then +y turns clockwise: wind the other way.
+            mesh.indices.insert(mesh.indices.end(), {p00, p11, p10, p00, p01, p11});
+        }
+    return mesh;
+}
+
+/// Part of a torus: the tube of radius `minor` swept `sweep` radians along a circle of radius `major`
+/// about `centre`, in the plane spanned by `u` (angle 0) and `v` (angle pi/2), `sweepSegments` x
+/// `tubeSegments` quads, outward-facing. A half sweep in a vertical plane is an arch.
+Mesh makeTorusPart(const std::string& name, int material, const glm::vec3& centre, const glm::vec3& u,
+                   const glm::vec3& v, float major, float minor, float sweep, int sweepSegments,
+                   int tubeSegments) {
+    Mesh mesh{.name = name, .material = material};
+    const glm::vec3 axis = glm::normalize(glm::cross(u, v));
+    const bool closed = sweep >= glm::two_pi<float>() - 1e-4f;
+    const int along = closed ? sweepSegments : sweepSegments + 1;
+    for (int j = 0; j < along; ++j) {
+        const float a = sweep * static_cast<float>(j) / static_cast<float>(sweepSegments);
+        const glm::vec3 out = std::cos(a) * u + std::sin(a) * v; // from the centre to the tube's axis
+        for (int i = 0; i < tubeSegments; ++i) {
+            const float b = glm::two_pi<float>() * static_cast<float>(i) / static_cast<float>(tubeSegments);
+            const glm::vec3 n = std::cos(b) * out + std::sin(b) * axis;
+            mesh.positions.push_back(centre + major * out + minor * n);
+            mesh.texcoords.emplace_back(static_cast<float>(j) / static_cast<float>(sweepSegments) * 4.0f,
+                                        static_cast<float>(i) / static_cast<float>(tubeSegments));
+        }
+    }
+    const auto tube = static_cast<std::uint32_t>(tubeSegments);
+    const auto rows = static_cast<std::uint32_t>(along);
+    for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(sweepSegments); ++j)
+        for (std::uint32_t i = 0; i < tube; ++i) {
+            const std::uint32_t j1 = (j + 1) % rows;
+            const std::uint32_t p00 = j * tube + i, p10 = j * tube + (i + 1) % tube, p01 = j1 * tube + i,
+                                p11 = j1 * tube + (i + 1) % tube;
+            // Seen from outside, +tube angle then +sweep turns clockwise: wind the other way.
+            mesh.indices.insert(mesh.indices.end(), {p00, p11, p10, p00, p01, p11});
+        }
+    return mesh;
+}
+
+/// A 16 x 12 x 9 m courtyard open to the sky: two colonnades of fluted columns joined by arches, a
+/// fountain ring, a stone floor (texture), ivy on the west wall and a pergola under the open roof
+/// (alpha-masked textures), lit by the sun through the pergola. `detail` scales every curved
+/// surface's tessellation in both directions (1: about 560k triangles, the triangle count grows
+/// with its square).
+Scene makeAtrium(double detail) {
+    Scene scene;
+    auto steps = [&](int full, int least) {
+        return std::max(least, static_cast<int>(std::lround(full * detail)));
+    };
+    const int floorTexture = addTexture(scene, "stone_tiles", 128, true, [](int x, int y) {
+        const bool dark = ((x / 64) + (y / 64)) % 2 == 1;
+        const float grain = 0.85f + 0.15f * hash01(x / 2, y / 2, 1);
+        const bool grout = x % 64 < 2 || y % 64 < 2;
+        const glm::vec3 c = grout ? glm::vec3(0.35f)
+                                  : (dark ? glm::vec3(0.42f, 0.38f, 0.33f) : glm::vec3(0.8f, 0.76f, 0.68f));
+        const glm::vec3 srgb = glm::pow(glm::clamp(c * grain, 0.0f, 1.0f), glm::vec3(1.0f / 2.2f)) * 255.0f;
+        return glm::u8vec4(glm::u8vec3(srgb), 255);
+    });
+    // Leaves: discs at hashed positions in 16 x 16 cells, each opaque inside, cut out between.
+    const int ivyTexture = addTexture(scene, "ivy_leaves", 128, true, [](int x, int y) {
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int cx = x / 16 + dx, cy = y / 16 + dy;
+                const float px = (static_cast<float>(cx) + hash01(cx, cy, 2)) * 16.0f;
+                const float py = (static_cast<float>(cy) + hash01(cx, cy, 3)) * 16.0f;
+                const float r = 6.0f + 5.0f * hash01(cx, cy, 4);
+                const float d =
+                    glm::length(glm::vec2(static_cast<float>(x) - px, static_cast<float>(y) - py));
+                if (d < r) {
+                    const float g = 0.5f + 0.5f * hash01(cx, cy, 5);
+                    return glm::u8vec4(static_cast<std::uint8_t>(40 * g), static_cast<std::uint8_t>(150 * g),
+                                       30, 255);
+                }
+            }
+        return glm::u8vec4(30, 90, 20, 0);
+    });
+    // Slats: a bar along each edge of the tile (a quarter of it), open in between.
+    const int latticeTexture = addTexture(scene, "pergola_lattice", 64, true, [](int x, int y) {
+        const bool bar = x % 32 < 8 || y % 32 < 6;
+        return glm::u8vec4(120, 80, 45, bar ? 255 : 0);
+    });
+
+    auto add = [&](Material m) {
+        scene.materials.push_back(std::move(m));
+        return static_cast<int>(scene.materials.size()) - 1;
+    };
+    const int stone = add({.name = "stone_floor", .baseColorTexture = floorTexture, .roughness = 0.8f});
+    const int plaster = add({.name = "plaster", .baseColor = {0.75f, 0.72f, 0.66f, 1.0f}, .roughness = 0.9f});
+    const int marble = add({.name = "marble", .baseColor = {0.85f, 0.83f, 0.8f, 1.0f}, .roughness = 0.5f});
+    const int basin = add({.name = "basin", .baseColor = {0.35f, 0.37f, 0.4f, 1.0f}, .roughness = 0.7f});
+    const int ivy = add({.name = "ivy",
+                         .baseColorTexture = ivyTexture,
+                         .roughness = 0.7f,
+                         .alphaMode = Material::Alpha::Mask,
+                         .alphaCutoff = 0.5f});
+    const int pergola = add({.name = "pergola",
+                             .baseColorTexture = latticeTexture,
+                             .roughness = 0.8f,
+                             .alphaMode = Material::Alpha::Mask,
+                             .alphaCutoff = 0.5f});
+
+    const float hx = 8.0f, hz = 6.0f, wallHeight = 9.0f;
+    auto grid = [&](const std::string& name, int material, glm::vec3 origin, glm::vec3 u, glm::vec3 v, int n,
+                    float uvScale) {
+        Mesh mesh{.name = name, .material = material};
+        addGrid(mesh, origin, u, v, n);
+        for (glm::vec2& t : mesh.texcoords) t *= uvScale;
+        scene.meshes.push_back(std::move(mesh));
+    };
+    grid("floor", stone, {-hx, 0, -hz}, {0, 0, 2 * hz}, {2 * hx, 0, 0}, 24, 8.0f);
+    grid("back_wall", plaster, {-hx, 0, -hz}, {2 * hx, 0, 0}, {0, wallHeight, 0}, 8, 1.0f);
+    grid("front_wall", plaster, {hx, 0, hz}, {-2 * hx, 0, 0}, {0, wallHeight, 0}, 8, 1.0f);
+    grid("left_wall", plaster, {-hx, 0, -hz}, {0, wallHeight, 0}, {0, 0, 2 * hz}, 8, 1.0f);
+    grid("right_wall", plaster, {hx, 0, -hz}, {0, 0, 2 * hz}, {0, wallHeight, 0}, 8, 1.0f);
+    // Ivy on the west wall, facing the default view down the court.
+    for (int k = 0; k < 3; ++k) {
+        const float z0 = -4.5f + 3.25f * static_cast<float>(k);
+        grid("ivy_" + std::to_string(k), ivy, {-hx + 0.08f, 0.5f, z0}, {0, 4.0f, 0}, {0, 0, 2.5f}, 1, 3.0f);
+    }
+    // Facing down, under the open top: the sun reaches the floor through its gaps.
+    grid("pergola", pergola, {-hx, 8.0f, -hz}, {2 * hx, 0, 0}, {0, 0, 2 * hz}, 4, 12.0f);
+
+    // Colonnades: seven fluted columns a row at z = +-3.5, arches between them, a beam along the top.
+    const int segments = steps(128, 8), rings = steps(128, 2);
+    const float columnBase = 0.25f, columnTop = 4.0f, capital = 0.3f;
+    for (float z : {-3.5f, 3.5f}) {
+        const std::string side = z < 0.0f ? "north" : "south";
+        for (int i = 0; i < 7; ++i) {
+            const float x = -6.0f + 2.0f * static_cast<float>(i);
+            const std::string id = side + "_" + std::to_string(i);
+            scene.meshes.push_back(
+                makeColumn("column_" + id, marble, {x, columnBase, z}, columnTop - columnBase, segments,
+                           rings, [](float phi, float t) {
+                               // Slight entasis and 24 flutes.
+                               return 0.26f - 0.03f * t * t + 0.012f * std::cos(24.0f * phi);
+                           }));
+            scene.meshes.push_back(
+                makeBox("base_" + id, marble, {x, columnBase / 2, z}, {0.7f, columnBase, 0.7f}, 0.0f));
+            scene.meshes.push_back(makeBox("capital_" + id, marble, {x, columnTop + capital / 2, z},
+                                           {0.75f, capital, 0.75f}, 0.0f));
+            if (i + 1 < 7)
+                scene.meshes.push_back(makeTorusPart("arch_" + id, marble, {x + 1.0f, columnTop + capital, z},
+                                                     {1, 0, 0}, {0, 1, 0}, 1.0f, 0.18f, glm::pi<float>(),
+                                                     steps(96, 4), steps(32, 4)));
+        }
+        scene.meshes.push_back(makeBox("beam_" + side, marble, {0.0f, 5.75f, z}, {12.8f, 0.5f, 0.5f}, 0.0f));
+    }
+    scene.meshes.push_back(makeTorusPart("fountain", basin, {0.0f, 0.25f, 0.0f}, {1, 0, 0}, {0, 0, -1}, 1.2f,
+                                         0.25f, glm::two_pi<float>(), steps(256, 8), steps(48, 4)));
+
+    scene.lights.push_back(Light{.name = "sun",
+                                 .type = LightType::Directional,
+                                 .position = {0.0f, 12.0f, 0.0f},
+                                 .direction = glm::normalize(glm::vec3(-0.35f, -1.0f, -0.25f)),
+                                 .color = {1.0f, 0.95f, 0.85f},
+                                 .intensity = 3.0f});
+    scene.cameras.push_back(Camera{.name = "default",
+                                   .position = {7.4f, 2.6f, 1.2f},
+                                   .target = {-6.0f, 2.2f, -0.8f},
+                                   .up = glm::vec3(0.0f, 1.0f, 0.0f),
+                                   .yfovRadians = glm::radians(60.0f),
+                                   .znear = 0.05f,
+                                   .zfar = 60.0f});
+    return scene;
+}
+
+/// The atrium's detail for about `triangles` triangles (its count grows with detail^2).
+double atriumDetail(double triangles) {
+    constexpr double kTrianglesAtDetail1 = 560000.0;
+    return std::sqrt(std::max(triangles, 1.0) / kTrianglesAtDetail1);
+}
+
 } // namespace
 
 std::vector<std::string> builtinSceneNames() {
-    return {"cornell", "cornell-empty", "cornell-dense", "crease",         "cornell-black",
-            "gallery", "cornell-point", "sun-room",      "cornell-colored"};
+    return {"cornell", "cornell-empty", "cornell-dense", "crease",          "cornell-black",
+            "gallery", "cornell-point", "sun-room",      "cornell-colored", "atrium"};
 }
 
 Scene makeBuiltinScene(const std::string& name) {
@@ -341,6 +561,13 @@ Scene makeBuiltinScene(const std::string& name) {
         scene = makeSunRoom();
     else if (name == "cornell-colored")
         scene = makeCornellColored();
+    else if (name == "atrium")
+        scene = makeAtrium(1.0);
+    else if (int k = 0; name.starts_with("atrium-") && name.ends_with("k") &&
+                        std::sscanf(name.c_str(), "atrium-%dk", &k) == 1 && k >= 1 && k <= 20000 &&
+                        name == "atrium-" + std::to_string(k) + "k")
+        // The benchmarks' sizes (docs/scenes.md): atrium-10k .. atrium-2000k, about k thousand triangles.
+        scene = makeAtrium(atriumDetail(1000.0 * k));
     else {
         std::string known;
         for (const auto& n : builtinSceneNames()) known += (known.empty() ? "" : ", ") + n;

@@ -25,7 +25,43 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
 TEST(BuiltinScenes, NamesList) {
     EXPECT_EQ(builtinSceneNames(), (std::vector<std::string>{
                                        "cornell", "cornell-empty", "cornell-dense", "crease", "cornell-black",
-                                       "gallery", "cornell-point", "sun-room", "cornell-colored"}));
+                                       "gallery", "cornell-point", "sun-room", "cornell-colored", "atrium"}));
+}
+
+TEST(BuiltinScenes, AtriumIsBigTexturedAndCutOut) {
+    const Scene atrium = loadScene("builtin:atrium");
+    EXPECT_GE(atrium.triangleCount(), 500000u);
+    EXPECT_GE(atrium.textures.size(), 3u);
+    int masked = 0, textured = 0;
+    for (const Material& m : atrium.materials) {
+        masked += m.alphaMode == Material::Alpha::Mask ? 1 : 0;
+        textured += m.baseColorTexture >= 0 ? 1 : 0;
+    }
+    EXPECT_GE(masked, 2);
+    EXPECT_GE(textured, 3);
+    // The cutout textures are partly transparent, partly opaque.
+    for (const TextureImage& t : atrium.textures) {
+        if (t.name == "stone_tiles") continue;
+        int transparent = 0, opaque = 0;
+        for (std::size_t i = 3; i < t.rgba.size(); i += 4) (t.rgba[i] < 128 ? transparent : opaque) += 1;
+        EXPECT_GT(transparent, 0) << t.name;
+        EXPECT_GT(opaque, 0) << t.name;
+    }
+    // The 16 x 9 x 12 m courtyard: the scene-relative knobs' unit is its 16 m.
+    EXPECT_NEAR(atrium.bounds.longestSide(), 16.0f, 1e-3f);
+}
+
+TEST(BuiltinScenes, AtriumSizesForTheBenchmarks) {
+    for (const auto& [name, target] :
+         {std::pair{"atrium-10k", 10000.0}, {"atrium-100k", 100000.0}, {"atrium-2000k", 2000000.0}}) {
+        const Scene s = loadScene(std::string("builtin:") + name);
+        const double ratio = static_cast<double>(s.triangleCount()) / target;
+        EXPECT_GT(ratio, 0.75) << name << ": " << s.triangleCount();
+        EXPECT_LT(ratio, 1.35) << name << ": " << s.triangleCount();
+    }
+    for (const char* bad :
+         {"atrium-0k", "atrium-k", "atrium-01k", "atrium-10", "atrium-99999k", "atrium-1.5k"})
+        EXPECT_THROW(makeBuiltinScene(bad), InputError) << bad;
 }
 
 TEST(BuiltinScenes, LightScenesHaveTheirLightTypes) {
