@@ -821,6 +821,17 @@ private:
                 fail(context + ": COLOR_0 has " + std::to_string(mesh.colors.size()) +
                      " elements, POSITION " + std::to_string(mesh.positions.size()));
         }
+        // The file's own tangents where its material maps normals: exporters compute them with
+        // MikkTSpace, which the tangents generated at load only approximate.
+        const bool normalMapped =
+            prim.material >= 0 && prim.material < static_cast<int>(mScene.materials.size()) &&
+            mScene.materials[static_cast<std::size_t>(prim.material)].normalTexture >= 0;
+        if (const int a = attribute("TANGENT"); a >= 0 && normalMapped) {
+            mesh.tangents = readVectors<4>(a, TINYGLTF_TYPE_VEC4, context + " TANGENT");
+            if (mesh.tangents.size() != mesh.positions.size())
+                fail(context + ": TANGENT has " + std::to_string(mesh.tangents.size()) +
+                     " elements, POSITION " + std::to_string(mesh.positions.size()));
+        }
         if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
             fail(context + ": NORMAL has " + std::to_string(mesh.normals.size()) + " elements, POSITION " +
                  std::to_string(mesh.positions.size()));
@@ -846,6 +857,14 @@ private:
         for (auto& p : mesh.positions) p = glm::vec3(world * glm::vec4(p, 1.0f));
         // Zero results are left for finalizeScene, which replaces them with face normals.
         for (auto& n : mesh.normals) n = safeNormalize(normalMatrix * n, glm::vec3(0.0f));
+        // Tangents follow the surface (the linear part); a mirror flips the bitangent's handedness.
+        // One that is zero or not finite stays zero: that vertex's normal is left unmapped.
+        const float handedness = glm::determinant(linear) < 0.0f ? -1.0f : 1.0f;
+        for (auto& t : mesh.tangents) {
+            const glm::vec3 v = safeNormalize(linear * glm::vec3(t), glm::vec3(0.0f));
+            t = v == glm::vec3(0.0f) ? glm::vec4(0.0f)
+                                     : glm::vec4(v, (t.w < 0.0f ? -1.0f : 1.0f) * handedness);
+        }
         // A mirroring transform turns CCW into CW; swap to keep front faces CCW (glTF 3.7.4).
         if (glm::determinant(linear) < 0.0f)
             for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
@@ -858,7 +877,7 @@ private:
         const std::uint64_t bytes =
             mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
             mesh.texcoords.size() * sizeof(glm::vec2) + mesh.colors.size() * sizeof(glm::vec4) +
-            mesh.indices.size() * sizeof(std::uint32_t);
+            mesh.tangents.size() * sizeof(glm::vec4) + mesh.indices.size() * sizeof(std::uint32_t);
         if (!mContext.spend(bytes, context)) fail(mContext.refusal);
         mScene.meshes.push_back(std::move(mesh));
     }

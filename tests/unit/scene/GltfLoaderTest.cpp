@@ -403,6 +403,36 @@ TEST(GltfLoader, NormalMapGetsTangentsAlongU) {
     EXPECT_TRUE(s.notShown.empty());
 }
 
+// The file's own TANGENT attribute is used where it maps normals (not regenerated), carried through
+// the node's transform: a mirror flips the handedness; a zero tangent stays zero (unmapped there).
+TEST(GltfLoader, NormalMapUsesTheFilesTangents) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode(); // facing +y
+    const int uv = b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 0, 0, 1}), test::kFloat, 3, "VEC2");
+    // Deliberately not what generation would give (+x): the file's (0, 0, 1) and (0, 0, 0).
+    const int tangents =
+        b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 1, 0, 0, 1, -1, 0, 0, 0, 1}), test::kFloat, 3, "VEC4");
+    auto& prim = b.doc["meshes"][0]["primitives"][0];
+    prim["attributes"]["TEXCOORD_0"] = uv;
+    prim["attributes"]["TANGENT"] = tangents;
+    prim["material"] = 0;
+    addTinyTexture(b);
+    b.doc["materials"] = {{{"normalTexture", {{"index", 0}}}}};
+    b.doc["nodes"][static_cast<std::size_t>(tri)]["scale"] = {-2.0, 1.0, 1.0}; // a mirror in x
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "tangents.glb"));
+    const Mesh& mesh = s.meshes[0];
+    ASSERT_EQ(mesh.tangents.size(), 3u);
+    EXPECT_EQ(mesh.tangents[0], glm::vec4(0, 0, 1, -1)) << "mirrored: w flips";
+    EXPECT_EQ(mesh.tangents[1], glm::vec4(0, 0, 1, 1));
+    EXPECT_EQ(mesh.tangents[2], glm::vec4(0.0f)) << "a zero tangent leaves that vertex unmapped";
+
+    // Without a normal map the attribute is not needed and not kept.
+    b.doc["materials"] = {{{"name", "plain"}}};
+    EXPECT_TRUE(loadGltf(b.writeGlb(dir, "plain.glb")).meshes[0].tangents.empty());
+}
+
 TEST(GltfLoader, SpecularFactorDefaultsToGltfsDielectricAndReadsTheExtension) {
     TempDir dir;
     GltfBuilder b;
