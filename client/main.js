@@ -36,7 +36,7 @@ import {
     formatCompare, referenceLabel, validateCompareRequest, viewKey,
 } from './accuracy.js';
 import { MessageStack, describeError, describeHttpError, noticeFor } from './messages.js';
-import { uploadGlb, uploadName } from './upload.js';
+import { uploadScene, uploadName } from './upload.js';
 
 const RESIZE_DEBOUNCE_MS = 200;
 const MESSAGE_HIDE_MS = 8000;
@@ -1023,8 +1023,9 @@ const sceneGui = (() => {
         flushOutbox();
         if (steer(sceneMsg(name))) state.scene = name;
     });
-    const uploadCtl = describe(gui.add(model, 'upload').name('Upload .glb…'), 'upload',
-        'or drop a .glb file on the view; it is loaded for this session only');
+    const uploadCtl = describe(gui.add(model, 'upload').name('Upload .glb or .zip…'), 'upload',
+        'a .glb, or a .zip holding a .gltf with its .bin and textures; or drop one on the view. '
+        + 'It is loaded for this session only');
     const progress = addBlock(gui, block('div', 'upload-progress block'));
     progress.hidden = true;
     const bar = progress.appendChild(Object.assign(document.createElement('progress'), { max: 1, value: 0 }));
@@ -1868,7 +1869,7 @@ async function uploadFile(file) {
     if (state.viewer) return;
     const name = uploadName(file?.name);
     if (!name) {
-        showMessage(`Only binary glTF (.glb) files can be uploaded, not "${file?.name ?? '?'}".`);
+        showMessage(`Only binary glTF (.glb) files, or a .gltf zipped with its files (.zip), can be uploaded, not "${file?.name ?? '?'}".`);
         return;
     }
     const resumeToken = state.welcome?.resume_token;
@@ -1879,7 +1880,7 @@ async function uploadFile(file) {
     const size = formatBytes(file.size);
     sceneGui.progress(0, `uploading ${name} (${size})`);
     try {
-        const answer = await uploadGlb(file, name, {
+        const answer = await uploadScene(file, name, {
             resumeToken,
             serverToken: page.token,
             onProgress: (f) => sceneGui.progress(f, `uploading ${name}: ${(100 * f).toFixed(0)} % of ${size}`),

@@ -13,6 +13,7 @@ find_package(TinyGLTF CONFIG REQUIRED)                 # shared lib: never defin
 pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)    # libstb-dev: image headers read before decoding
 find_package(draco CONFIG REQUIRED)                    # libdraco-dev: KHR_draco_mesh_compression
 find_package(meshoptimizer CONFIG REQUIRED)            # libmeshoptimizer-dev: EXT_meshopt_compression
+pkg_check_modules(LIBZIP REQUIRED IMPORTED_TARGET libzip) # libzip-dev: zipped .gltf uploads
 find_package(libjpeg-turbo CONFIG REQUIRED)
 find_package(PNG REQUIRED)
 find_package(libwebsockets CONFIG REQUIRED)

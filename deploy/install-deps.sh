@@ -17,6 +17,8 @@ PACKAGES=(
     openimageio-tools libturbojpeg0-dev libwebp-dev libpng-dev
     # compressed glTF: Draco and meshopt decoding
     libdraco-dev libmeshoptimizer-dev
+    # zipped .gltf uploads (a .gltf with its .bin and textures)
+    libzip-dev
     # reference renderer
     libembree-dev libtbb-dev
     # network

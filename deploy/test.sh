@@ -54,8 +54,8 @@ if [[ "$FUZZ" == 1 ]]; then
     flags="-fsanitize=fuzzer-no-link,address,undefined"
     CC=clang CXX=clang++ cmake -S "$ROOT" -B "$ROOT/build/fuzz" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
         -DGIS_FUZZ=ON -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" >/dev/null
-    cmake --build "$ROOT/build/fuzz" -j "$JOBS" --target gis_fuzz_gltf gis_fuzz_protocol
-    for target in gltf protocol; do
+    cmake --build "$ROOT/build/fuzz" -j "$JOBS" --target gis_fuzz_gltf gis_fuzz_archive gis_fuzz_protocol
+    for target in gltf archive protocol; do
         # A scratch copy: new corpus entries stay out of the tree; crashes land in build/fuzz.
         work="$(mktemp -d)"
         cp -r "$ROOT/tests/fuzz/corpus/$target/." "$work/"

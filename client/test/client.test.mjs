@@ -24,7 +24,7 @@ import {
     referenceLabel, validateCompareRequest, viewKey,
 } from '../accuracy.js';
 import { describeError, describeHttpError } from '../messages.js';
-import { uploadName } from '../upload.js';
+import { uploadName, uploadType } from '../upload.js';
 import { cameraMsg, lightAddMsg, lightMsg, validateClientMessage, validateParamValues } from '../protocol.js';
 import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from '../schemas.js';
 import { dot, length, normalize } from '../vec.js';
@@ -534,7 +534,10 @@ test('upload names follow the server\'s rules', () => {
     assert.equal(uploadName('.hidden.glb'), 'hidden.glb');
     assert.equal(uploadName('.glb'), 'scene.glb');
     assert.equal(uploadName(`${'x'.repeat(300)}.glb`).length, 100);
-    assert.equal(uploadName('scene.gltf'), null);
+    assert.equal(uploadName('scene.gltf'), null, 'a .gltf needs its files: zip them');
+    assert.equal(uploadName('Sponza (glTF).ZIP'), 'Sponza_glTF_.zip');
+    assert.equal(uploadType(uploadName('a.zip')), 'application/zip');
+    assert.equal(uploadType(uploadName('a.glb')), 'model/gltf-binary');
     assert.equal(uploadName(undefined), null);
     for (const name of ['My Scene (2).glb', 'ü.glb', `${'y'.repeat(150)}.glb`]) {
         assert.match(uploadName(name), /^[A-Za-z0-9_-][A-Za-z0-9._-]{0,95}\.glb$/, name);

@@ -33,6 +33,7 @@
 #include "net/RateLimiter.h"
 #include "render/FrameRenderer.h"
 #include "job/RenderRequest.h"
+#include "scene/SceneArchive.h"
 #include "scene/SceneLoader.h"
 #include "session/GlWorkerPool.h"
 #include "session/RenderGate.h"
@@ -793,6 +794,45 @@ struct WsServer::Impl {
         awaiting[id] = wsi;
     }
 
+    /// A .zip upload: extracted beside (SceneArchive checks every entry and the unpacked size against
+    /// what the session's budget has left), then renamed over the old folder of that name.
+    void storeArchive(lws* wsi, PerSession* pss, const SessionEntry& entry, const std::string& name,
+                      const fs::path& dir, std::uintmax_t room) {
+        const HttpExchange* x = pss->http;
+        const fs::path partial = dir / ("." + name + ".part");
+        std::error_code ec;
+        fs::remove_all(partial, ec);
+        std::string sceneFile;
+        try {
+            sceneFile = extractSceneArchive(x->body, partial, ArchiveLimits{.maxBytes = room}, name);
+        } catch (const ArchiveTooLarge& e) {
+            respond(wsi, pss,
+                    errorResponse(413, "uploads_full",
+                                  e.reason() + " (what this session's upload budget of " +
+                                      std::to_string(config.maxSessionUploadsMb) + " MiB has left)"));
+            return;
+        } catch (const InputError& e) {
+            respond(wsi, pss, errorResponse(400, "bad_archive", e.reason()));
+            return;
+        } catch (const Error&) {
+            fs::remove_all(partial, ec);
+            respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
+            return;
+        }
+        fs::remove_all(dir / name, ec);
+        fs::rename(partial, dir / name, ec);
+        if (ec) {
+            fs::remove_all(partial, ec);
+            respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
+            return;
+        }
+        logInfo("net: session " + entry.session->id() + " stored upload:" + name + " (" +
+                std::to_string(x->body.size()) + " bytes, scene " + sceneFile + ") from " + peerAddress(wsi));
+        respond(
+            wsi, pss,
+            jsonResponse(201, {{"scene", "upload:" + name}, {"bytes", x->body.size()}, {"file", sceneFile}}));
+    }
+
     void handleUpload(lws* wsi, PerSession* pss) {
         HttpExchange* x = pss->http;
         const std::string name = urlArg(wsi, "name=");
@@ -812,19 +852,34 @@ struct WsServer::Impl {
                                   "send the resume token of a live session in the X-GI-Session header"));
             return;
         }
-        if (x->body.size() < 12 || x->body.compare(0, 4, "glTF") != 0) {
+        const bool zipped = name.ends_with(".zip");
+        if (zipped && !looksLikeZip(x->body)) {
+            respond(wsi, pss, errorResponse(400, "not_zip", "the body is not a zip archive"));
+            return;
+        }
+        if (!zipped && (x->body.size() < 12 || x->body.compare(0, 4, "glTF") != 0)) {
             respond(wsi, pss, errorResponse(400, "not_glb", "the body is not a binary glTF (.glb) file"));
             return;
         }
         std::error_code ec;
         const fs::path dir = entry->session->uploadDir();
         fs::create_directories(dir, ec);
-        // The session's uploads together (a replaced file no longer counts) stay within the budget.
+        // The session's uploads together (a replaced file no longer counts) stay within the budget;
+        // an archive counts as what it unpacks to.
         std::uintmax_t stored = 0;
-        for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
-             it.increment(ec))
-            if (it->is_regular_file(ec) && it->path().filename() != name) stored += it->file_size(ec);
+        for (auto it = fs::recursive_directory_iterator(dir, ec);
+             !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+            if (it.depth() == 0 && it->path().filename() == name) {
+                it.disable_recursion_pending();
+                continue;
+            }
+            if (it->is_regular_file(ec)) stored += it->file_size(ec);
+        }
         const std::uintmax_t budget = static_cast<std::uintmax_t>(config.maxSessionUploadsMb) << 20;
+        if (zipped) {
+            storeArchive(wsi, pss, *entry, name, dir, budget > stored ? budget - stored : 0);
+            return;
+        }
         if (stored + x->body.size() > budget) {
             respond(wsi, pss,
                     errorResponse(413, "uploads_full",

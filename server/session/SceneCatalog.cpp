@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <optional>
 #include <system_error>
 
 #include "core/Error.h"
+#include "scene/SceneArchive.h"
 #include "scene/SceneLoader.h"
 
 namespace gis {
@@ -64,7 +66,10 @@ std::vector<std::string> SceneCatalog::list(const std::string& uploadDir) const 
         std::error_code ec;
         for (auto it = fs::directory_iterator(uploadDir, ec); !ec && it != fs::directory_iterator();
              it.increment(ec))
-            if (it->is_regular_file(ec) && it->path().extension() == ".glb")
+            // A .glb file, or the folder a .zip was extracted into (scene/SceneArchive.h).
+            if ((it->is_regular_file(ec) && it->path().extension() == ".glb") ||
+                (it->is_directory(ec) && it->path().extension() == ".zip" &&
+                 it->path().filename().string()[0] != '.'))
                 uploads.push_back("upload:" + it->path().filename().string());
         std::sort(uploads.begin(), uploads.end());
         out.insert(out.end(), uploads.begin(), uploads.end());
@@ -98,7 +103,13 @@ std::string SceneCatalog::resolve(const std::string& name, const std::string& up
         std::error_code ec;
         const fs::path root = fs::canonical(uploadDir, ec);
         std::string resolved;
-        if (safe && !ec && inside(root / file, root.string(), resolved)) return resolved;
+        if (safe && !ec && inside(root / file, root.string(), resolved)) {
+            if (!file.ends_with(".zip")) return resolved;
+            // An extracted archive: its one scene file, which must stay inside the folder.
+            const std::optional<fs::path> scene = findArchivedScene(resolved);
+            std::string sceneFile;
+            if (scene && inside(*scene, resolved, sceneFile)) return sceneFile;
+        }
     }
     throw InputError("/name",
                      "unknown scene '" + name + "': pick one from welcome.scenes or GET /api/scenes");
@@ -108,7 +119,9 @@ SceneLoadOptions SceneCatalog::loadOptions(const std::string& name) const {
     SceneLoadOptions options;
     options.displayName = name;
     if (name == mDefault) return options; // the operator's own choice: no budget
-    options.allowExternalFiles = name.rfind("upload:", 0) != 0;
+    // A zipped upload's .gltf reads its .bin and textures from its own folder (the sandbox keeps it
+    // there); a .glb upload is self-contained.
+    options.allowExternalFiles = name.rfind("upload:", 0) != 0 || name.ends_with(".zip");
     options.maxDecodedBytes = mMaxDecodedBytes;
     return options;
 }
@@ -117,11 +130,12 @@ void SceneCatalog::checkUploadName(const std::string& name) {
     const bool charsOk = std::all_of(name.begin(), name.end(), [](unsigned char c) {
         return std::isalnum(c) || c == '.' || c == '_' || c == '-';
     });
-    if (name.empty() || name.size() > 100 || !charsOk || name[0] == '.' || !name.ends_with(".glb"))
-        throw InputError("name",
-                         "upload names use letters, digits, '.', '_' and '-', end in .glb and have at "
-                         "most 100 characters, got '" +
-                             name + "'");
+    if (name.empty() || name.size() > 100 || !charsOk || name[0] == '.' ||
+        !(name.ends_with(".glb") || name.ends_with(".zip")))
+        throw InputError(
+            "name", "upload names use letters, digits, '.', '_' and '-', end in .glb (binary glTF) or .zip "
+                    "(a .gltf with its files) and have at most 100 characters, got '" +
+                        name + "'");
 }
 
 } // namespace gis

@@ -33,8 +33,9 @@ public:
     /// path); uploads may not reach external files; client-chosen files get the decoded-size budget.
     SceneLoadOptions loadOptions(const std::string& name) const;
 
-    /// A safe file name for an upload: [A-Za-z0-9._-], ends in .glb, at most 100 characters, no
-    /// leading dot. Throws InputError(where = "name") otherwise.
+    /// A safe file name for an upload: [A-Za-z0-9._-], ends in .glb or .zip (a .gltf with its files,
+    /// extracted into a folder of that name), at most 100 characters, no leading dot. Throws
+    /// InputError(where = "name") otherwise.
     static void checkUploadName(const std::string& name);
 
 private:

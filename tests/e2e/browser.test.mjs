@@ -535,6 +535,17 @@ test('a .glb dropped on the view is uploaded with progress and shown', async () 
     await until('nothing is listed for the Cornell box', () => document.querySelector('[data-block="not-shown"]').hidden);
 });
 
+test('a zipped .gltf chosen in the file picker is uploaded and shown', async () => {
+    // glTF Transform's .gltf + .bin + PNG of the corpus box, zipped (tests/data/corpus/compress.sh).
+    await page.setInputFiles('#file-input', path.join(REPO, 'tests/data/corpus/textured_box_gltf.zip'));
+    await until('the zipped scene renders', () => window.giClient.lastStats?.scene === 'upload:textured_box_gltf.zip');
+    assert.match(await page.locator('.upload-text').textContent(), /uploaded textured_box_gltf\.zip/);
+    assert.equal(await control('scene', 'select').inputValue(), 'upload:textured_box_gltf.zip');
+    assert.equal((await page.evaluate(() => window.giClient.lastStats.counts.triangles)), 108);
+    await control('scene', 'select').selectOption('builtin:cornell');
+    await until('back on the Cornell box', () => window.giClient.lastStats?.scene === 'builtin:cornell');
+});
+
 test('the orbit target sits at the model; "Frame the model" fits it; Reset camera returns to the scene camera',
     async () => {
         // The bounds come with welcome and every state: no wait beyond a moment.

@@ -564,6 +564,32 @@ check('GET /metrics is Prometheus text with the session and frame counters', asy
     }
 });
 
+check('a zipped .gltf with its .bin and texture folder uploads and renders; bad archives are 400', async () => {
+    const client = await open(servers.main);
+    const upload = (name, body) => servers.main.http(`/api/upload?name=${name}`, {
+        method: 'POST', body, headers: { 'Content-Type': 'application/zip', 'X-GI-Session': client.welcome.resume_token },
+    });
+    // glTF Transform's .gltf + .bin + PNG of the corpus box, zipped (tests/data/corpus/compress.sh).
+    const zip = readFileSync(path.join(REPO, 'tests/data/corpus/textured_box_gltf.zip'));
+    const res = await upload('box.zip', zip);
+    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
+    const stored = JSON.parse(res.body.toString());
+    assert.equal(stored.scene, 'upload:box.zip');
+    assert.equal(stored.file, 'textured_box/textured_box.gltf');
+    client.send({ type: 'scene', name: 'upload:box.zip' });
+    const frame = await client.frame('a frame of the zipped scene', (s) => s.scene === 'upload:box.zip');
+    assert.equal(frame.stats.counts?.triangles, 108, 'the box, with its .bin read from the folder');
+
+    const notZip = await upload('bad.zip', Buffer.from('glTF not a zip'));
+    assert.equal(notZip.status, 400);
+    assert.equal(JSON.parse(notZip.body.toString()).error, 'not_zip');
+    const damaged = await upload('bad.zip', zip.subarray(0, zip.length / 2));
+    assert.equal(damaged.status, 400);
+    const body = JSON.parse(damaged.body.toString());
+    assert.equal(body.error, 'bad_archive');
+    assert.match(body.message, /damaged/);
+});
+
 check('POST /api/upload of a body that is not a .glb is 400', async () => {
     const client = await open(servers.main);
     const res = await servers.main.http('/api/upload?name=tiny.glb', {

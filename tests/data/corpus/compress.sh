@@ -6,6 +6,7 @@
 #   suzanne_meshopt.glb                           gltfpack -c (meshopt, quantized: KHR_mesh_quantization)
 #   textured_box_meshopt.glb                      gltfpack -cc -noq (meshopt with filters, float data)
 #   textured_box_quantized.glb                    gltfpack (quantized; UVs dequantized by KHR_texture_transform)
+#   textured_box_gltf.zip                         gltf-transform copy to .gltf + .bin + PNG, zipped
 # usage: tests/data/corpus/compress.sh [SCRATCH_DIR]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -20,3 +21,15 @@ done
 gltfpack -i "$here/suzanne.glb" -o "$here/suzanne_meshopt.glb" -c
 gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_meshopt.glb" -cc -noq
 gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_quantized.glb"
+# textured_box_gltf.zip: the box as glTF Transform writes a .gltf (JSON, a .bin and a PNG), with the
+# texture moved into textures/ as model sites lay them out, zipped in a folder (a zipped upload).
+zipdir="$scratch/zip/textured_box"
+rm -rf "$scratch/zip" && mkdir -p "$zipdir/textures"
+"$scratch/node_modules/.bin/gltf-transform" copy "$here/textured_box.glb" "$zipdir/textured_box.gltf"
+mv "$zipdir/baseColor.png" "$zipdir/textures/baseColor.png"
+sed -i -E 's|"uri": *"baseColor.png"|"uri": "textures/baseColor.png"|' "$zipdir/textured_box.gltf"
+rm -f "$here/textured_box_gltf.zip"
+(cd "$scratch/zip" && python3 -c 'import sys, zipfile
+with zipfile.ZipFile(sys.argv[1], "w", zipfile.ZIP_DEFLATED) as z:
+    for f in ("textured_box/textured_box.gltf", "textured_box/textured_box.bin", "textured_box/textures/baseColor.png"):
+        z.write(f)' "$here/textured_box_gltf.zip")

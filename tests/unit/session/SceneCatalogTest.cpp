@@ -21,6 +21,15 @@ struct TempTree {
         std::ofstream(root / "scenes/notes.txt") << "x";
         std::ofstream(root / "secret.glb") << "x";
         std::ofstream(root / "uploads/mine.glb") << "x";
+        // An extracted zip upload (scene/SceneArchive.h), one half-written, and one whose only scene
+        // file is a link out of its folder.
+        fs::create_directories(root / "uploads/pack.zip/model/textures");
+        std::ofstream(root / "uploads/pack.zip/model/scene.gltf") << "x";
+        std::ofstream(root / "uploads/pack.zip/model/textures/t.png") << "x";
+        fs::create_directories(root / "uploads/.next.zip.part");
+        std::ofstream(root / "uploads/.next.zip.part/a.gltf") << "x";
+        fs::create_directories(root / "uploads/linked.zip");
+        fs::create_symlink(root / "secret.glb", root / "uploads/linked.zip/a.glb");
         fs::create_symlink(root / "secret.glb", root / "scenes/link.glb");
     }
     ~TempTree() { fs::remove_all(root); }
@@ -36,6 +45,8 @@ TEST(SceneCatalog, ListsBuiltinsFilesAndUploads) {
     EXPECT_TRUE(has("file:a.glb"));
     EXPECT_TRUE(has("file:sub/b.gltf"));
     EXPECT_TRUE(has("upload:mine.glb"));
+    EXPECT_TRUE(has("upload:pack.zip"));
+    EXPECT_FALSE(has("upload:.next.zip.part"));
     EXPECT_FALSE(has("file:notes.txt"));
 }
 
@@ -56,10 +67,17 @@ TEST(SceneCatalog, NamesNeverEscapeTheirDirectory) {
     // Uploads resolve only with the session's own sandbox.
     EXPECT_NO_THROW(catalog.resolve("upload:mine.glb", (t.root / "uploads").string()));
     EXPECT_THROW(catalog.resolve("upload:../secret.glb", (t.root / "uploads").string()), gis::InputError);
+    // A zip upload resolves to the scene file inside its folder, never to one outside.
+    EXPECT_EQ(catalog.resolve("upload:pack.zip", (t.root / "uploads").string()),
+              fs::canonical(t.root / "uploads/pack.zip/model/scene.gltf").string());
+    EXPECT_THROW(catalog.resolve("upload:linked.zip", (t.root / "uploads").string()), gis::InputError);
+    EXPECT_TRUE(catalog.loadOptions("upload:pack.zip").allowExternalFiles); // its .bin and textures
+    EXPECT_FALSE(catalog.loadOptions("upload:mine.glb").allowExternalFiles);
 }
 
 TEST(SceneCatalog, UploadNamesAreChecked) {
     EXPECT_NO_THROW(gis::SceneCatalog::checkUploadName("room_2-final.glb"));
+    EXPECT_NO_THROW(gis::SceneCatalog::checkUploadName("sponza.zip"));
     for (const char* bad : {"", ".hidden.glb", "a/b.glb", "x.gltf", "sp ace.glb", "..glb"})
         EXPECT_THROW(gis::SceneCatalog::checkUploadName(bad), gis::InputError) << bad;
     EXPECT_THROW(gis::SceneCatalog({"/nonexistent/dir"}, ""), gis::InputError);
