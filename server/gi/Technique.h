@@ -60,9 +60,14 @@ struct FrameInputs {
     /// derived from them alone (the extracted VPLs) still holds.
     bool lightViewsReused = false;
     const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
-    /// Draws the scene's triangles (world-space positions at attribute 0) with `program` bound,
-    /// `instances` times; techniques see geometry only through this (VPL shadow maps).
+    /// Draws the scene's triangles (world-space positions at attribute 0, texture coordinates at 2,
+    /// vertex colours at 4) with `program` bound, `instances` times; techniques see geometry only
+    /// through this (VPL shadow maps). With sceneCutsOut it also sets the material uniforms of
+    /// render/material.glsl that `program` declares, for its cutout test.
     std::function<void(const gl::Program& program, int instances)> drawGeometry;
+    /// Some material cuts out (alpha MASK or BLEND): programs drawn through drawGeometry are built
+    /// with GIS_ALPHA_CUTOUT so cut-out fragments are let through, as in the frame's own passes.
+    bool sceneCutsOut = false;
     float sceneExtent = 1.0f; ///< diagonal of the scene's bounds (m), > 0
     /// Longest side of the scene's bounds (m), > 0: the unit of the scene-relative knobs
     /// (min_distance, clamp_b; gi/common/ParamSpecs.h).

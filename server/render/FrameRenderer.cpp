@@ -508,8 +508,14 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     in.lightViewsReused = reuseLights;
     in.frame = &u;
     in.drawGeometry = [this](const gl::Program& program, int instances) {
-        mSceneGpu->draw(program, nullptr, instances);
+        if (!mSceneCutsOut) {
+            mSceneGpu->draw(program, nullptr, instances);
+            return;
+        }
+        const MaterialSlots slots = MaterialSlots::of(program); // once a frame: a few lookups
+        mSceneGpu->draw(program, &slots, instances);
     };
+    in.sceneCutsOut = mSceneCutsOut;
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     in.sceneSize = std::max(mScene->bounds.longestSide(), kMinSceneSize);
     const TechniqueInfo& techniqueInfo = findTechniqueInfo(state.technique);

@@ -6,6 +6,8 @@
 #include "GlTestSupport.h"
 #include "analysis/Metrics.h"
 #include "reference/ReferenceRenderer.h"
+#include "render/FrameRenderer.h"
+#include "scene/SceneLoader.h"
 
 using namespace gis;
 using gis::test::renderScene;
@@ -19,6 +21,38 @@ double relativeRmseRgba(const std::vector<float>& test, const std::vector<float>
         for (size_t c = 0; c < 3; ++c) rgb[i * 3 + c] = test[i * 4 + c];
     return relativeRmse(ImageView{rgb.data(), w, h, 3}, ImageView{referenceRgb.data(), w, h, 3},
                         maskFromNonZero(ImageView{referenceRgb.data(), w, h, 3}));
+}
+
+/// The empty Cornell room with a horizontal 1.2 m card at mid-height, between the floor's VPLs and the
+/// ceiling: opaque, or cut out everywhere (alpha 0 under MASK).
+Scene roomWithCard(bool cutOut) {
+    Scene s = loadScene("builtin:cornell-empty");
+    Mesh card{.name = "card", .material = static_cast<int>(s.materials.size())};
+    card.positions = {{-0.6f, 1.0f, -0.6f}, {0.6f, 1.0f, -0.6f}, {0.6f, 1.0f, 0.6f}, {-0.6f, 1.0f, 0.6f}};
+    card.normals.assign(4, glm::vec3(0.0f, -1.0f, 0.0f));
+    card.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    card.indices = {0, 1, 2, 0, 2, 3};
+    s.meshes.push_back(card);
+    Material m{.name = "card", .baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)};
+    if (cutOut) {
+        m.baseColorTexture = static_cast<int>(s.textures.size());
+        m.alphaMode = Material::Alpha::Mask;
+        s.textures.push_back(TextureImage{.width = 1, .height = 1, .rgba = {255, 255, 255, 0}, .name = "clear"});
+    }
+    s.materials.push_back(m);
+    s.updateBounds();
+    return s;
+}
+
+FrameOutput renderWithVplShadows(const Scene& scene) {
+    test::sharedContext();
+    FrameRenderer renderer;
+    renderer.setScene(std::make_shared<const Scene>(scene));
+    FrameState state = makeFrameState(scene, "rsm_gather");
+    state.width = 48;
+    state.height = 48;
+    state.techniqueParams.apply({{"vpl_grid", 8}, {"vpl_shadows", true}});
+    return renderer.render(state, true);
 }
 
 double sum(const std::vector<float>& v) {
@@ -92,4 +126,21 @@ TEST(VplShadows, StableWithCompensationAndExtremes) {
             for (float v : f.linear) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
         }
     }
+}
+
+// A cut-out surface casts no indirect shadow either: the room with a card cut out everywhere renders
+// as the empty room (every pass lets it through, the VPLs' cube shadow maps too), while the same card
+// opaque darkens the ceiling's indirect light.
+TEST(VplShadows, AlphaCutoutsLetIndirectLightThrough) {
+    const FrameOutput empty = renderWithVplShadows(loadScene("builtin:cornell-empty"));
+    const FrameOutput clear = renderWithVplShadows(roomWithCard(true));
+    const FrameOutput opaque = renderWithVplShadows(roomWithCard(false));
+    const size_t pixels = 48 * 48;
+    const double clearError = test::relativeRmseOf(clear.linear, 4, empty.linear, 4, pixels);
+    const double opaqueChange = test::relativeRmseOf(opaque.linear, 4, empty.linear, 4, pixels);
+    std::printf("cut-out card against the empty room %.2e; an opaque card changes it by %.3f\n", clearError,
+                opaqueChange);
+    EXPECT_LT(clearError, 1e-4);
+    EXPECT_GT(opaqueChange, 0.05);
+    EXPECT_EQ(clear.stats["counts"]["vpl_shadowed"].get<double>(), 64);
 }

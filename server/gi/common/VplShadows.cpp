@@ -9,11 +9,18 @@ VplShadowHandles::VplShadowHandles(const gl::Program& p)
       far(p.optionalLocation("uVplShadowFar")), bias(p.optionalLocation("uVplShadowBias")),
       maps(p.optionalTextureUnit("uVplShadowMaps")) {}
 
-VplShadows::VplShadows() {
+VplShadows::MapProgram VplShadows::buildProgram(bool cutout) {
+    std::vector<std::pair<std::string, std::string>> defines;
+    if (cutout) defines.emplace_back("GIS_ALPHA_CUTOUT", "1");
     gl::Program p = gl::Program::build(
-        {{GL_VERTEX_SHADER, "gi/common/vpl_shadow.vert"}, {GL_FRAGMENT_SHADER, "gi/common/vpl_shadow.frag"}});
-    mProgram = {{}, p.location("uFirstVpl"), p.location("uFar"), p.storageBlock("VplBuffer")};
-    mProgram.program = std::move(p);
+        {{GL_VERTEX_SHADER, "gi/common/vpl_shadow.vert"}, {GL_FRAGMENT_SHADER, "gi/common/vpl_shadow.frag"}},
+        defines);
+    MapProgram m{{}, p.location("uFirstVpl"), p.location("uFar"), p.storageBlock("VplBuffer")};
+    m.program = std::move(p);
+    return m;
+}
+
+VplShadows::VplShadows() : mProgram(buildProgram(false)) {
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &mMaxLayers);
 }
 
@@ -34,11 +41,13 @@ int VplShadows::render(const FrameInputs& in, const ParamSet& params, const gl::
         mLayers = layers;
     }
     {
+        if (in.sceneCutsOut && !mCutoutProgram.program) mCutoutProgram = buildProgram(true);
+        const MapProgram& program = in.sceneCutsOut ? mCutoutProgram : mProgram;
         gl::Pass pass(timer, "vpl_shadows");
         pass.target(mFbo, size, size).clearDepth().depthTest(GL_LESS);
-        pass.use(mProgram.program).set(mProgram.firstVpl, 0).set(mProgram.far, in.sceneExtent);
-        pass.buffer(mProgram.vpls, vpls);
-        in.drawGeometry(mProgram.program, layers);
+        pass.use(program.program).set(program.firstVpl, 0).set(program.far, in.sceneExtent);
+        pass.buffer(program.vpls, vpls);
+        in.drawGeometry(program.program, layers);
     }
     mShadowed = shadowed;
     counters["vpl_shadowed"] = shadowed;

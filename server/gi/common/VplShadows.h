@@ -6,7 +6,8 @@
 // that are unshadowed and the count is reported (counter vpl_shadowed).
 //
 // Parameters (vplShadowParamSpecs): vpl_shadows (off), vpl_shadow_size (texels per face, 32),
-// vpl_shadow_bias (fraction of the VPL-receiver distance, 0.02).
+// vpl_shadow_bias (fraction of the VPL-receiver distance, 0.02). Alpha cutouts (MASK, BLEND at 0.5)
+// are let through, as in every other pass.
 #pragma once
 
 #include <vector>
@@ -45,7 +46,12 @@ private:
         gl::Program program;
         gl::UniformLocation firstVpl, far;
         gl::BlockBinding vpls;
-    } mProgram;
+    };
+    static MapProgram buildProgram(bool cutout);
+    MapProgram mProgram;
+    /// Built with GIS_ALPHA_CUTOUT on the first scene with cut-out materials (FrameInputs::sceneCutsOut):
+    /// their cut-out fragments cast no indirect shadow, as in the light's own shadow map.
+    MapProgram mCutoutProgram;
     gl::Texture mMaps;
     gl::Framebuffer mFbo;
     int mSize = 0, mLayers = 0, mShadowed = 0, mMaxLayers = 0;

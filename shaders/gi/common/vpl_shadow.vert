@@ -6,6 +6,8 @@
 #include "gi/common/vpl_shadow.glsl"
 
 layout(location = 0) in vec3 inPosition;
+layout(location = 2) in vec2 inTexcoord; // for alpha cutouts (vpl_shadow.frag)
+layout(location = 4) in vec4 inColor;    // COLOR_0: multiplies the base colour's alpha
 layout(std430, binding = 0) readonly buffer VplBuffer {
     Vpl gVpls[];
 };
@@ -13,11 +15,15 @@ uniform int uFirstVpl;
 uniform float uFar; // m
 
 out vec3 vFromVpl;
+out vec2 vTexcoord;
+out vec4 vColor;
 
 void main() {
     int face = gl_InstanceID % 6;
     vec3 p = inPosition - gVpls[uFirstVpl + gl_InstanceID / 6].position.xyz;
     vFromVpl = p;
+    vTexcoord = inTexcoord;
+    vColor = inColor;
     // (u, v, depth along the face axis), matching vplCubeFace.
     vec3 q = face == 0 ? vec3(p.yz, p.x) : face == 1 ? vec3(p.yz, -p.x) : face == 2 ? vec3(p.xz, p.y)
            : face == 3 ? vec3(p.xz, -p.y) : face == 4 ? vec3(p.xy, p.z) : vec3(p.xy, -p.z);
