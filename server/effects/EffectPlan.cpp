@@ -69,7 +69,7 @@ bool traceEyeRay(const RayScene& rays, const glm::dmat4& invViewProj, double nx,
     if (!(len > 0.0f)) return false;
     dir = (f - o) / len;
     ++rayCount;
-    return rays.intersect(o, dir, 0.0f, len, hit);
+    return rays.intersectFromCamera(o, dir, 0.0f, len, hit);
 }
 
 /// The forced state of one effect from its frame parameter; "auto" when the table lacks it.

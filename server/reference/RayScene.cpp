@@ -123,6 +123,31 @@ struct CollectContext {
     std::vector<RawHit>* hits;
 };
 
+struct CameraContext {
+    RTCIntersectContext base;                 // must stay first: Embree hands back a pointer to it
+    const std::vector<const Mesh*>* oneSided; // per Embree geometry: its mesh when single-sided
+};
+
+// A camera ray passes the back face of a single-sided mesh (glTF front faces are CCW).
+void cameraFilter(const RTCFilterFunctionNArguments* args) {
+    const auto* ctx = reinterpret_cast<const CameraContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const unsigned geom = RTCHitN_geomID(args->hit, args->N, i);
+        if (geom >= ctx->oneSided->size()) continue;
+        const Mesh* mesh = (*ctx->oneSided)[geom];
+        const std::size_t first = static_cast<std::size_t>(RTCHitN_primID(args->hit, args->N, i)) * 3;
+        if (!mesh || first + 2 >= mesh->indices.size() || mesh->positions.empty()) continue;
+        const auto last = static_cast<std::uint32_t>(mesh->positions.size() - 1);
+        const glm::vec3 p0 = mesh->positions[std::min(mesh->indices[first], last)],
+                        p1 = mesh->positions[std::min(mesh->indices[first + 1], last)],
+                        p2 = mesh->positions[std::min(mesh->indices[first + 2], last)];
+        const glm::vec3 dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                            RTCRayN_dir_z(args->ray, args->N, i));
+        if (glm::dot(glm::cross(p1 - p0, p2 - p0), dir) > 0.0f) args->valid[i] = 0;
+    }
+}
+
 // Records every candidate hit and rejects it, so traversal goes on to the next surface.
 void collectAllHits(const RTCFilterFunctionNArguments* args) {
     auto* ctx = reinterpret_cast<CollectContext*>(args->context);
@@ -169,6 +194,7 @@ struct RayScene::Impl {
     std::vector<int> meshOfGeometry; // Embree geometry id -> index into source.meshes
     std::vector<LinearTexture> textures;
     std::vector<std::unique_ptr<CutoutGeometry>> cutouts; // the filters' user data (stable addresses)
+    std::vector<const Mesh*> oneSided; // Embree geometry id -> its mesh when single-sided, else null
 
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
@@ -249,6 +275,10 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
         rtcReleaseGeometry(geom);
         if (m.meshOfGeometry.size() <= id) m.meshOfGeometry.resize(id + 1, -1);
         m.meshOfGeometry[id] = static_cast<int>(mi);
+        if (m.oneSided.size() <= id) m.oneSided.resize(id + 1, nullptr);
+        if (mesh.material >= 0 && static_cast<size_t>(mesh.material) < m.source.materials.size() &&
+            !m.source.materials[static_cast<size_t>(mesh.material)].doubleSided)
+            m.oneSided[id] = &mesh;
     }
     rtcCommitScene(m.scene);
     if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
@@ -272,6 +302,24 @@ bool RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tn
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(mImpl->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit = resolve(RawHit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v}, origin, dir);
+    return true;
+}
+
+bool RayScene::intersectFromCamera(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                                   SurfaceHit& hit) const {
+    CameraContext ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.oneSided = &mImpl->oneSided;
+    const bool anyOneSided = std::any_of(mImpl->oneSided.begin(), mImpl->oneSided.end(),
+                                         [](const Mesh* p) { return p != nullptr; });
+    if (anyOneSided) ctx.base.filter = cameraFilter;
+    RTCRayHit rh{};
+    rh.ray = makeRay(origin, dir, tnear, tfar);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(mImpl->scene, &ctx.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit = resolve(RawHit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v}, origin, dir);
     return true;

@@ -51,6 +51,10 @@ public:
     /// Closest hit in (tnear, tfar); false when the ray escapes.
     bool intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
                    SurfaceHit& hit) const;
+    /// intersect() for a ray from the camera: back faces of single-sided materials
+    /// (Material::doubleSided false) are passed, as the G-buffer culls them.
+    bool intersectFromCamera(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                             SurfaceHit& hit) const;
     /// True when anything lies in (tnear, tfar).
     bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
     /// Every surface crossing in (tnear, tfar), each triangle at most once, unordered. `hits` is cleared.

@@ -191,7 +191,7 @@ public:
     glm::vec3 sample(const glm::vec3& origin, const glm::vec3& dir, float tfar, Rng& rng,
                      std::vector<RawHit>& scratch) const {
         SurfaceHit hit;
-        if (!mRays.intersect(origin, dir, 0.0f, tfar, hit)) return glm::vec3(0.0f); // background
+        if (!mRays.intersectFromCamera(origin, dir, 0.0f, tfar, hit)) return glm::vec3(0.0f); // background
         const Vertex x = orient(hit, -dir); // camera-facing, like the G-buffer normal
         glm::vec3 radiance = x.hit.emission + reflectedDirect(x);
         switch (mMode) {

@@ -323,7 +323,7 @@ DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& v
     pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
     const MeshPass& gbuffer = gbufferPass();
     pass.use(gbuffer.program).set(gbuffer.view, -1);
-    const DrawCount count = mSceneGpu->draw(gbuffer.program, &gbuffer.materials, 1, -1, &viewProj);
+    const DrawCount count = mSceneGpu->draw(gbuffer.program, &gbuffer.materials, 1, -1, &viewProj, true);
     mResources.publish("gbuffer.position", "gbuffer", mGPosition);
     mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
     mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);

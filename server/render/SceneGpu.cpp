@@ -144,13 +144,14 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
 }
 
 DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int instances, int skipMesh,
-                         const glm::mat4* cullViewProj) const {
+                         const glm::mat4* cullViewProj, bool cullBackFaces) const {
     // The caller has bound the program; `materials` were resolved from it.
     glBindVertexArray(mVao.id());
     const std::optional<Frustum> frustum =
         cullViewProj ? std::optional<Frustum>(Frustum(*cullViewProj)) : std::nullopt;
     DrawCount count;
-    int uniformsOf = -1; // the mesh whose material uniforms are set (a mesh's runs share them)
+    int uniformsOf = -1;  // the mesh whose material uniforms are set (a mesh's runs share them)
+    bool culling = false; // GL_CULL_FACE is off in every pass (FrameRenderer::render) until set here
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
         const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
@@ -159,6 +160,20 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
             continue;
         }
         count.drawn += triangles;
+        if (cullBackFaces) {
+            const bool oneSided = d.material >= 0 &&
+                                  static_cast<std::size_t>(d.material) < mMaterials.size() &&
+                                  !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
+            if (oneSided != culling) {
+                if (oneSided) {
+                    glCullFace(GL_BACK);
+                    glEnable(GL_CULL_FACE);
+                } else {
+                    glDisable(GL_CULL_FACE);
+                }
+                culling = oneSided;
+            }
+        }
         if (materials && uniformsOf != d.mesh) {
             uniformsOf = d.mesh;
             const MaterialSlots& s = *materials;
@@ -187,6 +202,7 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
             reinterpret_cast<const void*>(static_cast<uintptr_t>(d.firstIndex) * 4), std::max(instances, 1),
             d.baseVertex);
     }
+    if (culling) glDisable(GL_CULL_FACE);
     return count;
 }
 

@@ -49,8 +49,11 @@ public:
     /// With `cullViewProj` (world -> clip, the matrix the program's vertex stage applies), runs whose
     /// bounds lie wholly outside one of its clip planes are skipped: GL would clip every triangle of
     /// them, so the image is the same.
+    /// With `cullBackFaces` (the camera's views), single-sided materials (Material::doubleSided false)
+    /// are drawn with back faces culled (front faces CCW, as glTF).
     DrawCount draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
-                   int skipMesh = -1, const glm::mat4* cullViewProj = nullptr) const;
+                   int skipMesh = -1, const glm::mat4* cullViewProj = nullptr,
+                   bool cullBackFaces = false) const;
     std::size_t triangleCount() const { return mTriangles; }
     std::size_t drawCount() const { return mDraws.size(); }
     /// The reflector id of each mesh, written by the G-buffer into the normal's w

@@ -494,6 +494,7 @@ private:
                                     ? static_cast<float>(src.normalTexture.scale)
                                     : 1.0f;
             }
+            m.doubleSided = src.doubleSided;
             if (src.alphaMode == "MASK") m.alphaMode = Material::Alpha::Mask;
             if (src.alphaMode == "BLEND") m.alphaMode = Material::Alpha::Blend;
             m.alphaCutoff = std::isfinite(src.alphaCutoff)

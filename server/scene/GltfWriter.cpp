@@ -133,7 +133,8 @@ void writeGlb(const Scene& scene, const std::string& path) {
         if (m.baseColorTexture >= 0) pbr["baseColorTexture"] = {{"index", m.baseColorTexture}};
         if (m.metallicRoughnessTexture >= 0)
             pbr["metallicRoughnessTexture"] = {{"index", m.metallicRoughnessTexture}};
-        nlohmann::json mat = {{"name", m.name}, {"pbrMetallicRoughness", pbr}};
+        nlohmann::json mat = {
+            {"name", m.name}, {"pbrMetallicRoughness", pbr}, {"doubleSided", m.doubleSided}};
         // glTF's emissiveFactor is at most 1: a brighter emitter carries the rest as its strength.
         const float strength = std::max({m.emissive.r, m.emissive.g, m.emissive.b, 1.0f});
         const glm::vec3 factor = m.emissive / strength;

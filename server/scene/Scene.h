@@ -54,6 +54,11 @@ struct Material {
     /// Whether some of the surface may be cut out, and below which alpha.
     bool cutsOut() const { return alphaMode != Alpha::Opaque; }
     float cutoff() const { return alphaMode == Alpha::Blend ? 0.5f : alphaCutoff; }
+    /// glTF doubleSided. False (glTF's default): the camera does not see the back faces (culled in the
+    /// G-buffer, passed by the reference's camera rays), so an interior of one-sided walls can be
+    /// looked into from outside; light views still see both sides. True: both sides shown, each lit
+    /// on the side it is seen from. Materials built in code are double-sided.
+    bool doubleSided = true;
 };
 
 /// One triangle list in world space. Every vertex attribute array has positions.size() entries.

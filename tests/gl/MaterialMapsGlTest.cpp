@@ -230,3 +230,27 @@ TEST(AlphaCutout, MaskedCardMatchesTheReferenceInEveryPass) {
     EXPECT_LT(test::relativeRmseOf(blended.gl.linear, 4, masked.gl.linear, 4, pixels), 1e-6);
     EXPECT_LT(test::relativeRmseOf(blended.reference.rgb, 3, masked.reference.rgb, 3, pixels), 1e-6);
 }
+
+// glTF doubleSided: the card turned face down over the floor, seen from above. Double-sided, the camera
+// sees its back (lit on that side); single-sided (glTF's default), the G-buffer culls it and the
+// reference's camera rays pass it, so the floor shows, still shadowed by the card (light views see
+// both sides). Both renderers change alike.
+TEST(DoubleSided, SingleSidedBackFacesAreNotSeenByTheCamera) {
+    auto faceDown = [](bool doubleSided) {
+        Scene s = cardScene(Material::Alpha::Opaque);
+        Mesh& card = s.meshes[1];
+        card.indices = {0, 1, 2, 0, 2, 3};
+        card.normals.assign(4, glm::vec3(0.0f, -1.0f, 0.0f));
+        s.materials[1].baseColorTexture = -1;
+        s.materials[1].doubleSided = doubleSided;
+        return s;
+    };
+    const Frames shown = renderScene(faceDown(true));
+    const Frames culled = renderScene(faceDown(false));
+    const Comparison c = compare("single-sided", shown, culled);
+    EXPECT_EQ(test::badValues(culled.gl), 0u);
+    EXPECT_GT(c.glChange, 0.1);
+    EXPECT_GT(c.referenceChange, 0.1);
+    EXPECT_NEAR(c.glChange, c.referenceChange, 0.25 * c.referenceChange);
+    EXPECT_LT(c.variantError, std::max(0.1, 1.5 * c.baseError));
+}

@@ -403,6 +403,21 @@ TEST(GltfLoader, NormalMapGetsTangentsAlongU) {
     EXPECT_TRUE(s.notShown.empty());
 }
 
+// glTF doubleSided: false unless the file says true (the built-in scenes' materials are double-sided).
+TEST(GltfLoader, DoubleSidedFollowsTheFile) {
+    TempDir dir;
+    GltfBuilder b;
+    const int tri = b.addTriangleNode();
+    b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["materials"] = {{{"name", "one"}}, {{"name", "two"}, {"doubleSided", true}}};
+    b.setScene({tri});
+    const Scene s = loadGltf(b.writeGlb(dir, "sides.glb"));
+    ASSERT_GE(s.materials.size(), 2u);
+    EXPECT_FALSE(s.materials[0].doubleSided);
+    EXPECT_TRUE(s.materials[1].doubleSided);
+    EXPECT_TRUE(makeBuiltinScene("cornell").materials[0].doubleSided);
+}
+
 // The file's own TANGENT attribute is used where it maps normals (not regenerated), carried through
 // the node's transform: a mirror flips the handedness; a zero tangent stays zero (unmapped there).
 TEST(GltfLoader, NormalMapUsesTheFilesTangents) {

@@ -46,6 +46,7 @@ TEST(GltfWriter, BuiltinScenesReadBackTheSame) {
             EXPECT_EQ(mb.metallic, ma.metallic) << ma.name;
             EXPECT_EQ(mb.roughness, ma.roughness) << ma.name;
             EXPECT_EQ(mb.alphaMode, ma.alphaMode) << ma.name;
+            EXPECT_EQ(mb.doubleSided, ma.doubleSided) << ma.name;
             EXPECT_EQ(mb.baseColorTexture >= 0, ma.baseColorTexture >= 0) << ma.name;
             if (ma.baseColorTexture >= 0 && mb.baseColorTexture >= 0) {
                 const TextureImage &ta = original.textures[static_cast<std::size_t>(ma.baseColorTexture)],
