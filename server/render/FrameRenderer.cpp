@@ -158,6 +158,8 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     mCompositePass.reflection = c.textureUnit("gReflection");
     mCompositePass.hasIndirect = c.location("uHasIndirect");
     mCompositePass.hasReflection = c.location("uHasReflection");
+    mCompositePass.albedo = c.textureUnit("gAlbedo");
+    mCompositePass.applyOcclusion = c.location("uApplyOcclusion");
     mPartAverage.program =
         gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/vpl_part_average.frag"}});
     mPartAverage.part = mPartAverage.program.textureUnit("gPart");
@@ -182,6 +184,8 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
     mSceneGpu = std::make_unique<SceneGpu>(*scene);
     mSceneCutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
                                 [](const Material& m) { return m.cutsOut(); });
+    mSceneHasOcclusionMaps = std::any_of(scene->materials.begin(), scene->materials.end(),
+                                         [](const Material& m) { return m.occlusionTexture >= 0; });
     if (mSceneCutsOut && !mCutoutPasses)
         mCutoutPasses = std::make_unique<CutoutPasses>(
             CutoutPasses{buildMeshPass("render/shadow.frag", MeshMaterials::None, true),
@@ -350,15 +354,18 @@ void FrameRenderer::renderDirect() {
 }
 
 void FrameRenderer::composite(int width, int height, const gl::Texture* indirect,
-                              const gl::Texture* reflection) {
+                              const gl::Texture* reflection, bool applyOcclusion) {
     gl::Pass pass(mTimer, "composite");
     const CompositePass& c = mCompositePass;
     const gl::Texture& direct = mResources.get("direct");
     pass.target(mCompositeFbo, width, height).use(c.program);
-    pass.set(c.hasIndirect, indirect ? 1 : 0).set(c.hasReflection, reflection ? 1 : 0);
+    pass.set(c.hasIndirect, indirect ? 1 : 0)
+        .set(c.hasReflection, reflection ? 1 : 0)
+        .set(c.applyOcclusion, indirect && applyOcclusion ? 1 : 0);
     pass.texture(c.direct, direct)
         .texture(c.indirect, indirect ? *indirect : direct)
-        .texture(c.reflection, reflection ? *reflection : direct);
+        .texture(c.reflection, reflection ? *reflection : direct)
+        .texture(c.albedo, mResources.get("gbuffer.albedo"));
     pass.drawFullscreen(mEmptyVao);
     mResources.publish("display", "composite", mDisplay);
     mResources.publish("linear", "composite", mLinear);
@@ -559,7 +566,14 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     else
         mResources.withdraw("reflection");
 
-    composite(state.width, state.height, indirect, reflection);
+    // glTF occlusion maps darken the indirect light only where no pass computed indirect shadows.
+    const bool indirectShadows =
+        (techniqueInfo.vplVisibility && state.techniqueParams.has("vpl_shadows") &&
+         state.techniqueParams.getBool("vpl_shadows")) ||
+        (techniqueInfo.indirectShadows && techniqueInfo.indirectShadows(state.techniqueParams));
+    const bool applyOcclusion = mSceneHasOcclusionMaps && !indirectShadows;
+    counters["occlusion_maps_applied"] = applyOcclusion ? 1 : 0;
+    composite(state.width, state.height, indirect, reflection, applyOcclusion);
 
     FrameOutput out;
     out.width = state.width;

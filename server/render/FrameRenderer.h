@@ -86,7 +86,9 @@ private:
     std::vector<double> readViewFlux(int views) const;
     DrawCount renderGBuffer(int width, int height, const glm::mat4& viewProj);
     void renderDirect();
-    void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection);
+    /// `applyOcclusion`: multiply the indirect light by the G-buffer's occlusion (glTF occlusion maps).
+    void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection,
+                   bool applyOcclusion);
     /// Folds one VPL part's indirect light into the running mean of the parts before it
     /// (FrameState::VplPart) and returns that mean; `followsLast`: followsLastPart() before this part.
     const gl::Texture& averageVplPart(const FrameState& state, const glm::mat4& viewProj, bool followsLast,
@@ -119,6 +121,7 @@ private:
     };
     std::unique_ptr<CutoutPasses> mCutoutPasses;
     bool mSceneCutsOut = false;
+    bool mSceneHasOcclusionMaps = false; ///< a material has a glTF occlusion texture
     const MeshPass& shadowPass() const { return mSceneCutsOut ? mCutoutPasses->shadow : mShadowPass; }
     const MeshPass& rsmPass() const { return mSceneCutsOut ? mCutoutPasses->rsm : mRsmPass; }
     const MeshPass& gbufferPass() const { return mSceneCutsOut ? mCutoutPasses->gbuffer : mGBufferPass; }
@@ -128,8 +131,8 @@ private:
     } mDirectPass;
     struct CompositePass {
         gl::Program program;
-        gl::TextureUnit direct, indirect, reflection;
-        gl::UniformLocation hasIndirect, hasReflection;
+        gl::TextureUnit direct, indirect, reflection, albedo;
+        gl::UniformLocation hasIndirect, hasReflection, applyOcclusion;
     } mCompositePass;
     struct FluxPass {
         gl::Program program;

@@ -137,6 +137,9 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     m.metalRoughTexture = unit("uMetalRoughTex");
     m.emissiveTexture = unit("uEmissiveTex");
     m.normalTexture = unit("uNormalTex");
+    m.occlusionTexture = unit("uOcclusionTex");
+    m.hasOcclusionTexture = slot("uHasOcclusionTex");
+    m.occlusionStrength = slot("uOcclusionStrength");
     m.hasNormalTexture = slot("uHasNormalTex");
     m.normalScale = slot("uNormalScale");
     m.hasVertexColor = slot("uHasVertexColor");
@@ -195,6 +198,9 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
             bind(m.metallicRoughnessTexture, s.hasMetalRoughTexture, s.metalRoughTexture);
             bind(m.emissiveTexture, s.hasEmissiveTexture, s.emissiveTexture);
             bind(m.normalTexture, s.hasNormalTexture, s.normalTexture);
+            bind(m.occlusionTexture, s.hasOcclusionTexture, s.occlusionTexture);
+            glUniform1f(s.occlusionStrength.location,
+                        std::isfinite(m.occlusionStrength) ? m.occlusionStrength : 1.0f);
             glUniform1f(s.normalScale.location, std::isfinite(m.normalScale) ? m.normalScale : 1.0f);
         }
         glDrawElementsInstancedBaseVertex(

@@ -16,9 +16,9 @@ struct MaterialSlots {
     gl::UniformLocation baseColor, emissive, hasTexture, metalRoughSpec, mirrorId;
     gl::UniformLocation alphaCutoff; ///< only in programs built with GIS_ALPHA_CUTOUT
     gl::UniformLocation hasMetalRoughTexture, hasEmissiveTexture, hasNormalTexture, normalScale,
-        hasVertexColor;
+        hasVertexColor, hasOcclusionTexture, occlusionStrength;
     gl::TextureUnit baseColorTexture{gl::kNoUnit}, metalRoughTexture{gl::kNoUnit},
-        emissiveTexture{gl::kNoUnit}, normalTexture{gl::kNoUnit};
+        emissiveTexture{gl::kNoUnit}, normalTexture{gl::kNoUnit}, occlusionTexture{gl::kNoUnit};
     /// `program`'s slots. With `complete`, every one must be active (the G-buffer's program, which
     /// reads them all: a misspelt name in material.glsl fails there); otherwise the ones a program
     /// leaves unused are skipped.

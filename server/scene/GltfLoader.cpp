@@ -488,6 +488,13 @@ private:
                     convertTexture(pbr.metallicRoughnessTexture.index, where + " metallic-roughness", false);
             if (src.emissiveTexture.index >= 0)
                 m.emissiveTexture = convertTexture(src.emissiveTexture.index, where + " emissive");
+            if (src.occlusionTexture.index >= 0) {
+                m.occlusionTexture = convertTexture(src.occlusionTexture.index, where + " occlusion", false);
+                m.occlusionStrength =
+                    std::isfinite(src.occlusionTexture.strength)
+                        ? std::clamp(static_cast<float>(src.occlusionTexture.strength), 0.0f, 1.0f)
+                        : 1.0f;
+            }
             if (src.normalTexture.index >= 0) {
                 m.normalTexture = convertTexture(src.normalTexture.index, where + " normal", false);
                 m.normalScale = std::isfinite(src.normalTexture.scale)
@@ -543,8 +550,9 @@ private:
         // samples (every one of them is mapped with one set: stats.not_shown says when they differ).
         const tinygltf::Material& m = mModel.materials[static_cast<std::size_t>(material)];
         UvSource info = uvSource(m.pbrMetallicRoughness.baseColorTexture);
-        for (const UvSource& other : {uvSource(m.pbrMetallicRoughness.metallicRoughnessTexture),
-                                      uvSource(m.emissiveTexture), uvSource(m.normalTexture)})
+        for (const UvSource& other :
+             {uvSource(m.pbrMetallicRoughness.metallicRoughnessTexture), uvSource(m.emissiveTexture),
+              uvSource(m.normalTexture), uvSource(m.occlusionTexture)})
             if (info.index < 0) info = other;
         if (info.index < 0) return uv;
         uv.set = std::max(0, info.texCoord);
@@ -639,13 +647,9 @@ private:
             std::function<bool(const tinygltf::Material&)> uses;
         };
         const Feature features[] = {
-            {"occlusionTexture",
-             "occlusion maps are not applied (the techniques compute their own occlusion)",
-             [](const tinygltf::Material& m) { return m.occlusionTexture.index >= 0; }},
             {"texture coordinates",
-             "the metallic-roughness, emissive or normal texture asks for another UV set or transform than "
-             "the base "
-             "colour texture: all are mapped with the base colour's",
+             "the metallic-roughness, emissive, normal or occlusion texture asks for another UV set or "
+             "transform than the base colour texture: all are mapped with the base colour's",
              [](const tinygltf::Material& m) {
                  const UvSource base = uvSource(m.pbrMetallicRoughness.baseColorTexture);
                  auto differs = [&](const UvSource& other) {
@@ -657,7 +661,8 @@ private:
                             (aHas && bHas && !(a->second == b->second));
                  };
                  return differs(uvSource(m.pbrMetallicRoughness.metallicRoughnessTexture)) ||
-                        differs(uvSource(m.emissiveTexture)) || differs(uvSource(m.normalTexture));
+                        differs(uvSource(m.emissiveTexture)) || differs(uvSource(m.normalTexture)) ||
+                        differs(uvSource(m.occlusionTexture));
              }},
             {"alphaMode BLEND",
              "transparency is approximated as a cutout: alpha below 0.5 is cut out, the rest renders opaque",

@@ -146,6 +146,8 @@ void writeGlb(const Scene& scene, const std::string& path) {
         if (m.emissiveTexture >= 0) mat["emissiveTexture"] = {{"index", m.emissiveTexture}};
         if (m.normalTexture >= 0)
             mat["normalTexture"] = {{"index", m.normalTexture}, {"scale", m.normalScale}};
+        if (m.occlusionTexture >= 0)
+            mat["occlusionTexture"] = {{"index", m.occlusionTexture}, {"strength", m.occlusionStrength}};
         if (m.alphaMode == Material::Alpha::Mask) {
             mat["alphaMode"] = "MASK";
             mat["alphaCutoff"] = m.alphaCutoff;

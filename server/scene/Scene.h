@@ -45,6 +45,11 @@ struct Material {
     /// glTF normalTexture (linear, tangent space: rgb * 2 - 1) and its scale (applied to x and y).
     int normalTexture = -1;
     float normalScale = 1.0f;
+    /// glTF occlusionTexture (linear, red channel) and its strength: ao = 1 + strength (r - 1). It
+    /// darkens the GL pipeline's indirect light where no technique pass computes indirect visibility
+    /// (the small-scale occlusion VPL gathers leave out); the reference traces visibility instead.
+    int occlusionTexture = -1;
+    float occlusionStrength = 1.0f;
     /// glTF alphaMode. MASK cuts out where the base colour's alpha (factor times texture) is below
     /// alphaCutoff, in every pass (G-buffer, shadow maps, RSMs, reflections) and in the reference.
     /// BLEND is approximated as a cutout at 0.5: half-transparent surfaces are either opaque or gone

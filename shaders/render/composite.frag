@@ -6,7 +6,9 @@
 layout(binding = 0) uniform sampler2D gDirect;
 layout(binding = 1) uniform sampler2D gIndirect;
 layout(binding = 2) uniform sampler2D gReflection; // env probe + planar mirrors (render/Reflections)
+layout(binding = 3) uniform sampler2D gAlbedo;     // a: glTF occlusion (1 without a map)
 uniform int uHasIndirect;
+uniform int uApplyOcclusion; // 1: the indirect light is multiplied by the occlusion map
 uniform int uHasReflection;
 
 layout(location = 0) out vec4 outDisplay; // RGBA8: tone-mapped sRGB
@@ -26,7 +28,12 @@ vec3 linearToSrgb(vec3 c) {
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec3 c = sanitize(texelFetch(gDirect, px, 0).rgb);
-    if (uHasIndirect == 1) c += sanitize(texelFetch(gIndirect, px, 0).rgb);
+    if (uHasIndirect == 1) {
+        vec3 indirect = sanitize(texelFetch(gIndirect, px, 0).rgb);
+        float ao = texelFetch(gAlbedo, px, 0).a;
+        if (uApplyOcclusion == 1) indirect *= ao >= 0.0 ? min(ao, 1.0) : 1.0; // NaN: no occlusion
+        c += indirect;
+    }
     if (uHasReflection == 1) c += max(sanitize(texelFetch(gReflection, px, 0).rgb), vec3(0.0));
     c = max(c, vec3(0.0));
     outLinear = vec4(c, 1.0);

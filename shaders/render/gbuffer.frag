@@ -10,7 +10,7 @@ in vec4 vTangent;
 
 layout(location = 0) out vec4 outPosition; // xyz world (m), w = 1 covered
 layout(location = 1) out vec4 outNormal;   // xyz unit normal facing the camera
-layout(location = 2) out vec4 outAlbedo;   // rgb linear albedo
+layout(location = 2) out vec4 outAlbedo;   // rgb linear albedo, a occlusion (1: none)
 layout(location = 3) out vec4 outEmissive; // rgb emitted radiance
 layout(location = 4) out vec4 outSpecular; // rgb F0, a perceptual roughness (render/brdf.glsl)
 
@@ -21,7 +21,7 @@ void main() {
     n = materialNormal(n, vNormal, vTangent, vTexcoord);
     outPosition = vec4(vWorldPos, 1.0);
     outNormal = vec4(n, float(uMirrorId)); // w: reflector id (mirror k + 1, local probe -(k + 1), 0)
-    outAlbedo = vec4(materialAlbedo(vTexcoord), 1.0);
+    outAlbedo = vec4(materialAlbedo(vTexcoord), materialOcclusion(vTexcoord));
     outSpecular = materialSpecular(vTexcoord);
     outEmissive = vec4(max(sanitize(materialEmissive(vTexcoord)), vec3(0.0)), 1.0);
 }

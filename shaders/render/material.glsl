@@ -19,6 +19,17 @@ uniform int uHasEmissiveTex;
 layout(binding = 1) uniform sampler2D uMetalRoughTex;
 layout(binding = 2) uniform sampler2D uEmissiveTex;
 
+// glTF occlusionTexture (linear, red channel) with its strength, unit 4: 1 + strength (r - 1), in
+// [0, 1]; 1 without a map. The G-buffer keeps it for the composite (albedo alpha).
+uniform int uHasOcclusionTex;
+uniform float uOcclusionStrength;
+layout(binding = 4) uniform sampler2D uOcclusionTex;
+float materialOcclusion(vec2 uv) {
+    if (uHasOcclusionTex != 1) return 1.0;
+    float ao = 1.0 + uOcclusionStrength * (texture(uOcclusionTex, uv).r - 1.0);
+    return isnan(ao) ? 1.0 : clamp(ao, 0.0, 1.0);
+}
+
 // glTF normalTexture (linear, tangent space: rgb * 2 - 1, x and y scaled by uNormalScale), unit 3.
 uniform int uHasNormalTex;
 uniform float uNormalScale;

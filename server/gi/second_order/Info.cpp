@@ -80,6 +80,7 @@ TechniqueInfo secondOrderInfo() {
     };
     info.biasCompensation = true;
     info.viewSampled = true;
+    info.indirectShadows = [](const ParamSet& p) { return p.getInt("negative_count") > 0; };
     return info;
 }
 
