@@ -48,11 +48,12 @@ constexpr std::size_t kMaxViewersPerSession = 32;
 constexpr std::size_t kMaxRenderRequestBytes = 1 << 20;
 constexpr std::size_t kMaxDirectMessages = 64;
 
-/// Runs teardown work (joining render threads, deleting upload sandboxes) away from the loop.
-class Reaper {
+/// Runs slow work away from the loop, in order, on one thread of its own: teardowns (joining render
+/// threads, deleting upload sandboxes) on one queue, unpacking zipped uploads on another.
+class BackgroundQueue {
 public:
-    Reaper() : mThread([this] { loop(); }) {}
-    ~Reaper() {
+    BackgroundQueue() : mThread([this] { loop(); }) {}
+    ~BackgroundQueue() {
         {
             std::lock_guard lock(mMutex);
             mStop = true;
@@ -68,7 +69,7 @@ public:
         }
         mCv.notify_all();
     }
-    /// Teardowns queued or running: it should fall back to 0 soon after sessions end.
+    /// Work queued or running (teardowns: it should fall back to 0 soon after sessions end).
     std::size_t pending() {
         std::lock_guard lock(mMutex);
         return mPending;
@@ -236,7 +237,7 @@ struct HttpExchange {
     std::string body;
     bool bodyTooLarge = false;
     std::size_t bodyLimit = 0;
-    std::uint64_t jobId = 0; ///< awaiting a render when non-zero
+    std::uint64_t jobId = 0; ///< awaiting a render or an archive extraction when non-zero
     bool ready = false;
     bool headersSent = false;
     HttpResponse response;
@@ -311,7 +312,7 @@ struct WsServer::Impl {
     MetricsRegistry metrics;
     std::map<lws*, std::unique_ptr<Connection>> connections;
     std::map<std::string, std::shared_ptr<SessionEntry>> sessions; // by id
-    std::unique_ptr<Reaper> reaper = std::make_unique<Reaper>();
+    std::unique_ptr<BackgroundQueue> reaper = std::make_unique<BackgroundQueue>();
     std::uint64_t nextSessionId = 1;
     lws_protocols protocols[3];
     Housekeeping housekeeping{};
@@ -336,6 +337,8 @@ struct WsServer::Impl {
     std::mutex doneMutex;
     std::map<std::uint64_t, HttpResponse> done;
     std::map<std::uint64_t, lws*> awaiting;
+    /// Unpacks zipped uploads (declared after `done`: joined before it goes).
+    std::unique_ptr<BackgroundQueue> unpacker = std::make_unique<BackgroundQueue>();
     std::uint64_t nextJobId = 1;
 
     static Impl* from(lws* wsi) { return static_cast<Impl*>(lws_context_user(lws_get_context(wsi))); }
@@ -794,43 +797,52 @@ struct WsServer::Impl {
         awaiting[id] = wsi;
     }
 
-    /// A .zip upload: extracted beside (SceneArchive checks every entry and the unpacked size against
-    /// what the session's budget has left), then renamed over the old folder of that name.
+    /// A .zip upload: extracted beside on the unpacker's thread (SceneArchive checks every entry and
+    /// the unpacked size against what the session's budget has left), then renamed over the old folder
+    /// of that name; the answer is delivered on the loop like an API render's.
     void storeArchive(lws* wsi, PerSession* pss, const SessionEntry& entry, const std::string& name,
                       const fs::path& dir, std::uintmax_t room) {
-        const HttpExchange* x = pss->http;
-        const fs::path partial = dir / ("." + name + ".part");
-        std::error_code ec;
-        fs::remove_all(partial, ec);
-        std::string sceneFile;
-        try {
-            sceneFile = extractSceneArchive(x->body, partial, ArchiveLimits{.maxBytes = room}, name);
-        } catch (const ArchiveTooLarge& e) {
-            respond(wsi, pss,
-                    errorResponse(413, "uploads_full",
-                                  e.reason() + " (what this session's upload budget of " +
-                                      std::to_string(config.maxSessionUploadsMb) + " MiB has left)"));
-            return;
-        } catch (const InputError& e) {
-            respond(wsi, pss, errorResponse(400, "bad_archive", e.reason()));
-            return;
-        } catch (const Error&) {
+        HttpExchange* x = pss->http;
+        const std::uint64_t id = nextJobId++;
+        lws_context* ctx = context;
+        auto body = std::make_shared<const std::string>(std::move(x->body));
+        x->body.clear();
+        const std::string what = "net: session " + entry.session->id() + " stored upload:" + name + " (" +
+                                 std::to_string(body->size()) + " bytes, scene ";
+        const std::string from = ") from " + peerAddress(wsi);
+        const int budgetMb = config.maxSessionUploadsMb;
+        unpacker->retire([this, id, ctx, body, name, dir, room, what, from, budgetMb] {
+            const fs::path partial = dir / ("." + name + ".part");
+            std::error_code ec;
             fs::remove_all(partial, ec);
-            respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
-            return;
-        }
-        fs::remove_all(dir / name, ec);
-        fs::rename(partial, dir / name, ec);
-        if (ec) {
-            fs::remove_all(partial, ec);
-            respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
-            return;
-        }
-        logInfo("net: session " + entry.session->id() + " stored upload:" + name + " (" +
-                std::to_string(x->body.size()) + " bytes, scene " + sceneFile + ") from " + peerAddress(wsi));
-        respond(
-            wsi, pss,
-            jsonResponse(201, {{"scene", "upload:" + name}, {"bytes", x->body.size()}, {"file", sceneFile}}));
+            HttpResponse response;
+            try {
+                const std::string sceneFile =
+                    extractSceneArchive(*body, partial, ArchiveLimits{.maxBytes = room}, name);
+                fs::remove_all(dir / name, ec);
+                fs::rename(partial, dir / name, ec);
+                if (ec) throw Error("cannot rename the extracted folder");
+                logInfo(what + sceneFile + from);
+                response = jsonResponse(
+                    201, {{"scene", "upload:" + name}, {"bytes", body->size()}, {"file", sceneFile}});
+            } catch (const ArchiveTooLarge& e) {
+                response = errorResponse(413, "uploads_full",
+                                         e.reason() + " (what this session's upload budget of " +
+                                             std::to_string(budgetMb) + " MiB has left)");
+            } catch (const InputError& e) {
+                response = errorResponse(400, "bad_archive", e.reason());
+            } catch (const std::exception&) {
+                fs::remove_all(partial, ec);
+                response = errorResponse(500, "upload_failed", "cannot store the upload");
+            }
+            {
+                std::lock_guard lock(doneMutex);
+                done[id] = std::move(response);
+            }
+            lws_cancel_service(ctx);
+        });
+        x->jobId = id;
+        awaiting[id] = wsi;
     }
 
     void handleUpload(lws* wsi, PerSession* pss) {
@@ -1632,6 +1644,7 @@ WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
 
 WsServer::~WsServer() {
     mImpl->stop = true;
+    mImpl->unpacker.reset(); // finishes an extraction in progress: it wakes the loop's context
     if (mImpl->context) lws_context_destroy(mImpl->context); // closes connections: sessions end
     for (auto& [id, e] : std::map(mImpl->sessions)) mImpl->endSession(e, "", "");
     mImpl->workers.reset();
