@@ -3,9 +3,12 @@
 // reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms, the
 // steps' VPL counts and the most VPL parts a tile was split into.
 // usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--scene builtin:NAME] [--technique T]
-//        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"] [--whole 1]
+//        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"] [--whole 1] [--nudge 8]
 // --whole 1 asks for whole images instead of patches (as a client that does not draw patches); --verbose 1
 // prints every tile sent (step, parts, size, ms, passes). Steps that completed are reported with their time.
+// --nudge S sends the same camera again every S seconds (input, then a still view again): each
+// refinement round is reported apart (its first tile's parts, the share it reached), which shows what a
+// round learns from the ones before.
 import { spawn } from 'node:child_process';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -13,12 +16,12 @@ import WebSocket from 'ws';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const opts = { server: path.join(root, 'build/ci/bin/gi-server'), technique: '', params: '', seconds: 15,
-    'server-args': '', whole: 0, scene: '', verbose: 0 };
+    'server-args': '', whole: 0, scene: '', verbose: 0, nudge: 0 };
 const argv = process.argv.slice(2);
 for (let i = 0; i < argv.length; i++) {
     const key = argv[i].replace(/^--/, '');
     if (key === 'help') {
-        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1] [--verbose 1]');
+        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1] [--verbose 1] [--nudge S]');
         process.exit(0);
     }
     if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
@@ -34,6 +37,8 @@ if (!log.includes('listening')) throw new Error(`gi-server did not start:\n${log
 
 const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
 let stats = null;
+let camera = null;
+let round = 0;
 const tiles = [];
 const progress = [];
 const stepsDone = [];
@@ -49,6 +54,8 @@ ws.on('message', (data, isBinary) => {
     if (!isBinary) {
         const m = JSON.parse(data.toString());
         if (m.type === 'stats') stats = m;
+        const cam = m.state?.camera ?? m.camera;
+        if (cam?.position) camera = cam; // the latest: a scene change brings its own
         else if (m.type === 'progress') progress.push(`${m.state} ${m.step}: ${m.reason}`);
         return;
     }
@@ -58,12 +65,26 @@ ws.on('message', (data, isBinary) => {
         if (opts.verbose) console.log(JSON.stringify({ step: stats.quality, share: +stats.refine.share.toFixed(3),
             parts: `${stats.refine.vpl_parts_done}/${stats.refine.vpl_parts}`, tile: stats.tile?.size, ms: +stats.frame_ms.toFixed(1),
             passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(1)])) }));
-        tiles.push({ ms: stats.frame_ms, encodeMs: stats.encode_ms ?? 0, bytes: stats.bytes ?? 0, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
+        tiles.push({ round, share: stats.refine.share, ms: stats.frame_ms, encodeMs: stats.encode_ms ?? 0, bytes: stats.bytes ?? 0, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
             parts: stats.refine.vpl_parts ?? 1, index: tiles.length, tile: stats.tile?.size,
             passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(2)])) });
     }
 });
+if (opts.nudge > 0) {
+    setInterval(() => {
+        if (!camera) return;
+        round += 1;
+        ws.send(JSON.stringify({ type: 'camera', position: camera.position, target: camera.target, up: camera.up ?? [0, 1, 0] }));
+    }, opts.nudge * 1000);
+}
 setTimeout(() => {
+    const rounds = [];
+    for (let r = 0; r <= round; r++) {
+        const t = tiles.filter((x) => x.round === r);
+        if (t.length) rounds.push({ round: r, tiles: t.length, first_tile_parts: t[0].parts, first_tile_ms: +t[0].ms.toFixed(1),
+            share: +Math.max(...t.map((x) => x.share)).toFixed(3) });
+    }
+    if (opts.nudge > 0) console.log(JSON.stringify({ rounds }));
     const ms = tiles.map((t) => t.ms).sort((a, b) => a - b);
     const p = (q, v = ms) => (v.length ? +v[Math.min(v.length - 1, Math.floor(q * v.length))].toFixed(1) : null);
     const enc = tiles.map((t) => t.encodeMs).sort((a, b) => a - b);

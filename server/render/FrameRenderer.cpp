@@ -197,6 +197,7 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
         mNotShown.push_back({{"feature", n.feature}, {"detail", n.detail}});
     mScene = std::move(scene);
     mLightPassesValid = false;
+    mPartAverage.averaged = 0; // no part of another scene's image follows
 }
 
 void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadowSide, int views) {
@@ -328,13 +329,17 @@ DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& v
     const MeshPass& gbuffer = gbufferPass();
     pass.use(gbuffer.program).set(gbuffer.view, -1);
     const DrawCount count = mSceneGpu->draw(gbuffer.program, &gbuffer.materials, 1, -1, &viewProj, true);
+    publishGBuffer();
+    return count;
+}
+
+void FrameRenderer::publishGBuffer() {
     mResources.publish("gbuffer.position", "gbuffer", mGPosition);
     mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
     mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);
     mResources.publish("gbuffer.emissive", "gbuffer", mGEmissive);
     mResources.publish("gbuffer.specular", "gbuffer", mGSpecular);
     mResources.publish("gbuffer.depth", "gbuffer", mGDepth);
-    return count;
 }
 
 void FrameRenderer::renderDirect() {
@@ -401,6 +406,7 @@ const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const 
     a.key = partKey(state);
     a.viewProj = viewProj;
     a.techniqueParams = state.techniqueParams.toJson();
+    a.frameParams = state.frameParams.toJson();
     {
         gl::Pass pass(mTimer, "vpl_part_average");
         pass.target(a.fbo, state.width, state.height)
@@ -490,11 +496,27 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
              {"lights.rsm.position", "lights.rsm.normal", "lights.rsm.flux", "lights.rsm.specular"})
             mResources.withdraw(name);
     }
-    const DrawCount eyeDraws = renderGBuffer(state.width, state.height, u.viewProj);
-    renderDirect();
+    const TechniqueInfo& techniqueInfo = findTechniqueInfo(state.technique);
+    const bool vplParts =
+        state.vplPart.active() && techniqueInfo.vplParts && techniqueInfo.vplParts(state.techniqueParams);
+    // Decided before the part joins the mean (averageVplPart records it as the last part).
+    const bool followsLast = vplParts && followsLastPart(state, u.viewProj);
+    // A later VPL part of the same image under the same lights and frame parameters sees the same
+    // G-buffer and direct light as the part before: they are kept rather than drawn again.
+    const bool keepEyePasses =
+        followsLast && reuseLights && state.frameParams.toJson() == mPartAverage.frameParams;
+    DrawCount eyeDraws;
+    if (keepEyePasses) {
+        publishGBuffer();
+        mResources.publish("direct", "direct", mDirect);
+    } else {
+        eyeDraws = renderGBuffer(state.width, state.height, u.viewProj);
+        renderDirect();
+    }
 
     // The technique's indirect passes read the G-buffer, the RSM and the direct light by name.
     Counters counters;
+    if (keepEyePasses) counters["vpl_part_kept_gbuffer"] = 1;
     // Frustum culling's measure: triangles the G-buffer and the light views (shadow maps and RSMs,
     // every view; 0 when last frame's are reused) drew and left out.
     counters["triangles_gbuffer"] = static_cast<double>(eyeDraws.drawn);
@@ -525,11 +547,6 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     in.sceneCutsOut = mSceneCutsOut;
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     in.sceneSize = std::max(mScene->bounds.longestSide(), kMinSceneSize);
-    const TechniqueInfo& techniqueInfo = findTechniqueInfo(state.technique);
-    const bool vplParts =
-        state.vplPart.active() && techniqueInfo.vplParts && techniqueInfo.vplParts(state.techniqueParams);
-    // Decided before the part joins the mean (averageVplPart records it as the last part).
-    const bool followsLast = vplParts && followsLastPart(state, u.viewProj);
     if (vplParts) {
         in.vplParts = state.vplPart.count;
         in.vplPart = std::clamp(state.vplPart.index, 0, state.vplPart.count - 1);

@@ -172,7 +172,10 @@ private:
         /// The camera and technique parameters of the parts in the mean.
         glm::mat4 viewProj{0.0f};
         nlohmann::json techniqueParams;
+        nlohmann::json frameParams; ///< with the light block: whether the G-buffer and direct light hold
     } mPartAverage;
+    /// Publishes the G-buffer's textures as this frame's (after drawing them, or keeping them).
+    void publishGBuffer();
 
     Reflections mReflections;
 

@@ -636,7 +636,38 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     partLimits.minTilePixels = double(kMinTileSide + 2 * guard) * (kMinTileSide + 2 * guard);
     partLimits.maxParts = kMaxVplParts;
     VplPartPlanner partPlanner(partLimits);
+    // The last step with these tiles taught the planner what a part costs: start from it. Whatever
+    // way this step ends (done, abandoned for input, failed), what it learned is kept for the next.
+    const std::string partKey = w.scene->name + "/" + full.technique + "/" +
+                                std::to_string(static_cast<long>(partLimits.tilePixels)) + "/" +
+                                std::to_string(static_cast<long>(partLimits.minTilePixels)) + "/" +
+                                std::to_string(sliceMs);
+    if (splittable)
+        if (const auto known = mPartMemory.find(partKey); known != mPartMemory.end())
+            partPlanner.recall(known->second, vpls);
+    struct KeepFits {
+        std::map<std::string, VplPartPlanner::Memory>& memory;
+        const std::string& key;
+        const VplPartPlanner& planner;
+        long vpls;
+        bool enabled;
+        ~KeepFits() {
+            if (!enabled) return;
+            VplPartPlanner::Memory learned = planner.remember(vpls);
+            if (!learned.empty()) memory[key] = std::move(learned);
+        }
+    } keepFits{mPartMemory, partKey, partPlanner, vpls, splittable};
     int maxPartsUsed = 1;
+    // The step's first tile draws the light views and environment cubes that its later tiles reuse
+    // (hundreds of ms with a large scene): that tile's time would size the rest for work they do not
+    // do, so it is left out of the rate and the part planner once per step.
+    bool skippedOneTimeWork = false;
+    auto drewOneTimeWork = [](const FrameOutput& f) {
+        const nlohmann::json& c = f.stats.value("counts", nlohmann::json::object());
+        const bool lightViews = c.value("triangles_light_views", 0.0) > 0.0;
+        const bool envCubes = c.value("env_probes", 0.0) > 0.0 && c.value("env_cubes_reused", 1.0) == 0.0;
+        return lightViews || envCubes;
+    };
     progress("refining", 0.0, rate > 0.0 ? rate * fullPixels : 0.0,
              "the view is still: rendering the " + stepLabel + " step in tiles of about " +
                  std::to_string(sliceMs) + " ms" + (note.empty() ? std::string() : "; " + note));
@@ -667,6 +698,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const FrameState tile = tileState(full, rect, guard);
         const double tilePixels = static_cast<double>(tile.width) * tile.height;
         double tileMs = 0.0;
+        bool measureTile = true;
         for (int part = 0; part < parts; ++part) {
             if (part > 0 && inputPending()) return abandoned();
             FrameState piece = tile;
@@ -676,7 +708,12 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
                 return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
             const FrameOutput& frame = rendered.frame;
             tileMs += rendered.renderMs;
-            if (planned) partPlanner.record(tilePixels, parts, rendered.renderMs);
+            const bool oneTime = !skippedOneTimeWork && drewOneTimeWork(frame);
+            if (oneTime) {
+                skippedOneTimeWork = true;
+                measureTile = false;
+            }
+            if (planned && !oneTime) partPlanner.record(tilePixels, parts, rendered.renderMs);
             renderedMs += rendered.renderMs;
             pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
             unsent = unite(unsent, clipToImage(rect, full.width, full.height));
@@ -736,11 +773,11 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const double measured = tileMs / tilePixels;
         // A slow tile counts at once (tiles must not overrun); a cheap one (mostly background) lowers
         // the estimate by at most a fifth, since the next one may cover geometry.
-        rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
+        if (measureTile) rate = rate > 0.0 ? std::max(measured, 0.8 * rate) : measured;
         // A smallest tile over the slice that cannot split its VPLs: its cost is mostly per VPL (each
         // batch of them is a draw), so the step starts again with the VPLs this measurement allows
         // (workerMain caps them).
-        if (!splittable && rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
+        if (measureTile && !splittable && rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
             const std::string key = w.scene->name + "/" + full.technique + "/" + std::to_string(step);
             const double perVpl = tileMs / static_cast<double>(vpls);
             auto known = mMinTileMsPerVpl.find(key);

@@ -30,6 +30,7 @@
 #include "session/ProtocolMessages.h"
 #include "session/SceneCache.h"
 #include "session/SceneCatalog.h"
+#include "session/VplPartPlanner.h"
 
 namespace gis {
 
@@ -231,6 +232,9 @@ private:
     /// Worker only: scene/technique/step -> ms per VPL of the smallest refinement tile, where one
     /// overran its slice (the VPL cap of that step follows it).
     std::map<std::string, double> mMinTileMsPerVpl;
+    /// Refinement's VPL-part fits by scene, technique and tile limits (session/VplPartPlanner.h): a
+    /// step starts from the last one's instead of a prediction (worker thread only).
+    std::map<std::string, VplPartPlanner::Memory> mPartMemory;
     double predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const;
     void recordRefineCost(const std::string& sceneName, const FrameState& state, int step, double msPerPixel);
     std::atomic<bool> mStop{false};

@@ -118,6 +118,36 @@ VplPartPlan VplPartPlanner::plan(long vpls, double allVplRate) {
     return out;
 }
 
+VplPartPlanner::Memory VplPartPlanner::remember(long vpls) const {
+    Memory m;
+    const double count = static_cast<double>(std::max(vpls, 1L));
+    for (const auto& [rung, data] : mRungs) {
+        double fixedMs = 0, vplMs = 0;
+        if (fit(rung, fixedMs, vplMs)) m.fixedAndPerVpl[rung] = {fixedMs, vplMs / count};
+    }
+    m.shrinkFutile = mShrinkFutile;
+    return m;
+}
+
+void VplPartPlanner::recall(const Memory& memory, long vpls) {
+    const double count = static_cast<double>(std::max(vpls, 1L));
+    // Two part counts far enough apart that fit() reproduces the remembered costs, each worth one
+    // sample: this step's measurements outweigh them from its first tiles on.
+    constexpr int kFew = 1, kMany = 16;
+    for (const auto& [rung, costs] : memory.fixedAndPerVpl) {
+        if (rung < 0 || rung > mLowestRung || !std::isfinite(costs.first) || !std::isfinite(costs.second))
+            continue;
+        const double vplMs = costs.second * count;
+        Rung& r = mRungs[rung];
+        r.byParts[kFew] = {costs.first + vplMs / kFew, 1};
+        r.byParts[kMany] = {costs.first + vplMs / kMany, 1};
+        r.lastParts = kMany;
+    }
+    // The tile size is chosen again from the largest: the last step may have shrunk its tiles for a
+    // VPL count this one does not have (plan() steps down while fixed work fills the target).
+    mShrinkFutile = memory.shrinkFutile;
+}
+
 void VplPartPlanner::record(double pixels, int parts, double ms) {
     if (!(pixels > 0.0) || parts < 1 || !std::isfinite(ms) || ms < 0.0) return;
     const int rungIndex = rungOf(pixels);

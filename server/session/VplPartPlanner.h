@@ -42,6 +42,20 @@ public:
     /// counts were measured at it.
     bool fitted(double& fixedMs, double& vplMs) const;
 
+    /// What a step learned, for the next step with the same tiles: per tile size with a fit, its fixed
+    /// ms and its VPL ms per VPL (the next step may have another VPL count), and whether smaller tiles
+    /// proved no cheaper.
+    struct Memory {
+        std::map<int, std::pair<double, double>> fixedAndPerVpl; ///< by rung
+        bool shrinkFutile = false;
+        bool empty() const { return fixedAndPerVpl.empty(); }
+    };
+    /// This planner's fits, for steps of `vpls` VPLs.
+    Memory remember(long vpls) const;
+    /// Starts (before any record) from an earlier step's fits, scaled to this step's `vpls`, so its
+    /// first tiles are not sized from a prediction again; this step's own parts then take over.
+    void recall(const Memory& memory, long vpls);
+
 private:
     struct Mean {
         double ms = 0;

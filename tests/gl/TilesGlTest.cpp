@@ -180,6 +180,35 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
     }
     EXPECT_GE(techniques, 2) << "rsm_gather and multires_gather render in parts";
 
+    // As sessions render (light passes reused), later parts of one image also keep the G-buffer and
+    // the direct light: the same mean without drawing them again; a changed frame parameter draws them.
+    {
+        FrameRenderer reusing;
+        reusing.setReuseLightPasses(true);
+        reusing.setScene(std::make_shared<const Scene>(scene));
+        FrameState whole = stateFor(scene, "rsm_gather", 96, 80);
+        whole.techniqueParams.set("vpl_grid", 12);
+        const FrameOutput reference = reusing.render(whole, true);
+        FrameOutput out;
+        for (int p = 0; p < 4; ++p) {
+            FrameState part = whole;
+            part.vplPart = {p, 4};
+            out = reusing.render(part, true);
+            EXPECT_EQ(counter(out, "vpl_part_kept_gbuffer"), p > 0 ? 1.0 : 0.0) << "part " << p;
+            EXPECT_EQ(hasPass(out, "gbuffer"), p == 0) << "part " << p;
+            EXPECT_EQ(hasPass(out, "direct"), p == 0) << "part " << p;
+        }
+        EXPECT_LT(maxRelativeDifference(out.linear, reference.linear), 1e-4);
+        FrameState changed = whole;
+        changed.vplPart = {0, 2};
+        reusing.render(changed);
+        changed.vplPart = {1, 2};
+        changed.frameParams.set("pcf_radius", 0);
+        const FrameOutput redrawn = reusing.render(changed);
+        EXPECT_EQ(counter(redrawn, "vpl_part_kept_gbuffer"), 0.0);
+        EXPECT_TRUE(hasPass(redrawn, "gbuffer"));
+    }
+
     FrameState full = stateFor(scene, "rsm_gather", 96, 80);
     FrameOutput last;
 

@@ -126,3 +126,44 @@ TEST(VplPartPlanner, IgnoresUnusableMeasurements) {
 
 } // namespace
 } // namespace gis
+
+namespace gis {
+namespace {
+
+// A step starts from what the last one learned, scaled to its own VPL count: its first plan is the
+// settled one (not the prediction's hundreds of parts), and a step with four times the VPLs starts
+// with about four times the VPL share per part.
+TEST(VplPartPlanner, RemembersItsFitsForTheNextStep) {
+    VplPartPlanner first(limits());
+    double lastMs = 0;
+    // Mostly fixed work (6 ms a part) and a little VPL work (4 ms for the tile's 1600 VPLs).
+    const double fixedPerPixel = 6.0 / 4096, vplPerPixel = 4.0 / 4096;
+    const VplPartPlan settled = settle(first, 1600, 1.0, fixedPerPixel, vplPerPixel, &lastMs);
+    EXPECT_LE(lastMs, 14.0);
+    const VplPartPlanner::Memory memory = first.remember(1600);
+    ASSERT_FALSE(memory.empty());
+
+    VplPartPlanner fresh(limits());
+    const VplPartPlan guessed = fresh.plan(1600, 1.0); // a prediction of 4096 ms for the tile
+    EXPECT_GT(guessed.parts, 100);
+
+    VplPartPlanner next(limits());
+    next.recall(memory, 1600);
+    const VplPartPlan recalled = next.plan(1600, 1.0);
+    EXPECT_EQ(recalled.parts, settled.parts);
+    EXPECT_EQ(recalled.pixels, settled.pixels);
+    double fixedMs = 0, vplMs = 0;
+    ASSERT_TRUE(next.fitted(fixedMs, vplMs));
+    EXPECT_NEAR(fixedMs, 6.0 * settled.pixels / 4096, 0.05);
+
+    VplPartPlanner bigger(limits());
+    bigger.recall(memory, 6400);
+    ASSERT_TRUE(bigger.fitted(fixedMs, vplMs));
+    EXPECT_NEAR(vplMs, 4.0 * 4.0 * settled.pixels / 4096, 0.2);
+    EXPECT_LE(partMs(bigger.plan(6400, 1.0).pixels, bigger.plan(6400, 1.0).parts, fixedPerPixel,
+                     4.0 * vplPerPixel),
+              14.0 + 1e-9);
+}
+
+} // namespace
+} // namespace gis
