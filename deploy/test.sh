@@ -9,7 +9,8 @@
 #                         12-minute budget of this stage on 2 cores; =all adds every other layer's
 #                         unit tests (about twice the build: docs/stability.md)
 #   GIS_FUZZ_TESTS=1      the libFuzzer targets (clang, build/fuzz), each for FUZZ_SECONDS (default
-#                         60) on a copy of its committed seed corpus in tests/fuzz/corpus/
+#                         40: three targets, two minutes in all) on a copy of its committed seed
+#                         corpus in tests/fuzz/corpus/
 # Set either to 0 to skip it in CI.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,7 +20,7 @@ default_extra=0
 [[ "${CI:-}" == "true" ]] && default_extra=1
 SANITIZE="${GIS_SANITIZE_TESTS:-$default_extra}"
 FUZZ="${GIS_FUZZ_TESTS:-$default_extra}"
-FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
+FUZZ_SECONDS="${FUZZ_SECONDS:-40}"
 
 bash "$ROOT/deploy/install-deps.sh"
 
