@@ -223,7 +223,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
                 const glm::mat4 face = faceViewProj(f, probe, zNear, zFar);
                 pass.set(fw.viewProj, face);
                 const DrawCount drawn =
-                    in.sceneGpu->draw(fw.program, &fw.materials, 1, probes[p].skipMesh, &face);
+                    in.sceneGpu->draw(fw.program, &fw.materials, 1, probes[p].skipMesh, &face, true);
                 counters["triangles_env"] += static_cast<double>(drawn.drawn);
                 counters["triangles_env_culled"] += static_cast<double>(drawn.culled);
             }

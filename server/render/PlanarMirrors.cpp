@@ -290,7 +290,9 @@ void PlanarMirrors::execute(const ReflectionInputs& in, const ParamSet& fp, cons
                     .set(fw.viewProj, reflected)
                     .set(fw.clipPlane, glm::vec4(n, d))
                     .set(fw.eye, v.eye);
-                in.sceneGpu->draw(fw.program, &fw.materials, 1, -1, &reflected);
+                // Single-sided materials are culled from behind here too: frontFace above keeps
+                // "behind" right in the mirrored view.
+                in.sceneGpu->draw(fw.program, &fw.materials, 1, -1, &reflected, true);
                 previous.push_back(static_cast<int>(views.size()));
                 views.push_back(v);
             }

@@ -49,8 +49,9 @@ public:
     /// With `cullViewProj` (world -> clip, the matrix the program's vertex stage applies), runs whose
     /// bounds lie wholly outside one of its clip planes are skipped: GL would clip every triangle of
     /// them, so the image is the same.
-    /// With `cullBackFaces` (the camera's views), single-sided materials (Material::doubleSided false)
-    /// are drawn with back faces culled (front faces CCW, as glTF).
+    /// With `cullBackFaces` (the views that show surfaces: the G-buffer, environment-probe faces and
+    /// mirrored views), single-sided materials (Material::doubleSided false) are drawn with back faces
+    /// culled (front faces as the pass's glFrontFace says: CCW, as glTF, unless mirrored).
     DrawCount draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
                    int skipMesh = -1, const glm::mat4* cullViewProj = nullptr,
                    bool cullBackFaces = false) const;

@@ -60,8 +60,9 @@ struct Material {
     bool cutsOut() const { return alphaMode != Alpha::Opaque; }
     float cutoff() const { return alphaMode == Alpha::Blend ? 0.5f : alphaCutoff; }
     /// glTF doubleSided. False (glTF's default): the camera does not see the back faces (culled in the
-    /// G-buffer, passed by the reference's camera rays), so an interior of one-sided walls can be
-    /// looked into from outside; light views still see both sides. True: both sides shown, each lit
+    /// G-buffer, the environment-probe faces and mirrored views; passed by the reference's camera
+    /// rays), so an interior of one-sided walls can be looked into from outside; light views still
+    /// see both sides. True: both sides shown, each lit
     /// on the side it is seen from. Materials built in code are double-sided.
     bool doubleSided = true;
 };
