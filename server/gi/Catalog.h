@@ -41,9 +41,9 @@ struct TechniqueInfo {
     /// refinement step (frame/Tiles.h) then samples its own set, so tiles differ slightly at their
     /// seams where a whole frame would not (tests/gl/TilesGlTest.cpp measures by how much).
     bool viewSampled = false;
-    /// Whether, with these parameters, its indirect light already carries indirect shadows of its own
-    /// beyond vpl_shadows (second_order's negative lights): the renderer then leaves glTF occlusion
-    /// maps out of it, as it does with vpl_shadows on. Empty: none.
+    /// Whether, with these parameters, its indirect light already carries indirect shadows (vpl_shadows
+    /// on, second_order's negative lights): the renderer then leaves glTF occlusion maps out of it.
+    /// Empty: never.
     std::function<bool(const ParamSet&)> indirectShadows;
     /// Whether, with these parameters, the technique honours FrameInputs::vplPart: it renders one of
     /// vplParts interleaved subsets of its VPLs scaled by vplParts, so that the average of the parts

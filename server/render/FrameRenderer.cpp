@@ -585,9 +585,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
 
     // glTF occlusion maps darken the indirect light only where no pass computed indirect shadows.
     const bool indirectShadows =
-        (techniqueInfo.vplVisibility && state.techniqueParams.has("vpl_shadows") &&
-         state.techniqueParams.getBool("vpl_shadows")) ||
-        (techniqueInfo.indirectShadows && techniqueInfo.indirectShadows(state.techniqueParams));
+        techniqueInfo.indirectShadows && techniqueInfo.indirectShadows(state.techniqueParams);
     const bool applyOcclusion = mSceneHasOcclusionMaps && !indirectShadows;
     counters["occlusion_maps_applied"] = applyOcclusion ? 1 : 0;
     composite(state.width, state.height, indirect, reflection, applyOcclusion);

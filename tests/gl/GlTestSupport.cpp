@@ -38,6 +38,19 @@ FrameOutput renderScene(const std::string& sceneName, const std::string& techniq
     return renderer->render(state, true);
 }
 
+FrameOutput renderScene(const Scene& scene, const std::string& technique, int w, int h,
+                        const nlohmann::json& params, const std::function<void(FrameState&)>& edit,
+                        bool wantDirect) {
+    FrameRenderer& renderer = sharedRenderer();
+    renderer.setScene(std::make_shared<const Scene>(scene));
+    FrameState state = makeFrameState(scene, technique);
+    state.width = w;
+    state.height = h;
+    if (!params.is_null()) applyParams(state, params, "test");
+    if (edit) edit(state);
+    return renderer.render(state, true, wantDirect);
+}
+
 IndirectPair indirectOnly(const FrameOutput& gl, const FrameOutput& glDirect, const std::vector<float>& ref,
                           const std::vector<float>& refDirect) {
     IndirectPair out;

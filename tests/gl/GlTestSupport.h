@@ -25,6 +25,11 @@ FrameRenderer& sharedRenderer();
 FrameOutput renderScene(const std::string& scene, const std::string& technique, int w, int h,
                         const nlohmann::json& params = nlohmann::json::object(),
                         const std::function<void(FrameState&)>& edit = {});
+/// The same for a scene the test built (uploaded to the shared renderer for this frame); with
+/// `wantDirect` the frame's direct pass too (FrameOutput::linearDirect).
+FrameOutput renderScene(const Scene& scene, const std::string& technique, int w, int h,
+                        const nlohmann::json& params = nlohmann::json::object(),
+                        const std::function<void(FrameState&)>& edit = {}, bool wantDirect = false);
 
 /// Each side's indirect light (its total minus its own direct term), GL frames (RGBA) against
 /// reference images (RGB), as interleaved RGB; `glSum` and `refSum` receive their sums.

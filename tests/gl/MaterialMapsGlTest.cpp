@@ -81,15 +81,10 @@ struct Frames {
 };
 
 Frames renderScene(const Scene& scene) {
-    test::sharedContext();
-    FrameRenderer renderer;
-    renderer.setScene(std::make_shared<const Scene>(scene));
-    FrameState state = makeFrameState(scene, "none");
-    state.width = kSide;
-    state.height = kSide;
-    state.frameParams.set("shadow_map_size", 1024);
+    FrameState state;
     Frames f;
-    f.gl = renderer.render(state, true);
+    f.gl = test::renderScene(scene, "none", kSide, kSide, {{"shadow_map_size", 1024}},
+                             [&](FrameState& used) { state = used; });
     ReferenceRenderer reference(scene);
     f.reference = reference.render(state, {.mode = "direct", .spp = 16, .seed = 3, .jitter = true});
     return f;

@@ -1,13 +1,10 @@
 // glTF occlusion maps: they darken the indirect light (not the direct) by the map, where no pass
 // computes indirect shadows; with vpl_shadows (or second_order's negative lights) they are left out.
 #include <cstdio>
-#include <memory>
 
 #include <gtest/gtest.h>
 
 #include "GlTestSupport.h"
-#include "frame/FrameState.h"
-#include "render/FrameRenderer.h"
 #include "scene/SceneLoader.h"
 
 using namespace gis;
@@ -34,14 +31,8 @@ Scene room(bool occlusion) {
 }
 
 FrameOutput render(const Scene& scene, bool vplShadows) {
-    test::sharedContext();
-    FrameRenderer renderer;
-    renderer.setScene(std::make_shared<const Scene>(scene));
-    FrameState state = makeFrameState(scene, "rsm_gather");
-    state.width = kSide;
-    state.height = kSide;
-    state.techniqueParams.apply({{"vpl_grid", 8}, {"vpl_shadows", vplShadows}});
-    return renderer.render(state, true, true);
+    return test::renderScene(scene, "rsm_gather", kSide, kSide,
+                             {{"vpl_grid", 8}, {"vpl_shadows", vplShadows}}, {}, true);
 }
 
 } // namespace
@@ -68,7 +59,8 @@ TEST(OcclusionMap, DarkensTheIndirectLightByTheMap) {
         EXPECT_LE(ratio, 1.0 + 1e-4);
         EXPECT_GE(ratio, 64.0 / 255.0 - 0.01);
     }
-    std::printf("indirect scaled by the map's 0.251: %d pixels, by 1: %d, between: %d\n", quarter, whole, other);
+    std::printf("indirect scaled by the map's 0.251: %d pixels, by 1: %d, between: %d\n", quarter, whole,
+                other);
     EXPECT_GT(quarter, 100);
     EXPECT_GT(whole, 500); // the walls and the ceiling
     EXPECT_EQ(other, 0);

@@ -6,7 +6,6 @@
 #include "GlTestSupport.h"
 #include "analysis/Metrics.h"
 #include "reference/ReferenceRenderer.h"
-#include "render/FrameRenderer.h"
 #include "scene/SceneLoader.h"
 
 using namespace gis;
@@ -37,7 +36,8 @@ Scene roomWithCard(bool cutOut) {
     if (cutOut) {
         m.baseColorTexture = static_cast<int>(s.textures.size());
         m.alphaMode = Material::Alpha::Mask;
-        s.textures.push_back(TextureImage{.width = 1, .height = 1, .rgba = {255, 255, 255, 0}, .name = "clear"});
+        s.textures.push_back(
+            TextureImage{.width = 1, .height = 1, .rgba = {255, 255, 255, 0}, .name = "clear"});
     }
     s.materials.push_back(m);
     s.updateBounds();
@@ -45,14 +45,7 @@ Scene roomWithCard(bool cutOut) {
 }
 
 FrameOutput renderWithVplShadows(const Scene& scene) {
-    test::sharedContext();
-    FrameRenderer renderer;
-    renderer.setScene(std::make_shared<const Scene>(scene));
-    FrameState state = makeFrameState(scene, "rsm_gather");
-    state.width = 48;
-    state.height = 48;
-    state.techniqueParams.apply({{"vpl_grid", 8}, {"vpl_shadows", true}});
-    return renderer.render(state, true);
+    return renderScene(scene, "rsm_gather", 48, 48, {{"vpl_grid", 8}, {"vpl_shadows", true}});
 }
 
 double sum(const std::vector<float>& v) {

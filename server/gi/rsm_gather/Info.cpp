@@ -14,6 +14,11 @@ bool gatherVplParts(const ParamSet& technique) {
     return technique.getInt("ssbc_iterations") == 0;
 }
 
+/// Its indirect shadows: the VPLs' cube shadow maps, when on.
+bool vplShadowsOn(const ParamSet& p) {
+    return p.getBool("vpl_shadows");
+}
+
 } // namespace
 
 TechniqueInfo rsmGatherInfo() {
@@ -23,6 +28,7 @@ TechniqueInfo rsmGatherInfo() {
     info.vplEstimate = gridVplEstimate;
     info.limitVpls = limitGridVpls;
     info.vplVisibility = true;
+    info.indirectShadows = vplShadowsOn;
     info.biasCompensation = true;
     info.vplParts = gatherVplParts;
     return info;
@@ -42,6 +48,7 @@ TechniqueInfo ssbcInfo() {
     info.vplEstimate = gridVplEstimate;
     info.limitVpls = limitGridVpls;
     info.vplVisibility = true;
+    info.indirectShadows = vplShadowsOn;
     info.biasCompensation = true;
     info.vplParts = gatherVplParts;
     return info;

@@ -23,6 +23,20 @@ TEST(Catalog, CapabilitiesAreBackedByTheDeclaredParameters) {
                       p.find("normal_threshold") != nullptr && p.find("diagonal_refine") != nullptr)
             << info.name;
         EXPECT_EQ(static_cast<bool>(info.vplEstimate), info.name != "none") << info.name;
+        // VPL visibility is an indirect shadow: a technique with the knob says when it is on.
+        if (info.vplVisibility) {
+            EXPECT_TRUE(static_cast<bool>(info.indirectShadows)) << info.name;
+        }
+        if (info.indirectShadows) {
+            ParamSet on(info.params), off(info.params);
+            if (p.find("vpl_shadows")) {
+                on.set("vpl_shadows", true);
+                off.set("vpl_shadows", false);
+            }
+            if (p.find("negative_count")) off.set("negative_count", 0);
+            EXPECT_TRUE(info.indirectShadows(on)) << info.name;
+            EXPECT_FALSE(info.indirectShadows(off)) << info.name;
+        }
     }
     EXPECT_THROW(findTechniqueInfo("nope"), InputError);
 }
