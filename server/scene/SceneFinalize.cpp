@@ -67,8 +67,10 @@ void repairNormals(Mesh& mesh) {
 }
 
 // Per-vertex tangents from the texture coordinates (each triangle's dP/du, summed by area as the
-// normals are, then made orthogonal to the normal); w is the bitangent's handedness. Vertices on no
-// usable triangle get a zero tangent, which leaves their normal unmapped.
+// normals are, then made orthogonal to the normal); w is the bitangent's handedness. glTF's texture
+// v runs down the image while a normal map's +y is up it, so the bitangent b = w cross(n, t) points
+// along -dP/dv, as the MikkTSpace tangents exporters write. Vertices on no usable triangle get a zero
+// tangent, which leaves their normal unmapped.
 void generateTangents(Mesh& mesh) {
     const std::size_t n = mesh.positions.size();
     if (mesh.texcoords.size() != n || mesh.normals.size() != n) return;
@@ -95,7 +97,7 @@ void generateTangents(Mesh& mesh) {
         const glm::vec3 nrm = mesh.normals[i];
         const glm::vec3 t = safeNormalize(tangent[i] - nrm * glm::dot(nrm, tangent[i]), glm::vec3(0.0f));
         if (t == glm::vec3(0.0f)) continue;
-        const float w = glm::dot(glm::cross(nrm, t), bitangent[i]) < 0.0f ? -1.0f : 1.0f;
+        const float w = glm::dot(glm::cross(nrm, t), bitangent[i]) > 0.0f ? -1.0f : 1.0f;
         mesh.tangents[i] = glm::vec4(t, w);
     }
 }

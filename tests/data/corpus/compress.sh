@@ -7,6 +7,7 @@
 #   textured_box_meshopt.glb                      gltfpack -cc -noq (meshopt with filters, float data)
 #   textured_box_quantized.glb                    gltfpack (quantized; UVs dequantized by KHR_texture_transform)
 #   textured_box_gltf.zip                         gltf-transform copy to .gltf + .bin + PNG, zipped
+#   textured_box_normalmap_mikk.glb               its checker as a normal map too, gltf-transform tangents (MikkTSpace)
 # usage: tests/data/corpus/compress.sh [SCRATCH_DIR]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -33,3 +34,17 @@ rm -f "$here/textured_box_gltf.zip"
 with zipfile.ZipFile(sys.argv[1], "w", zipfile.ZIP_DEFLATED) as z:
     for f in ("textured_box/textured_box.gltf", "textured_box/textured_box.bin", "textured_box/textures/baseColor.png"):
         z.write(f)' "$here/textured_box_gltf.zip")
+# textured_box_normalmap_mikk.glb: the Blender box with its checker also as a normal map (a JSON edit),
+# then MikkTSpace tangents from glTF Transform's `tangents`: the loader's own tangents must agree.
+python3 - "$here/textured_box.glb" "$scratch/normalmap.glb" <<'PY'
+import json, struct, sys
+b = open(sys.argv[1], 'rb').read()
+n = struct.unpack_from('<I', b, 12)[0]
+doc, rest = json.loads(b[20:20 + n]), b[20 + n:]
+doc['materials'][0]['normalTexture'] = {'index': 0}
+j = json.dumps(doc).encode()
+j += b' ' * (-len(j) % 4)
+open(sys.argv[2], 'wb').write(struct.pack('<III', 0x46546C67, 2, 20 + len(j) + len(rest)) +
+                              struct.pack('<II', len(j), 0x4E4F534A) + j + rest)
+PY
+"$scratch/node_modules/.bin/gltf-transform" tangents "$scratch/normalmap.glb" "$here/textured_box_normalmap_mikk.glb"

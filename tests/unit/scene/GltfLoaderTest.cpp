@@ -1,4 +1,6 @@
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <map>
 
 #include <glm/gtc/constants.hpp>
@@ -374,7 +376,7 @@ TEST(GltfLoader, MetallicRoughnessAndEmissiveTexturesAreRead) {
 }
 
 // A normal map gets tangents generated from the texture coordinates: unit, orthogonal to the normal,
-// along +u, with the bitangent's handedness.
+// along +u, with the bitangent's handedness (glTF's: up the image, along -v).
 TEST(GltfLoader, NormalMapGetsTangentsAlongU) {
     TempDir dir;
     GltfBuilder b;
@@ -397,10 +399,53 @@ TEST(GltfLoader, NormalMapGetsTangentsAlongU) {
         EXPECT_NEAR(t.x, 1.0f, 1e-5f);
         EXPECT_NEAR(t.y, 0.0f, 1e-5f);
         EXPECT_NEAR(t.z, 0.0f, 1e-5f);
-        // b = w cross(n, t) = w cross(+y, +x) = -w z must run along +v, i.e. -z: w = +1.
-        EXPECT_EQ(t.w, 1.0f);
+        // b = w cross(n, t) = w cross(+y, +x) = -w z must run along -v (up the image: glTF's v runs
+        // down it, a normal map's +y up), i.e. +z: w = -1.
+        EXPECT_EQ(t.w, -1.0f);
     }
     EXPECT_TRUE(s.notShown.empty());
+}
+
+// Against another tool's tangents: the corpus box with its checker as a normal map and MikkTSpace
+// tangents from glTF Transform (tests/data/corpus/compress.sh). The tangents generated when the file
+// has none point the same way and have the same handedness at every vertex.
+TEST(GltfLoader, GeneratedTangentsAgreeWithMikkTSpace) {
+    const std::string path =
+        std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/textured_box_normalmap_mikk.glb";
+    const Scene withFile = loadGltf(path);
+    // The same file without its TANGENT attribute, as a GltfBuilder holding its JSON and binary chunk.
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<std::uint8_t> glb((std::istreambuf_iterator<char>(in)),
+                                        std::istreambuf_iterator<char>());
+    ASSERT_GT(glb.size(), 28u);
+    auto u32 = [&](std::size_t at) {
+        return std::uint32_t(glb[at]) | std::uint32_t(glb[at + 1]) << 8 | std::uint32_t(glb[at + 2]) << 16 |
+               std::uint32_t(glb[at + 3]) << 24;
+    };
+    const std::size_t jsonLength = u32(12);
+    GltfBuilder b;
+    b.doc =
+        nlohmann::json::parse(glb.begin() + 20, glb.begin() + 20 + static_cast<std::ptrdiff_t>(jsonLength));
+    b.bin.assign(glb.begin() + 28 + static_cast<std::ptrdiff_t>(jsonLength), glb.end());
+    for (auto& mesh : b.doc["meshes"])
+        for (auto& primitive : mesh["primitives"]) ASSERT_EQ(primitive["attributes"].erase("TANGENT"), 1u);
+    TempDir dir;
+    const Scene generated = loadGltf(b.writeGlb(dir, "no_tangents.glb"));
+
+    ASSERT_EQ(withFile.meshes.size(), generated.meshes.size());
+    int vertices = 0, sameSide = 0, sameHandedness = 0;
+    for (std::size_t m = 0; m < withFile.meshes.size(); ++m) {
+        const auto &a = withFile.meshes[m].tangents, &g = generated.meshes[m].tangents;
+        ASSERT_EQ(a.size(), g.size());
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            ++vertices;
+            sameSide += glm::dot(glm::vec3(a[i]), glm::vec3(g[i])) > 0.99f ? 1 : 0;
+            sameHandedness += a[i].w == g[i].w ? 1 : 0;
+        }
+    }
+    EXPECT_GT(vertices, 0);
+    EXPECT_EQ(sameSide, vertices);
+    EXPECT_EQ(sameHandedness, vertices);
 }
 
 // glTF doubleSided: false unless the file says true (the built-in scenes' materials are double-sided).
@@ -426,8 +471,8 @@ TEST(GltfLoader, NormalMapUsesTheFilesTangents) {
     const int tri = b.addTriangleNode(); // facing +y
     const int uv = b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 0, 0, 1}), test::kFloat, 3, "VEC2");
     // Deliberately not what generation would give (+x): the file's (0, 0, 1) and (0, 0, 0).
-    const int tangents =
-        b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 1, 0, 0, 1, -1, 0, 0, 0, 1}), test::kFloat, 3, "VEC4");
+    const int tangents = b.addAccessor(b.addView(std::vector<float>{0, 0, 1, 1, 0, 0, 1, -1, 0, 0, 0, 1}),
+                                       test::kFloat, 3, "VEC4");
     auto& prim = b.doc["meshes"][0]["primitives"][0];
     prim["attributes"]["TEXCOORD_0"] = uv;
     prim["attributes"]["TANGENT"] = tangents;
