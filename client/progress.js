@@ -73,11 +73,16 @@ export class RefineTracker {
             this.flash = { kind: 'abandoned', text: `refinement abandoned${reason ? `: ${reason}` : ' (input)'}`,
                 until: now + FLASH_MS.abandoned };
             break;
-        case 'loading':
-            // A scene load: no refinement runs meanwhile; it says what is loading until it ends.
+        case 'loading': {
+            // A scene load: no refinement runs meanwhile; it says what is loading until it ends. A long
+            // load repeats the message with how far it got (share > 0) and the time left.
             this.current = null;
-            this.flash = { kind: 'loading', text: reason || 'loading the scene', until: now + FLASH_MS.loading };
+            const share = Number.isFinite(msg.share) && msg.share > 0 ? Math.min(1, msg.share) : null;
+            const eta = share !== null && Number.isFinite(msg.eta_ms) && msg.eta_ms > 0 ? msg.eta_ms : null;
+            this.flash = { kind: 'loading', text: reason || 'loading the scene', share, etaMs: eta, at: now,
+                until: now + FLASH_MS.loading };
             break;
+        }
         case 'loaded':
             this.flash = { kind: 'loaded', text: reason || 'scene loaded', until: now + FLASH_MS.loaded };
             break;
@@ -109,13 +114,20 @@ export class RefineTracker {
 
     /**
      * What to show at `now`: null, or {kind: 'refining' | 'done' | 'abandoned' | 'skipped' | 'loading' |
-     * 'loaded', text,
-     * share (0..1, refining only)}. The time left counts down between messages.
+     * 'loaded', text, share (0..1: refining, and loading once the server said how far it got, else
+     * null)}. The time left counts down between messages.
      */
     view(now) {
         if (this.flash && this.flash.until <= now) this.flash = null;
         const c = this.current;
-        if (!c) return this.flash ? { kind: this.flash.kind, text: this.flash.text, share: null } : null;
+        if (!c) {
+            const f = this.flash;
+            if (!f) return null;
+            if (f.kind !== 'loading' || f.share == null) return { kind: f.kind, text: f.text, share: null };
+            const parts = [f.text, percent(f.share)];
+            if (f.etaMs !== null) parts.push(`${formatSeconds(Math.max(0, f.etaMs - (now - f.at)))} left`);
+            return { kind: 'loading', text: parts.join(' · '), share: f.share };
+        }
         const parts = [`refining ${c.step ?? '…'}`, percent(c.share)];
         if (c.etaMs !== null) parts.push(`${formatSeconds(Math.max(0, c.etaMs - (now - c.at)))} left`);
         // A step skipped before this one ("skipped balanced: over budget") stays readable.

@@ -243,3 +243,19 @@ test('a scene load shows while it runs, then what it cost; a failed one leaves t
     r.message({ type: 'progress', state: 'load_failed', step: 'scene', reason: 'could not load upload:bad.glb' }, 70100);
     assert.equal(r.view(70200), null);
 });
+
+test('a long load shows how far it got and the time left, counting down between messages', () => {
+    const r = new RefineTracker();
+    r.message({ type: 'progress', state: 'loading', step: 'scene', share: 0, eta_ms: 0, reason: 'loading upload:city.glb (48.0 MiB)' }, 0);
+    assert.equal(r.view(10).share, null, 'the first message knows nothing yet');
+    r.message({ type: 'progress', state: 'loading', step: 'scene', share: 0.4, eta_ms: 3000,
+        reason: 'loading upload:city.glb (48.0 MiB): decoding images: 3 of 12' }, 2000);
+    const v = r.view(2500);
+    assert.equal(v.kind, 'loading');
+    assert.equal(v.share, 0.4);
+    assert.equal(v.text, 'loading upload:city.glb (48.0 MiB): decoding images: 3 of 12 · 40 % · 2.5 s left');
+    assert.match(busyText({ refine: v }), /3 of 12 · 40 %/);
+    assert.match(r.view(9000).text, /0\.0 s left$/, 'the countdown stops at zero');
+    r.message({ type: 'progress', state: 'loaded', step: 'scene', share: 1, reason: 'loaded upload:city.glb' }, 9100);
+    assert.deepEqual(r.view(9200), { kind: 'loaded', text: 'loaded upload:city.glb', share: null });
+});

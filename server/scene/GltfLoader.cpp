@@ -66,6 +66,35 @@ struct LoadContext {
     std::uint64_t budget = 0; ///< 0: no limit
     std::uint64_t spent = 0;
     std::string refusal; ///< the first refusal, for the error message
+    std::function<void(const SceneLoadProgress&)> onProgress;
+    SceneLoadProgress progress;
+    std::size_t imagesTotal = 0, imagesDecoded = 0; ///< images in the document, decoded so far
+
+    /// Where each stage's share of the load starts; a stage the file does not need takes none.
+    struct StageShares {
+        double decompress = 0.1, images = 0.2, meshes = 0.6, finishing = 0.95;
+    } shares;
+    /// Reports `done` of `total` in `stage`; the share rises linearly inside the stage's range.
+    void report(SceneLoadProgress::Stage stage, std::size_t done, std::size_t total) {
+        if (!onProgress) return;
+        using S = SceneLoadProgress::Stage;
+        const double from = stage == S::Reading         ? 0.0
+                            : stage == S::Decompressing ? shares.decompress
+                            : stage == S::Images        ? shares.images
+                            : stage == S::Meshes        ? shares.meshes
+                                                        : shares.finishing;
+        const double to = stage == S::Reading         ? shares.decompress
+                          : stage == S::Decompressing ? shares.images
+                          : stage == S::Images        ? shares.meshes
+                          : stage == S::Meshes        ? shares.finishing
+                                                      : 1.0;
+        const double within = total > 0 ? static_cast<double>(std::min(done, total)) / total : 0.0;
+        progress.stage = stage;
+        progress.done = std::min(done, total);
+        progress.total = total;
+        progress.share = std::max(progress.share, from + (to - from) * within);
+        onProgress(progress);
+    }
 
     /// Counts `bytes` against the budget; false (with the refusal recorded) when it would overflow.
     bool spend(std::uint64_t bytes, const std::string& what) {
@@ -167,6 +196,7 @@ bool sandboxReadFile(std::vector<unsigned char>* out, std::string* err, const st
         if (err) *err = "cannot read '" + validUtf8(uri) + "'";
         return false;
     }
+    c.progress.bytesRead += size;
     return true;
 }
 
@@ -200,7 +230,10 @@ bool budgetedImageLoader(tinygltf::Image* image, const int index, std::string* e
     if (!c.spend(cost,
                  "image " + std::to_string(index) + " (" + std::to_string(w) + "x" + std::to_string(h) + ")"))
         return false;
-    return tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
+    const bool decoded =
+        tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
+    c.report(SceneLoadProgress::Stage::Images, ++c.imagesDecoded, c.imagesTotal);
+    return decoded;
 }
 
 int componentCount(int type) {
@@ -319,12 +352,18 @@ public:
 
     Scene read() {
         checkRequiredExtensions();
+        // Each node is one tree's (glTF): the nodes' primitives are what the walk reads.
+        for (const auto& node : mModel.nodes)
+            if (node.mesh >= 0 && node.mesh < static_cast<int>(mModel.meshes.size()))
+                mPrimitivesTotal += mModel.meshes[static_cast<std::size_t>(node.mesh)].primitives.size();
+        mContext.report(SceneLoadProgress::Stage::Meshes, 0, mPrimitivesTotal);
         readMaterials();
         collectNotShown();
         for (int root : rootNodes()) visitNode(root, glm::mat4(1.0f));
         mScene.name = mPath;
         mScene.updateBounds();
         closeInfiniteFarPlanes();
+        mContext.report(SceneLoadProgress::Stage::Finishing, 0, 0);
         finalizeScene(mScene, mPath);
         return std::move(mScene);
     }
@@ -754,8 +793,10 @@ private:
         if (meshIndex >= static_cast<int>(mModel.meshes.size()))
             fail("mesh " + std::to_string(meshIndex) + " does not exist");
         const tinygltf::Mesh& mesh = mModel.meshes[static_cast<std::size_t>(meshIndex)];
-        for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+        for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
             addPrimitive(mesh, meshIndex, static_cast<int>(p), world);
+            mContext.report(SceneLoadProgress::Stage::Meshes, ++mPrimitivesRead, mPrimitivesTotal);
+        }
     }
 
     static std::vector<std::uint32_t> toTriangleList(const std::vector<std::uint32_t>& v, int mode) {
@@ -968,6 +1009,7 @@ private:
     const std::string& mPath;
     LoadContext& mContext;
     Scene mScene;
+    std::size_t mPrimitivesTotal = 0, mPrimitivesRead = 0;
     std::vector<int> mImageTexture;       ///< glTF image -> Scene::textures index, kNotConverted, or -1
     std::vector<int> mLinearImageTexture; ///< the same for images read as linear data
     std::vector<bool> mOnPath;            ///< nodes on the current root-to-node path, to reject cycles
@@ -1021,9 +1063,19 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
     if (!context.spend(size, "the file")) throw InputError(name, context.refusal);
     std::string bytes(size, '\0');
     {
+        // In chunks, so a big file's read reports how far it got.
+        constexpr std::uintmax_t kChunk = 8u << 20;
+        context.progress.fileBytes = size;
         std::ifstream in(path, std::ios::binary);
-        if (!in.read(bytes.data(), static_cast<std::streamsize>(size)))
-            throw InputError(name, "cannot read the file");
+        for (std::uintmax_t at = 0; at < size;) {
+            const std::uintmax_t n = std::min(kChunk, size - at);
+            if (!in.read(bytes.data() + at, static_cast<std::streamsize>(n)))
+                throw InputError(name, "cannot read the file");
+            at += n;
+            context.progress.bytesRead = at;
+            context.report(SceneLoadProgress::Stage::Reading, static_cast<std::size_t>(at),
+                           static_cast<std::size_t>(size));
+        }
     }
     // tinygltf walks extras and extensions recursively: a deep document must never reach it.
     const std::string_view json = binary ? glbJsonChunk(bytes, name) : std::string_view(bytes);
@@ -1047,6 +1099,12 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
                                                             : "cannot read '" + validUtf8(uri) + "'");
         return std::string(data.begin(), data.end());
     };
+    const bool compressed = json.find("KHR_draco_mesh_compression") != std::string_view::npos ||
+                            json.find("_meshopt_compression") != std::string_view::npos;
+    if (compressed)
+        context.report(SceneLoadProgress::Stage::Decompressing, 0, 1);
+    else
+        context.shares.images = context.shares.decompress;
     const auto decompressed = decompressGltf(bytes, binary, json, name, spend, readExternal);
     if (decompressed) {
         for (const auto& what : decompressed->decoded) logInfo("scene: " + name + ": decoded " + what);
@@ -1054,7 +1112,11 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
         checkedJson = binary ? glbJsonChunk(bytes, name) : std::string_view(bytes);
     }
     // Version, required extensions and dangling references, said with their JSON path.
-    preflightGltfJson(checkedJson, name);
+    const GltfOutline outline = preflightGltfJson(checkedJson, name);
+    // The images stage's share only where there are images to decode.
+    if (outline.images == 0) context.shares.meshes = context.shares.images;
+    context.imagesTotal = outline.images;
+    if (outline.images > 0) context.report(SceneLoadProgress::Stage::Images, 0, outline.images);
 
     tinygltf::TinyGLTF parser;
     parser.SetFsCallbacks(
@@ -1092,6 +1154,7 @@ Scene loadGltf(const std::string& path, const SceneLoadOptions& options) {
     context.name = options.displayName.empty() ? path : options.displayName;
     context.allowExternal = options.allowExternalFiles;
     context.budget = options.maxDecodedBytes;
+    context.onProgress = options.onProgress;
     try {
         std::error_code ec;
         const std::filesystem::path absolute = std::filesystem::absolute(path, ec);

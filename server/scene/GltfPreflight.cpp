@@ -259,11 +259,15 @@ const std::vector<std::string>& gltfReadableExtensions() {
     return names;
 }
 
-void preflightGltfJson(std::string_view json, const std::string& fileName) {
+GltfOutline preflightGltfJson(std::string_view json, const std::string& fileName) {
     // The caller has bounded the nesting depth; a parse error is the parser's to report (it says where).
     Json doc = Json::parse(json.begin(), json.end(), nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) return;
+    if (doc.is_discarded() || !doc.is_object()) return {};
     Preflight(doc, fileName).run();
+    GltfOutline outline;
+    if (const auto images = doc.find("images"); images != doc.end() && images->is_array())
+        outline.images = images->size();
+    return outline;
 }
 
 } // namespace gis

@@ -12,6 +12,7 @@
 // Throws gis::InputError naming `fileName`; a document that is not JSON at all is left to the parser.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +22,11 @@ namespace gis {
 /// The extensions a file may require: the loader reads them.
 const std::vector<std::string>& gltfReadableExtensions();
 
-void preflightGltfJson(std::string_view json, const std::string& fileName);
+/// What the checked document holds, for the loader's progress (zeros when the JSON does not parse).
+struct GltfOutline {
+    std::size_t images = 0;
+};
+
+GltfOutline preflightGltfJson(std::string_view json, const std::string& fileName);
 
 } // namespace gis

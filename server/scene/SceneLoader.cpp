@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <string_view>
 
 #include "core/Error.h"
@@ -27,6 +28,30 @@ std::string joinedBuiltinNames() {
 }
 
 } // namespace
+
+std::string SceneLoadProgress::describe() const {
+    auto mib = [](std::uint64_t b) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(b) / (1024.0 * 1024.0));
+        return std::string(text);
+    };
+    auto of = [&](const char* what) {
+        return std::string(what) + ": " + std::to_string(done) + " of " + std::to_string(total);
+    };
+    switch (stage) {
+    case Stage::Reading:
+        return "reading the file: " + mib(bytesRead) + " of " + mib(fileBytes);
+    case Stage::Decompressing:
+        return "decoding compressed meshes";
+    case Stage::Images:
+        return of("decoding images");
+    case Stage::Meshes:
+        return of("reading meshes");
+    case Stage::Finishing:
+        return "normals, tangents and checks";
+    }
+    return {};
+}
 
 Scene loadScene(const std::string& name, const SceneLoadOptions& options) {
     if (name.starts_with(kBuiltinPrefix)) return makeBuiltinScene(name.substr(kBuiltinPrefix.size()));

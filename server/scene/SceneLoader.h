@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,10 +18,27 @@ namespace gis {
 ///
 /// Whatever the options, a glTF file's external URIs resolve only inside the file's own directory:
 /// absolute paths and '..' segments are refused, and symbolic links that lead out of it too.
+/// Where a glTF load is, for a user waiting on a big file. Stages run in this order (a stage the file
+/// does not need is passed over): reading the file, decoding Draco/meshopt data, decoding images,
+/// reading the node graph's meshes, finishing (normals, tangents, validation).
+struct SceneLoadProgress {
+    enum class Stage { Reading, Decompressing, Images, Meshes, Finishing } stage = Stage::Reading;
+    std::size_t done = 0, total = 0; ///< images decoded / mesh primitives read (0 of 0 elsewhere)
+    std::uint64_t bytesRead = 0;     ///< of the file and its external files so far
+    std::uint64_t fileBytes = 0;     ///< the file's own size
+    double share = 0.0;              ///< of the whole load, [0, 1], never falling
+    /// "decoding images: 3 of 12", for a progress line.
+    std::string describe() const;
+};
+
 struct SceneLoadOptions {
     std::string displayName;           ///< how errors, logs and Scene::name call the file ("": the path)
     bool allowExternalFiles = true;    ///< false: only the GLB's own chunk and data: URIs (uploads)
     std::uint64_t maxDecodedBytes = 0; ///< file + external files + decoded images + geometry; 0: none
+    /// Called on the loading thread as a glTF load advances (every file chunk, image and mesh
+    /// primitive: the callee throttles); null for none. It must not throw. Built-in scenes, which
+    /// generate in milliseconds, report nothing.
+    std::function<void(const SceneLoadProgress&)> onProgress;
 };
 
 /// Deepest JSON nesting a glTF file may have: far beyond what exporters write (extras included),

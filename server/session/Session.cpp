@@ -42,6 +42,8 @@ constexpr int kSnapshotBudgetMs = 5000;
 // most 4096 parts (each at least one VPL).
 constexpr int kPartTileSide = 64;
 constexpr int kMaxVplParts = 4096;
+// A scene load's progress messages: at most one per 100 ms (a load reports every image and mesh).
+constexpr double kLoadProgressMs = 100.0;
 
 std::string mebibytes(std::uintmax_t bytes) {
     char text[32];
@@ -916,10 +918,22 @@ void Session::workerMain() {
                 broadcastProgress("loading", "scene", 0.0, 0.0,
                                   "loading " + validUtf8(sceneRequest) + sizeText);
                 Stopwatch loadClock;
+                SceneLoadOptions loadOptions =
+                    mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{};
+                // Where a long load is, at most every kLoadProgressMs: the bytes read, the images
+                // decoded and the meshes read, and the time left at the rate so far.
+                double lastReportMs = 0.0;
+                loadOptions.onProgress = [&](const SceneLoadProgress& p) {
+                    const double nowMs = loadClock.elapsedMs();
+                    if (nowMs - lastReportMs < kLoadProgressMs) return;
+                    lastReportMs = nowMs;
+                    const double etaMs = p.share > 0.02 ? nowMs * (1.0 - p.share) / p.share : 0.0;
+                    broadcastProgress("loading", "scene", p.share, etaMs,
+                                      "loading " + validUtf8(sceneRequest) + sizeText + ": " + p.describe());
+                };
                 std::shared_ptr<const Scene> next;
                 try {
-                    next = mScenes->get(path,
-                                        mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{});
+                    next = mScenes->get(path, loadOptions);
                 } catch (...) {
                     broadcastProgress("load_failed", "scene", 0.0, 0.0,
                                       "could not load " + validUtf8(sceneRequest));
