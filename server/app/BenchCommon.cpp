@@ -8,61 +8,10 @@
 
 namespace gis::bench {
 
-int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
-    try {
-        size_t used = 0;
-        long v = std::stol(text, &used);
-        if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
-    } catch (...) {
-    }
-    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                     "], got '" + text + "'"};
-}
-
-double parseDouble(const std::string& flag, const std::string& text, double lo, double hi) {
-    try {
-        size_t used = 0;
-        double v = std::stod(text, &used);
-        if (used == text.size() && v >= lo && v <= hi) return v;
-    } catch (...) {
-    }
-    std::ostringstream o;
-    o << flag << " must be a number in [" << lo << ", " << hi << "], got '" << text << "'";
-    throw UsageError{o.str()};
-}
-
-void parseSize(const std::string& flag, const std::string& text, int& width, int& height) {
-    auto x = text.find('x');
-    if (x == std::string::npos) throw UsageError{flag + " must look like 256x256, got '" + text + "'"};
-    width = parseInt(flag + " width", text.substr(0, x), 16, 4096);
-    height = parseInt(flag + " height", text.substr(x + 1), 16, 4096);
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-    std::vector<std::string> out;
-    std::stringstream s(text);
-    std::string item;
-    while (std::getline(s, item, ','))
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
-std::string joinList(const std::vector<std::string>& items) {
-    std::string out;
-    for (const auto& i : items) out += (out.empty() ? "" : ", ") + i;
-    return out;
-}
-
-std::string defaultCacheDir() {
-    if (const char* d = std::getenv("GI_CACHE_DIR"); d && *d) return d;
-    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/gi-render";
-    return "/tmp/gi-render-cache";
-}
-
 bool parseTiming(const std::string& text) {
     if (text == "query") return true;
     if (text == "finish") return false;
-    throw UsageError{"--timing must be query or finish, got '" + text + "'"};
+    throw UsageError("--timing must be query or finish, got '" + text + "'");
 }
 
 Config parseConfig(const std::string& spec) {
@@ -76,7 +25,7 @@ Config parseConfig(const std::string& spec) {
     while (std::getline(rest, kv, ',')) {
         auto eq = kv.find('=');
         if (eq == std::string::npos || eq == 0)
-            throw UsageError{"--config: expected name=value, got '" + kv + "'"};
+            throw UsageError("--config: expected name=value, got '" + kv + "'");
         c.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
     }
     return c;
@@ -93,7 +42,7 @@ std::vector<FrameState> makeStates(const Scene& scene, const std::vector<Config>
             s.height = height;
             states.push_back(std::move(s));
         } catch (const InputError& e) {
-            throw UsageError{e.what()};
+            throw UsageError(e.what());
         }
     }
     return states;

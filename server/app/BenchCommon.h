@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/CommandLine.h"
 #include "render/FrameRenderer.h"
 #include "frame/FrameState.h"
 #include "scene/Scene.h"
@@ -14,21 +15,9 @@
 
 namespace gis::bench {
 
-/// Bad command-line usage: main prints it and exits 2.
-struct UsageError {
-    std::string message;
-};
-
-int parseInt(const std::string& flag, const std::string& text, int lo, int hi);
-double parseDouble(const std::string& flag, const std::string& text, double lo, double hi);
-/// "WxH", each side 16..4096.
-void parseSize(const std::string& flag, const std::string& text, int& width, int& height);
-/// Comma-separated list, empty items dropped.
-std::vector<std::string> splitList(const std::string& text);
-/// "a, b, c" for error messages listing valid choices.
-std::string joinList(const std::vector<std::string>& items);
-/// $GI_CACHE_DIR, else ~/.cache/gi-render.
-std::string defaultCacheDir();
+using cli::joinList;
+using cli::splitList;
+using cli::UsageError;
 /// "query" (timer queries) or "finish" (glFinish around each pass).
 bool parseTiming(const std::string& text);
 
@@ -37,7 +26,7 @@ struct ArgCursor {
     const std::vector<std::string>& args;
     size_t i = 0;
     const std::string& value() {
-        if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+        if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
         return args[++i];
     }
 };

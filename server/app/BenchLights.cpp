@@ -64,15 +64,15 @@ int lights(const std::vector<std::string>& args) {
         if (a == "--scene")
             sceneName = c.value();
         else if (a == "--size")
-            parseSize("--size", c.value(), width, height);
+            cli::parseSize("--size", c.value(), 4096, width, height);
         else if (a == "--config")
             configs.push_back(parseConfig(c.value()));
         else if (a == "--counts") {
             counts.clear();
             for (const std::string& n : splitList(c.value()))
-                counts.push_back(parseInt("--counts", n, 1, 64));
+                counts.push_back(cli::parseInteger("--counts", n, 1, 64));
         } else if (a == "--frames")
-            frames = parseInt("--frames", c.value(), 1, 1000);
+            frames = cli::parseInteger("--frames", c.value(), 1, 1000);
         else if (a == "--json")
             jsonPath = c.value();
         else if (a == "--gl")
@@ -80,7 +80,7 @@ int lights(const std::vector<std::string>& args) {
         else if (a == "--timing")
             timerQueries = parseTiming(c.value());
         else
-            throw UsageError{"unknown option '" + a + "' (see --help)"};
+            throw UsageError("unknown option '" + a + "' (see --help)");
     }
     if (configs.empty())
         for (const char* t : {"none", "rsm_gather", "ssbc", "multires_splat", "multires_gather", "isr",

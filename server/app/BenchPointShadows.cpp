@@ -70,15 +70,15 @@ int pointShadows(const std::vector<std::string>& args) {
         if (a == "--scene")
             sceneName = c.value();
         else if (a == "--side")
-            side = parseInt("--side", c.value(), 16, 4096);
+            side = cli::parseInteger("--side", c.value(), 16, 4096);
         else if (a == "--repeats")
-            repeats = parseInt("--repeats", c.value(), 1, 1000);
+            repeats = cli::parseInteger("--repeats", c.value(), 1, 1000);
         else if (a == "--samples")
-            samples = parseInt("--samples", c.value(), 100, 10000000);
+            samples = cli::parseInteger("--samples", c.value(), 100, 10000000);
         else if (a == "--gl")
             gl = c.value();
         else
-            throw UsageError{"unknown option '" + a + "' (see --help)"};
+            throw UsageError("unknown option '" + a + "' (see --help)");
     }
     const Scene scene = loadScene(sceneName);
     FrameState state = makeFrameState(scene, "none");

@@ -383,16 +383,16 @@ ReportOptions parseOptions(const std::vector<std::string>& args) {
         else if (a == "--presets")
             o.presets = c.value();
         else if (a == "--budget-ms")
-            o.budgetMs = parseDouble("--budget-ms", c.value(), 0, 1e7);
+            o.budgetMs = cli::parseNumber("--budget-ms", c.value(), 0, 1e7);
         else if (a == "--final-ms")
-            o.finalMs = parseDouble("--final-ms", c.value(), 0, 1e7);
+            o.finalMs = cli::parseNumber("--final-ms", c.value(), 0, 1e7);
         else if (a == "--metric") {
             const std::string m = c.value();
             if (m != "indirect" && m != "image")
-                throw UsageError{"report: --metric must be indirect or image, got '" + m + "'"};
+                throw UsageError("report: --metric must be indirect or image, got '" + m + "'");
             o.indirectMetric = m == "indirect";
         } else
-            throw UsageError{"report: unknown option '" + a + "' (see gi-bench report --help)"};
+            throw UsageError("report: unknown option '" + a + "' (see gi-bench report --help)");
     }
     if (o.images.empty()) o.images = (fs::path(o.out).parent_path() / "images").string();
     if (o.images.empty()) o.images = "images";

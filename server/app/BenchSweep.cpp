@@ -79,7 +79,7 @@ struct Options {
     int width = 128, height = 128, steps = 4, maxPoints = 0, frames = 3;
     double maxFrameMs = 2000;
     ReferenceOptions reference;
-    std::string cacheDir = defaultCacheDir(), out = "bench-sweep", gl;
+    std::string cacheDir = cli::defaultCacheDir(), out = "bench-sweep", gl;
     bool paperTables = false;
     bool refineReference = true;
 };
@@ -223,8 +223,8 @@ void checkScenes(const std::vector<std::string>& scenes) {
         if (std::find(builtins.begin(), builtins.end(), s.substr(8)) == builtins.end()) {
             std::vector<std::string> valid;
             for (const auto& b : builtins) valid.push_back("builtin:" + b);
-            throw UsageError{"--scenes: unknown scene '" + s + "' (valid: " + joinList(valid) +
-                             ", or a .gltf/.glb file)"};
+            throw UsageError("--scenes: unknown scene '" + s + "' (valid: " + joinList(valid) +
+                             ", or a .gltf/.glb file)");
         }
     }
 }
@@ -247,23 +247,23 @@ Options parseOptions(const std::vector<std::string>& args) {
         else if (a == "--techniques")
             o.techniques = splitList(c.value());
         else if (a == "--size")
-            parseSize("--size", c.value(), o.width, o.height);
+            cli::parseSize("--size", c.value(), 4096, o.width, o.height);
         else if (a == "--steps")
-            o.steps = parseInt("--steps", c.value(), 2, 16);
+            o.steps = cli::parseInteger("--steps", c.value(), 2, 16);
         else if (a == "--knobs")
             o.knobs = splitList(c.value());
         else if (a == "--max-points")
-            o.maxPoints = parseInt("--max-points", c.value(), 1, 100000);
+            o.maxPoints = cli::parseInteger("--max-points", c.value(), 1, 100000);
         else if (a == "--frames")
-            o.frames = parseInt("--frames", c.value(), 1, 1000);
+            o.frames = cli::parseInteger("--frames", c.value(), 1, 1000);
         else if (a == "--max-frame-ms")
-            o.maxFrameMs = parseDouble("--max-frame-ms", c.value(), 0, 1e7);
+            o.maxFrameMs = cli::parseNumber("--max-frame-ms", c.value(), 0, 1e7);
         else if (a == "--reference")
             o.reference.mode = c.value();
         else if (a == "--spp")
-            o.reference.spp = parseInt("--spp", c.value(), 1, 1000000);
+            o.reference.spp = cli::parseInteger("--spp", c.value(), 1, 1000000);
         else if (a == "--noise-target")
-            o.reference.noiseTarget = parseDouble("--noise-target", c.value(), 0, 0.5);
+            o.reference.noiseTarget = cli::parseNumber("--noise-target", c.value(), 0, 0.5);
         else if (a == "--cache-dir")
             o.cacheDir = c.value();
         else if (a == "--paper-tables")
@@ -275,9 +275,9 @@ Options parseOptions(const std::vector<std::string>& args) {
         else if (a == "--gl")
             o.gl = c.value();
         else
-            throw UsageError{"sweep: unknown option '" + a + "' (see gi-bench sweep --help)"};
+            throw UsageError("sweep: unknown option '" + a + "' (see gi-bench sweep --help)");
     }
-    if (o.scenes.empty()) throw UsageError{"--scenes needs at least one scene"};
+    if (o.scenes.empty()) throw UsageError("--scenes needs at least one scene");
     checkScenes(o.scenes);
     if (o.techniques.empty())
         for (const auto& e : techniqueRegistry()) o.techniques.push_back(e.info.name);
@@ -291,13 +291,13 @@ Options parseOptions(const std::vector<std::string>& args) {
                 found |= s.name == k;
             }
         if (!found)
-            throw UsageError{"--knobs: unknown knob '" + k + "' for the selected techniques (valid: " +
-                             joinList({valid.begin(), valid.end()}) + ")"};
+            throw UsageError("--knobs: unknown knob '" + k + "' for the selected techniques (valid: " +
+                             joinList({valid.begin(), valid.end()}) + ")");
     }
     const auto modes = referenceModes();
     if (std::find(modes.begin(), modes.end(), o.reference.mode) == modes.end())
-        throw UsageError{"--reference must be one of " + joinList(modes) + ", got '" + o.reference.mode +
-                         "'"};
+        throw UsageError("--reference must be one of " + joinList(modes) + ", got '" + o.reference.mode +
+                         "'");
     return o;
 }
 

@@ -34,6 +34,7 @@
 namespace {
 
 using namespace gis::bench;
+namespace cli = gis::cli;
 
 constexpr int kMaxEyeLevels = 16;
 constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
@@ -103,7 +104,7 @@ report   writes docs/accuracy.md, its plots and presets/presets.json from a swee
 )";
 
 int compare(const std::vector<std::string>& args) {
-    if (args.size() != 2) throw UsageError{"compare needs two files: TEST.exr REFERENCE.exr"};
+    if (args.size() != 2) throw UsageError("compare needs two files: TEST.exr REFERENCE.exr");
     gis::ReferenceImage a = gis::readReferenceExr(args[0]);
     gis::ReferenceImage b = gis::readReferenceExr(args[1]);
     if (a.width != b.width || a.height != b.height)
@@ -128,20 +129,20 @@ int passes(const std::vector<std::string>& args) {
     std::vector<Config> configs, baseline;
     for (size_t i = 0; i < args.size(); ++i) {
         auto value = [&]() -> const std::string& {
-            if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+            if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
             return args[++i];
         };
         const std::string& a = args[i];
         if (a == "--scene")
             sceneName = value();
         else if (a == "--size")
-            parseSize("--size", value(), width, height);
+            cli::parseSize("--size", value(), 4096, width, height);
         else if (a == "--config")
             configs.push_back(parseConfig(value()));
         else if (a == "--baseline")
             baseline = {parseConfig(value())};
         else if (a == "--frames")
-            frames = parseInt("--frames", value(), 1, 1000);
+            frames = cli::parseInteger("--frames", value(), 1, 1000);
         else if (a == "--json")
             jsonPath = value();
         else if (a == "--gl")
@@ -149,7 +150,7 @@ int passes(const std::vector<std::string>& args) {
         else if (a == "--timing")
             timerQueries = parseTiming(value());
         else
-            throw UsageError{"unknown option '" + a + "' (see --help)"};
+            throw UsageError("unknown option '" + a + "' (see --help)");
     }
     if (configs.empty()) configs = {parseConfig("multires_splat"), parseConfig("multires_gather")};
 
@@ -270,7 +271,7 @@ int passes(const std::vector<std::string>& args) {
 }
 
 int table(const std::vector<std::string>& args) {
-    std::string sceneName = "builtin:cornell", jsonPath, gl, cacheDir = defaultCacheDir();
+    std::string sceneName = "builtin:cornell", jsonPath, gl, cacheDir = cli::defaultCacheDir();
     int width = 256, height = 256, frames = 5;
     bool timerQueries = false;
     std::vector<Config> configs;
@@ -281,27 +282,27 @@ int table(const std::vector<std::string>& args) {
     ro.noiseOfIndirect = true;
     for (size_t i = 0; i < args.size(); ++i) {
         auto value = [&]() -> const std::string& {
-            if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
+            if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
             return args[++i];
         };
         const std::string& a = args[i];
         if (a == "--scene")
             sceneName = value();
         else if (a == "--size")
-            parseSize("--size", value(), width, height);
+            cli::parseSize("--size", value(), 4096, width, height);
         else if (a == "--config")
             configs.push_back(parseConfig(value()));
         else if (a == "--reference")
             modes.push_back(value());
         else if (a == "--spp")
-            ro.spp = parseInt("--spp", value(), 1, 1000000);
+            ro.spp = cli::parseInteger("--spp", value(), 1, 1000000);
         else if (a == "--noise-target")
-            ro.noiseTarget = parseDouble("--noise-target", value(), 0, 0.5);
+            ro.noiseTarget = cli::parseNumber("--noise-target", value(), 0, 0.5);
         else if (a == "--caustic-min-roughness")
             ro.causticMinRoughness =
-                static_cast<float>(parseDouble("--caustic-min-roughness", value(), 0.0, 1.0));
+                static_cast<float>(cli::parseNumber("--caustic-min-roughness", value(), 0.0, 1.0));
         else if (a == "--frames")
-            frames = parseInt("--frames", value(), 1, 1000);
+            frames = cli::parseInteger("--frames", value(), 1, 1000);
         else if (a == "--cache-dir")
             cacheDir = value();
         else if (a == "--json")
@@ -311,7 +312,7 @@ int table(const std::vector<std::string>& args) {
         else if (a == "--timing")
             timerQueries = parseTiming(value());
         else
-            throw UsageError{"unknown option '" + a + "' (see --help)"};
+            throw UsageError("unknown option '" + a + "' (see --help)");
     }
     if (configs.empty()) configs = {parseConfig("none"), parseConfig("rsm_gather")};
     if (modes.empty()) modes = {"one-bounce-unoccluded", "one-bounce"};
@@ -432,23 +433,12 @@ int run(int argc, char** argv) {
     if (command == "report") return report(args);
     if (command == "lights") return lights(args);
     if (command == "point-shadows") return pointShadows(args);
-    throw UsageError{"unknown command '" + command +
-                     "': use compare, table, passes, sweep, report, lights or point-shadows (see --help)"};
+    throw UsageError("unknown command '" + command +
+                     "': use compare, table, passes, sweep, report, lights or point-shadows (see --help)");
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const UsageError& e) {
-        std::fprintf(stderr, "gi-bench: %s\n", e.message.c_str());
-        return 2;
-    } catch (const gis::InputError& e) {
-        std::fprintf(stderr, "gi-bench: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "gi-bench: %s\n", e.what());
-        return 1;
-    }
+    return gis::cli::runMain("gi-bench", [&] { return run(argc, argv); });
 }

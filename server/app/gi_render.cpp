@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/CommandLine.h"
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Log.h"
@@ -34,78 +35,22 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: gi-render [options]
+constexpr int kMaxSide = 4096; // --size, and the size a --request may ask for here
+
+constexpr const char* kUsageHead = R"(usage: gi-render [options]
 
 Renders a scene with a global-illumination technique and writes the image and per-pass timings.
 
-  --scene NAME          builtin:NAME or a .gltf/.glb file (default builtin:cornell)
-  --technique NAME      GI technique (default rsm_gather; see --list-techniques)
-  --preset NAME         start from the technique's preset: interactive, balanced or final
-                        (presets/presets.json or $GI_PRESETS; docs/accuracy.md); --param overrides it
-  --param NAME=VALUE    set a frame or technique parameter (repeatable; see --list-params)
-  --size WxH            image size in pixels, 16..4096 each (default 512x512)
-  --out FILE            write the image: .png, .jpg, .webp (tone-mapped) or .exr (linear radiance);
-                        the bytes equal the HTTP API's for the same request (PNG always, JPEG and
-                        WebP at the same --quality)
-  --quality N           JPEG and lossy WebP quality, 1..100 (default 90, as the API)
-  --stats FILE          write the stats JSON (per-pass ms, counts, params, scene_load_ms); '-' for
-                        stdout
-  --export FILE.glb     write the scene (after loading, as the renderer sees it) as binary glTF and
-                        exit: open a built-in scene in other tools, or time the loader on any size
-                        (builtin:atrium-10k .. builtin:atrium-2000k, docs/scenes.md)
-  --lights FILE         replace the scene's lights with a JSON array of lights (or {"lights": [...]}),
-                        each {"type": "spot"|"point"|"directional", "position", "direction",
-                        "intensity" (cd; lux for directional), "color", "range", "cone_deg",
-                        "inner_cone_deg", "enabled"}: the request's "lights" (protocol/PROTOCOL.md)
-  --request FILE        render a POST /api/render request (JSON; '-' for stdin) exactly as the server
-                        does: --out gets the encoded bytes, --stats the stats; scene, technique,
-                        preset, parameters, size, camera, light, format and compare come from the file
-  --frames N            render a warm-up frame, then N frames, and report per-pass medians (default 1)
-  --gl egl|osmesa       headless GL backend (default: $GI_GL, else egl)
-  --no-timer-queries    time passes with glFinish on the CPU instead of GPU timer queries
-  --list-techniques     list the techniques and exit
-  --list-params TECH    list the frame parameters and TECH's parameters and exit
-  --list-scenes         list the built-in scenes and exit
-  --list-resources      after rendering, print the frame's named resources (name, producer, format,
-                        size: the G-buffer, each light's shadow map and RSM, direct, indirect, ...)
-  --explain             print the effect plan (which effects run, why, measured values, estimated
-                        cost; docs/effects.md); exits after it unless --out, --stats or --compare is
-                        given. --param effects=auto applies the plan, effect_NAME=on|off forces one
+)";
 
-Ground truth and error (CPU reference renderer, Embree):
-  --reference MODE      render with the reference instead of GL: direct, one-bounce-unoccluded,
-                        one-bounce or path (.exr keeps linear radiance; .png/.jpg are tone-mapped)
-  --spp N               reference samples per pixel, 1..1000000 (default 256)
-  --time-budget S       stop the reference after S seconds (reports the spp reached)
-  --noise-target R      stop the reference once its relative noise (estimated from the samples'
-                        spread) is at most R, e.g. 0.01; --spp stays the upper bound
-  --noise-of WHAT       total (default) or indirect: what --noise-target is relative to (the image,
-                        or the image less its direct light, as GI comparisons measure)
-  --seed N              reference random seed (default 1)
-  --max-depth N         path mode: vertices per path, 1..64 (default 8)
-  --caustic-min-roughness R  leave out the lights' reflection off specular lobes smoother than R
-                        that reaches a rougher surface (caustics the GL pipeline does not render;
-                        biased, default 0 = unbiased; docs/nondiffuse.md)
-  --cache-dir DIR       reuse references rendered before ($GI_CACHE_DIR, default ~/.cache/gi-render)
-  --no-cache            always render the reference
-  --compare REF.exr     compare the rendered frame's linear radiance with a reference EXR of the same
-                        size: prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP (background
-                        pixels, black in the reference, are left out), the reference's own noise and
-                        the error corrected for it; and "indirect" (each side less its own direct
-                        light: the GI technique's error) and "direct" (the direct pass against the
-                        reference's, rendered here at pixel centres: the shadow map's error)
-  --quiet               only errors on stderr
-  --help                this text
-
+constexpr const char* kUsageTail = R"(
 Examples:
   gi-render --scene builtin:cornell --technique rsm_gather --param vpl_grid=16 \
             --size 512x512 --out out.png --stats stats.json
   echo '{"scene": "builtin:cornell", "params": {"vpl_grid": 16}}' | gi-render --request - --out out.png
 )";
 
-struct UsageError {
-    std::string message;
-};
+using gis::cli::UsageError;
 
 struct Options {
     std::string scene = "builtin:cornell";
@@ -135,12 +80,6 @@ struct Options {
     bool explain = false;
     bool listResources = false;
 };
-
-std::string defaultCacheDir() {
-    if (const char* d = std::getenv("GI_CACHE_DIR"); d && *d) return d;
-    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/gi-render";
-    return "/tmp/gi-render-cache";
-}
 
 /// Renders the CPU reference for `state` and writes it; returns the stats JSON.
 nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const gis::FrameState& state) {
@@ -192,24 +131,6 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
             {"noise", noise},       {"scene", o.scene}};
 }
 
-int parseInt(const std::string& flag, const std::string& text, int lo, int hi) {
-    try {
-        size_t used = 0;
-        long v = std::stol(text, &used);
-        if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
-    } catch (...) {
-    }
-    throw UsageError{flag + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                     "], got '" + text + "'"};
-}
-
-void parseSize(const std::string& text, int& w, int& h) {
-    auto x = text.find('x');
-    if (x == std::string::npos) throw UsageError{"--size must look like 512x512, got '" + text + "'"};
-    w = parseInt("--size width", text.substr(0, x), 16, 4096);
-    h = parseInt("--size height", text.substr(x + 1), 16, 4096);
-}
-
 void listTechniques() {
     int width = 0;
     for (const auto& e : gis::techniqueRegistry())
@@ -252,33 +173,28 @@ nlohmann::json readRequest(const std::string& path) {
 /// --request: parseRenderRequest + executeRenderJob, the server's path, with the CLI's bounds.
 int runRequest(const Options& o) {
     if (!o.sceneFlags.empty())
-        throw UsageError{
+        throw UsageError(
             o.sceneFlags.front() +
             " cannot be used with --request: the request file sets the scene, technique, preset, "
-            "parameters, size, format, quality and compare"};
+            "parameters, size, format, quality and compare");
     gis::RenderLimits limits;
-    limits.maxWidth = limits.maxHeight = 4096; // --size's bounds
-    limits.maxReferenceSpp = 1000000;          // --spp's
-    limits.maxReferenceSeconds = 0;            // a local run may take as long as it likes
+    limits.maxWidth = limits.maxHeight = kMaxSide; // --size's bounds
+    limits.maxReferenceSpp = 1000000;              // --spp's
+    limits.maxReferenceSeconds = 0;                // a local run may take as long as it likes
     const nlohmann::json request = readRequest(o.request);
     gis::RenderJob job;
     try {
         job = gis::parseRenderRequest(request, limits);
     } catch (const gis::InputError& e) {
-        throw UsageError{requestName(o.request) + ": " + e.what()};
+        throw UsageError(requestName(o.request) + ": " + e.what());
     }
     if (o.useCache) job.referenceCacheDir = o.cacheDir;
     if (!o.out.empty() && gis::codecForPath(o.out) != job.codec) {
         const std::string ext = job.codec == gis::ImageCodec::Jpeg ? "jpg" : gis::codecName(job.codec);
-        throw UsageError{"--out '" + o.out + "' does not match the request's format '" +
-                         gis::codecName(job.codec) + "': name it *." + ext};
+        throw UsageError("--out '" + o.out + "' does not match the request's format '" +
+                         gis::codecName(job.codec) + "': name it *." + ext);
     }
-    gis::gl::Backend backend;
-    try {
-        backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);
-    } catch (const gis::InputError& e) {
-        throw UsageError{e.what()};
-    }
+    const gis::gl::Backend backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);
     // Scene and state before GL, as on the flag path: bad input fails fast.
     std::shared_ptr<const gis::Scene> scene = std::make_shared<gis::Scene>(gis::loadScene(job.scene));
     gis::makeJobFrameState(*scene, job);
@@ -303,154 +219,192 @@ int runRequest(const Options& o) {
     return 0;
 }
 
+/// What a flag asks for besides a render: print something and exit.
+enum class Action { Render, ListTechniques, ListScenes, ListParams };
+
+/// gi-render's options, each declared once: --help and the parse both come from here.
+gis::cli::OptionTable optionTable(Options& o, Action& action, std::string& listParamsOf) {
+    using gis::cli::parseNumber;
+    gis::cli::OptionTable t;
+    t.value("--scene", "NAME", "builtin:NAME or a .gltf/.glb file (default builtin:cornell)",
+            [&](const std::string& v) { o.scene = v; })
+        .value("--technique", "NAME", "GI technique (default rsm_gather; see --list-techniques)",
+               [&](const std::string& v) { o.technique = v; })
+        .value("--preset", "NAME",
+               "start from the technique's preset: interactive, balanced or final (presets/presets.json or "
+               "$GI_PRESETS; docs/accuracy.md); --param overrides it",
+               [&](const std::string& v) { o.preset = v; })
+        .value("--param", "NAME=VALUE", "set a frame or technique parameter (repeatable; see --list-params)",
+               [&](const std::string& kv) {
+                   const auto eq = kv.find('=');
+                   if (eq == std::string::npos || eq == 0)
+                       throw UsageError("--param must look like NAME=VALUE, got '" + kv + "'");
+                   o.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+               })
+        .value("--size", "WxH",
+               "image size in pixels, 16.." + std::to_string(kMaxSide) + " each (default 512x512)",
+               [&](const std::string& v) { gis::cli::parseSize("--size", v, kMaxSide, o.width, o.height); })
+        .value("--out", "FILE",
+               "write the image: .png, .jpg, .webp (tone-mapped) or .exr (linear radiance); the bytes "
+               "equal the HTTP API's for the same request (PNG always, JPEG and WebP at the same "
+               "--quality)",
+               [&](const std::string& v) { o.out = v; })
+        .integer("--quality", "N", "JPEG and lossy WebP quality (as the API)", 1, 100, o.quality)
+        .value("--stats", "FILE",
+               "write the stats JSON (per-pass ms, counts, params, scene_load_ms); '-' for stdout",
+               [&](const std::string& v) { o.stats = v; })
+        .value("--export", "FILE.glb",
+               "write the scene (after loading, as the renderer sees it) as binary glTF and exit: open a "
+               "built-in scene in other tools, or time the loader on any size (builtin:atrium-10k .. "
+               "builtin:atrium-2000k, docs/scenes.md)",
+               [&](const std::string& v) { o.exportGlb = v; })
+        .value("--lights", "FILE",
+               "replace the scene's lights with a JSON array of lights (or {\"lights\": [...]}), each "
+               "{\"type\": \"spot\"|\"point\"|\"directional\", \"position\", \"direction\", \"intensity\" "
+               "(cd; lux for directional), \"color\", \"range\", \"cone_deg\", \"inner_cone_deg\", "
+               "\"enabled\"}: the request's \"lights\" (protocol/PROTOCOL.md)",
+               [&](const std::string& v) { o.lights = v; })
+        .value("--request", "FILE",
+               "render a POST /api/render request (JSON; '-' for stdin) exactly as the server does: --out "
+               "gets the encoded bytes, --stats the stats; scene, technique, preset, parameters, size, "
+               "camera, light, format and compare come from the file",
+               [&](const std::string& v) { o.request = v; })
+        .integer("--frames", "N", "render a warm-up frame, then N frames, and report per-pass medians", 1,
+                 10000, o.frames)
+        .value("--gl", "egl|osmesa", "headless GL backend (default: $GI_GL, else egl)",
+               [&](const std::string& v) { o.gl = v; })
+        .flag("--no-timer-queries", "time passes with glFinish on the CPU instead of GPU timer queries",
+              [&] { o.timerQueries = false; })
+        .flag("--list-techniques", "list the techniques and exit", [&] { action = Action::ListTechniques; })
+        .value("--list-params", "TECH", "list the frame parameters and TECH's parameters and exit",
+               [&](const std::string& v) {
+                   action = Action::ListParams;
+                   listParamsOf = v;
+               })
+        .flag("--list-scenes", "list the built-in scenes and exit", [&] { action = Action::ListScenes; })
+        .flag("--list-resources",
+              "after rendering, print the frame's named resources (name, producer, format, size: the "
+              "G-buffer, each light's shadow map and RSM, direct, indirect, ...)",
+              [&] { o.listResources = true; })
+        .flag("--explain",
+              "print the effect plan (which effects run, why, measured values, estimated cost; "
+              "docs/effects.md); exits after it unless --out, --stats or --compare is given. --param "
+              "effects=auto applies the plan, effect_NAME=on|off forces one",
+              [&] { o.explain = true; })
+        .flag("--quiet", "only errors on stderr", [&] { o.quiet = true; })
+        .flag("--help", "this text", [] {})
+        .section("Ground truth and error (CPU reference renderer, Embree):")
+        .value("--reference", "MODE",
+               "render with the reference instead of GL: direct, one-bounce-unoccluded, one-bounce or "
+               "path (.exr keeps linear radiance; .png/.jpg are tone-mapped)",
+               [&](const std::string& v) { o.referenceMode = v; })
+        .integer("--spp", "N", "reference samples per pixel", 1, 1000000, o.reference.spp)
+        .value("--time-budget", "S", "stop the reference after S seconds (reports the spp reached)",
+               [&](const std::string& v) {
+                   o.reference.timeBudgetSeconds = parseNumber("--time-budget", v, 1e-3, 1e7);
+               })
+        .value("--noise-target", "R",
+               "stop the reference once its relative noise (estimated from the samples' spread) is at "
+               "most R, e.g. 0.01; --spp stays the upper bound",
+               [&](const std::string& v) {
+                   o.reference.noiseTarget = parseNumber("--noise-target", v, 1e-6, 0.999999);
+               })
+        .value("--noise-of", "WHAT",
+               "total (default) or indirect: what --noise-target is relative to (the image, or the image "
+               "less its direct light, as GI comparisons measure)",
+               [&](const std::string& v) {
+                   if (v != "total" && v != "indirect")
+                       throw UsageError("--noise-of must be total or indirect, got '" + v + "'");
+                   o.reference.noiseOfIndirect = v == "indirect";
+               })
+        .value("--seed", "N", "reference random seed, 0..2147483647 (default 1)",
+               [&](const std::string& v) {
+                   o.reference.seed =
+                       static_cast<std::uint64_t>(gis::cli::parseInteger("--seed", v, 0, 2147483647));
+               })
+        .integer("--max-depth", "N", "path mode: vertices per path", 1, 64, o.reference.maxDepth)
+        .value("--caustic-min-roughness", "R",
+               "leave out the lights' reflection off specular lobes smoother than R that reaches a "
+               "rougher surface (caustics the GL pipeline does not render; biased), 0..1 (default 0 = "
+               "unbiased; docs/nondiffuse.md)",
+               [&](const std::string& v) {
+                   o.reference.causticMinRoughness =
+                       static_cast<float>(parseNumber("--caustic-min-roughness", v, 0.0, 1.0));
+               })
+        .value("--cache-dir", "DIR",
+               "reuse references rendered before ($GI_CACHE_DIR, default ~/.cache/gi-render)",
+               [&](const std::string& v) { o.cacheDir = v; })
+        .flag("--no-cache", "always render the reference", [&] { o.useCache = false; })
+        .value("--compare", "REF.exr",
+               "compare the rendered frame's linear radiance with a reference EXR of the same size: prints "
+               "relative RMSE, RMSE, PSNR, max error, SSIM and FLIP (background pixels, black in the "
+               "reference, are left out), the reference's own noise and the error corrected for it; and "
+               "\"indirect\" (each side less its own direct light: the GI technique's error) and \"direct\" "
+               "(the direct pass against the reference's, rendered here at pixel centres: the shadow "
+               "map's error)",
+               [&](const std::string& v) { o.compare = v; });
+    return t;
+}
+
 int run(int argc, char** argv) {
     Options o;
-    std::vector<std::string> args(argv + 1, argv + argc);
-    auto value = [&](size_t& i) -> const std::string& {
-        if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
-        return args[++i];
-    };
+    Action action = Action::Render;
+    std::string listParamsOf;
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    const gis::cli::OptionTable options = optionTable(o, action, listParamsOf);
+    // Help wins over everything else on the line, mistakes included.
+    if (std::find(args.begin(), args.end(), "--help") != args.end() ||
+        std::find(args.begin(), args.end(), "-h") != args.end()) {
+        std::cout << kUsageHead << options.usage() << kUsageTail;
+        return 0;
+    }
+    options.parse(args);
+    switch (action) {
+    case Action::Render:
+        break;
+    case Action::ListTechniques:
+        listTechniques();
+        return 0;
+    case Action::ListScenes:
+        for (const auto& n : gis::builtinSceneNames()) std::printf("builtin:%s\n", n.c_str());
+        return 0;
+    case Action::ListParams: {
+        const auto& entry = gis::findTechnique(listParamsOf, "--list-params");
+        std::printf("frame parameters (every technique):\n%s", gis::frameParamTable().describe().c_str());
+        std::printf("%s parameters:\n%s", listParamsOf.c_str(),
+                    entry.info.params.empty() ? "  (none)\n" : entry.info.params.describe().c_str());
+        return 0;
+    }
+    }
     // Flags whose settings a --request file carries (or that do not apply to one frame of it).
     static const std::vector<std::string> kRequestConflicts = {
         "--scene",     "--technique", "--preset",    "--param",        "--size",        "--quality",
         "--frames",    "--explain",   "--reference", "--spp",          "--time-budget", "--seed",
         "--max-depth", "--compare",   "--lights",    "--noise-target", "--noise-of"};
-    for (size_t i = 0; i < args.size(); ++i) {
-        const std::string& a = args[i];
+    for (const std::string& a : args)
         if (std::find(kRequestConflicts.begin(), kRequestConflicts.end(), a) != kRequestConflicts.end())
             o.sceneFlags.push_back(a);
-        if (a == "--help" || a == "-h") {
-            std::cout << kUsage;
-            return 0;
-        } else if (a == "--list-techniques") {
-            listTechniques();
-            return 0;
-        } else if (a == "--list-scenes") {
-            for (const auto& n : gis::builtinSceneNames()) std::printf("builtin:%s\n", n.c_str());
-            return 0;
-        } else if (a == "--list-params") {
-            const std::string& t = value(i);
-            const auto& entry = gis::findTechnique(t, "--list-params");
-            std::printf("frame parameters (every technique):\n%s", gis::frameParamTable().describe().c_str());
-            std::printf("%s parameters:\n%s", t.c_str(),
-                        entry.info.params.empty() ? "  (none)\n" : entry.info.params.describe().c_str());
-            return 0;
-        } else if (a == "--scene")
-            o.scene = value(i);
-        else if (a == "--technique")
-            o.technique = value(i);
-        else if (a == "--preset")
-            o.preset = value(i);
-        else if (a == "--param") {
-            const std::string& kv = value(i);
-            auto eq = kv.find('=');
-            if (eq == std::string::npos || eq == 0)
-                throw UsageError{"--param must look like NAME=VALUE, got '" + kv + "'"};
-            o.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-        } else if (a == "--size")
-            parseSize(value(i), o.width, o.height);
-        else if (a == "--out")
-            o.out = value(i);
-        else if (a == "--stats")
-            o.stats = value(i);
-        else if (a == "--export")
-            o.exportGlb = value(i);
-        else if (a == "--quality")
-            o.quality = parseInt("--quality", value(i), 1, 100);
-        else if (a == "--request")
-            o.request = value(i);
-        else if (a == "--lights")
-            o.lights = value(i);
-        else if (a == "--frames")
-            o.frames = parseInt("--frames", value(i), 1, 10000);
-        else if (a == "--gl")
-            o.gl = value(i);
-        else if (a == "--no-timer-queries")
-            o.timerQueries = false;
-        else if (a == "--quiet")
-            o.quiet = true;
-        else if (a == "--explain")
-            o.explain = true;
-        else if (a == "--list-resources")
-            o.listResources = true;
-        else if (a == "--reference")
-            o.referenceMode = value(i);
-        else if (a == "--spp")
-            o.reference.spp = parseInt("--spp", value(i), 1, 1000000);
-        else if (a == "--time-budget") {
-            const std::string& t = value(i);
-            try {
-                size_t used = 0;
-                o.reference.timeBudgetSeconds = std::stod(t, &used);
-                if (used != t.size() || !(o.reference.timeBudgetSeconds > 0)) throw std::invalid_argument(t);
-            } catch (const std::exception&) {
-                throw UsageError{"--time-budget must be a positive number of seconds, got '" + t + "'"};
-            }
-        } else if (a == "--noise-target") {
-            const std::string& t = value(i);
-            try {
-                size_t used = 0;
-                o.reference.noiseTarget = std::stod(t, &used);
-                if (used != t.size() || !(o.reference.noiseTarget > 0 && o.reference.noiseTarget < 1))
-                    throw std::invalid_argument(t);
-            } catch (const std::exception&) {
-                throw UsageError{"--noise-target must be a relative noise in (0, 1), e.g. 0.01, got '" + t +
-                                 "'"};
-            }
-        } else if (a == "--noise-of") {
-            const std::string& t = value(i);
-            if (t != "total" && t != "indirect")
-                throw UsageError{"--noise-of must be total or indirect, got '" + t + "'"};
-            o.reference.noiseOfIndirect = t == "indirect";
-        } else if (a == "--seed")
-            o.reference.seed = static_cast<std::uint64_t>(parseInt("--seed", value(i), 0, 2147483647));
-        else if (a == "--max-depth")
-            o.reference.maxDepth = parseInt("--max-depth", value(i), 1, 64);
-        else if (a == "--caustic-min-roughness") {
-            const std::string& t = value(i);
-            try {
-                size_t used = 0;
-                const double r = std::stod(t, &used);
-                if (used != t.size() || !(r >= 0.0 && r <= 1.0)) throw std::invalid_argument(t);
-                o.reference.causticMinRoughness = static_cast<float>(r);
-            } catch (const std::exception&) {
-                throw UsageError{"--caustic-min-roughness must be a roughness in [0, 1], got '" + t + "'"};
-            }
-        } else if (a == "--cache-dir")
-            o.cacheDir = value(i);
-        else if (a == "--no-cache")
-            o.useCache = false;
-        else if (a == "--compare")
-            o.compare = value(i);
-        else
-            throw UsageError{"unknown option '" + a + "' (see --help)"};
-    }
     if (o.quiet) gis::setLogLevel(gis::LogLevel::Error);
-    if (o.cacheDir.empty()) o.cacheDir = defaultCacheDir();
+    if (o.cacheDir.empty()) o.cacheDir = gis::cli::defaultCacheDir();
     if (!o.referenceMode.empty()) {
         auto modes = gis::referenceModes();
         if (std::find(modes.begin(), modes.end(), o.referenceMode) == modes.end()) {
             std::string known;
             for (const auto& m : modes) known += (known.empty() ? "" : ", ") + m;
-            throw UsageError{"--reference must be one of " + known + ", got '" + o.referenceMode + "'"};
+            throw UsageError("--reference must be one of " + known + ", got '" + o.referenceMode + "'");
         }
         if (!o.compare.empty())
-            throw UsageError{"--compare compares a GL frame: it cannot be used with --reference"};
+            throw UsageError("--compare compares a GL frame: it cannot be used with --reference");
     }
     if (!o.request.empty()) return runRequest(o);
     if (!o.out.empty() && !gis::codecForPath(o.out) && !gis::imageFileNeedsLinear(o.out))
-        throw UsageError{"--out must end in .png, .jpg, .webp or .exr, got '" + o.out + "'"};
+        throw UsageError("--out must end in .png, .jpg, .webp or .exr, got '" + o.out + "'");
 
     // Validate everything that needs no GL before creating a context.
-    gis::gl::Backend backend;
-    try {
-        backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);
-    } catch (const gis::InputError& e) {
-        throw UsageError{e.what()};
-    }
+    const gis::gl::Backend backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);
     if (!o.exportGlb.empty()) {
         if (!o.exportGlb.ends_with(".glb"))
-            throw UsageError{"--export writes binary glTF: the file must end in .glb"};
+            throw UsageError("--export writes binary glTF: the file must end in .glb");
         const gis::Stopwatch loadClock;
         const gis::Scene loaded = gis::loadScene(o.scene);
         const double loadMs = loadClock.elapsedMs();
@@ -463,7 +417,7 @@ int run(int argc, char** argv) {
     auto scene = std::make_shared<gis::Scene>(gis::loadScene(o.scene));
     const double sceneLoadMs = loadClock.elapsedMs();
     gis::FrameState state;
-    try {
+    {
         // The flags become the RenderJob of the equivalent request, and the state comes from it as in
         // executeRenderJob, so `--request` and the flags cannot drift apart. The flags are checked
         // first on their own state, for errors that name the flag.
@@ -487,8 +441,6 @@ int run(int argc, char** argv) {
             job.lights = list;
         }
         state = gis::makeJobFrameState(*scene, job);
-    } catch (const gis::InputError& e) {
-        throw UsageError{e.what()};
     }
 
     // Effect planning runs before GL (it needs only the scene) and never for a reference, which is
@@ -516,9 +468,9 @@ int run(int argc, char** argv) {
     if (!o.compare.empty()) {
         compareWith = gis::readReferenceExr(o.compare);
         if (compareWith.width != o.width || compareWith.height != o.height)
-            throw UsageError{"--compare: '" + o.compare + "' is " + std::to_string(compareWith.width) + "x" +
+            throw UsageError("--compare: '" + o.compare + "' is " + std::to_string(compareWith.width) + "x" +
                              std::to_string(compareWith.height) + " but --size is " +
-                             std::to_string(o.width) + "x" + std::to_string(o.height)};
+                             std::to_string(o.width) + "x" + std::to_string(o.height));
     }
 
     auto context = gis::gl::createContext(backend);
@@ -582,16 +534,5 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const UsageError& e) {
-        std::fprintf(stderr, "gi-render: %s\n", e.message.c_str());
-        return 2;
-    } catch (const gis::InputError& e) {
-        std::fprintf(stderr, "gi-render: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "gi-render: %s\n", e.what());
-        return 1;
-    }
+    return gis::cli::runMain("gi-render", [&] { return run(argc, argv); });
 }

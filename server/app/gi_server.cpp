@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "core/CommandLine.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "frame/Presets.h"
@@ -117,13 +118,5 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const gis::InputError& e) {
-        std::fprintf(stderr, "gi-server: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "gi-server: %s\n", e.what());
-        return 1;
-    }
+    return gis::cli::runMain("gi-server", [&] { return run(argc, argv); });
 }

@@ -6,9 +6,11 @@
 #include <iterator>
 #include <sstream>
 #include <thread>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
+#include "core/CommandLine.h"
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "gi/Technique.h"
@@ -17,66 +19,75 @@
 namespace gis {
 namespace {
 
-long parseInteger(const std::string& who, const std::string& text, long lo, long hi) {
-    try {
-        std::size_t used = 0;
-        const long v = std::stol(text, &used);
-        if (used == text.size() && v >= lo && v <= hi) return v;
-    } catch (...) {
-    }
-    throw InputError(who, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                              "], got '" + text + "'");
+using cli::numberText;
+using cli::parseInteger;
+using cli::parseNumber;
+using cli::splitList;
+
+/// A list setting as the startup summary shows it.
+std::string shownList(const std::vector<std::string>& items) {
+    return items.empty() ? "(none)" : cli::joinList(items, ",");
 }
 
-double parseNumber(const std::string& who, const std::string& text, double lo, double hi) {
-    try {
-        std::size_t used = 0;
-        const double v = std::stod(text, &used);
-        if (used == text.size() && std::isfinite(v) && v >= lo && v <= hi) return v;
-    } catch (...) {
-    }
-    std::ostringstream range;
-    range << "[" << lo << ", " << hi << "]";
-    throw InputError(who, "must be a number in " + range.str() + ", got '" + text + "'");
+// Builders keep the table below one entry per line of meaning. A field is a generic lambda returning
+// the setting's reference in a ServerConfig (const or not). Numeric options append their range and
+// default to the help line, so both are stated once: in the call and in ServerConfig.
+
+/// The defaults as declared (not defaultConfig(): the help must not depend on the machine).
+const ServerConfig& declaredDefaults() {
+    static const ServerConfig defaults;
+    return defaults;
 }
 
-void parseSize(const std::string& who, const std::string& text, int& w, int& h) {
-    const auto x = text.find('x');
-    if (x == std::string::npos) throw InputError(who, "must look like 512x512, got '" + text + "'");
-    w = static_cast<int>(parseInteger(who + " width", text.substr(0, x), 16, 8192));
-    h = static_cast<int>(parseInteger(who + " height", text.substr(x + 1), 16, 8192));
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-    std::vector<std::string> out;
-    std::stringstream in(text);
-    for (std::string item; std::getline(in, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
-std::string joinList(const std::vector<std::string>& items) {
-    std::string out;
-    for (const auto& i : items) out += (out.empty() ? "" : ",") + i;
-    return out.empty() ? "(none)" : out;
-}
-
-std::string numberText(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
-// Builders keep the table below one entry per line of meaning.
-ServerOption intOption(std::string flag, std::string env, std::string help, long lo, long hi,
-                       int ServerConfig::*field) {
-    ServerOption o{flag, env, "N", std::move(help), nullptr, nullptr};
+template <typename Field>
+ServerOption integerOption(std::string flag, std::string env, std::string valueName, std::string help,
+                           long lo, long hi, Field field, const std::string& defaultText = {}) {
+    help += ", " + std::to_string(lo) + ".." + std::to_string(hi) +
+            (defaultText.empty() ? " (default " + std::to_string(field(declaredDefaults())) + ")"
+                                 : " (default: " + defaultText + ")");
+    ServerOption o{flag, std::move(env), std::move(valueName), std::move(help), nullptr, nullptr};
     o.set = [flag, lo, hi, field](ServerConfig& c, const std::string& v) {
-        c.*field = static_cast<int>(parseInteger(flag, v, lo, hi));
+        auto& target = field(c);
+        target = static_cast<std::remove_reference_t<decltype(target)>>(parseInteger(flag, v, lo, hi));
     };
-    o.show = [field](const ServerConfig& c) { return std::to_string(c.*field); };
+    o.show = [field](const ServerConfig& c) { return std::to_string(field(c)); };
     return o;
 }
+
+template <typename Field>
+ServerOption numberOption(std::string flag, std::string env, std::string valueName, std::string help,
+                          double lo, double hi, Field field) {
+    help += ", " + numberText(lo) + ".." + numberText(hi) + " (default " +
+            numberText(field(declaredDefaults())) + ")";
+    ServerOption o{flag, std::move(env), std::move(valueName), std::move(help), nullptr, nullptr};
+    o.set = [flag, lo, hi, field](ServerConfig& c, const std::string& v) {
+        field(c) = parseNumber(flag, v, lo, hi);
+    };
+    o.show = [field](const ServerConfig& c) { return numberText(field(c)); };
+    return o;
+}
+
+/// WxH, each side 16..kMaxFrameSide; `width` and `height` are fields as above.
+constexpr int kMaxFrameSide = 8192;
+template <typename Width, typename Height>
+ServerOption sizeOption(std::string flag, std::string env, std::string help, Width width, Height height) {
+    const ServerConfig& d = declaredDefaults();
+    help += ", 16.." + std::to_string(kMaxFrameSide) + " each (default " + std::to_string(width(d)) + "x" +
+            std::to_string(height(d)) + ")";
+    ServerOption o{flag, std::move(env), "WxH", std::move(help), nullptr, nullptr};
+    o.set = [flag, width, height](ServerConfig& c, const std::string& v) {
+        cli::parseSize(flag, v, kMaxFrameSide, width(c), height(c));
+    };
+    o.show = [width, height](const ServerConfig& c) {
+        return std::to_string(width(c)) + "x" + std::to_string(height(c));
+    };
+    return o;
+}
+
+#define GIS_FIELD(expr)                                                                                      \
+    [](auto& c) -> auto& {                                                                                   \
+        return c.expr;                                                                                       \
+    }
 
 ServerOption stringOption(std::string flag, std::string env, std::string valueName, std::string help,
                           std::string ServerConfig::*field) {
@@ -92,7 +103,7 @@ ServerOption listOption(std::string flag, std::string env, std::string valueName
     o.set = [field](ServerConfig& c, const std::string& v) {
         for (auto& item : splitList(v)) (c.*field).push_back(item);
     };
-    o.show = [field](const ServerConfig& c) { return joinList(c.*field); };
+    o.show = [field](const ServerConfig& c) { return shownList(c.*field); };
     o.repeatable = true;
     return o;
 }
@@ -101,8 +112,7 @@ std::vector<ServerOption> buildOptions() {
     std::vector<ServerOption> t;
     t.push_back(stringOption("--host", "GI_HOST", "ADDR", "address to listen on (default 127.0.0.1)",
                              &ServerConfig::host));
-    t.push_back(
-        intOption("--port", "GI_PORT", "TCP port, 1..65535 (default 8080)", 1, 65535, &ServerConfig::port));
+    t.push_back(integerOption("--port", "GI_PORT", "N", "TCP port", 1, 65535, GIS_FIELD(port)));
     t.push_back(stringOption("--client-dir", "GI_CLIENT_DIR", "DIR",
                              "directory served at / (default: the source tree's client/)",
                              &ServerConfig::clientDir));
@@ -126,126 +136,53 @@ std::vector<ServerOption> buildOptions() {
         o.show = [](const ServerConfig& c) { return c.session.technique; };
         t.push_back(o);
     }
-    {
-        ServerOption o{"--size", "GI_SIZE", "WxH", "default frame size, 16..8192 each (default 512x512)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            parseSize("--size", v, c.session.width, c.session.height);
-        };
-        o.show = [](const ServerConfig& c) {
-            return std::to_string(c.session.width) + "x" + std::to_string(c.session.height);
-        };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{
-            "--max-size", "GI_MAX_SIZE", "WxH",
-            "largest frame a client may ask for; larger viewports are scaled down (default 2048x2048)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            parseSize("--max-size", v, c.session.limits.maxWidth, c.session.limits.maxHeight);
-        };
-        o.show = [](const ServerConfig& c) {
-            return std::to_string(c.session.limits.maxWidth) + "x" +
-                   std::to_string(c.session.limits.maxHeight);
-        };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{"--max-vpls", "GI_MAX_VPLS", "N",
-                       "most VPLs a parameter set may ask for, 1..16777216 (default 65536)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.session.limits.maxVpls = parseInteger("--max-vpls", v, 1, 16777216);
-        };
-        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.maxVpls); };
-        t.push_back(o);
-    }
-    t.push_back(intOption("--jpeg-quality", "GI_JPEG_QUALITY",
-                          "default JPEG/WebP stream quality, 1..100 (default 85)", 1, 100,
-                          &ServerConfig::jpegQuality));
-    {
-        ServerOption o{"--interactive-scale", "GI_INTERACTIVE_SCALE", "F",
-                       "largest size factor of interactive frames while input arrives (the frame budget "
-                       "picks one up to it; with --frame-target-ms 0, the factor), 0.1..1 (default 1)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.session.limits.interactiveScale = parseNumber("--interactive-scale", v, 0.1, 1.0);
-        };
-        o.show = [](const ServerConfig& c) { return numberText(c.session.limits.interactiveScale); };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{"--frame-target-ms", "GI_FRAME_TARGET_MS", "MS",
-                       "render + encode time an interactive frame should take: each session sizes its "
-                       "interactive frames and caps their VPLs from what its frames measured; a client may "
-                       "ask for its own; 0 = no budget, 0..2000 (default 80)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.session.limits.frameTargetMs = static_cast<int>(parseInteger("--frame-target-ms", v, 0, 2000));
-        };
-        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.frameTargetMs); };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{"--slice-ms", "GI_SLICE_MS", "MS",
-                       "time one tile of a refinement step should take: input waits at most about this long "
-                       "for the tile in progress, 5..1000 (default 20)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.session.limits.sliceMs = static_cast<int>(parseInteger("--slice-ms", v, 5, 1000));
-        };
-        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.sliceMs); };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{
-            "--settle-ms", "GI_SETTLE_MS", "MS",
-            "quiet time before refinement to the balanced and final presets, 0..10000 (default 250)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.session.limits.settleMs = static_cast<int>(parseInteger("--settle-ms", v, 0, 10000));
-        };
-        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.settleMs); };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{
-            "--refine-budget-ms", "GI_REFINE_BUDGET_MS", "MS",
-            "skip a refinement step predicted to take longer in all (steps render in tiles input "
-            "interrupts: this bounds the work, not the wait); 0 = no limit, 0..600000 (default 30000)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.session.limits.refineBudgetMs =
-                static_cast<int>(parseInteger("--refine-budget-ms", v, 0, 600000));
-        };
-        o.show = [](const ServerConfig& c) { return std::to_string(c.session.limits.refineBudgetMs); };
-        t.push_back(o);
-    }
-    t.push_back(intOption("--max-sessions", "GI_MAX_SESSIONS",
-                          "concurrent sessions, 1..256 (default 8); more are refused as busy", 1, 256,
-                          &ServerConfig::maxSessions));
+    t.push_back(sizeOption("--size", "GI_SIZE", "default frame size", GIS_FIELD(session.width),
+                           GIS_FIELD(session.height)));
+    t.push_back(sizeOption("--max-size", "GI_MAX_SIZE",
+                           "largest frame a client may ask for; larger viewports are scaled down",
+                           GIS_FIELD(session.limits.maxWidth), GIS_FIELD(session.limits.maxHeight)));
+    t.push_back(integerOption("--max-vpls", "GI_MAX_VPLS", "N", "most VPLs a parameter set may ask for", 1,
+                              16777216, GIS_FIELD(session.limits.maxVpls)));
+    t.push_back(integerOption("--jpeg-quality", "GI_JPEG_QUALITY", "N", "default JPEG/WebP stream quality", 1,
+                              100, GIS_FIELD(jpegQuality)));
+    t.push_back(numberOption("--interactive-scale", "GI_INTERACTIVE_SCALE", "F",
+                             "largest size factor of interactive frames while input arrives (the frame "
+                             "budget picks one up to it; with --frame-target-ms 0, the factor)",
+                             0.1, 1.0, GIS_FIELD(session.limits.interactiveScale)));
+    t.push_back(
+        integerOption("--frame-target-ms", "GI_FRAME_TARGET_MS", "MS",
+                      "render + encode time an interactive frame should take: each session sizes its "
+                      "interactive frames and caps their VPLs from what its frames measured; a client "
+                      "may ask for its own; 0 = no budget",
+                      0, 2000, GIS_FIELD(session.limits.frameTargetMs)));
+    t.push_back(
+        integerOption("--slice-ms", "GI_SLICE_MS", "MS",
+                      "time one tile of a refinement step should take: input waits at most about this "
+                      "long for the tile in progress",
+                      5, 1000, GIS_FIELD(session.limits.sliceMs)));
+    t.push_back(integerOption("--settle-ms", "GI_SETTLE_MS", "MS",
+                              "quiet time before refinement to the balanced and final presets", 0, 10000,
+                              GIS_FIELD(session.limits.settleMs)));
+    t.push_back(integerOption("--refine-budget-ms", "GI_REFINE_BUDGET_MS", "MS",
+                              "skip a refinement step predicted to take longer in all (steps render in tiles "
+                              "input interrupts: this bounds the work, not the wait); 0 = no limit",
+                              0, 600000, GIS_FIELD(session.limits.refineBudgetMs)));
+    t.push_back(integerOption("--max-sessions", "GI_MAX_SESSIONS", "N",
+                              "concurrent sessions (more are refused as busy)", 1, 256,
+                              GIS_FIELD(maxSessions)));
     // The default is the machine's core count, not printed here: docs/operations.md embeds this text
     // and must not depend on the machine that generated it (the startup summary shows the value).
-    t.push_back(intOption("--render-slots", "GI_RENDER_SLOTS",
-                          "renders at once across all sessions and the HTTP API, 1..256 (default: the number "
-                          "of cores)",
-                          1, 256, &ServerConfig::renderSlots));
-    t.push_back(intOption("--http-queue", "GI_HTTP_QUEUE",
-                          "POST /api/render jobs waiting before 503, 0..1024 (default 8)", 0, 1024,
-                          &ServerConfig::httpRenderQueue));
-    {
-        ServerOption o{"--max-message-bytes", "GI_MAX_MESSAGE_BYTES", "N",
-                       "largest client message, 256..16777216 (default 65536)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.maxMessageBytes =
-                static_cast<std::size_t>(parseInteger("--max-message-bytes", v, 256, 16777216));
-        };
-        o.show = [](const ServerConfig& c) { return std::to_string(c.maxMessageBytes); };
-        t.push_back(o);
-    }
-    {
-        ServerOption o{"--rate-limit", "GI_RATE_LIMIT", "N",
-                       "messages per second per connection (bursts of twice that), 0 = unlimited, 0..100000 "
-                       "(default 200)"};
-        o.set = [](ServerConfig& c, const std::string& v) {
-            c.messagesPerSecond = parseNumber("--rate-limit", v, 0, 100000);
-        };
-        o.show = [](const ServerConfig& c) { return numberText(c.messagesPerSecond); };
-        t.push_back(o);
-    }
+    t.push_back(integerOption("--render-slots", "GI_RENDER_SLOTS", "N",
+                              "renders at once across all sessions and the HTTP API", 1, 256,
+                              GIS_FIELD(renderSlots), "the number of cores"));
+    t.push_back(integerOption("--http-queue", "GI_HTTP_QUEUE", "N",
+                              "POST /api/render jobs waiting before 503", 0, 1024,
+                              GIS_FIELD(httpRenderQueue)));
+    t.push_back(integerOption("--max-message-bytes", "GI_MAX_MESSAGE_BYTES", "N", "largest client message",
+                              256, 16777216, GIS_FIELD(maxMessageBytes)));
+    t.push_back(numberOption("--rate-limit", "GI_RATE_LIMIT", "N",
+                             "messages per second per connection (bursts of twice that), 0 = unlimited", 0,
+                             100000, GIS_FIELD(messagesPerSecond)));
     {
         ServerOption o =
             stringOption("--token", "GI_TOKEN", "TOKEN",
@@ -260,23 +197,21 @@ std::vector<ServerOption> buildOptions() {
                    "also accept requests from this origin, e.g. https://demo.example (repeatable; default: "
                    "the server's own origin only)",
                    &ServerConfig::allowOrigins));
-    t.push_back(intOption("--resume-grace", "GI_RESUME_GRACE",
-                          "a dropped controller's session waits this many seconds "
-                          "for a resume, 0..3600 (default 30)",
-                          0, 3600, &ServerConfig::resumeGraceS));
+    t.push_back(integerOption("--resume-grace", "GI_RESUME_GRACE", "N",
+                              "a dropped controller's session waits this many seconds for a resume", 0, 3600,
+                              GIS_FIELD(resumeGraceS)));
+    t.push_back(integerOption("--idle-timeout", "GI_IDLE_TIMEOUT", "N",
+                              "end sessions without steering input for this many seconds", 10, 604800,
+                              GIS_FIELD(idleTimeoutS)));
+    t.push_back(integerOption("--hello-timeout", "GI_HELLO_TIMEOUT", "N",
+                              "close connections that send no hello within this many seconds", 1, 300,
+                              GIS_FIELD(helloTimeoutS)));
     t.push_back(
-        intOption("--idle-timeout", "GI_IDLE_TIMEOUT",
-                  "end sessions without steering input for this many seconds, 10..604800 (default 900)", 10,
-                  604800, &ServerConfig::idleTimeoutS));
-    t.push_back(
-        intOption("--hello-timeout", "GI_HELLO_TIMEOUT",
-                  "close connections that send no hello within this many seconds, 1..300 (default 10)", 1,
-                  300, &ServerConfig::helloTimeoutS));
-    t.push_back(intOption("--drain-seconds", "GI_DRAIN_SECONDS",
-                          "on SIGTERM or SIGINT refuse new sessions, tell clients and let running sessions "
-                          "finish for up to this many seconds, then close them and exit 0; a second signal "
-                          "stops at once; 0 = no wait, 0..3600 (default 20)",
-                          0, 3600, &ServerConfig::drainSeconds));
+        integerOption("--drain-seconds", "GI_DRAIN_SECONDS", "N",
+                      "on SIGTERM or SIGINT refuse new sessions, tell clients and let running sessions "
+                      "finish for up to this many seconds, then close them and exit 0; a second signal "
+                      "stops at once; 0 = no wait",
+                      0, 3600, GIS_FIELD(drainSeconds)));
     t.push_back(listOption("--scene-dir", "GI_SCENE_DIR", "DIR",
                            "offer the .gltf/.glb files below DIR as file:NAME scenes (repeatable)",
                            &ServerConfig::sceneDirs));
@@ -284,30 +219,29 @@ std::vector<ServerOption> buildOptions() {
         stringOption("--upload-dir", "GI_UPLOAD_DIR", "DIR",
                      "where per-session upload sandboxes live (default: a private directory under $TMPDIR)",
                      &ServerConfig::uploadDir));
-    t.push_back(intOption("--max-upload-mb", "GI_MAX_UPLOAD_MB",
-                          "largest uploaded .glb in MiB, 0..1024 (0 disables "
-                          "uploads; default 32)",
-                          0, 1024, &ServerConfig::maxUploadMb));
+    t.push_back(integerOption("--max-upload-mb", "GI_MAX_UPLOAD_MB", "N",
+                              "largest uploaded .glb or .zip in MiB (0 disables uploads)", 0, 1024,
+                              GIS_FIELD(maxUploadMb)));
     t.push_back(
-        intOption("--max-decoded-mb", "GI_MAX_DECODED_MB",
-                  "most memory one uploaded or file: scene may take once decoded (buffers, images, "
-                  "geometry), checked from image headers before decoding, 16..65536 MiB (default 512)",
-                  16, 65536, &ServerConfig::maxDecodedMb));
-    t.push_back(intOption("--max-session-uploads-mb", "GI_MAX_SESSION_UPLOADS_MB",
-                          "all uploads of one session together, 1..65536 MiB (default 128)", 1, 65536,
-                          &ServerConfig::maxSessionUploadsMb));
-    t.push_back(intOption("--max-connections", "GI_MAX_CONNECTIONS",
-                          "open HTTP and WebSocket connections; more are closed at accept; 0 = the open-file "
-                          "limit less a reserve for sessions and files, 0..1000000 (default 0)",
-                          0, 1000000, &ServerConfig::maxConnections));
-    t.push_back(intOption("--max-pending-per-ip", "GI_MAX_PENDING_PER_IP",
-                          "connections from one address that have not finished their HTTP request or hello, "
-                          "1..100000 (default 32)",
-                          1, 100000, &ServerConfig::maxPendingPerIp));
-    t.push_back(intOption("--request-timeout", "GI_REQUEST_TIMEOUT",
-                          "seconds an HTTP request may take from its first byte to the end of its body, "
-                          "1..3600 (default 30)",
-                          1, 3600, &ServerConfig::requestTimeoutS));
+        integerOption("--max-decoded-mb", "GI_MAX_DECODED_MB", "N",
+                      "most memory in MiB one uploaded or file: scene may take once decoded (buffers, "
+                      "images, geometry), checked from image headers before decoding",
+                      16, 65536, GIS_FIELD(maxDecodedMb)));
+    t.push_back(integerOption("--max-session-uploads-mb", "GI_MAX_SESSION_UPLOADS_MB", "N",
+                              "all uploads of one session together, in MiB", 1, 65536,
+                              GIS_FIELD(maxSessionUploadsMb)));
+    t.push_back(
+        integerOption("--max-connections", "GI_MAX_CONNECTIONS", "N",
+                      "open HTTP and WebSocket connections; more are closed at accept; 0 = the open-file "
+                      "limit less a reserve for sessions and files",
+                      0, 1000000, GIS_FIELD(maxConnections)));
+    t.push_back(
+        integerOption("--max-pending-per-ip", "GI_MAX_PENDING_PER_IP", "N",
+                      "connections from one address that have not finished their HTTP request or hello", 1,
+                      100000, GIS_FIELD(maxPendingPerIp)));
+    t.push_back(integerOption("--request-timeout", "GI_REQUEST_TIMEOUT", "N",
+                              "seconds an HTTP request may take from its first byte to the end of its body",
+                              1, 3600, GIS_FIELD(requestTimeoutS)));
     {
         ServerOption o{"--gl", "GI_GL", "egl|osmesa", "headless GL backend (default egl)"};
         o.set = [](ServerConfig& c, const std::string& v) {
