@@ -190,7 +190,7 @@ int runRequest(const Options& o) {
     }
     if (o.useCache) job.referenceCacheDir = o.cacheDir;
     if (!o.out.empty() && gis::codecForPath(o.out) != job.codec) {
-        const std::string ext = job.codec == gis::ImageCodec::Jpeg ? "jpg" : gis::codecName(job.codec);
+        const std::string& ext = gis::codecInfo(job.codec).extensions.front();
         throw UsageError("--out '" + o.out + "' does not match the request's format '" +
                          gis::codecName(job.codec) + "': name it *." + ext);
     }
@@ -398,7 +398,7 @@ int run(int argc, char** argv) {
     }
     if (!o.request.empty()) return runRequest(o);
     if (!o.out.empty() && !gis::codecForPath(o.out) && !gis::imageFileNeedsLinear(o.out))
-        throw UsageError("--out must end in .png, .jpg, .webp or .exr, got '" + o.out + "'");
+        throw UsageError("--out must end in " + gis::codecExtensionList() + " or .exr, got '" + o.out + "'");
 
     // Validate everything that needs no GL before creating a context.
     const gis::gl::Backend backend = o.gl.empty() ? gis::gl::defaultBackend() : gis::gl::parseBackend(o.gl);

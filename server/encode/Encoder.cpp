@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <csetjmp>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 
@@ -28,41 +29,33 @@ std::string lowerExtension(const std::string& path) {
 } // namespace
 
 ImageCodec parseImageCodec(const std::string& name, const std::string& where) {
-    for (ImageCodec c : {ImageCodec::Jpeg, ImageCodec::Png, ImageCodec::Webp})
-        if (name == codecName(c)) return c;
-    throw InputError(where, "unknown image format '" + name + "' (known: jpeg, png, webp)");
+    std::string known;
+    for (const CodecInfo& c : imageCodecs()) {
+        if (name == c.name) return c.id;
+        known += (known.empty() ? "" : ", ") + std::string(c.name);
+    }
+    throw InputError(where, "unknown image format '" + name + "' (known: " + known + ")");
 }
 
 const char* codecName(ImageCodec codec) {
-    switch (codec) {
-    case ImageCodec::Jpeg:
-        return "jpeg";
-    case ImageCodec::Png:
-        return "png";
-    case ImageCodec::Webp:
-        return "webp";
-    }
-    return "unknown";
+    return codecInfo(codec).name;
 }
 
 const char* codecMimeType(ImageCodec codec) {
-    switch (codec) {
-    case ImageCodec::Jpeg:
-        return "image/jpeg";
-    case ImageCodec::Png:
-        return "image/png";
-    case ImageCodec::Webp:
-        return "image/webp";
-    }
-    return "application/octet-stream";
+    return codecInfo(codec).mimeType;
 }
 
 std::optional<ImageCodec> codecForPath(const std::string& path) {
     const std::string ext = lowerExtension(path);
-    if (ext == "jpg" || ext == "jpeg") return ImageCodec::Jpeg;
-    if (ext == "png") return ImageCodec::Png;
-    if (ext == "webp") return ImageCodec::Webp;
+    for (const CodecInfo& c : imageCodecs())
+        if (std::find(c.extensions.begin(), c.extensions.end(), ext) != c.extensions.end()) return c.id;
     return std::nullopt;
+}
+
+std::string codecExtensionList() {
+    std::string out;
+    for (const CodecInfo& c : imageCodecs()) out += (out.empty() ? "." : ", .") + c.extensions.front();
+    return out;
 }
 
 std::vector<std::uint8_t> encodeJpeg(const std::uint8_t* rgba, int width, int height, int quality) {
@@ -99,8 +92,9 @@ namespace {
 bool writePng(png_structp png, png_infop info, const std::uint8_t* rgba, int width, int height,
               png_textp text, int textCount, std::uint8_t* row) {
     if (setjmp(png_jmpbuf(png))) return false;
-    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+                 PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
     // Fixed settings: the bytes are part of the contract (gi-render and the API must agree).
     png_set_compression_level(png, 6);
     if (textCount > 0) png_set_text(png, info, text, textCount);
@@ -183,20 +177,55 @@ std::vector<std::uint8_t> encodeWebpLossless(const std::uint8_t* rgba, int width
     return encodeWebpWith(rgba, width, height, true, 0);
 }
 
-std::vector<std::uint8_t> encodeImage(ImageCodec codec, const std::uint8_t* rgba, int width, int height,
-                                      int quality, const ImageMetadata& pngText) {
-    switch (codec) {
-    case ImageCodec::Jpeg:
-        return encodeJpeg(rgba, width, height, quality);
-    case ImageCodec::Png:
-        return encodePng(rgba, width, height, pngText);
-    case ImageCodec::Webp:
-        return encodeWebp(rgba, width, height, quality);
-    }
-    throw Error("encode: unknown codec " + std::to_string(static_cast<int>(codec)));
+const std::vector<CodecInfo>& imageCodecs() {
+    static const std::vector<CodecInfo> table = {
+        {ImageCodec::Jpeg,
+         "jpeg",
+         "image/jpeg",
+         {"jpg", "jpeg"},
+         true,
+         false,
+         [](const std::uint8_t* rgba, int w, int h, int quality, bool, const ImageMetadata&) {
+             return encodeJpeg(rgba, w, h, quality);
+         }},
+        {ImageCodec::Png,
+         "png",
+         "image/png",
+         {"png"},
+         false,
+         true,
+         [](const std::uint8_t* rgba, int w, int h, int, bool, const ImageMetadata& text) {
+             return encodePng(rgba, w, h, text);
+         }},
+        {ImageCodec::Webp,
+         "webp",
+         "image/webp",
+         {"webp"},
+         true,
+         true,
+         [](const std::uint8_t* rgba, int w, int h, int quality, bool exact, const ImageMetadata&) {
+             return exact ? encodeWebpLossless(rgba, w, h) : encodeWebp(rgba, w, h, quality);
+         }},
+    };
+    return table;
 }
 
-bool imageFileNeedsLinear(const std::string& path) { return lowerExtension(path) == "exr"; }
+const CodecInfo& codecInfo(ImageCodec codec) {
+    for (const CodecInfo& c : imageCodecs())
+        if (c.id == codec) return c;
+    GIS_ASSERT_MSG(false,
+                   "codec " + std::to_string(static_cast<int>(codec)) + " has no row in imageCodecs()");
+    std::abort();
+}
+
+std::vector<std::uint8_t> encodeImage(ImageCodec codec, const std::uint8_t* rgba, int width, int height,
+                                      int quality, const ImageMetadata& pngText, bool exact) {
+    return codecInfo(codec).encode(rgba, width, height, quality, exact, pngText);
+}
+
+bool imageFileNeedsLinear(const std::string& path) {
+    return lowerExtension(path) == "exr";
+}
 
 void writeBinaryFile(const std::string& path, const std::vector<std::uint8_t>& bytes) {
     std::ofstream f(path, std::ios::binary | std::ios::trunc);
@@ -216,7 +245,8 @@ void writeImageFile(const std::string& path, int width, int height, const std::v
         return;
     }
     if (ext != "exr")
-        throw InputError(path, "unsupported image extension '." + ext + "': use .png, .jpg, .webp or .exr");
+        throw InputError(path, "unsupported image extension '." + ext + "': use " + codecExtensionList() +
+                                   " or .exr");
     if (linear.size() != static_cast<size_t>(width) * static_cast<size_t>(height) * 4)
         throw Error("encode: EXR output needs the linear frame");
     auto out = OIIO::ImageOutput::create(path);

@@ -16,21 +16,43 @@ namespace gis {
 /// (protocol/PROTOCOL.md).
 enum class ImageCodec : std::uint8_t { Jpeg = 1, Png = 2, Webp = 3 };
 
-/// "jpeg", "png" or "webp" (exactly these names). Throws InputError(where, ...) listing them.
+/// Text chunks of a PNG file, (keyword, text) in order. Keywords: 1..79 printable Latin-1 characters.
+using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
+
+/// Everything about one codec, in one row of imageCodecs(): the encoder, the CLI's file names, the
+/// protocol's and the API's names and the HTTP type all read it. The protocol schemas' codec lists
+/// and the client's header table are checked against it (tests/unit/encode/CodecTableTest.cpp).
+struct CodecInfo {
+    ImageCodec id;                       ///< also the binary frame header's codec byte
+    const char* name;                    ///< "jpeg": hello.codecs, snapshot.codec, the API's format
+    const char* mimeType;                ///< "image/jpeg"
+    std::vector<std::string> extensions; ///< lower case, without the dot; the first is the one suggested
+    bool lossy;                          ///< encodes at a quality 1..100 (what the stream uses)
+    bool lossless;                       ///< can encode without loss (what a snapshot may ask for)
+    /// RGBA8 rows top to bottom -> bytes. `quality` for lossy encoding; `exact` asks for the lossless
+    /// mode of a codec that has both; `text` for codecs with text chunks (PNG).
+    std::vector<std::uint8_t> (*encode)(const std::uint8_t* rgba, int width, int height, int quality,
+                                        bool exact, const ImageMetadata& text);
+};
+
+/// Every codec, in the order of their ids.
+const std::vector<CodecInfo>& imageCodecs();
+const CodecInfo& codecInfo(ImageCodec codec);
+
+/// A codec by its name (exactly). Throws InputError(where, ...) listing the names.
 ImageCodec parseImageCodec(const std::string& name, const std::string& where = {});
 /// "jpeg", "png", "webp".
 const char* codecName(ImageCodec codec);
 /// "image/jpeg", "image/png", "image/webp".
 const char* codecMimeType(ImageCodec codec);
-/// The codec a file name's extension calls for (.jpg/.jpeg, .png, .webp, any case); nullopt otherwise.
+/// The codec a file name's extension calls for (any case); nullopt otherwise.
 std::optional<ImageCodec> codecForPath(const std::string& path);
+/// ".png, .jpg, .webp" (the suggested extensions), for messages about file names.
+std::string codecExtensionList();
 
 /// Quality of the lossy codecs when nobody asks for another: the HTTP API's default and what image
 /// files written by writeImageFile use, so that both give the same bytes.
 constexpr int kDefaultImageQuality = 90;
-
-/// Text chunks of a PNG file, (keyword, text) in order. Keywords: 1..79 printable Latin-1 characters.
-using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
 /// RGBA8 rows top to bottom -> JPEG (alpha dropped). quality in [1, 100]. Throws gis::Error.
 std::vector<std::uint8_t> encodeJpeg(const std::uint8_t* rgba, int width, int height, int quality);
@@ -45,10 +67,11 @@ std::vector<std::uint8_t> encodeWebp(const std::uint8_t* rgba, int width, int he
 /// RGBA8 rows top to bottom -> lossless WebP (RGB, alpha dropped). Throws gis::Error.
 std::vector<std::uint8_t> encodeWebpLossless(const std::uint8_t* rgba, int width, int height);
 
-/// Encodes with `codec`: JPEG and WebP lossy at `quality` (1..100, clamped), PNG lossless with
-/// `pngText` (ignored by the other codecs). Throws gis::Error.
+/// Encodes with `codec` (its row's encode): JPEG and WebP lossy at `quality` (1..100, clamped), PNG
+/// lossless with `pngText` (ignored by the other codecs); with `exact`, WebP's lossless mode. Throws
+/// gis::Error.
 std::vector<std::uint8_t> encodeImage(ImageCodec codec, const std::uint8_t* rgba, int width, int height,
-                                      int quality, const ImageMetadata& pngText = {});
+                                      int quality, const ImageMetadata& pngText = {}, bool exact = false);
 
 /// Writes a tone-mapped RGBA8 image or linear radiance, chosen by the file extension:
 ///  - .png: encodePng with `metadata` as text chunks;

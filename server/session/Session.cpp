@@ -366,7 +366,8 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
             if (msg.contains("frame_target_ms")) mStream.frameTargetMs = msg["frame_target_ms"].get<int>();
         } else if (type == "snapshot") {
             mSnapshotFor = from;
-            mSnapshotCodec = msg.value("codec", "png") == "webp" ? ImageCodec::Webp : ImageCodec::Png;
+            // The schema admits only lossless codecs (protocol/schema/snapshot.json).
+            mSnapshotCodec = parseImageCodec(msg.value("codec", "png"), "/codec");
             lock.unlock();
             mCv.notify_all();
             return;
@@ -478,9 +479,9 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
         const std::vector<std::uint8_t> cropped =
             region ? cropRgba8(rgba, width, height, *region) : std::vector<std::uint8_t>();
         const std::uint8_t* pixels = region ? cropped.data() : rgba.data();
-        encoded = snapshotFor && codec == ImageCodec::Webp
-                      ? encodeWebpLossless(pixels, sentWidth, sentHeight)
-                      : encodeImage(codec, pixels, sentWidth, sentHeight, stream.quality);
+        // A snapshot is lossless in whichever codec it asked for.
+        encoded =
+            encodeImage(codec, pixels, sentWidth, sentHeight, stream.quality, {}, snapshotFor != nullptr);
     } catch (const std::exception& e) {
         fail(std::string("the frame could not be encoded: ") + e.what());
         return false;
