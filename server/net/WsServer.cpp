@@ -17,7 +17,6 @@
 #include <fstream>
 #include <map>
 #include <mutex>
-#include <random>
 #include <set>
 #include <thread>
 #include <vector>
@@ -31,6 +30,7 @@
 #include "gi/Technique.h"
 #include "net/Metrics.h"
 #include "net/RateLimiter.h"
+#include "net/SessionDirectory.h"
 #include "render/FrameRenderer.h"
 #include "job/RenderRequest.h"
 #include "scene/SceneArchive.h"
@@ -99,27 +99,6 @@ private:
     bool mStop = false;
     std::thread mThread;
 };
-
-std::string randomToken(const char* prefix) {
-    static std::mutex mutex;
-    static std::random_device device;
-    std::lock_guard lock(mutex);
-    static const char* hex = "0123456789abcdef";
-    std::string out = prefix;
-    for (int i = 0; i < 4; ++i) {
-        const std::uint32_t v = device();
-        for (int b = 0; b < 8; ++b) out += hex[(v >> (4 * b)) & 0xf];
-    }
-    return out;
-}
-
-bool sameSecret(const std::string& a, const std::string& b) {
-    // Constant time in the length of the expected secret: no early exit on the first difference.
-    unsigned diff = a.size() == b.size() ? 0u : 1u;
-    for (std::size_t i = 0; i < b.size(); ++i)
-        diff |= static_cast<unsigned>(b[i] ^ (i < a.size() ? a[i] : 0));
-    return diff == 0;
-}
 
 std::string header(lws* wsi, lws_token_indexes token) {
     const int len = lws_hdr_total_length(wsi, token);
@@ -244,7 +223,10 @@ struct HttpExchange {
     std::string endpoint; ///< for metrics
 };
 
-struct SessionEntry;
+struct Connection;
+/// Sessions by id and token, steered by connections (net/SessionDirectory.h).
+using Directory = SessionDirectory<Session, Connection>;
+using SessionEntry = Directory::Entry;
 
 struct Connection {
     lws* wsi = nullptr;
@@ -263,14 +245,6 @@ struct Connection {
     bool closing = false;
     int closeCode = 1000;
     std::string closeReason;
-};
-
-struct SessionEntry {
-    std::shared_ptr<Session> session;
-    std::string resumeToken, viewToken;
-    Connection* controller = nullptr;
-    Clock::time_point detachedAt{};
-    bool ended = false;
 };
 
 // Per-connection storage lws allocates (zeroed, plain memory): pointers and flags only.
@@ -311,7 +285,7 @@ struct WsServer::Impl {
     std::unique_ptr<GlWorkerPool> workers;
     MetricsRegistry metrics;
     std::map<lws*, std::unique_ptr<Connection>> connections;
-    std::map<std::string, std::shared_ptr<SessionEntry>> sessions; // by id
+    std::unique_ptr<Directory> sessions; // made with the config's limits
     std::unique_ptr<BackgroundQueue> reaper = std::make_unique<BackgroundQueue>();
     std::uint64_t nextSessionId = 1;
     lws_protocols protocols[3];
@@ -374,7 +348,7 @@ struct WsServer::Impl {
     }
     void updateGauges() {
         std::size_t controllers = 0, viewers = 0, detached = 0;
-        for (const auto& [id, e] : sessions) {
+        for (const auto& e : sessions->all()) {
             if (e->controller)
                 ++controllers;
             else
@@ -382,7 +356,7 @@ struct WsServer::Impl {
             viewers += e->session->viewerCount();
         }
         metrics.gauge("gis_sessions", "open sessions (including those waiting for a resume)")
-            .set(static_cast<double>(sessions.size()));
+            .set(static_cast<double>(sessions->size()));
         metrics.gauge("gis_sessions_detached", "sessions waiting for their controller to resume")
             .set(static_cast<double>(detached));
         metrics.gauge("gis_clients", "attached clients by role", {{"role", "controller"}})
@@ -579,7 +553,7 @@ struct WsServer::Impl {
             const bool draining = phase != Phase::Running;
             nlohmann::json body = {
                 {"status", draining ? "draining" : "ok"},
-                {"sessions", sessions.size()},
+                {"sessions", sessions->size()},
                 {"renders_active", gate->active()},
                 {"renders_waiting", gate->waiting()},
                 {"teardowns_pending", reaper->pending()},
@@ -855,9 +829,7 @@ struct WsServer::Impl {
             return;
         }
         const std::string token = customHeader(wsi, "x-gi-session:");
-        std::shared_ptr<SessionEntry> entry;
-        for (const auto& [id, e] : sessions)
-            if (!token.empty() && sameSecret(token, e->resumeToken)) entry = e;
+        const std::shared_ptr<SessionEntry> entry = sessions->byResumeToken(token);
         if (!entry) {
             respond(wsi, pss,
                     errorResponse(404, "unknown_session",
@@ -996,8 +968,7 @@ struct WsServer::Impl {
 
     void endSession(const std::shared_ptr<SessionEntry>& entry, const std::string& code,
                     const std::string& message) {
-        if (entry->ended) return;
-        entry->ended = true;
+        if (!sessions->end(*entry)) return;
         for (auto& [wsi, c] : connections) {
             if (c->entry != entry) continue;
             if (!code.empty())
@@ -1008,7 +979,6 @@ struct WsServer::Impl {
             c->link.reset();
             c->entry.reset();
         }
-        sessions.erase(entry->session->id());
         logInfo("net: session " + entry->session->id() + " ended (" + (code.empty() ? "closed" : code) +
                 ") after " + std::to_string(entry->session->framesRendered()) + " frames");
         auto session = entry->session;
@@ -1017,12 +987,6 @@ struct WsServer::Impl {
             std::error_code ec;
             if (!session->uploadDir().empty()) fs::remove_all(session->uploadDir(), ec);
         });
-    }
-
-    std::shared_ptr<SessionEntry> findEntry(const std::string& token, bool resume) {
-        for (const auto& [id, e] : sessions)
-            if (sameSecret(token, resume ? e->resumeToken : e->viewToken)) return e;
-        return nullptr;
     }
 
     nlohmann::json welcomeFor(const SessionEntry& entry, ClientRole role, bool resumed, int maxInFlight) {
@@ -1105,17 +1069,20 @@ struct WsServer::Impl {
         stream.frameTargetMs = hello.value("frame_target_ms", -1);
         if (hello.contains("codecs")) stream.codec = parseImageCodec(hello["codecs"][0].get<std::string>());
 
-        if (hello.contains("view")) {
-            auto entry = findEntry(hello["view"], false);
-            if (!entry) {
-                closeWith(c, {"unknown_view_token", "no live session has this view token", "/view", "hello"},
-                          1008);
-                return;
-            }
-            if (entry->session->viewerCount() >= kMaxViewersPerSession) {
-                closeWith(c, {"busy", "this session has its maximum of viewers", "", "hello"}, 1013);
-                return;
-            }
+        auto token = [&](const char* key) {
+            return hello.contains(key) ? std::optional<std::string>(hello[key].get<std::string>())
+                                       : std::nullopt;
+        };
+        const Directory::HelloDecision decision = sessions->decide(token("view"), token("resume"));
+        using Kind = Directory::HelloDecision::Kind;
+        if (decision.kind == Kind::Refuse) {
+            if (decision.refusal.code == "busy" && !hello.contains("view"))
+                metrics.counter("gis_sessions_refused_total", "sessions refused at the session cap").inc();
+            closeWith(c, decision.refusal, decision.closeCode);
+            return;
+        }
+        std::shared_ptr<SessionEntry> entry = decision.entry;
+        if (decision.kind == Kind::Viewer) {
             c.link = makeLink(ClientRole::Viewer, maxInFlight, acceptsPatches);
             c.entry = entry;
             c.helloDone = true;
@@ -1125,55 +1092,31 @@ struct WsServer::Impl {
             logInfo("net: a viewer joined session " + entry->session->id() + " from " + peerAddress(c.wsi));
             return;
         }
-        std::shared_ptr<SessionEntry> entry;
-        bool resumed = false;
-        if (hello.contains("resume")) {
-            entry = findEntry(hello["resume"], true);
-            if (!entry) {
-                closeWith(c,
-                          {"resume_failed",
-                           "the session has ended or the token is unknown; connect without resume", "/resume",
-                           "hello"},
-                          1008);
-                return;
-            }
-            if (entry->controller) {
-                // The old connection may be half-open and not noticed yet: the resume takes over.
-                Connection* old = entry->controller;
-                old->link.reset();
-                old->entry.reset();
-                closeWith(*old, {"session_ended", "another connection resumed this session", "", ""}, 1001);
-            }
-            resumed = true;
-        } else {
-            if (static_cast<int>(sessions.size()) >= config.maxSessions) {
-                closeWith(c,
-                          {"busy",
-                           "the server has reached its session limit (" + std::to_string(config.maxSessions) +
-                               "); try again later",
-                           "", "hello"},
-                          1013);
-                metrics.counter("gis_sessions_refused_total", "sessions refused at the session cap").inc();
-                return;
-            }
-            entry = std::make_shared<SessionEntry>();
-            const std::string id = "s" + std::to_string(nextSessionId++);
+        const bool resumed = decision.kind == Kind::Resume;
+        if (resumed && entry->controller) {
+            // The old connection may be half-open and not noticed yet: the resume takes over.
+            Connection* old = entry->controller;
+            old->link.reset();
+            old->entry.reset();
+            closeWith(*old, {"session_ended", "another connection resumed this session", "", ""}, 1001);
+        }
+        if (!resumed) {
+            const std::string id = sessions->nextId();
+            std::shared_ptr<Session> session;
             try {
-                entry->session = std::make_shared<Session>(id, config.session, scenes, catalog, gate.get(),
-                                                           (fs::path(uploadRoot) / id).string());
+                session = std::make_shared<Session>(id, config.session, scenes, catalog, gate.get(),
+                                                    (fs::path(uploadRoot) / id).string());
             } catch (const std::exception& e) {
                 closeWith(c,
                           {"render_failed", std::string("cannot start a session: ") + e.what(), "", "hello"},
                           1011);
                 return;
             }
-            entry->session->setObservers([this](const FrameReport& r) { onFrame(r); },
-                                         [this](const std::string& code) { countError(code); });
+            session->setObservers([this](const FrameReport& r) { onFrame(r); },
+                                  [this](const std::string& code) { countError(code); });
             lws_context* ctx = context;
-            entry->session->setFailureObserver([ctx] { lws_cancel_service(ctx); });
-            entry->resumeToken = randomToken("r-");
-            entry->viewToken = randomToken("v-");
-            sessions[id] = entry;
+            session->setFailureObserver([ctx] { lws_cancel_service(ctx); });
+            entry = sessions->add(session);
             metrics.counter("gis_sessions_started_total", "sessions created").inc();
         }
         if (hello.contains("size")) {
@@ -1187,15 +1130,14 @@ struct WsServer::Impl {
         c.entry = entry;
         c.helloDone = true;
         settle(c.wsi);
-        entry->controller = &c;
-        entry->detachedAt = {};
+        sessions->attach(*entry, &c);
         // Attach first so that welcome reports the negotiated stream; it still goes out before any
         // frame (direct replies are written before the link's queue).
         entry->session->attach(c.link, &stream);
         sendDirect(c, welcomeFor(*entry, ClientRole::Controller, resumed, maxInFlight));
         if (!resumed) entry->session->start();
         logInfo("net: session " + entry->session->id() + (resumed ? " resumed" : " opened") + " by " +
-                peerAddress(c.wsi) + " (" + std::to_string(sessions.size()) + " open)");
+                peerAddress(c.wsi) + " (" + std::to_string(sessions->size()) + " open)");
     }
 
     void onMessage(Connection& c, const std::string& text) {
@@ -1383,7 +1325,7 @@ struct WsServer::Impl {
                     entry->session->detach(link);
                 } else if (entry->controller == &c) {
                     entry->session->detach(link);
-                    entry->controller = nullptr;
+                    sessions->detach(*entry, Clock::now()); // the grace period starts
                     if (stop || phase == Phase::Closing) {
                         endSession(entry, "", ""); // the server is going down: no messages
                     } else if (phase == Phase::Draining) {
@@ -1395,7 +1337,6 @@ struct WsServer::Impl {
                     } else if (c.peerCloseCode == 1000 || config.resumeGraceS == 0) {
                         endSession(entry, "session_ended", "the controller closed the session");
                     } else {
-                        entry->detachedAt = Clock::now();
                         logInfo("net: session " + entry->session->id() + " lost its controller; kept " +
                                 std::to_string(config.resumeGraceS) + " s for a resume");
                     }
@@ -1437,7 +1378,7 @@ struct WsServer::Impl {
         }
         if (phase == Phase::Running) return;
         const auto now = Clock::now();
-        if (phase == Phase::Draining && ((sessions.empty() && awaiting.empty()) || now >= drainDeadline))
+        if (phase == Phase::Draining && ((sessions->empty() && awaiting.empty()) || now >= drainDeadline))
             beginClosing(std::chrono::seconds(2));
         if (phase == Phase::Closing && (connections.empty() || now >= closeDeadline)) stop = true;
     }
@@ -1445,14 +1386,11 @@ struct WsServer::Impl {
     void beginDrain() {
         phase = Phase::Draining;
         drainDeadline = Clock::now() + std::chrono::seconds(config.drainSeconds);
-        logInfo("net: draining: new sessions are refused; " + std::to_string(sessions.size()) +
+        logInfo("net: draining: new sessions are refused; " + std::to_string(sessions->size()) +
                 " session(s) and " + std::to_string(awaiting.size()) + " HTTP render(s) have up to " +
                 std::to_string(config.drainSeconds) + " s to finish (a second signal stops at once)");
         // A detached session waits for a resume that can no longer come (hello is refused).
-        std::vector<std::shared_ptr<SessionEntry>> detached;
-        for (const auto& [id, e] : sessions)
-            if (!e->controller) detached.push_back(e);
-        for (const auto& e : detached)
+        for (const auto& e : sessions->detached())
             endSession(e, "shutting_down",
                        "the server is shutting down and the session's controller is gone");
         const nlohmann::json notice = {
@@ -1476,9 +1414,9 @@ struct WsServer::Impl {
     void beginClosing(Clock::duration flush) {
         phase = Phase::Closing;
         closeDeadline = Clock::now() + flush;
-        if (!sessions.empty())
-            logInfo("net: drain over: closing " + std::to_string(sessions.size()) + " session(s)");
-        for (auto& [id, e] : std::map(sessions))
+        if (!sessions->empty())
+            logInfo("net: drain over: closing " + std::to_string(sessions->size()) + " session(s)");
+        for (const auto& e : sessions->all())
             endSession(e, "shutting_down", "the server's drain period is over");
         for (auto& [wsi, c] : connections)
             if (!c->closing) closeWith(*c, shuttingDown("", "the server is shutting down"), 1001);
@@ -1494,10 +1432,8 @@ struct WsServer::Impl {
     /// A session whose renderer failed ends alone, with the reason; the process and every other
     /// session go on.
     void endFailedSessions() {
-        std::vector<std::shared_ptr<SessionEntry>> failed;
-        for (const auto& [id, e] : sessions)
-            if (e->session->failed()) failed.push_back(e);
-        for (const auto& e : failed) endSession(e, "render_failed", e->session->failure());
+        for (const auto& e : sessions->all())
+            if (e->session->failed()) endSession(e, "render_failed", e->session->failure());
     }
 
     void housekeep() {
@@ -1522,20 +1458,8 @@ struct WsServer::Impl {
                           {"hello_required", "no hello within " + std::to_string(config.helloTimeoutS) + " s",
                            "", ""},
                           1008);
-        std::vector<std::pair<std::shared_ptr<SessionEntry>, std::string>> expired;
-        for (const auto& [id, e] : sessions) {
-            if (!e->controller && e->detachedAt != Clock::time_point{} &&
-                now - e->detachedAt > std::chrono::seconds(config.resumeGraceS))
-                expired.emplace_back(e, "session_ended");
-            else if (e->session->idleSeconds() > config.idleTimeoutS)
-                expired.emplace_back(e, "idle_timeout");
-        }
-        for (auto& [e, code] : expired)
-            endSession(e, code,
-                       code == "idle_timeout"
-                           ? "no steering input for " + std::to_string(config.idleTimeoutS) + " s"
-                           : "the controller did not come back within " +
-                                 std::to_string(config.resumeGraceS) + " s");
+        for (const auto& expiry : sessions->expired(now))
+            endSession(expiry.entry, expiry.code, expiry.message);
         updateGauges();
         if (!stop) scheduleHousekeeping();
     }
@@ -1613,6 +1537,11 @@ struct WsServer::Impl {
 WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
     m.config = std::move(config);
+    m.sessions = std::make_unique<Directory>(
+        Directory::Limits{.maxSessions = m.config.maxSessions,
+                          .maxViewersPerSession = kMaxViewersPerSession,
+                          .resumeGrace = std::chrono::seconds(m.config.resumeGraceS),
+                          .idleTimeoutS = static_cast<double>(m.config.idleTimeoutS)});
     char resolved[PATH_MAX];
     if (!realpath(m.config.clientDir.c_str(), resolved))
         throw InputError("--client-dir", "directory '" + m.config.clientDir + "' does not exist");
@@ -1646,7 +1575,7 @@ WsServer::~WsServer() {
     mImpl->stop = true;
     mImpl->unpacker.reset(); // finishes an extraction in progress: it wakes the loop's context
     if (mImpl->context) lws_context_destroy(mImpl->context); // closes connections: sessions end
-    for (auto& [id, e] : std::map(mImpl->sessions)) mImpl->endSession(e, "", "");
+    for (const auto& e : mImpl->sessions->all()) mImpl->endSession(e, "", "");
     mImpl->workers.reset();
     mImpl->reaper.reset(); // joins every render thread
     if (mImpl->ownsUploadRoot) {
