@@ -2,20 +2,18 @@
 // JSON-Schema subset validator. Pure functions without DOM access so node's test runner can load
 // this module as it is.
 
+import { MESSAGES, SERVER_SCHEMAS } from './schemas.js';
+
 export const PROTOCOL_VERSION = 2;
 export const SUBPROTOCOL = 'gi-stream';
 export const CLIENT_NAME = 'gi-web/0.2';
 
-export const CLIENT_MESSAGE_TYPES = Object.freeze([
-    'hello', 'camera', 'light', 'light_add', 'light_remove', 'technique', 'params', 'resize', 'scene', 'quality',
-    'snapshot', 'ack', 'ping',
-]);
+// Both lists come from protocol/messages.json (through the generated schemas.js).
+export const CLIENT_MESSAGE_TYPES = Object.freeze(Object.keys(MESSAGES.client));
 
-// What the server sends as text. `progress` (protocol 2) reports refinement; a type outside this
-// list is logged and ignored, so a newer server's additions cannot break the page.
-export const SERVER_MESSAGE_TYPES = Object.freeze([
-    'welcome', 'stats', 'state', 'error', 'pong', 'shutdown', 'progress',
-]);
+// What the server sends as text. A type outside this list is logged and ignored, so a newer
+// server's additions cannot break the page.
+export const SERVER_MESSAGE_TYPES = Object.freeze(Object.keys(MESSAGES.server));
 
 // The bounds of the resize/hello schemas; the server scales the product size x dpr down to its
 // own limits.max_size, so the client only has to stay inside the schema.
@@ -362,6 +360,16 @@ export function validateParamValues(values, ...paramSchemas) {
         if (v) return { code: 'invalid_param', where: where + v.where, message: v.message };
     }
     return null;
+}
+
+/**
+ * Checks a message the server sent against protocol/schema/server/<type>.json. Returns null when it
+ * conforms (or is of a type this client does not know: newer servers may add some), else
+ * {where, message}.
+ */
+export function validateServerMessage(msg) {
+    const schema = Object.hasOwn(SERVER_SCHEMAS, msg?.type) ? SERVER_SCHEMAS[msg.type] : undefined;
+    return schema ? validateJson(msg, schema) : null;
 }
 
 /** Whether `type` is a server message this client knows (SERVER_MESSAGE_TYPES). */

@@ -8,13 +8,16 @@ import path from 'node:path';
 import {
     ackMsg, buildFrameHeader, cameraMsg, CLIENT_MESSAGE_TYPES, CODEC_MIME, CODECS, helloMsg, lightAddMsg, lightMsg,
     lightRemoveMsg, paramsMsg, parseFrameHeader, parseServerMessage, pingMsg, PROTOCOL_VERSION, qualityMsg, resizeMsg,
-    sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateJson, validateParamValues, viewportFor,
+    sceneMsg, snapshotMsg, techniqueMsg, validateClientMessage, validateJson, validateParamValues, validateServerMessage,
+    viewportFor,
 } from '../protocol.js';
 import { OrbitCamera, cameraBasis, orbitFromPosition, positionFromOrbit } from '../camera.js';
 import { backoffDelay, pageOptions, shareLink, streamUrl } from '../connection.js';
 import { niceStep, widgetKind } from '../params.js';
-import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from '../schemas.js';
-import { loadProtocolSchemas, loadRenderRequestSchema, loadVectors, PROTOCOL_DIR } from '../tools/protocol-files.mjs';
+import { CLIENT_SCHEMAS, MESSAGES, RENDER_REQUEST_SCHEMA, SERVER_SCHEMAS } from '../schemas.js';
+import {
+    loadMessageTable, loadProtocolSchemas, loadRenderRequestSchema, loadServerSchemas, loadVectors, PROTOCOL_DIR,
+} from '../tools/protocol-files.mjs';
 
 const schemas = loadProtocolSchemas();
 
@@ -29,6 +32,32 @@ test('every client message type has a schema and the client carries the current 
         'client/schemas.js differs from protocol/schema; run node client/tools/update-schemas.mjs');
     assert.deepEqual(RENDER_REQUEST_SCHEMA, loadRenderRequestSchema(),
         'client/schemas.js differs from protocol/http/render_request.json; run node client/tools/update-schemas.mjs');
+});
+
+test('the message table names every schema, and the client carries the current table and server schemas', () => {
+    const table = loadMessageTable();
+    delete table.$comment;
+    assert.deepEqual(MESSAGES, table, 'client/schemas.js differs from protocol/messages.json; run node client/tools/update-schemas.mjs');
+    assert.deepEqual(Object.keys(table.client).sort(), Object.keys(schemas).sort(), 'a client schema per client row');
+    const serverSchemas = loadServerSchemas();
+    assert.deepEqual(Object.keys(table.server).sort(), Object.keys(serverSchemas).sort(), 'a server schema per server row');
+    assert.deepEqual(SERVER_SCHEMAS, serverSchemas,
+        'client/schemas.js differs from protocol/schema/server; run node client/tools/update-schemas.mjs');
+    for (const [type, row] of Object.entries(table.client)) {
+        assert.ok(['connection', 'session'].includes(row.handler), `${type}: handler`);
+        assert.equal(typeof row.viewers, 'boolean', `${type}: viewers`);
+    }
+    const viewerTypes = Object.keys(table.client).filter((t) => table.client[t].viewers).sort();
+    assert.deepEqual(viewerTypes, ['ack', 'hello', 'ping', 'snapshot'], 'viewers only watch, acknowledge and snapshot');
+});
+
+test('server messages are checked against their schemas', () => {
+    assert.equal(validateServerMessage({ type: 'pong', t: 12.5 }), null);
+    assert.equal(validateServerMessage({ type: 'error', code: 'busy', message: 'full', request: 'hello' }), null);
+    assert.deepEqual(validateServerMessage({ type: 'pong', t: 'soon' })?.where, '/t');
+    assert.ok(validateServerMessage({ type: 'progress', state: 'rendering', step: 'final', share: 0, eta_ms: 0, reason: '' }));
+    assert.ok(validateServerMessage({ type: 'error', code: 'busy' }), 'an error says what is wrong');
+    assert.equal(validateServerMessage({ type: 'from_the_future' }), null, 'unknown types are left to the caller');
 });
 
 // The vectors protocol v1 added; listed so that losing one fails a test instead of shrinking it.

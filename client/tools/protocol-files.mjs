@@ -22,6 +22,20 @@ export function loadProtocolSchemas() {
     return schemas;
 }
 
+/** {type: schema} for every protocol/schema/server/<type>.json (what the server sends as text). */
+export function loadServerSchemas() {
+    const schemas = {};
+    for (const f of jsonFilesIn(path.join(PROTOCOL_DIR, 'schema', 'server'))) {
+        schemas[path.basename(f.name, '.json')] = JSON.parse(readFileSync(f.path, 'utf8'));
+    }
+    return schemas;
+}
+
+/** protocol/messages.json: every message, who may send it and who answers it. */
+export function loadMessageTable() {
+    return JSON.parse(readFileSync(path.join(PROTOCOL_DIR, 'messages.json'), 'utf8'));
+}
+
 /** protocol/http/render_request.json: the body of POST /api/render. */
 export function loadRenderRequestSchema() {
     return JSON.parse(readFileSync(path.join(PROTOCOL_DIR, 'http', 'render_request.json'), 'utf8'));

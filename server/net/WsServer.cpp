@@ -1164,31 +1164,47 @@ struct WsServer::Impl {
             onHello(c, msg);
             return;
         }
-        if (type == "hello") {
-            sendError(c, {"invalid_message", "hello was already accepted on this connection", "/type", type});
-            return;
-        }
-        if (type == "ping") {
-            nlohmann::json pong = {{"type", "pong"}};
-            if (msg.contains("t")) pong["t"] = msg["t"];
-            sendDirect(c, pong);
+        // parseClientMessage accepts only the table's types (protocol/messages.json).
+        const ClientMessageSpec& spec = *findClientMessage(type);
+        if (spec.connection) {
+            (this->*connectionHandlers().at(type))(c, msg);
             return;
         }
         if (!c.entry || !c.link) return; // the session ended; the close is on its way
-        if (type == "ack") {
-            try {
-                c.entry->session->ack(c.link, msg["frame"].get<std::uint32_t>());
-            } catch (const ProtocolError& e) {
-                sendError(c, e);
-            }
-            return;
-        }
-        if (c.link->role() == ClientRole::Viewer && type != "snapshot") {
+        if (c.link->role() == ClientRole::Viewer && !spec.viewers) {
             sendError(c, {"read_only", "viewers cannot steer a shared session", "/type", type});
             return;
         }
         try {
             c.entry->session->apply(msg, c.link);
+        } catch (const ProtocolError& e) {
+            sendError(c, e);
+        }
+    }
+
+    /// The client messages the stream endpoint answers itself (`handler` "connection" in
+    /// protocol/messages.json); the rest go to the session. Checked against the table at start.
+    using ConnectionHandler = void (Impl::*)(Connection&, const nlohmann::json&);
+    static const std::map<std::string, ConnectionHandler>& connectionHandlers() {
+        static const std::map<std::string, ConnectionHandler> handlers = {
+            {"hello", &Impl::onHelloAgain}, {"ping", &Impl::onPing}, {"ack", &Impl::onAck}};
+        return handlers;
+    }
+
+    void onHelloAgain(Connection& c, const nlohmann::json&) {
+        sendError(c, {"invalid_message", "hello was already accepted on this connection", "/type", "hello"});
+    }
+
+    void onPing(Connection& c, const nlohmann::json& msg) {
+        nlohmann::json pong = {{"type", "pong"}};
+        if (msg.contains("t")) pong["t"] = msg["t"];
+        sendDirect(c, pong);
+    }
+
+    void onAck(Connection& c, const nlohmann::json& msg) {
+        if (!c.entry || !c.link) return; // the session ended; the close is on its way
+        try {
+            c.entry->session->ack(c.link, msg["frame"].get<std::uint32_t>());
         } catch (const ProtocolError& e) {
             sendError(c, e);
         }
@@ -1537,6 +1553,10 @@ struct WsServer::Impl {
 WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
     m.config = std::move(config);
+    for (const ClientMessageSpec& spec : clientMessages())
+        if (spec.connection != (Impl::connectionHandlers().count(spec.type) == 1))
+            throw Error("net: protocol/messages.json says '" + spec.type + "' is answered by the " +
+                        (spec.connection ? "connection" : "session") + ", and the stream endpoint disagrees");
     m.sessions = std::make_unique<Directory>(
         Directory::Limits{.maxSessions = m.config.maxSessions,
                           .maxViewersPerSession = kMaxViewersPerSession,

@@ -5,35 +5,89 @@
 #include <mutex>
 
 #include "core/EmbeddedFiles.h"
+#include "core/Error.h"
 #include "core/JsonSchema.h"
 
 namespace gis {
 namespace {
 
-const nlohmann::json* schemaFor(const std::string& type) {
+/// The embedded schemas by path below protocol/schema, without ".json": "camera", "server/stats".
+const nlohmann::json* schemaFor(const std::string& name) {
     static std::once_flag once;
     static std::map<std::string, nlohmann::json> schemas;
     std::call_once(once, [] {
+        constexpr std::string_view kDir = "schema/", kExt = ".json";
         for (const auto& f : embedded::protocol()) {
-            // "schema/camera.json" -> "camera"
-            std::string_view p = f.path;
-            auto slash = p.rfind('/');
-            auto dot = p.rfind('.');
-            if (slash == std::string_view::npos || dot == std::string_view::npos || dot < slash) continue;
-            schemas[std::string(p.substr(slash + 1, dot - slash - 1))] = nlohmann::json::parse(f.content);
+            const std::string_view p = f.path;
+            if (!p.starts_with(kDir) || !p.ends_with(kExt)) continue;
+            schemas[std::string(p.substr(kDir.size(), p.size() - kDir.size() - kExt.size()))] =
+                nlohmann::json::parse(f.content);
         }
     });
-    auto it = schemas.find(type);
+    auto it = schemas.find(name);
     return it == schemas.end() ? nullptr : &it->second;
+}
+
+const nlohmann::json& messageTable() {
+    static const nlohmann::json table = [] {
+        const auto text = findEmbedded(embedded::protocol(), "messages.json");
+        GIS_ASSERT_MSG(text.has_value(), "protocol/messages.json is not embedded");
+        return nlohmann::json::parse(*text);
+    }();
+    return table;
 }
 
 } // namespace
 
+const std::vector<ClientMessageSpec>& clientMessages() {
+    static const std::vector<ClientMessageSpec> rows = [] {
+        std::vector<ClientMessageSpec> out;
+        for (const auto& [type, row] : messageTable().at("client").items()) {
+            GIS_ASSERT_MSG(schemaFor(type) != nullptr, "protocol/schema/" + type + ".json is missing");
+            out.push_back(
+                {type, row.value("viewers", false), row.value("handler", "session") == "connection"});
+        }
+        return out;
+    }();
+    return rows;
+}
+
+const ClientMessageSpec* findClientMessage(std::string_view type) {
+    for (const auto& m : clientMessages())
+        if (m.type == type) return &m;
+    return nullptr;
+}
+
 const std::vector<std::string>& clientMessageTypes() {
-    static const std::vector<std::string> types = {
-        "hello",  "camera", "light",   "light_add", "light_remove", "technique", "params",
-        "resize", "scene",  "quality", "snapshot",  "ack",          "ping"};
+    static const std::vector<std::string> types = [] {
+        std::vector<std::string> out;
+        for (const auto& m : clientMessages()) out.push_back(m.type);
+        return out;
+    }();
     return types;
+}
+
+const std::vector<std::string>& serverMessageTypes() {
+    static const std::vector<std::string> types = [] {
+        std::vector<std::string> out;
+        for (const auto& [type, row] : messageTable().at("server").items()) out.push_back(type);
+        return out;
+    }();
+    return types;
+}
+
+std::string checkServerMessage(const nlohmann::json& message) {
+    if (!message.is_object() || !message.contains("type") || !message["type"].is_string())
+        return "a server message is an object with a string type";
+    const std::string type = message["type"];
+    const auto& types = serverMessageTypes();
+    if (std::find(types.begin(), types.end(), type) == types.end())
+        return "'" + type + "' is not a server message in protocol/messages.json";
+    const nlohmann::json* schema = schemaFor("server/" + type);
+    if (!schema) return "protocol/schema/server/" + type + ".json is missing";
+    if (auto v = validateJson(message, *schema))
+        return (v->pointer.empty() ? "" : v->pointer + ": ") + v->message;
+    return {};
 }
 
 nlohmann::json parseClientMessage(std::string_view text) {
@@ -48,8 +102,7 @@ nlohmann::json parseClientMessage(std::string_view text) {
         throw ProtocolError{"invalid_message", "missing string field 'type'", "/type", ""};
     const std::string t = *type;
     const auto& types = clientMessageTypes();
-    const nlohmann::json* schema =
-        std::find(types.begin(), types.end(), t) == types.end() ? nullptr : schemaFor(t);
+    const nlohmann::json* schema = findClientMessage(t) ? schemaFor(t) : nullptr;
     if (!schema) {
         std::string known;
         for (const auto& k : types) known += (known.empty() ? "" : ", ") + k;

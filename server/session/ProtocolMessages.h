@@ -28,8 +28,25 @@ struct ProtocolError {
     std::string request; ///< the message type, when known
 };
 
+/// One row of protocol/messages.json's client table: a message a client may send, who may send it
+/// and who answers it. Its schema is protocol/schema/<type>.json.
+struct ClientMessageSpec {
+    std::string type;
+    bool viewers = false;    ///< a viewer may send it too (else: read_only)
+    bool connection = false; ///< the stream endpoint answers it itself; else Session::apply
+};
+
+/// Every client message, from the embedded protocol/messages.json.
+const std::vector<ClientMessageSpec>& clientMessages();
+/// The row of `type`, or null for a type the protocol does not have.
+const ClientMessageSpec* findClientMessage(std::string_view type);
 /// The message types a client may send (one schema each in protocol/schema).
 const std::vector<std::string>& clientMessageTypes();
+/// The message types the server sends as text (one schema each in protocol/schema/server).
+const std::vector<std::string>& serverMessageTypes();
+/// Checks a message the server is about to send against protocol/schema/server/<type>.json: the
+/// first violation ("/state/size: ..."), or an empty string when it conforms. For tests.
+std::string checkServerMessage(const nlohmann::json& message);
 /// Parses and validates one client text message. Returns the parsed object; throws ProtocolError.
 nlohmann::json parseClientMessage(std::string_view text);
 

@@ -11,7 +11,7 @@ import { fileURLToPath } from 'node:url';
 import { inflateSync } from 'node:zlib';
 import WebSocket from 'ws';
 
-import { helloMsg, parseFrameHeader, SUBPROTOCOL } from '../../client/protocol.js';
+import { helloMsg, parseFrameHeader, SUBPROTOCOL, validateServerMessage } from '../../client/protocol.js';
 
 export const REPO = fileURLToPath(new URL('../../', import.meta.url));
 export const SERVER = path.resolve(REPO, process.env.GI_SERVER ?? 'build/ci/bin/gi-server');
@@ -216,6 +216,17 @@ export class ServerProcess {
  * without losing ones that arrive early. Text messages are parsed JSON; binary ones are
  * {binary: Buffer}.
  */
+/**
+ * Every text message any test receives is checked against protocol/schema/server/<type>.json; a
+ * message that does not conform fails the waits that follow and, at the latest, the test file's exit.
+ */
+const schemaViolations = [];
+process.on('exit', () => {
+    if (schemaViolations.length === 0) return;
+    console.error(`server messages that break their schema (protocol/schema/server):\n  ${schemaViolations.join('\n  ')}`);
+    process.exitCode = 1;
+});
+
 export class Inbox {
     constructor(socket) {
         this.queue = [];
@@ -223,6 +234,16 @@ export class Inbox {
         this.closed = null;
         socket.on('message', (data, isBinary) => {
             const item = isBinary ? { binary: Buffer.from(data) } : JSON.parse(data.toString('utf8'));
+            const violation = isBinary ? null : validateServerMessage(item);
+            if (violation) {
+                const text = `${item.type}${violation.where}: ${violation.message} in ${JSON.stringify(item).slice(0, 300)}`;
+                schemaViolations.push(text);
+                this.violation ??= text;
+                for (const w of this.waiters.splice(0)) {
+                    clearTimeout(w.timer);
+                    w.reject(new Error(`${w.what}: the server sent ${text}`));
+                }
+            }
             this.queue.push(item);
             this.flush();
         });
@@ -253,6 +274,10 @@ export class Inbox {
     /** The first message (queued or yet to come) for which match(msg) holds. */
     next(match, what, timeoutMs = REPLY_TIMEOUT_MS) {
         return new Promise((resolve, reject) => {
+            if (this.violation) {
+                reject(new Error(`${what}: the server sent ${this.violation}`));
+                return;
+            }
             const i = this.queue.findIndex(match);
             if (i >= 0) {
                 resolve(this.queue.splice(i, 1)[0]);

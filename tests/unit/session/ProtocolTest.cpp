@@ -123,7 +123,47 @@ TEST(Protocol, ErrorsQuotingInvalidUtf8StaySerialisable) {
         EXPECT_NE(dumped.find("\\\\xFD"), std::string::npos) << dumped;
     }
     EXPECT_EQ(gis::validUtf8("caf\xc3\xa9 \xe2\x82\xac"), "caf\xc3\xa9 \xe2\x82\xac"); // valid UTF-8 kept
-    EXPECT_EQ(gis::validUtf8("a\xc3"), "a\\xC3");                                       // truncated
-    EXPECT_EQ(gis::validUtf8("\xc0\xaf"), "\\xC0\\xAF");                                // overlong
-    EXPECT_EQ(gis::validUtf8("\xed\xa0\x80"), "\\xED\\xA0\\x80");                       // surrogate
+    EXPECT_EQ(gis::validUtf8("a\xc3"), "a\\xC3");                                      // truncated
+    EXPECT_EQ(gis::validUtf8("\xc0\xaf"), "\\xC0\\xAF");                               // overlong
+    EXPECT_EQ(gis::validUtf8("\xed\xa0\x80"), "\\xED\\xA0\\x80");                      // surrogate
+}
+
+TEST(Protocol, EveryServerMessageHasASchemaAndViceVersa) {
+    std::vector<std::string> schemas;
+    for (const auto& e : fs::directory_iterator(fs::path(GIS_SOURCE_DIR) / "protocol/schema/server"))
+        if (e.path().extension() == ".json") schemas.push_back(e.path().stem().string());
+    std::sort(schemas.begin(), schemas.end());
+    auto types = gis::serverMessageTypes();
+    std::sort(types.begin(), types.end());
+    EXPECT_EQ(schemas, types);
+}
+
+TEST(Protocol, TheMessageTableSaysWhoSendsAndWhoAnswers) {
+    std::vector<std::string> viewers, connection;
+    for (const auto& m : gis::clientMessages()) {
+        if (m.viewers) viewers.push_back(m.type);
+        if (m.connection) connection.push_back(m.type);
+    }
+    std::sort(viewers.begin(), viewers.end());
+    std::sort(connection.begin(), connection.end());
+    EXPECT_EQ(viewers, (std::vector<std::string>{"ack", "hello", "ping", "snapshot"}));
+    EXPECT_EQ(connection, (std::vector<std::string>{"ack", "hello", "ping"}));
+    ASSERT_NE(gis::findClientMessage("camera"), nullptr);
+    EXPECT_FALSE(gis::findClientMessage("camera")->viewers);
+    EXPECT_EQ(gis::findClientMessage("welcome"), nullptr) << "a server message";
+}
+
+TEST(Protocol, ServerMessagesAreCheckedAgainstTheirSchemas) {
+    EXPECT_EQ(gis::checkServerMessage(gis::errorMessage({"busy", "the server is full", "", "hello"})), "");
+    EXPECT_EQ(gis::checkServerMessage({{"type", "pong"}, {"t", 3.5}}), "");
+    EXPECT_NE(gis::checkServerMessage({{"type", "pong"}, {"t", "soon"}}), "");
+    EXPECT_EQ(gis::checkServerMessage({{"type", "progress"},
+                                       {"state", "loading"},
+                                       {"step", "scene"},
+                                       {"share", 0.4},
+                                       {"eta_ms", 120.0},
+                                       {"reason", "loading x.glb: decoding images: 1 of 3"}}),
+              "");
+    EXPECT_NE(gis::checkServerMessage({{"type", "progress"}, {"state", "rendering"}}), "");
+    EXPECT_NE(gis::checkServerMessage({{"type", "camera"}}).find("not a server message"), std::string::npos);
 }
