@@ -250,7 +250,7 @@ struct Connection {
 // Per-connection storage lws allocates (zeroed, plain memory): pointers and flags only.
 struct PerSession {
     Connection* connection;
-    HttpExchange* http;
+    HttpExchange* http; ///< owned by Impl::exchanges
     bool headerAuth;
 };
 
@@ -285,7 +285,8 @@ struct WsServer::Impl {
     std::unique_ptr<GlWorkerPool> workers;
     MetricsRegistry metrics;
     std::map<lws*, std::unique_ptr<Connection>> connections;
-    std::unique_ptr<Directory> sessions; // made with the config's limits
+    std::map<lws*, std::unique_ptr<HttpExchange>> exchanges; ///< PerSession::http points into it
+    std::unique_ptr<Directory> sessions;                     // made with the config's limits
     std::unique_ptr<BackgroundQueue> reaper = std::make_unique<BackgroundQueue>();
     std::uint64_t nextSessionId = 1;
     lws_protocols protocols[3];
@@ -454,8 +455,21 @@ struct WsServer::Impl {
     }
 
     // --- HTTP -------------------------------------------------------------------------------
+    /// A fresh exchange for the request on `wsi`, owned by `exchanges` (lws's per-connection memory
+    /// is plain and zeroed: it can only point); the previous one on the connection goes.
+    HttpExchange& beginExchange(lws* wsi, PerSession* pss) {
+        auto& owned = exchanges[wsi];
+        owned = std::make_unique<HttpExchange>();
+        pss->http = owned.get();
+        return *owned;
+    }
+    void endExchange(lws* wsi, PerSession* pss) {
+        if (pss) pss->http = nullptr;
+        exchanges.erase(wsi);
+    }
+
     void respond(lws* wsi, PerSession* pss, HttpResponse response) {
-        if (!pss->http) pss->http = new HttpExchange;
+        if (!pss->http) beginExchange(wsi, pss);
         countHttp(pss->http->endpoint.empty() ? "static" : pss->http->endpoint, response.status);
         if (response.status >= 400 && response.status != 404)
             logRefusal("http_" + std::to_string(response.status), peerAddress(wsi) + " " +
@@ -500,8 +514,7 @@ struct WsServer::Impl {
         std::memcpy(body.data() + LWS_PRE, r.body.data(), r.body.size());
         const int n = lws_write(wsi, body.data() + LWS_PRE, r.body.size(), LWS_WRITE_HTTP_FINAL);
         const bool closeAfter = pss->http->closeAfter;
-        delete pss->http;
-        pss->http = nullptr;
+        endExchange(wsi, pss);
         if (n < 0 || closeAfter) return -1;
         return lws_http_transaction_completed(wsi) ? -1 : 0;
     }
@@ -532,8 +545,7 @@ struct WsServer::Impl {
 
     int onHttpRequest(lws* wsi, PerSession* pss, const std::string& uri) {
         const bool post = lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) > 0;
-        delete pss->http;
-        pss->http = new HttpExchange;
+        beginExchange(wsi, pss);
         pss->http->uri = uri;
         pss->http->post = post;
         pss->http->endpoint =
@@ -919,11 +931,9 @@ struct WsServer::Impl {
         case LWS_CALLBACK_HTTP_DROP_PROTOCOL:
         case LWS_CALLBACK_CLOSED_HTTP:
             bodiesPending.erase(wsi);
-            if (pss && pss->http) {
-                if (pss->http->jobId) awaiting.erase(pss->http->jobId); // the result is discarded
-                delete pss->http;
-                pss->http = nullptr;
-            }
+            if (pss && pss->http && pss->http->jobId)
+                awaiting.erase(pss->http->jobId); // the result is discarded
+            endExchange(wsi, pss);
             break;
         default:
             break;
@@ -1503,6 +1513,7 @@ struct WsServer::Impl {
             return 0;
         case LWS_CALLBACK_WSI_DESTROY:
             peerDestroyed(wsi);
+            exchanges.erase(wsi); // in case the connection went without CLOSED_HTTP
             return 0;
         case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
             // An upgrade without Sec-WebSocket-Protocol lands on the HTTP protocol: refuse it.
