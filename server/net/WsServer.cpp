@@ -21,17 +21,16 @@
 #include <thread>
 #include <vector>
 
-#include "core/Base64.h"
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Log.h"
 #include "frame/FrameParams.h"
-#include "frame/VplBudget.h"
 #include "gi/Technique.h"
 #include "net/Metrics.h"
 #include "net/RateLimiter.h"
 #include "net/SessionDirectory.h"
 #include "render/FrameRenderer.h"
+#include "job/ApiRender.h"
 #include "job/RenderRequest.h"
 #include "scene/SceneArchive.h"
 #include "scene/SceneLoader.h"
@@ -183,29 +182,8 @@ nlohmann::json techniquesJson() {
     return list;
 }
 
-std::string base64(const std::vector<std::uint8_t>& data) {
-    return base64Encode(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
-}
-
 /// One HTTP response, written in two writable callbacks: headers, then the body.
-struct HttpResponse {
-    unsigned status = 200;
-    std::string contentType = "application/json";
-    std::vector<std::pair<std::string, std::string>> headers; ///< ("x-gi-stats:", value)
-    std::string body;
-};
-
-HttpResponse jsonResponse(unsigned status, const nlohmann::json& body) {
-    return {status, "application/json", {}, body.dump()};
-}
-
-HttpResponse errorResponse(unsigned status, const std::string& code, const std::string& message,
-                           const std::string& where = {}) {
-    // Messages may quote the request's bytes (a path, a query value): only valid UTF-8 may reach dump().
-    nlohmann::json body = {{"error", code}, {"message", validUtf8(message)}};
-    if (!where.empty()) body["where"] = validUtf8(where);
-    return jsonResponse(status, body);
-}
+using HttpResponse = HttpReply;
 
 struct HttpExchange {
     std::string uri;
@@ -522,13 +500,13 @@ struct WsServer::Impl {
     int serveFile(lws* wsi, PerSession* pss, const std::string& uri) {
         std::string path = uri == "/" ? "/index.html" : uri;
         if (path.find("..") != std::string::npos || path.find('\\') != std::string::npos || path[0] != '/') {
-            respond(wsi, pss, errorResponse(400, "bad_path", "paths may not contain '..' or backslashes"));
+            respond(wsi, pss, errorReply(400, "bad_path", "paths may not contain '..' or backslashes"));
             return 0;
         }
         char resolved[PATH_MAX];
         const std::string full = config.clientDir + path;
         if (!realpath(full.c_str(), resolved) || std::string(resolved).rfind(clientRoot + "/", 0) != 0) {
-            respond(wsi, pss, errorResponse(404, "not_found", "no such file: " + uri));
+            respond(wsi, pss, errorReply(404, "not_found", "no such file: " + uri));
             return 0;
         }
         countHttp("static", 200);
@@ -573,16 +551,16 @@ struct WsServer::Impl {
             if (draining)
                 body["drain_remaining_s"] =
                     std::max(0.0, std::chrono::duration<double>(drainDeadline - Clock::now()).count());
-            respond(wsi, pss, jsonResponse(draining ? 503 : 200, body));
+            respond(wsi, pss, jsonReply(draining ? 503 : 200, body));
             return 0;
         }
         const bool api = uri.rfind("/api/", 0) == 0 || uri == "/metrics";
         if (api && !originAllowed(wsi)) {
-            respond(wsi, pss, errorResponse(403, "forbidden_origin", "this origin may not use the API"));
+            respond(wsi, pss, errorReply(403, "forbidden_origin", "this origin may not use the API"));
             return 0;
         }
         if (api && !bearerOk(wsi)) {
-            HttpResponse r = errorResponse(401, "unauthorized", "send 'Authorization: Bearer <token>'");
+            HttpResponse r = errorReply(401, "unauthorized", "send 'Authorization: Bearer <token>'");
             r.headers.emplace_back("www-authenticate:", "Bearer");
             respond(wsi, pss, std::move(r));
             return 0;
@@ -592,28 +570,27 @@ struct WsServer::Impl {
             // malformed length would wait forever.
             if (!header(wsi, WSI_TOKEN_HTTP_TRANSFER_ENCODING).empty()) {
                 respond(wsi, pss,
-                        errorResponse(411, "length_required",
-                                      "send the body with a Content-Length header; chunked transfer "
-                                      "encoding is not accepted"));
+                        errorReply(411, "length_required",
+                                   "send the body with a Content-Length header; chunked transfer "
+                                   "encoding is not accepted"));
                 return 0;
             }
             const std::string length = header(wsi, WSI_TOKEN_HTTP_CONTENT_LENGTH);
             if (length.empty()) {
-                respond(wsi, pss,
-                        errorResponse(411, "length_required", "POST needs a Content-Length header"));
+                respond(wsi, pss, errorReply(411, "length_required", "POST needs a Content-Length header"));
                 return 0;
             }
             if (length.size() > 12 || length.find_first_not_of("0123456789") != std::string::npos) {
                 respond(wsi, pss,
-                        errorResponse(400, "bad_content_length",
-                                      "Content-Length must be a non-negative decimal number, got '" +
-                                          length.substr(0, 40) + "'"));
+                        errorReply(400, "bad_content_length",
+                                   "Content-Length must be a non-negative decimal number, got '" +
+                                       length.substr(0, 40) + "'"));
                 return 0;
             }
             if (uri == "/api/render" && phase != Phase::Running) {
                 HttpResponse r =
-                    errorResponse(503, "shutting_down",
-                                  "the server is shutting down; send the request to another instance");
+                    errorReply(503, "shutting_down",
+                               "the server is shutting down; send the request to another instance");
                 r.headers.emplace_back("retry-after:", "1");
                 respond(wsi, pss, std::move(r));
                 return 0;
@@ -623,20 +600,20 @@ struct WsServer::Impl {
             } else if (uri == "/api/upload") {
                 if (config.maxUploadMb == 0) {
                     respond(wsi, pss,
-                            errorResponse(403, "uploads_disabled", "this server does not accept uploads"));
+                            errorReply(403, "uploads_disabled", "this server does not accept uploads"));
                     return 0;
                 }
                 pss->http->bodyLimit = static_cast<std::size_t>(config.maxUploadMb) << 20;
             } else {
-                respond(wsi, pss, errorResponse(404, "not_found", "no POST endpoint " + uri));
+                respond(wsi, pss, errorReply(404, "not_found", "no POST endpoint " + uri));
                 return 0;
             }
             if (std::stoull(length) > pss->http->bodyLimit) {
                 // Refused from its header: the body is not read.
                 respond(wsi, pss,
-                        errorResponse(413, "too_large",
-                                      "the body of " + length + " bytes exceeds " +
-                                          std::to_string(pss->http->bodyLimit) + " bytes for " + uri));
+                        errorReply(413, "too_large",
+                                   "the body of " + length + " bytes exceeds " +
+                                       std::to_string(pss->http->bodyLimit) + " bytes for " + uri));
                 return 0;
             }
             return 0; // the body follows (LWS_CALLBACK_HTTP_BODY)
@@ -648,22 +625,22 @@ struct WsServer::Impl {
         }
         if (uri == "/api/techniques") {
             respond(wsi, pss,
-                    jsonResponse(200, {{"techniques", techniquesJson()},
-                                       {"frame_params_schema", frameParamTable().jsonSchema()}}));
+                    jsonReply(200, {{"techniques", techniquesJson()},
+                                    {"frame_params_schema", frameParamTable().jsonSchema()}}));
             return 0;
         }
         if (uri == "/api/scenes") {
-            respond(wsi, pss, jsonResponse(200, {{"scenes", scenesJson()}}));
+            respond(wsi, pss, jsonReply(200, {{"scenes", scenesJson()}}));
             return 0;
         }
         if (uri == "/api/render" || uri == "/api/upload") {
-            HttpResponse r = errorResponse(405, "method_not_allowed", uri + " takes POST");
+            HttpResponse r = errorReply(405, "method_not_allowed", uri + " takes POST");
             r.headers.emplace_back("allow:", "POST");
             respond(wsi, pss, std::move(r));
             return 0;
         }
         if (uri.rfind("/api/", 0) == 0) {
-            respond(wsi, pss, errorResponse(404, "not_found", "unknown API endpoint " + uri));
+            respond(wsi, pss, errorReply(404, "not_found", "unknown API endpoint " + uri));
             return 0;
         }
         return serveFile(wsi, pss, uri);
@@ -676,10 +653,9 @@ struct WsServer::Impl {
         settle(wsi);
         if (!x || x->ready) return; // already answered (auth, origin): the body is ignored
         if (x->bodyTooLarge) {
-            respond(
-                wsi, pss,
-                errorResponse(413, "too_large",
-                              "the body exceeds " + std::to_string(x->bodyLimit) + " bytes for " + x->uri));
+            respond(wsi, pss,
+                    errorReply(413, "too_large",
+                               "the body exceeds " + std::to_string(x->bodyLimit) + " bytes for " + x->uri));
             return;
         }
         if (x->uri == "/api/render")
@@ -695,31 +671,23 @@ struct WsServer::Impl {
         if (request.is_discarded() || !request.is_object()) {
             respond(
                 wsi, pss,
-                errorResponse(400, "invalid_json",
-                              request.is_discarded()
-                                  ? "the body is not valid JSON: " + parseError
-                                  : "the body must be a JSON object such as {\"scene\": \"builtin:cornell\"} "
-                                    "(see PROTOCOL.md)"));
+                errorReply(400, "invalid_json",
+                           request.is_discarded()
+                               ? "the body is not valid JSON: " + parseError
+                               : "the body must be a JSON object such as {\"scene\": \"builtin:cornell\"} "
+                                 "(see PROTOCOL.md)"));
             return;
         }
-        bool jsonReply = false;
-        if (auto it = request.find("response"); it != request.end()) {
-            if (!it->is_string() || (*it != "image" && *it != "json")) {
-                respond(wsi, pss,
-                        errorResponse(400, "invalid_request", "must be \"image\" or \"json\"", "/response"));
-                return;
-            }
-            jsonReply = *it == "json";
-            request.erase(it);
-        }
+        ApiReplyForm form = ApiReplyForm::Image;
         RenderLimits limits;
         limits.maxWidth = config.session.limits.maxWidth;
         limits.maxHeight = config.session.limits.maxHeight;
         std::shared_ptr<RenderJob> job;
         try {
+            form = takeReplyForm(request);
             job = std::make_shared<RenderJob>(parseRenderRequest(request, limits));
         } catch (const InputError& e) {
-            respond(wsi, pss, errorResponse(400, "invalid_request", e.reason(), e.where()));
+            respond(wsi, pss, errorReply(400, "invalid_request", e.reason(), e.where()));
             return;
         }
         const std::uint64_t id = nextJobId++;
@@ -734,47 +702,19 @@ struct WsServer::Impl {
             lws_cancel_service(ctx);
         };
         const long maxVpls = config.session.limits.maxVpls;
-        auto work = [job, jsonReply, catalogRef, sceneCache, finish, maxVpls](FrameRenderer& renderer,
-                                                                              double queueMs) {
-            try {
-                auto resolve = [&](const std::string& name) {
-                    try {
-                        return sceneCache->get(catalogRef->resolve(name), catalogRef->loadOptions(name));
-                    } catch (const InputError& e) {
-                        throw InputError("/scene", e.reason());
-                    }
-                };
-                const long vpls = vplEstimate(makeJobFrameState(*resolve(job->scene), *job));
-                if (vpls > maxVpls)
-                    throw InputError("/params", "these parameters ask for up to " + std::to_string(vpls) +
-                                                    " VPLs; the server allows " + std::to_string(maxVpls));
-                RenderResult result = executeRenderJob(renderer, *job, resolve);
-                result.stats["queue_ms"] = queueMs;
-                if (jsonReply) {
-                    finish(jsonResponse(
-                        200,
-                        result.referenceImage.empty()
-                            ? nlohmann::json{{"stats", result.stats}, {"image_base64", base64(result.image)}}
-                            : nlohmann::json{{"stats", result.stats},
-                                             {"image_base64", base64(result.image)},
-                                             {"reference_base64", base64(result.referenceImage)}}));
-                } else {
-                    HttpResponse r{200, result.mimeType, {{"x-gi-stats:", result.stats.dump()}}, {}};
-                    r.body.assign(result.image.begin(), result.image.end());
-                    finish(std::move(r));
-                }
-            } catch (const InputError& e) {
-                finish(errorResponse(400, "invalid_request", e.reason(), e.where()));
-            } catch (const std::exception& e) {
-                finish(errorResponse(500, "render_failed", e.what()));
-            }
+        auto work = [job, form, catalogRef, sceneCache, finish, maxVpls](FrameRenderer& renderer,
+                                                                         double queueMs) {
+            auto resolve = [&](const std::string& name) {
+                return sceneCache->get(catalogRef->resolve(name), catalogRef->loadOptions(name));
+            };
+            finish(renderApiRequest(renderer, *job, resolve, maxVpls, queueMs, form));
         };
         auto fail = [finish](const std::string& message) {
-            finish(errorResponse(500, "render_failed", message));
+            finish(errorReply(500, "render_failed", message));
         };
         if (!workers->submit(work, fail)) {
             HttpResponse r =
-                errorResponse(503, "busy", "every render slot and queue place is taken; retry shortly");
+                errorReply(503, "busy", "every render slot and queue place is taken; retry shortly");
             r.headers.emplace_back("retry-after:", "1");
             respond(wsi, pss, std::move(r));
             return;
@@ -809,17 +749,17 @@ struct WsServer::Impl {
                 fs::rename(partial, dir / name, ec);
                 if (ec) throw Error("cannot rename the extracted folder");
                 logInfo(what + sceneFile + from);
-                response = jsonResponse(
+                response = jsonReply(
                     201, {{"scene", "upload:" + name}, {"bytes", body->size()}, {"file", sceneFile}});
             } catch (const ArchiveTooLarge& e) {
-                response = errorResponse(413, "uploads_full",
-                                         e.reason() + " (what this session's upload budget of " +
-                                             std::to_string(budgetMb) + " MiB has left)");
+                response = errorReply(413, "uploads_full",
+                                      e.reason() + " (what this session's upload budget of " +
+                                          std::to_string(budgetMb) + " MiB has left)");
             } catch (const InputError& e) {
-                response = errorResponse(400, "bad_archive", e.reason());
+                response = errorReply(400, "bad_archive", e.reason());
             } catch (const std::exception&) {
                 fs::remove_all(partial, ec);
-                response = errorResponse(500, "upload_failed", "cannot store the upload");
+                response = errorReply(500, "upload_failed", "cannot store the upload");
             }
             {
                 std::lock_guard lock(doneMutex);
@@ -837,24 +777,24 @@ struct WsServer::Impl {
         try {
             SceneCatalog::checkUploadName(name);
         } catch (const InputError& e) {
-            respond(wsi, pss, errorResponse(400, "invalid_name", e.reason(), "name"));
+            respond(wsi, pss, errorReply(400, "invalid_name", e.reason(), "name"));
             return;
         }
         const std::string token = customHeader(wsi, "x-gi-session:");
         const std::shared_ptr<SessionEntry> entry = sessions->byResumeToken(token);
         if (!entry) {
             respond(wsi, pss,
-                    errorResponse(404, "unknown_session",
-                                  "send the resume token of a live session in the X-GI-Session header"));
+                    errorReply(404, "unknown_session",
+                               "send the resume token of a live session in the X-GI-Session header"));
             return;
         }
         const bool zipped = name.ends_with(".zip");
         if (zipped && !looksLikeZip(x->body)) {
-            respond(wsi, pss, errorResponse(400, "not_zip", "the body is not a zip archive"));
+            respond(wsi, pss, errorReply(400, "not_zip", "the body is not a zip archive"));
             return;
         }
         if (!zipped && (x->body.size() < 12 || x->body.compare(0, 4, "glTF") != 0)) {
-            respond(wsi, pss, errorResponse(400, "not_glb", "the body is not a binary glTF (.glb) file"));
+            respond(wsi, pss, errorReply(400, "not_glb", "the body is not a binary glTF (.glb) file"));
             return;
         }
         std::error_code ec;
@@ -878,12 +818,11 @@ struct WsServer::Impl {
         }
         if (stored + x->body.size() > budget) {
             respond(wsi, pss,
-                    errorResponse(413, "uploads_full",
-                                  "this session's uploads would take " +
-                                      std::to_string((stored + x->body.size()) >> 20) +
-                                      " MiB; a session may store " +
-                                      std::to_string(config.maxSessionUploadsMb) +
-                                      " MiB: upload under an existing name to replace a file"));
+                    errorReply(413, "uploads_full",
+                               "this session's uploads would take " +
+                                   std::to_string((stored + x->body.size()) >> 20) +
+                                   " MiB; a session may store " + std::to_string(config.maxSessionUploadsMb) +
+                                   " MiB: upload under an existing name to replace a file"));
             return;
         }
         // Written beside, then renamed: a scene load never sees half a file.
@@ -896,12 +835,12 @@ struct WsServer::Impl {
         if (!ec) fs::rename(partial, dir / name, ec);
         if (ec) {
             fs::remove(partial, ec);
-            respond(wsi, pss, errorResponse(500, "upload_failed", "cannot store the upload"));
+            respond(wsi, pss, errorReply(500, "upload_failed", "cannot store the upload"));
             return;
         }
         logInfo("net: session " + entry->session->id() + " stored upload:" + name + " (" +
                 std::to_string(x->body.size()) + " bytes) from " + peerAddress(wsi));
-        respond(wsi, pss, jsonResponse(201, {{"scene", "upload:" + name}, {"bytes", x->body.size()}}));
+        respond(wsi, pss, jsonReply(201, {{"scene", "upload:" + name}, {"bytes", x->body.size()}}));
     }
 
     int onHttp(lws* wsi, lws_callback_reasons reason, PerSession* pss, void* in, size_t len) {
@@ -1474,9 +1413,9 @@ struct WsServer::Impl {
             }
             if (now < pss->http->deadline) continue;
             respond(wsi, pss,
-                    errorResponse(408, "request_timeout",
-                                  "the request did not arrive within " +
-                                      std::to_string(config.requestTimeoutS) + " s (--request-timeout)"));
+                    errorReply(408, "request_timeout",
+                               "the request did not arrive within " + std::to_string(config.requestTimeoutS) +
+                                   " s (--request-timeout)"));
         }
         for (auto& [w, c] : connections)
             if (!c->helloDone && !c->closing && now - c->opened > std::chrono::seconds(config.helloTimeoutS))

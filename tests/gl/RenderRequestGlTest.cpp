@@ -9,6 +9,8 @@
 
 #include "GlTestSupport.h"
 #include "core/Error.h"
+#include "core/Base64.h"
+#include "job/ApiRender.h"
 #include "job/RenderRequest.h"
 
 namespace {
@@ -182,6 +184,45 @@ TEST(RenderRequestGl, ResolverDecidesTheScene) {
     } catch (const gis::InputError& e) {
         EXPECT_EQ(e.where(), "/scene");
     }
+}
+
+// POST /api/render's reply, built beside the job: the image with its stats in a header, the same
+// bytes in JSON as base64, the service's VPL cap and the resolver's refusals as 400s with a pointer.
+TEST(RenderRequestGl, ApiRepliesCarryTheSameImageEitherWay) {
+    gis::test::sharedContext();
+    const gis::RenderJob job = smallJob("png");
+    auto resolve = [](const std::string&) { return cornell(); };
+    const gis::HttpReply image = gis::renderApiRequest(gis::test::sharedRenderer(), job, resolve, 65536, 1.5,
+                                                       gis::ApiReplyForm::Image);
+    ASSERT_EQ(image.status, 200u) << image.body;
+    EXPECT_EQ(image.contentType, "image/png");
+    ASSERT_EQ(image.headers.size(), 1u);
+    EXPECT_EQ(image.headers[0].first, "x-gi-stats:");
+    EXPECT_EQ(nlohmann::json::parse(image.headers[0].second)["queue_ms"], 1.5);
+    const gis::HttpReply json =
+        gis::renderApiRequest(gis::test::sharedRenderer(), job, resolve, 65536, 0.0, gis::ApiReplyForm::Json);
+    ASSERT_EQ(json.status, 200u);
+    const auto body = nlohmann::json::parse(json.body);
+    EXPECT_EQ(gis::base64Decode(body["image_base64"].get<std::string>()).value_or(""), image.body)
+        << "the same PNG";
+    EXPECT_FALSE(body.contains("reference_base64")) << "no compare asked";
+
+    const gis::HttpReply capped =
+        gis::renderApiRequest(gis::test::sharedRenderer(), job, resolve, 8, 0.0, gis::ApiReplyForm::Image);
+    EXPECT_EQ(capped.status, 400u);
+    const auto cap = nlohmann::json::parse(capped.body);
+    EXPECT_EQ(cap["error"], "invalid_request");
+    EXPECT_EQ(cap["where"], "/params");
+    EXPECT_NE(cap["message"].get<std::string>().find("the server allows 8"), std::string::npos);
+
+    const gis::HttpReply refused = gis::renderApiRequest(
+        gis::test::sharedRenderer(), job,
+        [](const std::string&) -> std::shared_ptr<const gis::Scene> {
+            throw gis::InputError("x", "not offered");
+        },
+        65536, 0.0, gis::ApiReplyForm::Image);
+    EXPECT_EQ(refused.status, 400u);
+    EXPECT_EQ(nlohmann::json::parse(refused.body)["where"], "/scene");
 }
 
 } // namespace

@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "core/Error.h"
+#include "job/ApiRender.h"
 #include "job/RenderRequest.h"
 #include "scene/SceneLoader.h"
 
@@ -260,3 +261,25 @@ TEST(RenderRequest, EffectPlanRequestedByTheFrameParameters) {
 }
 
 } // namespace
+
+TEST(ApiRender, ReplyFormAndErrorBodies) {
+    nlohmann::json request = {{"scene", "builtin:cornell"}, {"response", "json"}};
+    EXPECT_EQ(gis::takeReplyForm(request), gis::ApiReplyForm::Json);
+    EXPECT_FALSE(request.contains("response")) << "the field is the API's, not the job's";
+    nlohmann::json plain = {{"scene", "builtin:cornell"}};
+    EXPECT_EQ(gis::takeReplyForm(plain), gis::ApiReplyForm::Image);
+    nlohmann::json bad = {{"scene", "builtin:cornell"}, {"response", "xml"}};
+    try {
+        gis::takeReplyForm(bad);
+        FAIL() << "accepted response: xml";
+    } catch (const gis::InputError& e) {
+        EXPECT_EQ(e.where(), "/response");
+    }
+    const gis::HttpReply error = gis::errorReply(400, "invalid_request", "bad \xff byte", "/size/0");
+    EXPECT_EQ(error.status, 400u);
+    EXPECT_EQ(error.contentType, "application/json");
+    const auto body = nlohmann::json::parse(error.body);
+    EXPECT_EQ(body["error"], "invalid_request");
+    EXPECT_EQ(body["where"], "/size/0");
+    EXPECT_EQ(body["message"], "bad \\xFF byte") << "invalid UTF-8 is escaped, never thrown on";
+}
