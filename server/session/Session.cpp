@@ -19,7 +19,6 @@
 #include "frame/StateJson.h"
 #include "frame/Tiles.h"
 #include "scene/SceneLoader.h"
-#include "session/FrameBudget.h"
 #include "session/RenderGate.h"
 #include "session/VplPartPlanner.h"
 #if GIS_HAVE_EFFECTS
@@ -31,11 +30,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Refinement tiles: 16 px cells, 16 x 16 at the smallest (a few ms of fixed cost per tile on llvmpipe,
-// so smaller ones would mostly repeat it).
+// Refinement tiles: 16 px cells, kMinRefineTileSide at the smallest (session/AdaptiveQuality.h).
 constexpr int kTileAlign = 16;
-constexpr int kMinTileSide = 16;
-constexpr int kSnapshotBudgetMs = 5000;
+constexpr int kMinTileSide = kMinRefineTileSide;
 // Tiles whose VPLs render in parts (FrameState::VplPart): at most 64 x 64 inner pixels or twice the
 // guard band (so the guard is not most of what a part renders), fewer when a part's fixed work
 // (G-buffer, direct light, composite, read-back) would fill the slice (session/VplPartPlanner.h); at
@@ -52,8 +49,7 @@ std::string mebibytes(std::uintmax_t bytes) {
 }
 
 const char* stepName(int step) {
-    static const char* names[] = {"interactive", "balanced", "final"};
-    return step >= 0 && step < 3 ? names[step] : "fixed";
+    return qualityStepName(static_cast<QualityStep>(step));
 }
 
 } // namespace
@@ -92,22 +88,6 @@ std::string effectPlanKey(const Scene& scene, const FrameState& s) {
 }
 } // namespace
 #endif
-
-double Session::predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const {
-    const std::string prefix = sceneName + "/" + state.technique + "/";
-    const double pixels = static_cast<double>(state.width) * state.height;
-    // Measured at the VPLs that step rendered with (perhaps capped): scaled to this state's.
-    if (auto own = mRefineCost.find(prefix + std::to_string(step)); own != mRefineCost.end())
-        return own->second.msPerPixel * pixels * static_cast<double>(std::max(1L, vplEstimate(state))) /
-               static_cast<double>(own->second.vpls);
-    // Not rendered yet: scale the nearest measured step by pixels and VPLs (gather cost grows with
-    // their product), so a final preset with 256 times the VPLs is predicted before it runs.
-    for (int other = step - 1; other >= 0; --other)
-        if (auto c = mRefineCost.find(prefix + std::to_string(other)); c != mRefineCost.end())
-            return c->second.msPerPixel * pixels * static_cast<double>(std::max(1L, vplEstimate(state))) /
-                   static_cast<double>(c->second.vpls);
-    return 0.0;
-}
 
 Session::Session(std::string id, SessionConfig config, std::shared_ptr<SceneCache> scenes,
                  std::shared_ptr<const SceneCatalog> catalog, RenderGate* gate, std::string uploadDir)
@@ -421,10 +401,10 @@ bool Session::stepReadyLocked(Clock::time_point now) const {
 
 struct Session::Worker {
     std::unique_ptr<FrameRenderer> renderer;
-    nlohmann::json presets;
     std::shared_ptr<const Scene> scene;
     std::uint32_t frameId = 0;
-    FrameBudget budget{FrameBudget::Config{}};
+    /// Which state each step renders, and what the steps measured (session/AdaptiveQuality.h).
+    std::unique_ptr<AdaptiveQuality> quality;
     /// The last image sent to the controller (RGBA8): the canvas a tiled step starts from.
     std::vector<std::uint8_t> lastImage;
     int lastWidth = 0, lastHeight = 0;
@@ -440,13 +420,6 @@ int Session::frameTargetMs(const StreamOptions& stream) const {
 bool Session::inputPending() const {
     std::lock_guard lock(mMutex);
     return mStop || mDirty || !mSnapshotFor.expired() || !mSceneRequest.empty();
-}
-
-void Session::recordRefineCost(const std::string& sceneName, const FrameState& state, int step,
-                               double msPerPixel) {
-    if (!(msPerPixel > 0.0) || !std::isfinite(msPerPixel)) return;
-    mRefineCost[sceneName + "/" + state.technique + "/" + std::to_string(step)] = {
-        msPerPixel, std::max(1L, vplEstimate(state))};
 }
 
 bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int width, int height,
@@ -616,9 +589,10 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     // model, with a margin (small tiles cost more per pixel than a whole step's average), else a
     // smallest first tile.
     double rate = 0.0;
-    double predicted = predictRefineMs(w.scene->name, full, step);
+    double predicted = w.quality->predictStepMs(w.scene->name, full, static_cast<QualityStep>(step));
     if (!(predicted > 0.0))
-        predicted = w.budget.predictMs(w.scene->name + "/" + full.technique, fullPixels, vplEstimate(full));
+        predicted = w.quality->budget().predictMs(w.scene->name + "/" + full.technique, fullPixels,
+                                                  vplEstimate(full));
     if (predicted > 0.0) rate = 2.0 * predicted / fullPixels;
     const int guard = tileGuardPx(full);
     std::vector<std::uint8_t> canvas =
@@ -781,12 +755,8 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         // batch of them is a draw), so the step starts again with the VPLs this measurement allows
         // (workerMain caps them).
         if (measureTile && !splittable && rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
-            const std::string key = w.scene->name + "/" + full.technique + "/" + std::to_string(step);
-            const double perVpl = tileMs / static_cast<double>(vpls);
-            auto known = mMinTileMsPerVpl.find(key);
-            const bool news = known == mMinTileMsPerVpl.end() || perVpl > 1.2 * known->second;
-            mMinTileMsPerVpl[key] =
-                known == mMinTileMsPerVpl.end() ? perVpl : std::max(perVpl, known->second);
+            const bool news = w.quality->recordMinTileCost(
+                w.scene->name, full, static_cast<QualityStep>(step), tileMs / static_cast<double>(vpls));
             if (news && vpls > 16 && info.limitVpls && !plan.done()) {
                 progress("abandoned", shareDone, 0.0,
                          "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +
@@ -798,7 +768,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     }
     // The whole step's cost per pixel, which predicts the next one (and its refinement-budget check);
     // single tiles would over-predict it, their fixed costs and the slowest regions included.
-    recordRefineCost(w.scene->name, full, step, renderedMs / fullPixels);
+    w.quality->recordStepCost(w.scene->name, full, static_cast<QualityStep>(step), renderedMs / fullPixels);
     if (step == static_cast<int>(Step::Final)) {
         std::string done =
             "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) + " ms";
@@ -820,20 +790,15 @@ void Session::workerMain() {
         fail(std::string("the renderer could not start: ") + e.what());
         return;
     }
-    try {
-        w.presets = loadPresets(defaultPresetsPath());
-    } catch (const std::exception& e) {
-        logWarn("session " + mId +
-                ": no presets, adaptive quality renders every step as requested: " + e.what());
-    }
     {
-        FrameBudget::Config budget;
-        budget.targetMs = mConfig.limits.frameTargetMs;
-        budget.maxScale = std::clamp(mConfig.limits.interactiveScale, 0.05, 1.0);
-        budget.preferredMinScale = std::min(budget.preferredMinScale, budget.maxScale);
-        budget.minScale = std::min(budget.minScale, budget.preferredMinScale);
-        budget.firstScale = std::min(budget.firstScale, budget.maxScale);
-        w.budget = FrameBudget(budget);
+        nlohmann::json presets;
+        try {
+            presets = loadPresets(defaultPresetsPath());
+        } catch (const std::exception& e) {
+            logWarn("session " + mId +
+                    ": no presets, adaptive quality renders every step as requested: " + e.what());
+        }
+        w.quality = std::make_unique<AdaptiveQuality>(mConfig.limits, std::move(presets));
     }
     w.scene = mScene;
 #if GIS_HAVE_EFFECTS
@@ -984,136 +949,20 @@ void Session::workerMain() {
         }
         // Adaptive steps: the step's preset under the client's explicit parameters; interactive
         // frames sized (and their VPLs capped) by the frame budget (protocol/PROTOCOL.md, "Adaptive
-        // quality").
-        double scale = 1.0;
-        std::string refineNote; // why a refinement step renders less than its preset
-        nlohmann::json budgetJson;
-        const std::string budgetKey = scene->name + "/" + state.technique;
-        long budgetVpls = 0;
-        if (step >= 0) {
-            static const char* presetNames[] = {"interactive", "balanced", "final"};
-            const FrameState requested = state;
-            auto presetState = [&](int s) {
-                FrameState out = requested;
-                if (w.presets.is_null()) return out;
-                try {
-                    FrameState preset = requested;
-                    preset.techniqueParams.resetToDefaults();
-                    applyPreset(preset, w.presets, presetNames[s]);
-                    nlohmann::json techniqueExplicit = nlohmann::json::object();
-                    for (const auto& [k, v] : explicitParams.items())
-                        if (preset.techniqueParams.has(k)) techniqueExplicit[k] = v;
-                    preset.techniqueParams.apply(techniqueExplicit);
-                    if (vplEstimate(preset) <= mConfig.limits.maxVpls) out = std::move(preset);
-                } catch (const InputError&) {
-                    // No preset for this technique: the step renders the parameters as they are.
-                }
-                return out;
-            };
-            state = presetState(step);
-            // A snapshot is the best step that fits the refinement budget, judged like refinement:
-            // a step never measured nor predictable counts as too slow, the interactive one (at full
-            // size) always fits.
-            // A snapshot renders in one piece, and the controller's input waits behind it: it gets at
-            // most kSnapshotBudgetMs even where tiled refinement may take the whole refinement budget.
-            if (snapshotFor && mConfig.limits.refineBudgetMs > 0) {
-                const double snapshotBudgetMs = std::min(mConfig.limits.refineBudgetMs, kSnapshotBudgetMs);
-                while (step > static_cast<int>(Step::Interactive)) {
-                    const double predictedMs = predictRefineMs(scene->name, state, step);
-                    if (predictedMs > 0.0 && predictedMs <= snapshotBudgetMs) break;
-                    state = presetState(--step);
-                }
-            }
-            if (step == static_cast<int>(Step::Final) && state.frameParams.has("effects") &&
-                !explicitParams.contains("effects")) {
-                // The plan's bias compensation (and direct/bounce decisions), but not indirect
-                // occlusion unless asked for: one cube shadow map per VPL costs minutes per frame on
-                // CPU rendering at the final preset's VPL counts.
-                state.frameParams.set("effects", "auto");
-                if (state.frameParams.has("effect_occlusion") && !explicitParams.contains("effect_occlusion"))
-                    state.frameParams.set("effect_occlusion", "off");
-            }
-            if (step != static_cast<int>(Step::Interactive) && !snapshotFor &&
-                mConfig.limits.refineBudgetMs > 0) {
-                const double budgetMs = mConfig.limits.refineBudgetMs;
-                const double predictedMs = predictRefineMs(scene->name, state, step);
-                // Fewer VPLs where the technique can take them (a step's cost is about proportional
-                // to them) when the whole step would overrun the budget, or, for a technique that
-                // cannot render its VPLs in parts, when even the smallest tile would overrun a slice
-                // (input waits for at most one tile); else a step over the budget is skipped. The
-                // client is told which.
-                const TechniqueInfo& info = findTechniqueInfo(state.technique);
-                const long vpls = vplEstimate(state);
-                double cap = static_cast<double>(vpls);
-                std::string why;
-                if (predictedMs > budgetMs) {
-                    cap = 0.9 * static_cast<double>(vpls) * budgetMs / predictedMs;
-                    why = "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
-                          " s, over the server's refinement budget of " +
-                          std::to_string(std::lround(budgetMs / 1000.0)) + " s (--refine-budget-ms)";
-                }
-                // The smallest tile's measured cost per VPL where a step measured one, else the
-                // interactive frames' cost per pixel and VPL.
-                const auto minTile =
-                    mMinTileMsPerVpl.find(scene->name + "/" + state.technique + "/" + std::to_string(step));
-                const double vplRate = w.budget.msPerPixelVpl(budgetKey);
-                const double minTileMsPerVpl = minTile != mMinTileMsPerVpl.end()
-                                                   ? minTile->second
-                                                   : vplRate * double(kMinTileSide) * kMinTileSide;
-                const bool inParts = info.vplParts && info.vplParts(state.techniqueParams);
-                if (minTileMsPerVpl > 0.0 && !inParts) {
-                    const double sliceCap = 0.8 * mConfig.limits.sliceMs / minTileMsPerVpl;
-                    if (sliceCap < cap) {
-                        cap = sliceCap;
-                        why = "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +
-                              " tile must fit one " + std::to_string(mConfig.limits.sliceMs) +
-                              " ms slice (--slice-ms)";
-                    }
-                }
-                // A final step capped to no more VPLs than the balanced one would only repeat it.
-                const long floorVpls =
-                    step == static_cast<int>(Step::Final)
-                        ? std::max(16L, vplEstimate(presetState(static_cast<int>(Step::Balanced))) + 1)
-                        : 16L;
-                const bool capped = cap < static_cast<double>(vpls);
-                if (capped && info.limitVpls && cap >= static_cast<double>(floorVpls)) {
-                    info.limitVpls(state.techniqueParams, static_cast<long>(cap));
-                    refineNote = "capped at " + std::to_string(vplEstimate(state)) + " of " +
-                                 std::to_string(vpls) + " VPLs: " + why;
-                } else if (predictedMs > budgetMs || (capped && info.limitVpls)) {
-                    if (capped && info.limitVpls)
-                        why = "at most " + std::to_string(std::max(0L, static_cast<long>(cap))) + " of " +
-                              std::to_string(vpls) + " VPLs fit (" + why + "), no more than the step before";
-                    broadcastProgress("skipped", stepName(step), 0.0, predictedMs, why);
-                    continue;
-                }
-            }
-            if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
-                const int target = frameTargetMs(stream);
-                budgetVpls = vplEstimate(state);
-                if (target > 0) {
-                    w.budget.setTargetMs(target);
-                    const TechniqueInfo& info = findTechniqueInfo(state.technique);
-                    const BudgetChoice choice =
-                        w.budget.choose(budgetKey, budgetVpls, static_cast<bool>(info.limitVpls),
-                                        static_cast<double>(state.width) * state.height);
-                    scale = choice.scale;
-                    if (choice.vplCap > 0 && info.limitVpls)
-                        info.limitVpls(state.techniqueParams, choice.vplCap);
-                    budgetJson = choice.toJson(target, budgetVpls);
-                } else {
-                    scale = std::clamp(mConfig.limits.interactiveScale, 0.05, 1.0);
-                    budgetJson = {{"target_ms", 0},
-                                  {"scale", scale},
-                                  {"vpls", budgetVpls},
-                                  {"vpl_cap", nullptr},
-                                  {"predicted_ms", 0},
-                                  {"reason", "no frame-time target: the server's interactive scale"}};
-                }
-                state.width = std::max(16, static_cast<int>(std::lround(state.width * scale)));
-                state.height = std::max(16, static_cast<int>(std::lround(state.height * scale)));
-            }
+        // quality"; session/AdaptiveQuality.h).
+        AdaptiveQuality::Plan quality =
+            w.quality->plan(scene->name, state, explicitParams, static_cast<QualityStep>(step),
+                            snapshotFor != nullptr, frameTargetMs(stream));
+        if (quality.skip) {
+            broadcastProgress("skipped", qualityStepName(quality.step), 0.0, quality.predictedMs, quality.why);
+            continue;
         }
+        step = static_cast<int>(quality.step);
+        state = std::move(quality.state);
+        const double scale = quality.scale;
+        const std::string& refineNote = quality.why;
+        const nlohmann::json& budgetJson = quality.budget;
+        const std::string& budgetKey = quality.budgetKey;
 #if GIS_HAVE_EFFECTS
         // The effect plan: measured again only when the scene, the parameters, or the camera or light
         // change materially, never every frame.
@@ -1143,8 +992,8 @@ void Session::workerMain() {
         const FrameOutput& frame = rendered.frame;
         const double queueMs = rendered.queueMs;
         if (step >= 0 && frame.width > 0 && frame.height > 0)
-            recordRefineCost(scene->name, state, step,
-                             rendered.renderMs / (static_cast<double>(frame.width) * frame.height));
+            w.quality->recordStepCost(scene->name, state, static_cast<QualityStep>(step),
+                                      rendered.renderMs / (static_cast<double>(frame.width) * frame.height));
         nlohmann::json stats = frame.stats;
         stats["scale"] = scale;
         stats["queue_ms"] = queueMs;
@@ -1172,7 +1021,7 @@ void Session::workerMain() {
                 std::lock_guard lock(mMutex);
                 cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);
             }
-            w.budget.record(budgetKey, cost);
+            w.quality->budget().record(budgetKey, cost);
         }
     }
     w.renderer.reset(); // GL objects die while the context is still current

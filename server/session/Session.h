@@ -27,9 +27,11 @@
 #include "gl/Platform.h"
 #include "frame/FrameState.h"
 #include "session/ClientLink.h"
+#include "session/AdaptiveQuality.h"
 #include "session/ProtocolMessages.h"
 #include "session/SceneCache.h"
 #include "session/SceneCatalog.h"
+#include "session/SessionLimits.h"
 #include "session/VplPartPlanner.h"
 
 namespace gis {
@@ -39,26 +41,6 @@ struct TileRect;
 class RenderGate;
 
 /// Server-wide limits a session enforces (protocol `welcome.limits`).
-struct SessionLimits {
-    int maxWidth = 2048, maxHeight = 2048; ///< px; larger requests are scaled down, aspect kept
-    long maxVpls = 65536;                  ///< upper bound on VPLs a parameter set may ask for
-    /// (0, 1]: the largest size factor of interactive frames (with frameTargetMs 0: the factor).
-    double interactiveScale = 1.0;
-    /// ms of render and encode an interactive frame should take: the frame budget picks its size and
-    /// VPL cap from measured costs (session/FrameBudget.h); a client may ask for its own in `hello` or
-    /// `quality`. 0 = no budget: interactive frames at interactiveScale with their preset.
-    int frameTargetMs = 80;
-    /// ms one tile of a refinement step should take (tiles are sized from measured slice times), so an
-    /// input waits for at most about this much before its own frame starts rendering.
-    int sliceMs = 20;
-    int settleMs = 250; ///< ms without input before refinement starts
-    /// ms; a refinement step whose predicted total time exceeds this is skipped (and the client told
-    /// so): from the measured tiles of its kind, or before the first one, from the previous step scaled
-    /// by pixels and VPLs. Steps are rendered in tiles that input interrupts, so this bounds the work,
-    /// not the wait. 0 = no limit.
-    int refineBudgetMs = 30000;
-};
-
 struct SessionConfig {
     gl::Backend backend = gl::Backend::Egl;
     std::string scene = "builtin:cornell";
@@ -223,20 +205,9 @@ private:
     bool mWholeFrameWanted = false;
     std::shared_ptr<ClientLink> mController;
     std::vector<std::shared_ptr<ClientLink>> mViewers;
-    struct StepCost {
-        double msPerPixel = 0;
-        long vpls = 1;
-    };
-    /// Worker only: scene/technique/step -> the last measured cost of that adaptive step.
-    std::map<std::string, StepCost> mRefineCost;
-    /// Worker only: scene/technique/step -> ms per VPL of the smallest refinement tile, where one
-    /// overran its slice (the VPL cap of that step follows it).
-    std::map<std::string, double> mMinTileMsPerVpl;
     /// Refinement's VPL-part fits by scene, technique and tile limits (session/VplPartPlanner.h): a
     /// step starts from the last one's instead of a prediction (worker thread only).
     std::map<std::string, VplPartPlanner::Memory> mPartMemory;
-    double predictRefineMs(const std::string& sceneName, const FrameState& state, int step) const;
-    void recordRefineCost(const std::string& sceneName, const FrameState& state, int step, double msPerPixel);
     std::atomic<bool> mStop{false};
     std::atomic<std::uint64_t> mFramesRendered{0};
     std::thread mWorker;

@@ -1,0 +1,213 @@
+#include "session/AdaptiveQuality.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/Error.h"
+#include "frame/Presets.h"
+#include "frame/VplBudget.h"
+#include "gi/Catalog.h"
+
+namespace gis {
+namespace {
+
+FrameBudget::Config budgetConfig(const SessionLimits& limits) {
+    FrameBudget::Config budget;
+    budget.targetMs = limits.frameTargetMs;
+    budget.maxScale = std::clamp(limits.interactiveScale, 0.05, 1.0);
+    budget.preferredMinScale = std::min(budget.preferredMinScale, budget.maxScale);
+    budget.minScale = std::min(budget.minScale, budget.preferredMinScale);
+    budget.firstScale = std::min(budget.firstScale, budget.maxScale);
+    return budget;
+}
+
+QualityStep lower(QualityStep step) {
+    return static_cast<QualityStep>(static_cast<int>(step) - 1);
+}
+
+} // namespace
+
+const char* qualityStepName(QualityStep step) {
+    switch (step) {
+    case QualityStep::Interactive:
+        return "interactive";
+    case QualityStep::Balanced:
+        return "balanced";
+    case QualityStep::Final:
+        return "final";
+    case QualityStep::Fixed:
+        break;
+    }
+    return "fixed";
+}
+
+AdaptiveQuality::AdaptiveQuality(const SessionLimits& limits, nlohmann::json presets)
+    : mLimits(limits), mPresets(std::move(presets)), mBudget(budgetConfig(limits)) {}
+
+std::string AdaptiveQuality::stepKey(const std::string& sceneName, const FrameState& state,
+                                     QualityStep step) {
+    return sceneName + "/" + state.technique + "/" + std::to_string(static_cast<int>(step));
+}
+
+FrameState AdaptiveQuality::presetState(const FrameState& requested, const nlohmann::json& explicitParams,
+                                        QualityStep step) const {
+    if (mPresets.is_null() || step == QualityStep::Fixed) return requested;
+    try {
+        FrameState preset = requested;
+        preset.techniqueParams.resetToDefaults();
+        applyPreset(preset, mPresets, qualityStepName(step));
+        nlohmann::json techniqueExplicit = nlohmann::json::object();
+        for (const auto& [k, v] : explicitParams.items())
+            if (preset.techniqueParams.has(k)) techniqueExplicit[k] = v;
+        preset.techniqueParams.apply(techniqueExplicit);
+        if (vplEstimate(preset) <= mLimits.maxVpls) return preset;
+    } catch (const InputError&) {
+        // No preset for this technique: the step renders the parameters as they are.
+    }
+    return requested;
+}
+
+double AdaptiveQuality::predictStepMs(const std::string& sceneName, const FrameState& state,
+                                      QualityStep step) const {
+    const double pixels = static_cast<double>(state.width) * state.height;
+    const double vpls = static_cast<double>(std::max(1L, vplEstimate(state)));
+    // Measured at the VPLs that step rendered with (perhaps capped): scaled to this state's. Not
+    // rendered yet: the nearest measured lower step, scaled by pixels and VPLs (gather cost grows with
+    // their product), so a final preset with 256 times the VPLs is predicted before it runs.
+    for (int s = static_cast<int>(step); s >= 0; --s)
+        if (auto c = mStepCost.find(stepKey(sceneName, state, static_cast<QualityStep>(s)));
+            c != mStepCost.end())
+            return c->second.msPerPixel * pixels * vpls / static_cast<double>(c->second.vpls);
+    return 0.0;
+}
+
+void AdaptiveQuality::recordStepCost(const std::string& sceneName, const FrameState& state, QualityStep step,
+                                     double msPerPixel) {
+    if (!(msPerPixel > 0.0) || !std::isfinite(msPerPixel)) return;
+    mStepCost[stepKey(sceneName, state, step)] = {msPerPixel, std::max(1L, vplEstimate(state))};
+}
+
+bool AdaptiveQuality::recordMinTileCost(const std::string& sceneName, const FrameState& state,
+                                        QualityStep step, double msPerVpl) {
+    if (!(msPerVpl > 0.0) || !std::isfinite(msPerVpl)) return false;
+    const std::string key = stepKey(sceneName, state, step);
+    auto known = mMinTileMsPerVpl.find(key);
+    const bool news = known == mMinTileMsPerVpl.end() || msPerVpl > 1.2 * known->second;
+    mMinTileMsPerVpl[key] = known == mMinTileMsPerVpl.end() ? msPerVpl : std::max(msPerVpl, known->second);
+    return news;
+}
+
+AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const FrameState& requested,
+                                            const nlohmann::json& explicitParams, QualityStep step,
+                                            bool snapshot, int frameTargetMs) {
+    Plan p;
+    p.step = step;
+    p.budgetKey = sceneName + "/" + requested.technique;
+    if (step == QualityStep::Fixed) {
+        p.state = requested;
+        return p;
+    }
+    p.state = presetState(requested, explicitParams, step);
+    // A snapshot is the best step that fits, judged like refinement: a step never measured nor
+    // predictable counts as too slow; the interactive one (at full size) always fits.
+    if (snapshot && mLimits.refineBudgetMs > 0) {
+        const double budgetMs = std::min(static_cast<double>(mLimits.refineBudgetMs), kSnapshotBudgetMs);
+        while (p.step > QualityStep::Interactive) {
+            const double predictedMs = predictStepMs(sceneName, p.state, p.step);
+            if (predictedMs > 0.0 && predictedMs <= budgetMs) break;
+            p.step = lower(p.step);
+            p.state = presetState(requested, explicitParams, p.step);
+        }
+    }
+    if (p.step == QualityStep::Final && p.state.frameParams.has("effects") &&
+        !explicitParams.contains("effects")) {
+        // The plan's bias compensation (and direct/bounce decisions), but not indirect occlusion unless
+        // asked for: one cube shadow map per VPL costs minutes per frame on CPU rendering at the final
+        // preset's VPL counts.
+        p.state.frameParams.set("effects", "auto");
+        if (p.state.frameParams.has("effect_occlusion") && !explicitParams.contains("effect_occlusion"))
+            p.state.frameParams.set("effect_occlusion", "off");
+    }
+    if (p.step != QualityStep::Interactive && !snapshot && mLimits.refineBudgetMs > 0)
+        planRefinement(sceneName, requested, explicitParams, p);
+    if (p.step == QualityStep::Interactive && !snapshot) planInteractive(frameTargetMs, p);
+    return p;
+}
+
+void AdaptiveQuality::planRefinement(const std::string& sceneName, const FrameState& requested,
+                                     const nlohmann::json& explicitParams, Plan& p) const {
+    const double budgetMs = mLimits.refineBudgetMs;
+    const double predictedMs = predictStepMs(sceneName, p.state, p.step);
+    p.predictedMs = predictedMs;
+    // Fewer VPLs where the technique can take them (a step's cost is about proportional to them) when
+    // the whole step would overrun the budget, or, for a technique that cannot render its VPLs in
+    // parts, when even the smallest tile would overrun a slice (input waits for at most one tile);
+    // else a step over the budget is skipped. The client is told which.
+    const TechniqueInfo& info = findTechniqueInfo(p.state.technique);
+    const long vpls = vplEstimate(p.state);
+    double cap = static_cast<double>(vpls);
+    std::string why;
+    if (predictedMs > budgetMs) {
+        cap = 0.9 * static_cast<double>(vpls) * budgetMs / predictedMs;
+        why = "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
+              " s, over the server's refinement budget of " + std::to_string(std::lround(budgetMs / 1000.0)) +
+              " s (--refine-budget-ms)";
+    }
+    // The smallest tile's measured cost per VPL where a step measured one, else the interactive
+    // frames' cost per pixel and VPL.
+    const auto minTile = mMinTileMsPerVpl.find(stepKey(sceneName, p.state, p.step));
+    const double minTileMsPerVpl =
+        minTile != mMinTileMsPerVpl.end()
+            ? minTile->second
+            : mBudget.msPerPixelVpl(p.budgetKey) * double(kMinRefineTileSide) * kMinRefineTileSide;
+    const bool inParts = info.vplParts && info.vplParts(p.state.techniqueParams);
+    if (minTileMsPerVpl > 0.0 && !inParts) {
+        const double sliceCap = 0.8 * mLimits.sliceMs / minTileMsPerVpl;
+        if (sliceCap < cap) {
+            cap = sliceCap;
+            why = "a " + std::to_string(kMinRefineTileSide) + " x " + std::to_string(kMinRefineTileSide) +
+                  " tile must fit one " + std::to_string(mLimits.sliceMs) + " ms slice (--slice-ms)";
+        }
+    }
+    // A final step capped to no more VPLs than the balanced one would only repeat it.
+    const long floorVpls =
+        p.step == QualityStep::Final
+            ? std::max(16L, vplEstimate(presetState(requested, explicitParams, QualityStep::Balanced)) + 1)
+            : 16L;
+    const bool capped = cap < static_cast<double>(vpls);
+    if (capped && info.limitVpls && cap >= static_cast<double>(floorVpls)) {
+        info.limitVpls(p.state.techniqueParams, static_cast<long>(cap));
+        p.why = "capped at " + std::to_string(vplEstimate(p.state)) + " of " + std::to_string(vpls) +
+                " VPLs: " + why;
+    } else if (predictedMs > budgetMs || (capped && info.limitVpls)) {
+        if (capped && info.limitVpls)
+            why = "at most " + std::to_string(std::max(0L, static_cast<long>(cap))) + " of " +
+                  std::to_string(vpls) + " VPLs fit (" + why + "), no more than the step before";
+        p.skip = true;
+        p.why = why;
+    }
+}
+
+void AdaptiveQuality::planInteractive(int frameTargetMs, Plan& p) {
+    const long requestedVpls = vplEstimate(p.state);
+    if (frameTargetMs > 0) {
+        mBudget.setTargetMs(frameTargetMs);
+        const TechniqueInfo& info = findTechniqueInfo(p.state.technique);
+        const BudgetChoice choice =
+            mBudget.choose(p.budgetKey, requestedVpls, static_cast<bool>(info.limitVpls),
+                           static_cast<double>(p.state.width) * p.state.height);
+        p.scale = choice.scale;
+        if (choice.vplCap > 0 && info.limitVpls) info.limitVpls(p.state.techniqueParams, choice.vplCap);
+        p.budget = choice.toJson(frameTargetMs, requestedVpls);
+    } else {
+        p.scale = std::clamp(mLimits.interactiveScale, 0.05, 1.0);
+        p.budget = {
+            {"target_ms", 0},        {"scale", p.scale},
+            {"vpls", requestedVpls}, {"vpl_cap", nullptr},
+            {"predicted_ms", 0},     {"reason", "no frame-time target: the server's interactive scale"}};
+    }
+    p.state.width = std::max(16, static_cast<int>(std::lround(p.state.width * p.scale)));
+    p.state.height = std::max(16, static_cast<int>(std::lround(p.state.height * p.scale)));
+}
+
+} // namespace gis

@@ -1,0 +1,95 @@
+// Adaptive quality's decisions for one session, without GL, sockets or threads (protocol/PROTOCOL.md,
+// "Adaptive quality"; docs/interactive.md):
+//   - each step renders its preset (presets/presets.json) under the parameters the client set;
+//   - a snapshot renders the best step predicted to fit the snapshot budget;
+//   - a refinement step predicted over the refinement budget, or whose smallest tile would overrun a
+//     slice, renders fewer VPLs where the technique can take them, else it is skipped, with the reason;
+//   - an interactive frame's size and VPL cap come from the frame budget (session/FrameBudget.h).
+// It keeps what it measured: each step's cost per pixel by scene and technique, the smallest tile's
+// cost per VPL where one overran its slice, and the frame budget's rates. Session's worker owns one
+// and asks it before every frame; tests drive it directly (tests/unit/session/AdaptiveQualityTest.cpp).
+#pragma once
+
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "frame/FrameState.h"
+#include "session/FrameBudget.h"
+#include "session/SessionLimits.h"
+
+namespace gis {
+
+/// The live view's steps; Fixed frames (adaptive off) are rendered as asked.
+enum class QualityStep : int { Fixed = -1, Interactive = 0, Balanced = 1, Final = 2 };
+const char* qualityStepName(QualityStep step); ///< "interactive", "balanced", "final", "fixed"
+
+/// The smallest refinement tile side (px): a few ms of fixed cost per tile on llvmpipe, so smaller
+/// ones would mostly repeat it.
+constexpr int kMinRefineTileSide = 16;
+/// A snapshot renders in one piece while the controller's input waits behind it: at most this long.
+constexpr double kSnapshotBudgetMs = 5000.0;
+
+class AdaptiveQuality {
+public:
+    /// `presets`: presets/presets.json's document, null for none (every step renders as requested).
+    AdaptiveQuality(const SessionLimits& limits, nlohmann::json presets);
+
+    /// What one frame renders.
+    struct Plan {
+        FrameState state;
+        QualityStep step = QualityStep::Fixed; ///< a snapshot may take a lower step than asked
+        bool skip = false;                     ///< a refinement step that cannot fit: render nothing
+        double predictedMs = 0.0;              ///< the step's predicted total, where known
+        std::string why;       ///< skip: why; a capped refinement step: what it renders less of
+        double scale = 1.0;    ///< interactive: the size factor applied to the state
+        nlohmann::json budget; ///< interactive: stats.budget (null otherwise)
+        std::string budgetKey; ///< "scene/technique": where the frame's cost is recorded
+    };
+    /// The plan for `step` of `requested` (the session's state: its full size, the client's
+    /// parameters) in scene `sceneName`. `explicitParams` are those the client set (they win over
+    /// presets); `snapshot` asks for the best step that fits kSnapshotBudgetMs; `frameTargetMs` is the
+    /// session's interactive target (0: none).
+    Plan plan(const std::string& sceneName, const FrameState& requested, const nlohmann::json& explicitParams,
+              QualityStep step, bool snapshot, int frameTargetMs);
+
+    /// `requested` under the preset of `step` and then the explicit parameters; `requested` itself
+    /// when there are no presets, none for this technique, or the preset asks for more VPLs than allowed.
+    FrameState presetState(const FrameState& requested, const nlohmann::json& explicitParams,
+                           QualityStep step) const;
+
+    /// The total ms a step of `state` is predicted to take: its own last measurement, else the nearest
+    /// lower step's, scaled by pixels and VPLs; 0 when neither was measured.
+    double predictStepMs(const std::string& sceneName, const FrameState& state, QualityStep step) const;
+    /// A finished step's cost per pixel (at the VPLs `state` rendered with).
+    void recordStepCost(const std::string& sceneName, const FrameState& state, QualityStep step,
+                        double msPerPixel);
+    /// A smallest tile of a technique that cannot split its VPLs overran its slice at `msPerVpl`; the
+    /// step's VPL cap follows it. True when this is news (first, or 20 % worse than known): the step
+    /// should start again with the cap.
+    bool recordMinTileCost(const std::string& sceneName, const FrameState& state, QualityStep step,
+                           double msPerVpl);
+
+    /// The interactive frames' budget (their measured rates, and the costs refinement predicts from).
+    FrameBudget& budget() { return mBudget; }
+    const FrameBudget& budget() const { return mBudget; }
+
+private:
+    struct StepCost {
+        double msPerPixel = 0;
+        long vpls = 1;
+    };
+    static std::string stepKey(const std::string& sceneName, const FrameState& state, QualityStep step);
+    void planRefinement(const std::string& sceneName, const FrameState& requested,
+                        const nlohmann::json& explicitParams, Plan& plan) const;
+    void planInteractive(int frameTargetMs, Plan& plan);
+
+    SessionLimits mLimits;
+    nlohmann::json mPresets;
+    FrameBudget mBudget;
+    std::map<std::string, StepCost> mStepCost;      ///< scene/technique/step
+    std::map<std::string, double> mMinTileMsPerVpl; ///< scene/technique/step
+};
+
+} // namespace gis

@@ -1,0 +1,162 @@
+// Adaptive quality's decisions without GL or threads: presets under the client's parameters, the
+// snapshot's step, refinement capped or skipped to fit the budget and the slices, interactive frames
+// sized by the frame budget, and predictions from what earlier steps measured.
+#include <gtest/gtest.h>
+
+#include "frame/FrameState.h"
+#include "frame/VplBudget.h"
+#include "scene/SceneLoader.h"
+#include "session/AdaptiveQuality.h"
+
+namespace gis {
+namespace {
+
+const Scene& cornell() {
+    static const Scene scene = loadScene("builtin:cornell");
+    return scene;
+}
+
+/// rsm_gather with vpl_grid 8 (64 VPLs) at 256 x 256.
+FrameState requested() {
+    FrameState s = makeFrameState(cornell(), "rsm_gather");
+    s.width = s.height = 256;
+    s.techniqueParams.set("vpl_grid", 8);
+    return s;
+}
+
+nlohmann::json presets() {
+    return {{"techniques",
+             {{"rsm_gather",
+               {{"interactive", {{"vpl_grid", 4}}},
+                {"balanced", {{"vpl_grid", 16}}},
+                {"final", {{"vpl_grid", 64}}}}}}}};
+}
+
+SessionLimits limits() {
+    SessionLimits l;
+    l.refineBudgetMs = 30000;
+    l.sliceMs = 20;
+    l.frameTargetMs = 80;
+    return l;
+}
+
+int grid(const FrameState& s) {
+    return s.techniqueParams.getInt("vpl_grid");
+}
+
+TEST(AdaptiveQuality, StepsRenderTheirPresetUnderTheClientsParameters) {
+    AdaptiveQuality q(limits(), presets());
+    const nlohmann::json none = nlohmann::json::object();
+    EXPECT_EQ(grid(q.presetState(requested(), none, QualityStep::Interactive)), 4);
+    EXPECT_EQ(grid(q.presetState(requested(), none, QualityStep::Final)), 64);
+    EXPECT_EQ(grid(q.presetState(requested(), {{"vpl_grid", 8}}, QualityStep::Final)), 8) << "explicit wins";
+    EXPECT_EQ(grid(q.presetState(requested(), none, QualityStep::Fixed)), 8) << "fixed: as asked";
+    AdaptiveQuality noPresets(limits(), nullptr);
+    EXPECT_EQ(grid(noPresets.presetState(requested(), none, QualityStep::Final)), 8);
+    SessionLimits tight = limits();
+    tight.maxVpls = 1000;
+    AdaptiveQuality capped(tight, presets());
+    EXPECT_EQ(grid(capped.presetState(requested(), none, QualityStep::Final)), 8)
+        << "a preset over the VPL limit is not used";
+}
+
+TEST(AdaptiveQuality, PredictionsScaleTheNearestMeasuredStep) {
+    AdaptiveQuality q(limits(), presets());
+    FrameState s = requested(); // 64 VPLs, 65,536 px
+    EXPECT_EQ(q.predictStepMs("cornell", s, QualityStep::Balanced), 0.0) << "nothing measured";
+    q.recordStepCost("cornell", s, QualityStep::Interactive, 1e-3); // 65.5 ms at 64 VPLs
+    EXPECT_NEAR(q.predictStepMs("cornell", s, QualityStep::Interactive), 65.536, 1e-9);
+    FrameState bigger = s;
+    bigger.techniqueParams.set("vpl_grid", 16); // 4x the VPLs
+    EXPECT_NEAR(q.predictStepMs("cornell", bigger, QualityStep::Final), 4 * 65.536, 1e-9)
+        << "the interactive step scaled by VPLs";
+    q.recordStepCost("cornell", bigger, QualityStep::Balanced, 2e-3);
+    EXPECT_NEAR(q.predictStepMs("cornell", bigger, QualityStep::Final), 131.072, 1e-9) << "the nearest one";
+    EXPECT_EQ(q.predictStepMs("other", s, QualityStep::Final), 0.0) << "per scene";
+    q.recordStepCost("cornell", s, QualityStep::Final, std::nan(""));
+    EXPECT_NEAR(q.predictStepMs("cornell", bigger, QualityStep::Final), 131.072, 1e-9) << "NaN is not kept";
+}
+
+TEST(AdaptiveQuality, RefinementOverTheBudgetIsCappedOrSkipped) {
+    SessionLimits l = limits();
+    l.refineBudgetMs = 1000;
+    AdaptiveQuality q(l, presets());
+    const nlohmann::json none = nlohmann::json::object();
+    // The final preset (4096 VPLs) predicted from the interactive step (16 VPLs, 16.4 ms) at 256 times
+    // that: 4.2 s, over the 1 s budget; 0.9 x 4096 / 4.2 = 879 VPLs fit, more than the balanced 256.
+    q.recordStepCost("cornell", q.presetState(requested(), none, QualityStep::Interactive),
+                     QualityStep::Interactive, 2.5e-4);
+    const AdaptiveQuality::Plan finalPlan =
+        q.plan("cornell", requested(), none, QualityStep::Final, false, 80);
+    EXPECT_FALSE(finalPlan.skip);
+    EXPECT_GT(finalPlan.predictedMs, 1000.0);
+    const long vpls = vplEstimate(finalPlan.state);
+    EXPECT_LT(vpls, 4096);
+    EXPECT_GT(vpls, 256) << "more than the balanced step's";
+    EXPECT_NE(finalPlan.why.find("capped at"), std::string::npos) << finalPlan.why;
+    EXPECT_NE(finalPlan.why.find("--refine-budget-ms"), std::string::npos) << finalPlan.why;
+
+    l.refineBudgetMs = 10; // nothing fits: not even the balanced step's VPLs
+    AdaptiveQuality tight(l, presets());
+    tight.recordStepCost("cornell", tight.presetState(requested(), none, QualityStep::Interactive),
+                         QualityStep::Interactive, 2.5e-4);
+    const AdaptiveQuality::Plan skipped =
+        tight.plan("cornell", requested(), none, QualityStep::Final, false, 80);
+    EXPECT_TRUE(skipped.skip);
+    EXPECT_NE(skipped.why.find("no more than the step before"), std::string::npos) << skipped.why;
+}
+
+TEST(AdaptiveQuality, ASmallestTileOverItsSliceCapsTheStep) {
+    AdaptiveQuality q(limits(), presets());
+    // With bias compensation the gather cannot render its VPLs in parts: its tiles must fit a slice.
+    const nlohmann::json none = {{"ssbc_iterations", 1}};
+    const FrameState balanced = q.presetState(requested(), none, QualityStep::Balanced);
+    ASSERT_EQ(balanced.techniqueParams.getInt("ssbc_iterations"), 1);
+    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 0.1)) << "first: news";
+    EXPECT_FALSE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 0.11)) << "within 20 %";
+    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 0.2)) << "much worse";
+    const AdaptiveQuality::Plan p = q.plan("cornell", requested(), none, QualityStep::Balanced, false, 80);
+    // 0.8 x 20 ms / 0.2 ms per VPL = 80 VPLs, of 256.
+    EXPECT_FALSE(p.skip);
+    EXPECT_LE(vplEstimate(p.state), 80);
+    EXPECT_NE(p.why.find("slice (--slice-ms)"), std::string::npos) << p.why;
+}
+
+TEST(AdaptiveQuality, SnapshotsTakeTheBestStepThatFits) {
+    AdaptiveQuality q(limits(), presets());
+    const nlohmann::json none = nlohmann::json::object();
+    const AdaptiveQuality::Plan unknown = q.plan("cornell", requested(), none, QualityStep::Final, true, 80);
+    EXPECT_EQ(unknown.step, QualityStep::Interactive) << "nothing measured: the interactive step";
+    EXPECT_EQ(unknown.state.width, 256) << "at full size";
+    EXPECT_TRUE(unknown.budget.is_null());
+    q.recordStepCost("cornell", q.presetState(requested(), none, QualityStep::Balanced),
+                     QualityStep::Balanced, 1e-3);
+    const AdaptiveQuality::Plan fits = q.plan("cornell", requested(), none, QualityStep::Final, true, 80);
+    EXPECT_EQ(fits.step, QualityStep::Final) << "predicted at 262 ms from the balanced step";
+    EXPECT_EQ(grid(fits.state), 64);
+}
+
+TEST(AdaptiveQuality, InteractiveFramesFollowTheFrameBudget) {
+    AdaptiveQuality q(limits(), presets());
+    const nlohmann::json none = nlohmann::json::object();
+    const AdaptiveQuality::Plan first =
+        q.plan("cornell", requested(), none, QualityStep::Interactive, false, 80);
+    EXPECT_EQ(first.budgetKey, "cornell/rsm_gather");
+    EXPECT_LT(first.scale, 1.0) << "nothing measured: the budget's first guess";
+    EXPECT_EQ(first.state.width, static_cast<int>(std::lround(256 * first.scale)));
+    EXPECT_EQ(first.budget["target_ms"], 80);
+
+    const AdaptiveQuality::Plan noTarget =
+        q.plan("cornell", requested(), none, QualityStep::Interactive, false, 0);
+    EXPECT_EQ(noTarget.scale, 1.0) << "the server's interactive scale";
+    EXPECT_EQ(noTarget.state.width, 256);
+    EXPECT_EQ(noTarget.budget["reason"], "no frame-time target: the server's interactive scale");
+
+    const AdaptiveQuality::Plan fixed = q.plan("cornell", requested(), none, QualityStep::Fixed, false, 80);
+    EXPECT_EQ(grid(fixed.state), 8);
+    EXPECT_EQ(fixed.state.width, 256);
+    EXPECT_EQ(std::string(qualityStepName(fixed.step)), "fixed");
+}
+
+} // namespace
+} // namespace gis
