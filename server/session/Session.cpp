@@ -435,73 +435,32 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     // A patch goes out only where every client draws patches and none has missed one: encoding the
     // whole canvas of a large view took 50-70 ms a tile send, time that input waited behind.
     std::optional<TileRect> region;
-    if (patch && !snapshotFor && !targets.empty() &&
-        std::all_of(targets.begin(), targets.end(), [](const auto& c) { return c->acceptsPatches(); })) {
+    if (patch && !snapshotFor) {
         std::lock_guard lock(mMutex);
-        if (!mWholeFrameWanted) region = clipToImage(*patch, width, height);
+        if (!mWholeFrameWanted) region = patchToSend(*patch, width, height, targets);
     }
-    if (region && (region->width <= 0 || region->height <= 0)) region.reset();
     if (!region && !snapshotFor) {
         std::lock_guard lock(mMutex);
         mWholeFrameWanted = false;
     }
-    const int sentWidth = region ? region->width : width, sentHeight = region ? region->height : height;
-    Stopwatch encodeClock;
-    std::vector<std::uint8_t> encoded;
+    EncodedFrame frame;
     try {
-        const std::vector<std::uint8_t> cropped =
-            region ? cropRgba8(rgba, width, height, *region) : std::vector<std::uint8_t>();
-        const std::uint8_t* pixels = region ? cropped.data() : rgba.data();
         // A snapshot is lossless in whichever codec it asked for.
-        encoded =
-            encodeImage(codec, pixels, sentWidth, sentHeight, stream.quality, {}, snapshotFor != nullptr);
+        frame = encodeFrame(rgba, width, height, region, codec, stream.quality, snapshotFor != nullptr,
+                            w.frameId + 1);
     } catch (const std::exception& e) {
         fail(std::string("the frame could not be encoded: ") + e.what());
         return false;
     }
-    const double encodeMs = encodeClock.elapsedMs();
-    const std::uint32_t frameId = ++w.frameId;
+    ++w.frameId;
     ++mFramesRendered;
-    std::vector<std::uint8_t> message = makeFrameMessage(frameId, sentWidth, sentHeight, codec, encoded);
-    auto shared = std::make_shared<const std::string>(message.begin(), message.end());
-
-    stats["type"] = "stats";
-    stats["frame"] = frameId;
-    stats["quality"] = quality;
-    stats["refined"] = quality == "balanced" || quality == "final";
-    stats["snapshot"] = snapshotFor != nullptr;
-    stats["encode_ms"] = encodeMs;
-    stats["bytes"] = shared->size();
-    stats["codec"] = codecName(codec);
-    stats["scene"] = mSceneName.empty() ? w.scene->name : mSceneName;
-    if (region) {
-        stats["patch"] = {
-            {"x", region->x}, {"y", region->y}, {"width", region->width}, {"height", region->height}};
-        stats["size"] = {width, height};
-    }
-
-    FrameReport report;
-    report.quality = quality;
-    report.snapshot = snapshotFor != nullptr;
-    report.frameMs = stats.value("frame_ms", 0.0);
-    report.queueMs = stats.value("queue_ms", 0.0);
-    report.encodeMs = encodeMs;
-    report.bytes = shared->size();
-    if (stats.contains("passes"))
-        for (const auto& p : stats["passes"])
-            report.passMs.emplace_back(p.value("name", ""), p.value("gpu_ms", 0.0));
-    const std::size_t viewers = viewerCount();
-    bool patchMissed = false;
-    for (const auto& client : targets) {
-        stats["viewers"] = viewers;
-        stats["dropped_frames"] = client->droppedFrames();
-        if (client->offerFrame(frameId, stats.dump(), shared, snapshotFor != nullptr, region.has_value())) {
-            ++report.delivered;
-        } else {
-            ++report.dropped;
-            patchMissed = patchMissed || region.has_value();
-        }
-    }
+    addPublishingStats(stats, frame, quality, snapshotFor != nullptr,
+                       mSceneName.empty() ? w.scene->name : mSceneName, width, height);
+    FrameReport report = reportOf(stats, frame, quality, snapshotFor != nullptr);
+    const bool patchMissed =
+        offerToClients(targets, stats, frame, snapshotFor != nullptr, viewerCount(), report);
+    const std::uint32_t frameId = frame.id;
+    const auto& shared = frame.message;
     FrameObserver onFrame;
     {
         std::lock_guard lock(mMutex);
@@ -954,7 +913,8 @@ void Session::workerMain() {
             w.quality->plan(scene->name, state, explicitParams, static_cast<QualityStep>(step),
                             snapshotFor != nullptr, frameTargetMs(stream));
         if (quality.skip) {
-            broadcastProgress("skipped", qualityStepName(quality.step), 0.0, quality.predictedMs, quality.why);
+            broadcastProgress("skipped", qualityStepName(quality.step), 0.0, quality.predictedMs,
+                              quality.why);
             continue;
         }
         step = static_cast<int>(quality.step);

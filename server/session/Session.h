@@ -27,6 +27,7 @@
 #include "gl/Platform.h"
 #include "frame/FrameState.h"
 #include "session/ClientLink.h"
+#include "session/FramePublisher.h"
 #include "session/AdaptiveQuality.h"
 #include "session/ProtocolMessages.h"
 #include "session/SceneCache.h"
@@ -57,19 +58,9 @@ struct StreamOptions {
     int frameTargetMs = -1; ///< the client's frame-time target; -1: the server's (limits)
 };
 
-/// What one rendered frame cost, for the server's metrics (called on the worker thread).
-struct FrameReport {
-    std::string quality; ///< interactive, balanced, final, fixed
-    bool snapshot = false;
-    double frameMs = 0, queueMs = 0, encodeMs = 0;
-    std::vector<std::pair<std::string, double>> passMs;
-    std::size_t bytes = 0;     ///< per client that got it
-    std::size_t delivered = 0; ///< clients the frame was sent to
-    std::size_t dropped = 0;   ///< clients that skipped it
-};
-
 class Session {
 public:
+    /// What one rendered frame cost, for the server's metrics (called on the worker thread).
     using FrameObserver = std::function<void(const FrameReport&)>;
     using ErrorObserver = std::function<void(const std::string& code)>;
 
