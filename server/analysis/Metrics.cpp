@@ -546,6 +546,16 @@ std::vector<float> toneMapForMetrics(const ImageView& linear, double exposureEv)
     return toneMapUnchecked(linear, exposureEv);
 }
 
+std::vector<std::uint8_t> toneMapToRgba8(const ImageView& linear, double exposureEv) {
+    const std::vector<float> srgb = toneMapForMetrics(linear, exposureEv);
+    std::vector<std::uint8_t> rgba8(srgb.size() / 3 * 4, 255);
+    for (std::size_t i = 0, n = srgb.size() / 3; i < n; ++i)
+        for (int c = 0; c < 3; ++c)
+            rgba8[i * 4 + c] =
+                static_cast<std::uint8_t>(std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+    return rgba8;
+}
+
 double ssim(const ImageView& test, const ImageView& reference, const PixelMask& mask, double exposureEv) {
     const std::size_t pixels = checkPair(test, reference, mask);
     checkExposure(exposureEv);

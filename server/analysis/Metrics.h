@@ -104,6 +104,9 @@ double flipSrgb(std::span<const float> testSrgb, std::span<const float> referenc
 
 /// The display transform above: returns width * height * 3 sRGB-encoded values in [0, 1].
 std::vector<float> toneMapForMetrics(const ImageView& linear, double exposureEv = 0);
+/// The same as RGBA8 (alpha 255), rows as in `linear`: how a reference is shown and written (gi-render
+/// --reference's .png/.jpg, the HTTP API's reference_base64).
+std::vector<std::uint8_t> toneMapToRgba8(const ImageView& linear, double exposureEv = 0);
 
 struct ImageMetrics {
     double rmse = 0;

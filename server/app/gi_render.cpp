@@ -107,14 +107,8 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
             gis::writeReferenceExr(o.out, image);
         } else {
             gis::ImageView view(rgba.data(), image.width, image.height, 4);
-            std::vector<float> srgb = gis::toneMapForMetrics(view, state.frameParams.getFloat("exposure"));
-            std::vector<std::uint8_t> rgba8(rgba.size());
-            for (size_t i = 0, n = srgb.size() / 3; i < n; ++i) {
-                for (int c = 0; c < 3; ++c)
-                    rgba8[i * 4 + c] = static_cast<std::uint8_t>(
-                        std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
-                rgba8[i * 4 + 3] = 255;
-            }
+            const std::vector<std::uint8_t> rgba8 =
+                gis::toneMapToRgba8(view, state.frameParams.getFloat("exposure"));
             gis::writeImageFile(o.out, image.width, image.height, rgba8, rgba, {{"gi:reference", ro.mode}},
                                 o.quality);
         }

@@ -353,12 +353,7 @@ RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
         result.stats["compare"] = std::move(compare);
         // The reference as a PNG through the same display transform as gi-render --reference, so a
         // client can show it beside the frame.
-        const std::vector<float> srgb = toneMapForMetrics(truth, state.frameParams.getFloat("exposure"));
-        std::vector<std::uint8_t> rgba8(static_cast<size_t>(reference.width) * reference.height * 4, 255);
-        for (size_t i = 0, n = rgba8.size() / 4; i < n; ++i)
-            for (int c = 0; c < 3; ++c)
-                rgba8[i * 4 + c] =
-                    static_cast<std::uint8_t>(std::lround(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+        const std::vector<std::uint8_t> rgba8 = toneMapToRgba8(truth, state.frameParams.getFloat("exposure"));
         result.referenceImage = encodePng(rgba8.data(), reference.width, reference.height);
 #else
         throw InputError("/compare", "this build has no CPU reference renderer (Embree): leave out compare");
