@@ -1,6 +1,8 @@
 #include "app/BenchCommon.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <iostream>
 #include <sstream>
 
 #include "analysis/Accuracy.h"
@@ -29,6 +31,36 @@ Config parseConfig(const std::string& spec) {
         c.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
     }
     return c;
+}
+
+void addRunOptions(cli::OptionTable& table, RunOptions& o, const std::string& configsDefault) {
+    table
+        .value("--scene", "NAME", "builtin:NAME or a .gltf/.glb file (default " + o.scene + ")",
+               [&o](const std::string& v) { o.scene = v; })
+        .value("--size", "WxH",
+               "frame size, 16..4096 each (default " + std::to_string(o.width) + "x" +
+                   std::to_string(o.height) + ")",
+               [&o](const std::string& v) { cli::parseSize("--size", v, 4096, o.width, o.height); })
+        .value("--config", "SPEC", "technique[:name=value,...], repeatable (default: " + configsDefault + ")",
+               [&o](const std::string& v) { o.configs.push_back(parseConfig(v)); })
+        .integer("--frames", "N", "timed GL frames per configuration, after a warm-up", 1, 1000, o.frames)
+        .value("--json", "FILE", "also write the rows as JSON", [&o](const std::string& v) { o.json = v; })
+        .value("--gl", "egl|osmesa", "headless GL backend (default: $GI_GL, else egl)",
+               [&o](const std::string& v) { o.gl = v; })
+        .value(
+            "--timing", "query|finish",
+            "GPU timer queries, or glFinish around each pass (default finish: llvmpipe's queries attribute "
+            "deferred work to later passes)",
+            [&o](const std::string& v) { o.timerQueries = parseTiming(v); });
+}
+
+bool printedHelp(const std::vector<std::string>& args, const std::string& what,
+                 const cli::OptionTable& options) {
+    if (std::find(args.begin(), args.end(), "--help") == args.end() &&
+        std::find(args.begin(), args.end(), "-h") == args.end())
+        return false;
+    std::cout << what << "\n\n" << options.usage();
+    return true;
 }
 
 std::vector<FrameState> makeStates(const Scene& scene, const std::vector<Config>& configs, int width,

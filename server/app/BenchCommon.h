@@ -38,6 +38,22 @@ struct Config {
     std::string label;
 };
 Config parseConfig(const std::string& spec);
+
+/// The options gi-bench's GL commands share (table, passes, lights).
+struct RunOptions {
+    std::string scene = "builtin:cornell";
+    int width = 512, height = 512;
+    int frames = 5;
+    std::vector<Config> configs; ///< empty: the command's own list
+    std::string json, gl;
+    bool timerQueries = false;
+};
+/// Declares --scene, --size, --config, --frames, --json, --gl and --timing into `o`, their defaults
+/// taken from `o` as it is; `configsDefault` says what runs without --config.
+void addRunOptions(cli::OptionTable& table, RunOptions& o, const std::string& configsDefault);
+/// A command's --help: `what` (its description), then its options.
+bool printedHelp(const std::vector<std::string>& args, const std::string& what,
+                 const cli::OptionTable& options);
 std::vector<FrameState> makeStates(const Scene& scene, const std::vector<Config>& configs, int width,
                                    int height);
 

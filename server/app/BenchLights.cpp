@@ -54,34 +54,33 @@ double perLightMs(const nlohmann::json& stats) {
 } // namespace
 
 int lights(const std::vector<std::string>& args) {
-    std::string sceneName = "builtin:cornell", jsonPath, gl;
-    int width = 512, height = 512, frames = 3;
-    bool timerQueries = false;
+    RunOptions o;
+    o.frames = 3;
     std::vector<int> counts = {1, 2, 4, 8, 16};
-    std::vector<Config> configs;
-    for (ArgCursor c{args}; c.i < args.size(); ++c.i) {
-        const std::string& a = args[c.i];
-        if (a == "--scene")
-            sceneName = c.value();
-        else if (a == "--size")
-            cli::parseSize("--size", c.value(), 4096, width, height);
-        else if (a == "--config")
-            configs.push_back(parseConfig(c.value()));
-        else if (a == "--counts") {
-            counts.clear();
-            for (const std::string& n : splitList(c.value()))
-                counts.push_back(cli::parseInteger("--counts", n, 1, 64));
-        } else if (a == "--frames")
-            frames = cli::parseInteger("--frames", c.value(), 1, 1000);
-        else if (a == "--json")
-            jsonPath = c.value();
-        else if (a == "--gl")
-            gl = c.value();
-        else if (a == "--timing")
-            timerQueries = parseTiming(c.value());
-        else
-            throw UsageError("unknown option '" + a + "' (see --help)");
-    }
+    cli::OptionTable options;
+    addRunOptions(options, o, "every technique");
+    options.value("--counts", "N,N,...", "light counts, each 1..64 (default 1,2,4,8,16)",
+                  [&](const std::string& v) {
+                      counts.clear();
+                      for (const std::string& n : splitList(v))
+                          counts.push_back(cli::parseInteger("--counts", n, 1, 64));
+                  });
+    if (printedHelp(
+            args,
+            "usage: gi-bench lights [options]\n\n"
+            "Frame time against light count: for each technique, N spot lights on a ring under the ceiling "
+            "sharing the first light's power, at the technique's default (total) VPL budget; frames of every "
+            "N interleaved; prints the median frame time, the ratio of each N to one light and the "
+            "per-light passes (shadow_map, rsm, rsm_flux) at the largest N.",
+            options))
+        return 0;
+    options.parse(args);
+    const std::string& sceneName = o.scene;
+    const std::string& jsonPath = o.json;
+    const std::string& gl = o.gl;
+    const int width = o.width, height = o.height, frames = o.frames;
+    const bool timerQueries = o.timerQueries;
+    std::vector<Config>& configs = o.configs;
     if (configs.empty())
         for (const char* t : {"none", "rsm_gather", "ssbc", "multires_splat", "multires_gather", "isr",
                               "hier_isr", "second_order"})

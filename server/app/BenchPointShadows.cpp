@@ -65,21 +65,24 @@ double medianMs(std::vector<double> v) {
 int pointShadows(const std::vector<std::string>& args) {
     std::string sceneName = "builtin:cornell-point", gl;
     int side = 512, repeats = 15, samples = 20000;
-    for (ArgCursor c{args}; c.i < args.size(); ++c.i) {
-        const std::string& a = args[c.i];
-        if (a == "--scene")
-            sceneName = c.value();
-        else if (a == "--side")
-            side = cli::parseInteger("--side", c.value(), 16, 4096);
-        else if (a == "--repeats")
-            repeats = cli::parseInteger("--repeats", c.value(), 1, 1000);
-        else if (a == "--samples")
-            samples = cli::parseInteger("--samples", c.value(), 100, 10000000);
-        else if (a == "--gl")
-            gl = c.value();
-        else
-            throw UsageError("unknown option '" + a + "' (see --help)");
-    }
+    cli::OptionTable options;
+    options
+        .value("--scene", "NAME", "a scene with a point light (default builtin:cornell-point)",
+               [&](const std::string& v) { sceneName = v; })
+        .integer("--side", "N", "cube face side (the paraboloids get sqrt(3) N)", 16, 4096, side)
+        .integer("--samples", "N", "surface points", 100, 10000000, samples)
+        .integer("--repeats", "N", "timed renders of each", 1, 1000, repeats)
+        .value("--gl", "egl|osmesa", "headless GL backend (default: $GI_GL, else egl)",
+               [&](const std::string& v) { gl = v; });
+    if (printedHelp(
+            args,
+            "usage: gi-bench point-shadows [options]\n\n"
+            "A point light's shadow map as a cube (the renderer's six faces) and as a dual paraboloid with "
+            "the same texel count: render time (median of --repeats, glFinish) and the share of surface "
+            "points whose visibility disagrees with a ray (docs/lights.md).",
+            options))
+        return 0;
+    options.parse(args);
     const Scene scene = loadScene(sceneName);
     FrameState state = makeFrameState(scene, "none");
     const LightSetModel set = makeLightSet(state, scene.bounds);

@@ -37,71 +37,36 @@ using namespace gis::bench;
 namespace cli = gis::cli;
 
 constexpr int kMaxEyeLevels = 16;
-constexpr const char* kUsage = R"(usage: gi-bench compare TEST.exr REFERENCE.exr
-       gi-bench table [options]
-       gi-bench passes [options]
-       gi-bench sweep [options]     (gi-bench sweep --help)
-       gi-bench report [options]    (gi-bench report --help)
-       gi-bench lights [options]
-       gi-bench point-shadows [options]
+constexpr const char* kUsage =
+    R"(usage: gi-bench COMMAND [options]   (gi-bench COMMAND --help for its options)
 
-compare  prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
+compare TEST.exr REFERENCE.exr
+         prints relative RMSE, RMSE, PSNR, max error, SSIM and FLIP of TEST against REFERENCE (same
          size; pixels black in the reference are left out) as JSON, with the reference's own
          noise (when its EXR carries the variance, as gi-render's do) and the error corrected for it.
-
-table    renders each technique configuration with GL (median frame time over --frames after a
-         warm-up) and the CPU references, then prints one row per configuration: frame time, the sum
-         of the GPU pass times, and the error against every reference: whole image, indirect light
-         alone (each side less its own direct light: the GI technique's error) and the direct pass
-         alone (the shadow map's error), each corrected for the reference's noise, which is
-         printed beside it.
-  --scene NAME            (default builtin:cornell)
-  --size WxH              (default 256x256)
-  --config SPEC           technique[:name=value,...], repeatable (default: none, rsm_gather)
-  --reference MODE        reference mode, repeatable (default: one-bounce-unoccluded, one-bounce)
-  --spp N                 reference samples per pixel at most (default 65536)
-  --noise-target R        stop each reference once its indirect light's relative noise is at most
-                          R (default 0.02; 0 = exactly --spp samples)
-  --caustic-min-roughness R  leave out of the reference the lights' reflection off specular
-                          lobes smoother than R reaching a rougher surface (caustics the GL
-                          pipeline does not render; biased; default 0 = unbiased; see
-                          docs/nondiffuse.md)
-  --frames N              timed GL frames per configuration (default 5)
-  --cache-dir DIR         reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)
-  --json FILE             also write the rows as JSON
-  --gl egl|osmesa
-  --timing query|finish   GPU timer queries, or glFinish around each pass (default finish:
-                          llvmpipe's queries attribute deferred work to later passes)
-
-passes   renders every configuration --frames times, interleaved (frame k of each configuration
-         before frame k+1 of any), and prints the median ms of each pass per configuration, the
-         total, the ratio of each total to the first configuration's, the receivers per eye level
-         against the covered pixels (fill-rate saving) and, with --baseline, the relative RMSE of
-         each configuration against that GL configuration (rendered once, untimed).
-  --scene, --size, --config, --frames, --gl, --timing, --json as for table (default size 512x512)
-  --baseline SPEC         GL configuration the errors are measured against
-
-sweep    runs each technique over its parameter grid and appends time and error per point to CSV
-         and JSON Lines; see gi-bench sweep --help.
-lights   frame time against light count: for each technique, N spot lights on a ring under the
-         ceiling sharing the first light's power (N = 1, 2, 4, 8, 16), at the technique's default
-         (total) VPL budget; frames of every N interleaved; prints the median frame time, the ratio
-         of each N to one light and the per-light passes (shadow_map, rsm, rsm_flux) at the largest N.
-  --scene, --size, --config, --frames, --gl, --timing, --json as for passes (default 512x512,
-                          every technique, 3 frames)
-  --counts N,N,...        light counts (default 1,2,4,8,16)
-
-point-shadows  a point light's shadow map as a cube (the renderer's six faces) and as a dual
-         paraboloid with the same texel count: render time (median of --repeats, glFinish) and the
-         share of surface points whose visibility disagrees with a ray (docs/lights.md).
-  --scene NAME            a scene with a point light (default builtin:cornell-point)
-  --side N                cube face side (default 512; the paraboloids get sqrt(3) N)
-  --samples N             surface points (default 20000)
-  --repeats N             timed renders of each (default 15)
-
-report   writes docs/accuracy.md, its plots and presets/presets.json from a sweep; see
-         gi-bench report --help.
+table    GL frame time and error against converged CPU references, one row per configuration.
+passes   the median ms of each pass per configuration, interleaved, and the fill-rate saving.
+sweep    each technique over its parameter grid: time and error per point (CSV, JSON Lines).
+report   docs/accuracy.md, its plots and presets/presets.json from a sweep.
+lights   frame time against light count.
+point-shadows  a point light's cube shadow map against a dual paraboloid: time and disagreement.
 )";
+
+constexpr const char* kTableHelp = R"(usage: gi-bench table [options]
+
+Renders each technique configuration with GL (median frame time over --frames after a warm-up) and
+the CPU references, then prints one row per configuration: frame time, the sum of the GPU pass
+times, and the error against every reference: whole image, indirect light alone (each side less its
+own direct light: the GI technique's error) and the direct pass alone (the shadow map's error), each
+corrected for the reference's noise, which is printed beside it.)";
+
+constexpr const char* kPassesHelp = R"(usage: gi-bench passes [options]
+
+Renders every configuration --frames times, interleaved (frame k of each configuration before frame
+k+1 of any), and prints the median ms of each pass per configuration, the total, the ratio of each
+total to the first configuration's, the receivers per eye level against the covered pixels
+(fill-rate saving) and, with --baseline, the relative RMSE of each configuration against that GL
+configuration.)";
 
 int compare(const std::vector<std::string>& args) {
     if (args.size() != 2) throw UsageError("compare needs two files: TEST.exr REFERENCE.exr");
@@ -123,35 +88,21 @@ int compare(const std::vector<std::string>& args) {
 }
 
 int passes(const std::vector<std::string>& args) {
-    std::string sceneName = "builtin:cornell", jsonPath, gl;
-    int width = 512, height = 512, frames = 5;
-    bool timerQueries = false;
-    std::vector<Config> configs, baseline;
-    for (size_t i = 0; i < args.size(); ++i) {
-        auto value = [&]() -> const std::string& {
-            if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
-            return args[++i];
-        };
-        const std::string& a = args[i];
-        if (a == "--scene")
-            sceneName = value();
-        else if (a == "--size")
-            cli::parseSize("--size", value(), 4096, width, height);
-        else if (a == "--config")
-            configs.push_back(parseConfig(value()));
-        else if (a == "--baseline")
-            baseline = {parseConfig(value())};
-        else if (a == "--frames")
-            frames = cli::parseInteger("--frames", value(), 1, 1000);
-        else if (a == "--json")
-            jsonPath = value();
-        else if (a == "--gl")
-            gl = value();
-        else if (a == "--timing")
-            timerQueries = parseTiming(value());
-        else
-            throw UsageError("unknown option '" + a + "' (see --help)");
-    }
+    RunOptions o; // 512x512, 5 frames
+    std::vector<Config> baseline;
+    cli::OptionTable options;
+    addRunOptions(options, o, "multires_splat, multires_gather");
+    options.value("--baseline", "SPEC",
+                  "GL configuration the errors are measured against (rendered once, untimed)",
+                  [&](const std::string& v) { baseline = {parseConfig(v)}; });
+    if (printedHelp(args, kPassesHelp, options)) return 0;
+    options.parse(args);
+    const std::string& sceneName = o.scene;
+    const std::string& jsonPath = o.json;
+    const std::string& gl = o.gl;
+    const int width = o.width, height = o.height, frames = o.frames;
+    const bool timerQueries = o.timerQueries;
+    std::vector<Config>& configs = o.configs;
     if (configs.empty()) configs = {parseConfig("multires_splat"), parseConfig("multires_gather")};
 
     auto scene = std::make_shared<gis::Scene>(gis::loadScene(sceneName));
@@ -271,49 +222,45 @@ int passes(const std::vector<std::string>& args) {
 }
 
 int table(const std::vector<std::string>& args) {
-    std::string sceneName = "builtin:cornell", jsonPath, gl, cacheDir = cli::defaultCacheDir();
-    int width = 256, height = 256, frames = 5;
-    bool timerQueries = false;
-    std::vector<Config> configs;
+    RunOptions o;
+    o.width = o.height = 256;
+    std::string cacheDir = cli::defaultCacheDir();
     std::vector<std::string> modes;
     gis::ReferenceOptions ro;
     ro.spp = 65536;
     ro.noiseTarget = 0.02;
     ro.noiseOfIndirect = true;
-    for (size_t i = 0; i < args.size(); ++i) {
-        auto value = [&]() -> const std::string& {
-            if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
-            return args[++i];
-        };
-        const std::string& a = args[i];
-        if (a == "--scene")
-            sceneName = value();
-        else if (a == "--size")
-            cli::parseSize("--size", value(), 4096, width, height);
-        else if (a == "--config")
-            configs.push_back(parseConfig(value()));
-        else if (a == "--reference")
-            modes.push_back(value());
-        else if (a == "--spp")
-            ro.spp = cli::parseInteger("--spp", value(), 1, 1000000);
-        else if (a == "--noise-target")
-            ro.noiseTarget = cli::parseNumber("--noise-target", value(), 0, 0.5);
-        else if (a == "--caustic-min-roughness")
-            ro.causticMinRoughness =
-                static_cast<float>(cli::parseNumber("--caustic-min-roughness", value(), 0.0, 1.0));
-        else if (a == "--frames")
-            frames = cli::parseInteger("--frames", value(), 1, 1000);
-        else if (a == "--cache-dir")
-            cacheDir = value();
-        else if (a == "--json")
-            jsonPath = value();
-        else if (a == "--gl")
-            gl = value();
-        else if (a == "--timing")
-            timerQueries = parseTiming(value());
-        else
-            throw UsageError("unknown option '" + a + "' (see --help)");
-    }
+    cli::OptionTable options;
+    addRunOptions(options, o, "none, rsm_gather");
+    options
+        .value("--reference", "MODE",
+               "reference mode, repeatable (default: one-bounce-unoccluded, one-bounce)",
+               [&](const std::string& v) { modes.push_back(v); })
+        .integer("--spp", "N", "reference samples per pixel at most", 1, 1000000, ro.spp)
+        .number(
+            "--noise-target", "R",
+            "stop each reference once its indirect light's relative noise is at most R (0 = exactly --spp "
+            "samples)",
+            0, 0.5, ro.noiseTarget)
+        .value(
+            "--caustic-min-roughness", "R",
+            "leave out of the reference the lights' reflection off specular lobes smoother than R reaching a "
+            "rougher surface (caustics the GL pipeline does not render; biased), 0..1 (default 0 = unbiased; "
+            "docs/nondiffuse.md)",
+            [&](const std::string& v) {
+                ro.causticMinRoughness =
+                    static_cast<float>(cli::parseNumber("--caustic-min-roughness", v, 0, 1));
+            })
+        .value("--cache-dir", "DIR", "reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)",
+               [&](const std::string& v) { cacheDir = v; });
+    if (printedHelp(args, kTableHelp, options)) return 0;
+    options.parse(args);
+    const std::string& sceneName = o.scene;
+    const std::string& jsonPath = o.json;
+    const std::string& gl = o.gl;
+    const int width = o.width, height = o.height, frames = o.frames;
+    const bool timerQueries = o.timerQueries;
+    std::vector<Config>& configs = o.configs;
     if (configs.empty()) configs = {parseConfig("none"), parseConfig("rsm_gather")};
     if (modes.empty()) modes = {"one-bounce-unoccluded", "one-bounce"};
 
