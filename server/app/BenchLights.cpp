@@ -75,12 +75,7 @@ int lights(const std::vector<std::string>& args) {
             options))
         return 0;
     options.parse(args);
-    const std::string& sceneName = o.scene;
-    const std::string& jsonPath = o.json;
-    const std::string& gl = o.gl;
-    const int width = o.width, height = o.height, frames = o.frames;
-    const bool timerQueries = o.timerQueries;
-    std::vector<Config>& configs = o.configs;
+    auto& [sceneName, width, height, frames, configs, jsonPath, gl, timerQueries] = o;
     if (configs.empty())
         for (const char* t : {"none", "rsm_gather", "ssbc", "multires_splat", "multires_gather", "isr",
                               "hier_isr", "second_order"})

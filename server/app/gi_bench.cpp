@@ -97,12 +97,7 @@ int passes(const std::vector<std::string>& args) {
                   [&](const std::string& v) { baseline = {parseConfig(v)}; });
     if (printedHelp(args, kPassesHelp, options)) return 0;
     options.parse(args);
-    const std::string& sceneName = o.scene;
-    const std::string& jsonPath = o.json;
-    const std::string& gl = o.gl;
-    const int width = o.width, height = o.height, frames = o.frames;
-    const bool timerQueries = o.timerQueries;
-    std::vector<Config>& configs = o.configs;
+    auto& [sceneName, width, height, frames, configs, jsonPath, gl, timerQueries] = o;
     if (configs.empty()) configs = {parseConfig("multires_splat"), parseConfig("multires_gather")};
 
     auto scene = std::make_shared<gis::Scene>(gis::loadScene(sceneName));
@@ -255,12 +250,7 @@ int table(const std::vector<std::string>& args) {
                [&](const std::string& v) { cacheDir = v; });
     if (printedHelp(args, kTableHelp, options)) return 0;
     options.parse(args);
-    const std::string& sceneName = o.scene;
-    const std::string& jsonPath = o.json;
-    const std::string& gl = o.gl;
-    const int width = o.width, height = o.height, frames = o.frames;
-    const bool timerQueries = o.timerQueries;
-    std::vector<Config>& configs = o.configs;
+    auto& [sceneName, width, height, frames, configs, jsonPath, gl, timerQueries] = o;
     if (configs.empty()) configs = {parseConfig("none"), parseConfig("rsm_gather")};
     if (modes.empty()) modes = {"one-bounce-unoccluded", "one-bounce"};
 
