@@ -9,6 +9,14 @@ import { checkTypedNumber, controlSpec, orderedProperties, paramHelp } from './p
 export { GUI };
 
 /** A collapsible sidebar section titled `title`, appended to `container`. */
+/** A DOM element: `tag` with `className` and, when given, `text`. */
+export function block(tag, className, text) {
+    const el = document.createElement(tag);
+    if (className) el.className = className;
+    if (text !== undefined) el.textContent = text;
+    return el;
+}
+
 export function makeSection(container, title, { id, closed = false } = {}) {
     const gui = new GUI({ container, title, closeFolders: false });
     gui.domElement.classList.add('section');

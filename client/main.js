@@ -1,42 +1,43 @@
-// App wiring: connection and session role, frame display, the sidebar sections, the stats overlay,
-// refinement progress and the busy badge, the lights panel and gizmo, and the accuracy view. The
-// pure pieces live in their own modules (protocol, camera, light, lights, params, stats, progress,
-// budget, restore, accuracy, messages, upload); this file talks to the DOM.
+// App wiring: the connection and session role, sending and the outbox, receiving, frame decode and
+// draw, the stats overlay, refinement progress and the busy badge, the light gizmo, uploads and the
+// page's state (a Store whose topics the sidebar sections in sections/ subscribe to; no section calls
+// another). The pure pieces live in their own modules (protocol, camera, light, lights, params,
+// stats, progress, budget, restore, accuracy, messages, upload, store).
 
 import {
     ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, lightAddMsg, lightMsg, lightRemoveMsg, paramsMsg,
     isKnownServerMessage, parseFrameHeader, parseServerMessage, pingMsg, qualityMsg, resizeMsg, sceneMsg,
     snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
 } from './protocol.js';
-import { CLIENT_SCHEMAS, RENDER_REQUEST_SCHEMA } from './schemas.js';
-import {
-    DRAG_TOOLS, MAX_FOV_DEG, MIN_FOV_DEG, OrbitCamera, attachViewControls, boundsSphere, withOrbitTarget,
-} from './camera.js';
+import { CLIENT_SCHEMAS } from './schemas.js';
+import { OrbitCamera, attachViewControls, boundsSphere, withOrbitTarget } from './camera.js';
 import { aimLight, gizmoKinds, moveLight } from './light.js';
-import {
-    LIGHT_TYPES, applyLightChanges, intensityUnit, lightLabel, lightStatuses, lightType, lightingLines, lightsOfState,
-    newLightFor, pickSelection,
-} from './lights.js';
+import { applyLightChanges, lightsOfState, newLightFor, pickSelection } from './lights.js';
 import { StreamConnection, formatCountdown, pageOptions, shareLink, streamUrl } from './connection.js';
-import { ParamPanel, addBlock, describe, makeSection } from './controls.js';
-import { presetChanges, resetPlan, schemaDefaults } from './params.js';
+import { block } from './controls.js';
+import { resetPlan, schemaDefaults } from './params.js';
 import { LatencyTracker, PassHistory, RateCounter, formatBytes, formatMs, networkMs } from './stats.js';
 import { DEFAULT_FRAME_TARGET_MS, InputWatch, RefineTracker, busyText, formatSeconds } from './progress.js';
 import {
-    DEFAULT_PIXEL_BUDGET, PIXEL_BUDGETS, budgetLine, budgetViewport, frameTargetOptions, frameTargetSupported,
-    normalizeFrameTarget, normalizePixelBudget,
+    DEFAULT_PIXEL_BUDGET, budgetLine, budgetViewport, frameTargetSupported, normalizeFrameTarget,
+    normalizePixelBudget,
 } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
-import { notShownLines, notShownSummary } from './scene-notes.js';
 import { enqueueFrame, patchPlacement } from './frames.js';
 import { PassChart } from './chart.js';
 import { LightGizmo } from './gizmo.js';
-import {
-    COMPARE_MODES, COMPARE_RANGES, DEFAULT_COMPARE, buildCompareRequest, canCompare, compareSettings, diffImage,
-    formatCompare, referenceLabel, validateCompareRequest, viewKey,
-} from './accuracy.js';
-import { MessageStack, describeError, describeHttpError, noticeFor } from './messages.js';
-import { uploadScene, uploadName } from './upload.js';
+import { DEFAULT_COMPARE, compareSettings } from './accuracy.js';
+import { MessageStack, describeError, noticeFor } from './messages.js';
+import { bindUploads } from './uploads.js';
+import { Store } from './store.js';
+import { createAccuracySection } from './sections/accuracy.js';
+import { createCameraSection } from './sections/camera.js';
+import { createLightSection } from './sections/light.js';
+import { createQualitySection } from './sections/quality.js';
+import { createSceneSection } from './sections/scene.js';
+import { createShareSection } from './sections/share.js';
+import { createStatsSection } from './sections/stats.js';
+import { createTechniqueSection } from './sections/technique.js';
 
 const RESIZE_DEBOUNCE_MS = 200;
 const MESSAGE_HIDE_MS = 8000;
@@ -55,10 +56,6 @@ const NARROW_QUERY = '(max-width: 760px)';
 // Errors after which the server closes the connection and retrying the same hello cannot help.
 const FATAL_ERRORS = new Set(['hello_required', 'protocol_mismatch', 'unauthorized', 'unknown_view_token',
     'session_ended', 'idle_timeout']);
-
-const TOOL_NAMES = {
-    orbit: 'orbit', pan: 'pan', zoom: 'zoom', fly: 'fly (WASD + look)', 'light-aim': 'aim light', 'light-move': 'move light',
-};
 
 const $ = (id) => document.getElementById(id);
 const ui = {
@@ -131,8 +128,11 @@ function saveSettings() {
     } catch { /* private mode: settings last for this page only */ }
 }
 
-const state = {
+// The page's state and its change notices: the sections subscribe to the topics (store.js).
+const store = new Store({
     viewer: page.view !== undefined, // joined with a view token: watch only
+    adaptive: true, // adaptive quality (the Technique section's toggle; welcome and restores set it)
+    viewport: null, // the last {size, dpr} announced in hello or resize
     welcome: null,
     techniques: new Map(), // name -> technique description from welcome
     technique: null,
@@ -169,7 +169,8 @@ const state = {
     connState: 'connecting',
     compare: null, // {request, key, result, image (canvas), at}
     compareRunning: null, // {abort, started}
-};
+});
+const state = store.state;
 
 const camera = new OrbitCamera();
 const rate = new RateCounter(1000);
@@ -206,7 +207,7 @@ const hook = {
     get compare() { return state.compare?.result ?? null; },
     get rttMs() { return state.rttMs; },
     get latencyMs() { return latency.typical; },
-    viewport: null, // the last {size, dpr} announced in hello or resize
+    get viewport() { return state.viewport ? structuredClone(state.viewport) : null; },
     sent: [], // the last messages sent, oldest first (camera, ack and ping left out: they would crowd the rest)
     get refine() { return refine.view(performance.now()); },
     get busy() { return ui.busy.hidden ? null : ui.busy.textContent; },
@@ -265,8 +266,8 @@ function sendResize(force = false) {
     if (!force && key === lastSize) return;
     if (send(resizeMsg(size[0], size[1], dpr))) {
         lastSize = key;
-        hook.viewport = { size, dpr };
-        qualityGui.update();
+        state.viewport = { size, dpr };
+        store.emit('viewport');
     }
 }
 
@@ -310,7 +311,7 @@ function scheduleCamera() {
     outbox.camera = true;
     scheduleFlush();
     gizmo.render();
-    cameraGui.update();
+    store.emit('camera');
 }
 
 function selectedLight() {
@@ -328,12 +329,12 @@ function changeLight(changes, id = state.selectedLightId) {
     outbox.lights.set(key, { ...(outbox.lights.get(key) ?? {}), ...structuredClone(changes) });
     scheduleFlush();
     gizmo.render();
-    lightGui.update();
+    store.emit('lights');
 }
 
 function selectLight(id) {
     state.selectedLightId = id;
-    lightGui.update();
+    store.emit('lights');
     gizmo.render();
 }
 
@@ -363,14 +364,13 @@ function sendParamsNow(values) {
     const problem = validateParamValues(values, technique?.params_schema, state.welcome?.frame_params_schema);
     if (problem) {
         showMessage(`Not sent: ${problem.where}: ${problem.message}`);
-        paramPanel.update(state.params, { force: true });
+        store.emit('params', state.params, { force: true });
         return;
     }
     if (steer(paramsMsg(values))) {
         Object.assign(state.params, values);
         for (const name of Object.keys(values)) state.explicit.add(name);
-        paramPanel.update(values);
-        sceneGui.update();
+        store.emit('params', values);
     }
 }
 
@@ -382,7 +382,7 @@ function buildHello() {
     if (state.viewer) return helloMsg({ ...common, view: page.view });
     const { size, dpr } = currentViewport();
     lastSize = `${size[0]}x${size[1]}@${dpr}`;
-    hook.viewport = { size, dpr };
+    state.viewport = { size, dpr };
     // Only where this page's schema copy has the field: an older server refuses a hello with it.
     const target = settings.frameTargetMs !== null && frameTargetSupported(null, CLIENT_SCHEMAS, 'hello')
         ? settings.frameTargetMs : undefined;
@@ -398,7 +398,7 @@ function frameTargetMs() {
 
 /** The quality message for the current adaptive choice and, where the server takes one, the frame target. */
 function sendQuality() {
-    const adaptive = techniqueGui.model.adaptive;
+    const adaptive = state.adaptive;
     const target = frameTargetSupported(state.welcome, CLIENT_SCHEMAS)
         ? settings.frameTargetMs ?? state.welcome?.limits?.frame_target_ms : undefined;
     if (!steer(qualityMsg(adaptive, Number.isInteger(target) ? target : undefined))) return false;
@@ -434,7 +434,7 @@ function handleClose(code) {
 function snapshotSession() {
     return sessionSnapshot({
         scene: state.scene, technique: state.technique, params: state.params, explicit: state.explicit,
-        camera: camera.toCamera(), adaptive: techniqueGui.model.adaptive,
+        camera: camera.toCamera(), adaptive: state.adaptive,
         lights: state.lightList ? state.lights : undefined,
     });
 }
@@ -497,7 +497,7 @@ function handleError(msg) {
         if (index >= 0) state.lightOps.splice(index, 1);
     } else if (msg.code === 'invalid_param' || msg.code === 'limit_exceeded') {
         // The server kept its values: show them again (the next stats carry what it renders).
-        paramPanel.update(state.params, { force: true });
+        store.emit('params', state.params, { force: true });
     }
 }
 
@@ -518,11 +518,10 @@ function handleWelcome(msg) {
     }
     state.techniques = new Map((msg.techniques ?? []).map((t) => [t.name, t]));
     state.scenes = msg.scenes ?? [];
-    techniqueGui.setTechniques([...state.techniques.keys()]);
-    techniqueGui.adaptive(msg.adaptive !== false);
-    shareGui.update();
+    store.emit('techniques', [...state.techniques.keys()]);
+    store.emit('adaptive', msg.adaptive !== false);
     applyState(msg.state ?? {}, { resumed: msg.resumed === true, fresh: true });
-    qualityGui.update();
+    store.emit('welcome');
     // A resumed session still has the viewport of before the outage (or the reload).
     if (msg.resumed) sendResize(true);
     const saved = state.restore;
@@ -547,13 +546,13 @@ function restoreSession(saved, welcome) {
     const restored = [];
     let quality = null;
     if (plan.adaptive !== null) {
-        techniqueGui.adaptive(plan.adaptive);
+        store.emit('adaptive', plan.adaptive);
         if (sendQuality()) quality = plan.adaptive ? 'adaptive quality' : 'fixed quality';
     }
     if (plan.scene) {
         if (steer(sceneMsg(plan.scene))) {
             state.scene = plan.scene;
-            sceneGui.setScenes();
+            store.emit('scenes');
             state.restoreAfterScene = { scene: plan.scene, messages, saved };
             restored.push(plan.scene);
         }
@@ -588,7 +587,7 @@ function sendRestoreMessages(messages) {
             if (steer(msg)) state.lightOps.push(msg.type === 'light_add' ? 'add' : 'remove');
         } else if (msg.type === 'camera') {
             camera.set(msg);
-            cameraGui.update();
+            store.emit('camera');
             steer(cameraMsg(camera.toCamera()));
             gizmo.render();
         }
@@ -602,7 +601,7 @@ function sendRestoreMessages(messages) {
 function applyState(s, { resumed = false, fresh = false } = {}) {
     if (s.scene !== undefined) state.scene = s.scene;
     state.serverScene = state.scene;
-    sceneGui.setScenes();
+    store.emit('scenes');
     if (s.bounds !== undefined) state.bounds = boundsSphere(s.bounds) ? structuredClone(s.bounds) : null;
     else if (s.scene !== undefined) state.bounds = null;
     if (s.camera) {
@@ -613,9 +612,9 @@ function applyState(s, { resumed = false, fresh = false } = {}) {
         if (s.scene_camera) camera.setHome(withOrbitTarget(s.scene_camera, state.bounds));
         else if (!resumed) camera.setHome(current);
         camera.set(current);
-        cameraGui.update();
+        store.emit('camera');
     }
-    cameraGui.setBounds(Boolean(state.bounds));
+    store.emit('bounds', Boolean(state.bounds));
     const lights = lightsOfState(s);
     if (lights) {
         showLights(lights, s, {});
@@ -625,8 +624,7 @@ function applyState(s, { resumed = false, fresh = false } = {}) {
     }
     if (s.params) state.params = { ...s.params };
     if (s.technique !== undefined || fresh) showTechnique(s.technique ?? state.technique);
-    else paramPanel.update(state.params);
-    sceneGui.update();
+    store.emit('params', state.params);
     gizmo.render();
 }
 
@@ -663,8 +661,8 @@ function showLights(lights, s, { expectAdded = false }) {
     state.lightList = Array.isArray(s.lights);
     if (s.lighting) state.lighting = s.lighting;
     state.selectedLightId = pickSelection(previousIds, state.lights, state.selectedLightId, { expectAdded });
-    lightGui.update();
-    lightGui.showLighting(state.lastDrawn?.stats?.lighting ?? state.lighting);
+    store.emit('lights');
+    store.emit('lighting', state.lastDrawn?.stats?.lighting ?? state.lighting);
     gizmo.render();
 }
 
@@ -792,16 +790,13 @@ function recordDraw(frame, decodeMs, frameBytes) {
     }
     if (state.viewer && stats?.scene && stats.scene !== state.scene) {
         state.scene = stats.scene;
-        sceneGui.setScenes();
+        store.emit('scenes');
     }
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
-    sceneGui.showPlan(stats?.plan, stats?.nondiffuse);
-    sceneGui.showNotShown(stats?.not_shown);
     noteDefaultLighting(stats?.lighting);
-    lightGui.showLighting(stats?.lighting ?? state.lighting);
-    statsGui.showDetails(stats);
-    accuracyGui.frameDrawn();
+    store.emit('lighting', stats?.lighting ?? state.lighting);
+    store.emit('frame', stats);
     gizmo.render();
     showProgress();
 }
@@ -876,16 +871,7 @@ function showFrameStats(header, stats, { decodeMs, net, bytes }) {
         `${header.width}×${header.height} ${stats?.codec ?? header.codec}`,
         `${stats?.quality ?? '–'}${stats?.refined ? ' (refined)' : ''}${stats?.snapshot ? ' snapshot' : ''}`,
     ].join(' · ');
-    showAccuracyLine();
-}
-
-function showAccuracyLine() {
-    const result = state.compare?.result;
-    ui.ovAccuracy.hidden = !result;
-    if (!result) return;
-    const f = formatCompare(result);
-    const stale = accuracyGui.stale() ? ' (earlier view)' : '';
-    ui.ovAccuracy.textContent = `${f.overlay} vs ${state.compare.request.compare.mode}${stale}`;
+    store.emit('rate');
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -896,10 +882,7 @@ function setRole(viewer) {
     state.viewer = viewer;
     document.body.classList.toggle('viewer', viewer);
     showRoleBadge();
-    for (const section of [techniqueGui.gui, lightGui.gui, cameraGui.gui, accuracyGui.gui]) section.show(!viewer);
-    qualityGui.setViewer(viewer);
-    sceneGui.setViewer(viewer);
-    shareGui.setViewer(viewer);
+    store.emit('role', viewer);
     gizmo.enabled = !viewer;
     gizmo.render();
 }
@@ -1003,179 +986,26 @@ function noteDefaultLighting(lighting) {
     showMessage(`Default lighting: ${lighting.note}. Ctrl-drag moves it, like any light.`, 'info');
 }
 
-function block(tag, className, text) {
-    const el = document.createElement(tag);
-    if (className) el.className = className;
-    if (text !== undefined) el.textContent = text;
-    return el;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Sidebar sections
 
-const sceneGui = (() => {
-    const gui = makeSection(ui.sections, 'Scene', { id: 'scene' });
-    const model = { scene: '', autoEffects: false, upload: () => ui.fileInput.click() };
-    let sceneCtl = describe(gui.add(model, 'scene', ['']).name('scene'), 'scene',
-        'built-in scenes, the server\'s scene directories and this session\'s uploads');
-    sceneCtl.onChange((name) => {
-        if (!name || name === state.scene) return;
-        flushOutbox();
-        if (steer(sceneMsg(name))) state.scene = name;
-    });
-    const uploadCtl = describe(gui.add(model, 'upload').name('Upload .glb or .zip…'), 'upload',
-        'a .glb, or a .zip holding a .gltf with its .bin and textures; or drop one on the view. '
-        + 'It is loaded for this session only');
-    const progress = addBlock(gui, block('div', 'upload-progress block'));
-    progress.hidden = true;
-    const bar = progress.appendChild(Object.assign(document.createElement('progress'), { max: 1, value: 0 }));
-    const progressText = progress.appendChild(block('span', 'upload-text'));
-    const effectsCtl = describe(gui.add(model, 'autoEffects').name('plan effects'), 'auto-effects',
-        'effects = auto: the server measures which lighting effects this view needs and switches the rest off');
-    effectsCtl.onChange((on) => queueParams({ effects: on ? 'auto' : 'manual' }));
-    // What the file asks for and is not shown (stats.not_shown): hidden while there is nothing.
-    const notes = addBlock(gui, block('div', 'not-shown block'));
-    notes.dataset.block = 'not-shown';
-    notes.hidden = true;
-    const notesSummary = notes.appendChild(block('p', 'not-shown-summary'));
-    const notesList = notes.appendChild(block('ul', 'not-shown-list'));
-    let lastNotesKey = '';
-    const planFolder = gui.addFolder('effect plan');
-    planFolder.domElement.dataset.folder = 'plan';
-    const plan = addBlock(planFolder, block('div', 'plan block'));
-    plan.dataset.block = 'plan';
-    const planSummary = plan.appendChild(block('p', 'plan-summary'));
-    const planList = plan.appendChild(block('ul', 'plan-list'));
-    let lastPlanKey = '';
+// What the sections get: the page's parts and the actions they may take. Sections never call each
+// other: what one changes reaches the rest as a store topic.
+const app = {
+    ui, state, settings, saveSettings, store, camera, chart, authHeaders,
+    actions: {
+        send, steer, flushOutbox, queueParams, sendQuality, sendResize, showMessage, showTechnique,
+        forgetTechniqueParams, resetParams, addLight, removeSelectedLight, changeLight, selectLight,
+        scheduleCamera, resetCamera, frameModel, copyShareLink, requestSnapshot,
+    },
+};
+store.on('gizmo', () => {
+    gizmo.visible = settings.gizmo;
+    gizmo.render();
+});
+createSceneSection(app);
 
-    return {
-        gui,
-        setScenes() {
-            const names = [...new Set([...state.scenes, ...state.uploads, ...(state.scene ? [state.scene] : [])])];
-            model.scene = state.scene ?? '';
-            sceneCtl.options(names.length ? names : ['']);
-            sceneCtl.updateDisplay();
-        },
-        update() {
-            model.autoEffects = state.params.effects === 'auto';
-            effectsCtl.updateDisplay();
-        },
-        setViewer(viewer) {
-            sceneCtl.disable(viewer);
-            uploadCtl.show(!viewer);
-            effectsCtl.show(!viewer);
-        },
-        progress(fraction, text) {
-            progress.hidden = fraction === null;
-            if (fraction !== null) bar.value = fraction;
-            progressText.textContent = text ?? '';
-        },
-        /**
-         * The effect plan of the frame on screen: each effect on or off, and why. Without a plan the
-         * renderer's own non-diffuse decisions (stats.nondiffuse: "on: reason" / "off: reason") are
-         * listed, since they run whatever the mode.
-         */
-        showNotShown(notShown) {
-            const lines = notShownLines(notShown);
-            const key = JSON.stringify(lines);
-            if (key === lastNotesKey) return;
-            lastNotesKey = key;
-            notes.hidden = lines.length === 0;
-            notesSummary.textContent = notShownSummary(lines);
-            notesList.replaceChildren(...lines.map((line) => {
-                const li = block('li', 'not-shown-item', line.text);
-                li.dataset.feature = line.feature;
-                return li;
-            }));
-        },
-        showPlan(p, nondiffuse) {
-            const key = `${state.params.effects}:${JSON.stringify(p ?? null)}:${JSON.stringify(nondiffuse ?? null)}`;
-            if (key === lastPlanKey) return;
-            lastPlanKey = key;
-            if (!p || p.mode === 'manual' || !Array.isArray(p.decisions)) {
-                planSummary.textContent = 'Manual: the technique\'s parameters decide which effects run. '
-                    + 'Turn on "plan effects" to let the server measure what this view needs.';
-                const entries = Object.entries(nondiffuse ?? {});
-                planList.replaceChildren(...entries.map(([effect, text]) => {
-                    const on = String(text).startsWith('on');
-                    const li = block('li', `decision ${on ? 'on' : 'off'}`);
-                    li.dataset.effect = effect;
-                    const head = li.appendChild(block('div', 'decision-head'));
-                    head.append(block('span', 'decision-name', effect), block('span', 'badge', on ? 'on' : 'off'));
-                    li.append(block('div', 'decision-reason', String(text).replace(/^(on|off): /, '')));
-                    return li;
-                }));
-                return;
-            }
-            const why = state.params.effects === 'auto' ? 'planned for this view'
-                : 'planned by the final refinement step (adaptive quality)';
-            planSummary.textContent = `Effects ${why}, from ${p.rays ?? '?'} rays `
-                + `in ${Number.isFinite(p.analysis_ms) ? p.analysis_ms.toFixed(0) : '?'} ms:`;
-            planList.replaceChildren(...p.decisions.map((d) => {
-                const li = block('li', `decision ${d.enabled ? 'on' : 'off'}`);
-                li.dataset.effect = d.effect;
-                const head = li.appendChild(block('div', 'decision-head'));
-                head.append(block('span', 'decision-name', d.effect),
-                    block('span', 'badge', `${d.enabled ? 'on' : 'off'}${d.forced ? ', forced' : ''}`
-                        + `${d.available === false ? ', no knob' : ''}`));
-                li.append(block('div', 'decision-reason', d.reason ?? ''));
-                return li;
-            }));
-        },
-    };
-})();
-
-const techniqueGui = (() => {
-    const gui = makeSection(ui.sections, 'Technique & parameters', { id: 'technique' });
-    const model = {
-        technique: '', adaptive: true, help: settings.help,
-        reset: () => resetParams(),
-    };
-    const techniqueCtl = describe(gui.add(model, 'technique', ['']).name('technique'), 'technique',
-        'the global-illumination technique; its parameters reset to their defaults');
-    techniqueCtl.onChange((name) => {
-        if (!name || name === state.technique) return;
-        flushOutbox(); // parameters still queued belong to the technique before
-        if (!steer(techniqueMsg(name))) return;
-        const technique = state.techniques.get(name);
-        Object.assign(state.params, schemaDefaults(technique?.params_schema));
-        forgetTechniqueParams();
-        showTechnique(name);
-    });
-    const info = addBlock(gui, block('p', 'technique-info block'));
-    describe(gui.add(model, 'adaptive').name('adaptive quality'), 'adaptive',
-        'render quickly while you steer, then refine the still view (balanced, then final preset)')
-        .onChange(() => sendQuality());
-    describe(gui.add(model, 'help').name('show help'), 'help', 'show each parameter\'s description, range and source')
-        .onChange((on) => {
-            settings.help = on;
-            saveSettings();
-            ui.sidebar.classList.toggle('show-help', on);
-        });
-    describe(gui.add(model, 'reset').name('Reset parameters'), 'reset-params',
-        'every parameter back to its default; the technique\'s parameters follow the adaptive presets again');
-    ui.sidebar.classList.toggle('show-help', settings.help);
-    return {
-        gui,
-        model,
-        setTechniques(names) {
-            techniqueCtl.options(names.length ? names : ['']);
-        },
-        adaptive(on) {
-            model.adaptive = on;
-            gui.controllers.find((c) => c.property === 'adaptive')?.updateDisplay();
-        },
-        show(name) {
-            model.technique = name ?? '';
-            techniqueCtl.updateDisplay();
-            const t = state.techniques.get(name);
-            info.textContent = t ? [t.description, t.paper ? `(${t.paper})` : ''].filter(Boolean).join(' ') : '';
-        },
-    };
-})();
-
-// The generated parameter folders go at the end of the Technique section.
-const paramPanel = new ParamPanel(techniqueGui.gui);
+createTechniqueSection(app);
 
 /** A technique message makes the server forget explicit technique parameters; frame parameters stay. */
 function forgetTechniqueParams() {
@@ -1201,274 +1031,21 @@ function resetParams() {
         forgetTechniqueParams();
     }
     if (Object.keys(plan.frame).length > 0) sendParamsNow(plan.frame);
-    paramPanel.update(state.params, { force: true });
-    sceneGui.update();
+    store.emit('params', state.params, { force: true });
     if (!plan.technique && Object.keys(plan.frame).length === 0) showMessage('Every parameter is at its default.', 'info');
 }
 
-/** Rebuilds the parameter folders for technique `name` with the session's values. */
+/** Technique `name` with the session's values: its section rebuilds the parameter folders. */
 function showTechnique(name) {
     state.technique = name;
-    techniqueGui.show(name);
-    const technique = state.techniques.get(name);
-    paramPanel.build([
-        { title: `${name ?? 'technique'} parameters`, schema: technique?.params_schema },
-        { title: 'frame parameters', schema: state.welcome?.frame_params_schema, closed: true },
-    ], state.params, (param, value) => queueParams({ [param]: value }), { onRefuse: (text) => showMessage(text) });
+    store.emit('technique', name);
 }
 
-const qualityGui = (() => {
-    const gui = makeSection(ui.sections, 'Resolution & quality', { id: 'quality' });
-    const model = { frameTarget: settings.frameTargetMs ?? 'default', pixelBudget: settings.pixelBudget };
-    const targetCtl = describe(gui.add(model, 'frameTarget', frameTargetOptions(null)).name('frame time target'),
-        'frame-target', 'what interactive frames must take at most while you steer: smooth renders fewer VPLs and '
-        + 'pixels, sharp more; refinement of the still view follows');
-    targetCtl.onChange((v) => {
-        settings.frameTargetMs = v === 'default' ? null : v;
-        saveSettings();
-        sendQuality();
-        update();
-    });
-    const budgetCtl = describe(gui.add(model, 'pixelBudget', Object.fromEntries(PIXEL_BUDGETS.map((b) => [b.label, b.px])))
-        .name('pixel budget'), 'pixel-budget',
-    'the most pixels a frame may have: on high-density screens the device pixel ratio sent to the server is lowered '
-        + 'to stay within it');
-    budgetCtl.onChange((v) => {
-        settings.pixelBudget = v;
-        saveSettings();
-        sendResize();
-        update();
-    });
-    const info = addBlock(gui, block('div', 'quality-info block'));
-    info.dataset.block = 'quality-info';
+createQualitySection(app);
 
-    function update() {
-        const supported = frameTargetSupported(state.welcome, CLIENT_SCHEMAS);
-        targetCtl.show(supported && !state.viewer);
-        if (supported) {
-            targetCtl.options(frameTargetOptions(state.welcome?.limits?.frame_target_ms));
-            model.frameTarget = settings.frameTargetMs ?? 'default';
-            targetCtl.updateDisplay();
-        }
-        const vp = hook.viewport;
-        const lines = [];
-        if (vp) {
-            const device = window.devicePixelRatio || 1;
-            const px = [Math.round(vp.size[0] * vp.dpr), Math.round(vp.size[1] * vp.dpr)];
-            lines.push(['frame size', `${px[0]}×${px[1]} (${(px[0] * px[1] / 1e6).toFixed(2)} MP)`]);
-            lines.push(['pixel ratio', vp.dpr < device ? `${vp.dpr} of this screen's ${device}` : String(vp.dpr)]);
-        }
-        if (state.frameTargetMs !== null) lines.push(['session target', `${state.frameTargetMs} ms`]);
-        const slice = state.welcome?.limits?.slice_ms;
-        if (Number.isFinite(slice)) lines.push(['refinement slice', `${slice} ms`]);
-        info.replaceChildren(...lines.map(([k, v]) => {
-            const div = block('div', 'kv');
-            div.append(block('span', 'k', k), block('span', 'v', v));
-            return div;
-        }));
-    }
+createLightSection(app);
 
-    return {
-        gui,
-        update,
-        setViewer(viewer) {
-            gui.show(!viewer);
-        },
-    };
-})();
-
-const lightGui = (() => {
-    const gui = makeSection(ui.sections, 'Light', { id: 'light' });
-    const model = {
-        addType: 'point',
-        add: () => addLight(model.addType),
-        remove: () => removeSelectedLight(),
-        enabled: true, intensity: 1, color: [1, 1, 1], cone_deg: 45, gizmo: settings.gizmo,
-        reset: () => {
-            const light = state.light;
-            const home = light ? state.lightHomes.get(light.id ?? '') : null;
-            if (home) changeLight(structuredClone(home), light.id ?? null);
-        },
-    };
-    const list = addBlock(gui, block('ul', 'light-list block'));
-    list.dataset.block = 'lights';
-    const addTypeCtl = describe(gui.add(model, 'addType', [...LIGHT_TYPES]).name('new light'), 'light-add-type',
-        'the type of light "Add light" adds: a spot, a point light (shines every way) or a directional light '
-        + '(parallel rays, like the sun)');
-    const addCtl = describe(gui.add(model, 'add').name('Add light'), 'light-add',
-        'adds a light of the type above, placed from the current view: a point light above the orbit target, '
-        + 'a directional light shining along the view and somewhat down, a spot aimed at the target');
-    const removeCtl = describe(gui.add(model, 'remove').name('Remove selected light'), 'light-remove',
-        'removes the selected light from this session');
-    const folder = gui.addFolder('selected light');
-    folder.domElement.dataset.folder = 'selected-light';
-    const enabledCtl = describe(folder.add(model, 'enabled').name('on'), 'light-enabled', 'the selected light on or off');
-    enabledCtl.onChange((v) => changeLight({ enabled: v }));
-    let intensityMax = 100;
-    const intensityCtl = describe(folder.add(model, 'intensity', 0, intensityMax, 0.1).name('intensity (cd)'),
-        'light-intensity', 'luminous intensity in candela; for a directional light, illuminance in lux');
-    intensityCtl.onChange((v) => changeLight({ intensity: v }));
-    const colorCtl = describe(folder.addColor(model, 'color', 1).name('colour'), 'light-color',
-        'the light\'s colour (linear RGB)');
-    colorCtl.onChange((v) => changeLight({ color: v.map((c) => Math.round(c * 1e4) / 1e4) }));
-    const coneCtl = describe(folder.add(model, 'cone_deg', 1, 85, 0.5).name('cone (deg)'), 'light-cone',
-        'outer half-angle of the spot cone, 1 to 85 degrees');
-    coneCtl.onChange((v) => changeLight({ cone_deg: v }));
-    const resetCtl = describe(folder.add(model, 'reset').name('Reset light'), 'light-reset',
-        'back to the light as the scene defined it (lights added here have none)');
-    describe(gui.add(model, 'gizmo').name('show gizmo'), 'light-gizmo',
-        'handles in the view for the selected light: drag the disc to move it, the small dot to aim it')
-        .onChange((on) => {
-            settings.gizmo = on;
-            saveSettings();
-            gizmo.visible = on;
-            gizmo.render();
-        });
-    const status = addBlock(gui, block('div', 'lighting-status block'));
-    status.dataset.block = 'lighting';
-    addBlock(gui, block('p', 'hint block',
-        'Click a light to edit it. Drag the gizmo in the view, or Ctrl-drag to aim and Ctrl+Shift-drag to move '
-        + 'the selected light (touch: pick "aim light" or "move light" as the drag tool under Camera). A point '
-        + 'light only moves, a directional light only turns.'));
-    let listKey = '';
-    let statusKey = '';
-    let rows = new Map(); // light id ('' without ids) -> its row in the list
-
-    function renderList() {
-        const selected = state.light;
-        const key = JSON.stringify([state.lights.map((l) => [l.id, l.name, l.type, l.enabled]), selected?.id ?? null]);
-        if (key === listKey) return;
-        listKey = key;
-        statusKey = '';
-        rows = new Map();
-        list.replaceChildren(...state.lights.map((light) => {
-            const id = light.id ?? null;
-            const li = block('li', 'light-row');
-            li.dataset.lightId = id ?? '';
-            li.classList.toggle('selected', light === selected);
-            const pick = li.appendChild(block('button', 'light-select'));
-            pick.type = 'button';
-            pick.title = 'edit this light';
-            pick.setAttribute('aria-pressed', String(light === selected));
-            pick.append(block('span', 'light-name', lightLabel(light)), block('span', 'light-type', lightType(light)));
-            pick.addEventListener('click', () => selectLight(id));
-            const toggle = li.appendChild(Object.assign(document.createElement('input'), {
-                type: 'checkbox', className: 'light-toggle', checked: light.enabled !== false,
-            }));
-            toggle.setAttribute('aria-label', `${lightLabel(light)} on`);
-            toggle.title = 'on or off';
-            toggle.addEventListener('change', () => changeLight({ enabled: toggle.checked }, id));
-            const reason = li.appendChild(block('div', 'light-reason'));
-            reason.hidden = true;
-            rows.set(id ?? '', { li, reason });
-            return li;
-        }));
-        if (state.lights.length === 0) list.append(block('li', 'hint', 'No lights: add one below.'));
-    }
-
-    return {
-        gui,
-        update() {
-            renderList();
-            addTypeCtl.show(state.lightList);
-            addCtl.show(state.lightList);
-            removeCtl.show(state.lightList);
-            const l = state.light;
-            removeCtl.disable(!l?.id);
-            folder.show(Boolean(l));
-            if (!l) return;
-            folder.title(`${lightLabel(l)} (${lightType(l)})`);
-            model.enabled = l.enabled !== false;
-            // The server's floats (60.000003814697266) shown as the numbers they stand for.
-            const round = (v, digits) => Math.round(v * 10 ** digits) / 10 ** digits;
-            model.intensity = round(l.intensity ?? model.intensity, 3);
-            if (model.intensity > intensityMax) {
-                intensityMax = Math.ceil(model.intensity * 4);
-                intensityCtl.max(intensityMax);
-            }
-            intensityCtl.name(`intensity (${intensityUnit(l)})`);
-            model.color = [...(l.color ?? [1, 1, 1])];
-            model.cone_deg = round(l.cone_deg ?? model.cone_deg, 2);
-            coneCtl.show(lightType(l) === 'spot');
-            resetCtl.disable(!state.lightHomes.has(l.id ?? ''));
-            for (const c of [enabledCtl, intensityCtl, colorCtl, coneCtl]) c.updateDisplay();
-        },
-        /**
-         * What the frame on screen says about the lights (stats.lighting): the server's note, its
-         * warning, and per light whether it was rendered or why not.
-         */
-        showLighting(lighting) {
-            renderList();
-            const key = JSON.stringify([lighting ?? null, listKey]);
-            if (key === statusKey) return;
-            statusKey = key;
-            for (const st of lightStatuses(state.lights, lighting)) {
-                const row = rows.get(st.id ?? '');
-                if (!row) continue;
-                row.li.classList.toggle('rendered', st.rendered === true);
-                row.li.classList.toggle('skipped', st.rendered === false);
-                row.reason.hidden = st.rendered !== false;
-                row.reason.textContent = st.rendered === false ? `not rendered: ${st.reason}` : '';
-            }
-            status.replaceChildren(...lightingLines(lighting).map((line) => block('p', line.kind, line.text)));
-        },
-    };
-})();
-
-const cameraGui = (() => {
-    const gui = makeSection(ui.sections, 'Camera', { id: 'camera' });
-    const model = {
-        tool: DRAG_TOOLS.includes(settings.tool) ? settings.tool : 'orbit',
-        fov: 40,
-        speed: settings.flySpeed,
-        reset: () => resetCamera(),
-        frame: () => frameModel(),
-    };
-    const toolOptions = Object.fromEntries(DRAG_TOOLS.map((t) => [TOOL_NAMES[t], t]));
-    describe(gui.add(model, 'tool', toolOptions).name('drag tool'), 'drag-tool',
-        'what a drag (or one finger) does; Shift or right-drag always pans, Ctrl-drag aims the light')
-        .onChange((t) => {
-            settings.tool = t;
-            saveSettings();
-            ui.canvas.dataset.tool = t;
-        });
-    const fovCtl = describe(gui.add(model, 'fov', MIN_FOV_DEG, MAX_FOV_DEG, 1).name('field of view (deg)'), 'fov',
-        'vertical field of view');
-    fovCtl.onChange((v) => {
-        camera.setFov(v);
-        scheduleCamera();
-    });
-    describe(gui.add(model, 'speed', 0.05, 3, 0.05).name('fly speed'), 'fly-speed',
-        'WASD speed in scene sizes per second (Shift: three times as fast)')
-        .onChange((v) => {
-            settings.flySpeed = v;
-            saveSettings();
-        });
-    describe(gui.add(model, 'reset').name('Reset camera'), 'reset-camera', 'back to the scene\'s camera (Home or R)');
-    const frameCtl = describe(gui.add(model, 'frame').name('Frame the model'), 'frame-model',
-        'orbit around the model\'s centre from far enough to see all of it, keeping the view direction (.)');
-    frameCtl.show(false);
-    addBlock(gui, block('p', 'hint block',
-        'Drag: the tool above · Shift- or right-drag: pan · wheel or pinch: zoom · two fingers: pan · '
-        + 'W A S D: fly, E/Q: up/down · arrows: orbit (fly: look) · +/−: zoom · Home or R: reset · '
-        + '. (full stop): frame the model · F: fullscreen. Click the view first for the keys.'));
-    ui.canvas.dataset.tool = model.tool;
-    return {
-        gui,
-        tool: () => model.tool,
-        speed: () => model.speed * camera.sceneScale,
-        update() {
-            if (Math.abs(model.fov - camera.fovDeg) > 1e-9) {
-                model.fov = camera.fovDeg;
-                fovCtl.updateDisplay();
-            }
-        },
-        /** Framing needs the scene's bounds (protocol 2's state.bounds). */
-        setBounds(known) {
-            frameCtl.show(known);
-        },
-    };
-})();
+createCameraSection(app);
 
 function resetCamera() {
     camera.reset();
@@ -1508,194 +1085,11 @@ function showFullscreenState() {
     ui.canvas.focus({ preventScroll: true });
 }
 
-const statsGui = (() => {
-    const gui = makeSection(ui.sections, 'Stats', { id: 'stats' });
-    const model = { overlay: settings.overlay, chart: settings.chart };
-    const applyOverlay = () => {
-        ui.overlay.hidden = !settings.overlay;
-        ui.ovChart.hidden = !settings.chart;
-        ui.ovLegend.hidden = !settings.chart;
-        if (!settings.chart) ui.ovChartNote.hidden = true;
-    };
-    describe(gui.add(model, 'overlay').name('overlay'), 'stats-overlay', 'frame rate, latency and times over the view')
-        .onChange((on) => {
-            settings.overlay = on;
-            saveSettings();
-            applyOverlay();
-        });
-    describe(gui.add(model, 'chart').name('pass chart'), 'stats-chart', 'stacked per-pass GPU time, last 10 s')
-        .onChange((on) => {
-            settings.chart = on;
-            saveSettings();
-            applyOverlay();
-            if (on) chart.resize();
-        });
-    const details = addBlock(gui, block('div', 'stats-details block'));
-    details.dataset.block = 'stats-details';
-    applyOverlay();
-    const row = (label, value) => {
-        const div = block('div', 'kv');
-        div.append(block('span', 'k', label), block('span', 'v', value));
-        return div;
-    };
-    return {
-        gui,
-        showDetails(stats) {
-            if (!stats) return;
-            const changed = presetChanges(stats.params, state.params);
-            const budget = budgetLine(stats.budget);
-            const r = stats.refine;
-            details.replaceChildren(
-                row('quality', `${stats.quality ?? '–'}${stats.refined ? ' (refined)' : ''}`
-                    + `${stats.scale !== undefined ? `, scale ${stats.scale}` : ''}`),
-                ...(budget ? [row('frame budget', budget.text), row('why', budget.reason || '–')] : []),
-                ...(r ? [row('refinement', `${r.step ?? stats.quality}: ${r.tiles_done ?? '?'} tiles, `
-                    + `${Math.round(100 * (r.share ?? 0))} %, ${formatMs(r.elapsed_ms, 0)}`
-                    + `${r.vpl_parts > 1 ? `, tile at ${r.vpl_parts_done} of ${r.vpl_parts} VPL parts` : ''}`
-                    + `${r.complete ? ', complete' : `, ${formatMs(r.eta_ms, 0)} left`}`)] : []),
-                row('queue', formatMs(stats.queue_ms)),
-                row('readback', formatMs(stats.readback_ms)),
-                row('timing', stats.timing ?? '–'),
-                row('VPLs', String(stats.counts?.vpl_count ?? '–')),
-                row('triangles', String(stats.counts?.triangles ?? '–')),
-                row('dropped', String(stats.dropped_frames ?? 0)),
-                row('viewers', String(stats.viewers ?? 0)),
-                row('round trip', formatMs(state.rttMs)),
-                row('this frame differs', changed.length
-                    ? changed.map(([k, v]) => `${k}=${typeof v === 'number' ? Number(v.toPrecision(4)) : v}`).join(', ')
-                    : 'no (the panel\'s values)'),
-            );
-        },
-    };
-})();
+createStatsSection(app);
 
-const accuracyGui = (() => {
-    const gui = makeSection(ui.sections, 'Accuracy', { id: 'accuracy', closed: false });
-    const model = {
-        mode: COMPARE_MODES.includes(settings.compareMode) ? settings.compareMode : DEFAULT_COMPARE.mode,
-        // The control shows percent; the settings and the request hold the fraction.
-        noisePct: Math.round(1000 * settings.compareNoiseTarget) / 10,
-        maxSpp: settings.compareMaxSpp,
-        maxSide: settings.compareMaxSide,
-        view: settings.compareView,
-        gain: settings.diffGain,
-        measure: () => measureAccuracy(),
-    };
-    const save = (key) => (v) => {
-        settings[key] = v;
-        saveSettings();
-    };
-    const modeCtl = describe(gui.add(model, 'mode', COMPARE_MODES).name('reference'), 'compare-mode',
-        'the CPU reference the frame is measured against (one-bounce-unoccluded matches what the VPL techniques simulate)');
-    const { noiseTarget: noiseRange, maxSpp: sppRange } = COMPARE_RANGES;
-    const noiseCtl = describe(gui.add(model, 'noisePct', 100 * noiseRange.min, 100 * noiseRange.max, 0.5)
-        .name('noise target (%)'), 'compare-noise',
-        'the reference renders until its own noise, estimated from its samples\' spread, is at most this share of '
-        + 'its indirect light: lower is cleaner and slower (a direct reference is exact and ignores it)')
-        .onChange((v) => save('compareNoiseTarget')(v / 100));
-    describe(gui.add(model, 'maxSpp', sppRange.min, sppRange.max, 1).name('max spp'), 'compare-max-spp',
-        'the most samples per pixel the reference may take on the way to the noise target; the server refuses '
-        + 'more than its limit (gi-server\'s is 1024) and says so').onChange(save('compareMaxSpp'));
-    // A direct reference is one exact sample: its noise target means nothing.
-    const showMode = (mode) => noiseCtl.enable(mode !== 'direct');
-    showMode(model.mode);
-    modeCtl.onChange((v) => {
-        save('compareMode')(v);
-        showMode(v);
-    });
-    describe(gui.add(model, 'maxSide', 32, 256, 16).name('size (px)'), 'compare-size',
-        'the longer side of the measured image; the current view\'s aspect is kept').onChange(save('compareMaxSide'));
-    const measureCtl = describe(gui.add(model, 'measure').name('Measure this view'), 'compare-run',
-        'render this view through POST /api/render with a CPU reference and report the error');
-    const progress = addBlock(gui, block('div', 'compare-progress block'));
-    progress.hidden = true;
-    progress.append(Object.assign(document.createElement('progress'), { className: 'busy' }));
-    const progressText = progress.appendChild(block('span', 'compare-progress-text'));
-    const result = addBlock(gui, block('div', 'compare-result block'));
-    result.dataset.block = 'compare-result';
-    result.textContent = 'Not measured yet. Measuring costs a few seconds of CPU time on the server.';
-    // How to read the figures (corrected or not, what "indirect" means): under them, once there are some.
-    const resultHint = addBlock(gui, block('p', 'hint block compare-hint'));
-    resultHint.dataset.block = 'compare-hint';
-    resultHint.hidden = true;
-    const views = { 'live stream': 'live', 'API render': 'api', reference: 'ref', difference: 'diff' };
-    const viewCtl = describe(gui.add(model, 'view', views).name('show'),
-        'compare-view', 'the live stream, the measured API render of the view, the CPU reference, or the difference '
-        + 'between render and reference');
-    viewCtl.onChange((v) => {
-        save('compareView')(v);
-        showCompareLayer();
-    });
-    describe(gui.add(model, 'gain', 1, 32, 1).name('difference gain'), 'compare-gain',
-        'the difference view multiplies |API render − reference| by this').onChange((v) => {
-        save('diffGain')(v);
-        showCompareLayer();
-    });
-    addBlock(gui, block('p', 'hint block',
-        '"API render" is the frame the server measured, "reference" its CPU reference, "difference" the two '
-        + 'apart (the stream instead of the reference when a server sends none).'));
-    return {
-        gui,
-        model,
-        running(text) {
-            progress.hidden = text === null;
-            progressText.textContent = text ?? '';
-            measureCtl.name(text === null ? 'Measure this view' : 'Cancel');
-        },
-        /** A sentence and/or [label, text] rows, and the hint on how to read them (hidden when null). */
-        showResult(text, lines, hint = null) {
-            result.replaceChildren();
-            if (text) result.append(block('p', '', text));
-            for (const [k, v] of lines ?? []) {
-                const div = block('div', 'kv');
-                div.append(block('span', 'k', k), block('span', 'v', v));
-                result.append(div);
-            }
-            resultHint.hidden = !hint;
-            resultHint.textContent = hint ?? '';
-        },
-        /** True when the view on screen is no longer the one measured. */
-        stale() {
-            const current = currentCompareRequest();
-            return !current || !state.compare || viewKey(current) !== state.compare.key;
-        },
-        frameDrawn() {
-            if (model.view === 'diff' && state.compare) showCompareLayer();
-        },
-    };
-})();
+createAccuracySection(app);
 
-const shareGui = (() => {
-    const gui = makeSection(ui.sections, 'Share', { id: 'share' });
-    const model = {
-        copy: () => copyShareLink(),
-        snapshot: () => requestSnapshot(),
-    };
-    const copyCtl = describe(gui.add(model, 'copy').name('Copy view-only link'), 'share-link',
-        'a link that shows this view live without steering it');
-    const linkBox = addBlock(gui, block('div', 'share-box block'));
-    const linkInput = linkBox.appendChild(Object.assign(document.createElement('input'), {
-        type: 'text', readOnly: true, className: 'share-url', id: 'share-url',
-    }));
-    linkInput.setAttribute('aria-label', 'view-only link');
-    linkBox.hidden = true;
-    describe(gui.add(model, 'snapshot').name('Snapshot (PNG)'), 'snapshot',
-        'render the current view at final quality and full size, and save it losslessly');
-    return {
-        gui,
-        update() {
-            linkBox.hidden = true;
-        },
-        showLink(link) {
-            linkInput.value = link;
-            linkBox.hidden = false;
-            linkInput.select();
-        },
-        setViewer(viewer) {
-            copyCtl.show(!viewer);
-        },
-    };
-})();
+createShareSection(app);
 
 async function copyShareLink() {
     const token = state.welcome?.view_token;
@@ -1705,7 +1099,7 @@ async function copyShareLink() {
     }
     const link = shareLink(window.location, token);
     // The link is always shown too: the clipboard may be refused (plain http on another host).
-    shareGui.showLink(link);
+    store.emit('share-link', link);
     try {
         await navigator.clipboard.writeText(link);
         showMessage('View-only link copied.', 'info');
@@ -1724,209 +1118,8 @@ function requestSnapshot() {
 // ---------------------------------------------------------------------------------------------
 // Accuracy
 
-/** The compare request for the frame on screen, or null when there is none to measure. */
-function currentCompareRequest() {
-    const drawn = state.lastDrawn;
-    if (!drawn?.stats) return null;
-    const m = accuracyGui.model;
-    return buildCompareRequest({
-        scene: state.scene,
-        technique: drawn.stats.technique ?? state.technique,
-        params: drawn.stats.params ?? state.params,
-        camera: camera.toCamera(),
-        // Every light, so the reference sees what the stream renders; a protocol-1 server only
-        // knows its one light.
-        lights: state.lightList ? state.lights : undefined,
-        light: state.lightList ? undefined : state.light ?? undefined,
-        frameSize: [drawn.width, drawn.height],
-        maxSide: m.maxSide,
-        mode: m.mode,
-        noiseTarget: m.noisePct / 100,
-        maxSpp: m.maxSpp,
-    });
-}
-
 function authHeaders() {
     return page.token ? { Authorization: `Bearer ${page.token}` } : {};
-}
-
-async function measureAccuracy() {
-    if (state.compareRunning) {
-        state.compareRunning.abort.abort();
-        return;
-    }
-    if (!canCompare(state.scene)) {
-        showMessage('Uploaded scenes belong to this session\'s stream: the HTTP API cannot render them, '
-            + 'so they cannot be measured.');
-        return;
-    }
-    const request = currentCompareRequest();
-    if (!request) {
-        showMessage('No frame to measure yet.');
-        return;
-    }
-    const problem = validateCompareRequest(request, RENDER_REQUEST_SCHEMA);
-    if (problem) {
-        showMessage(`Not sent: ${problem.where}: ${problem.message}`);
-        return;
-    }
-    const abort = new AbortController();
-    const started = performance.now();
-    state.compareRunning = { abort, started };
-    const label = referenceLabel(request);
-    const tick = () => accuracyGui.running(
-        `rendering the reference (${label}): ${((performance.now() - started) / 1000).toFixed(1)} s`);
-    tick();
-    const timer = setInterval(tick, 100);
-    try {
-        const res = await fetch('api/render', {
-            method: 'POST',
-            headers: { 'Content-Type': 'application/json', ...authHeaders() },
-            body: JSON.stringify(request),
-            signal: abort.signal,
-        });
-        const body = await res.json().catch(() => null);
-        if (!res.ok) throw new Error(describeHttpError(res.status, body));
-        const image = await canvasFromBase64Png(body.image_base64);
-        // The reference, tone-mapped like the frame (servers that predate it send none).
-        const reference = body.reference_base64 ? await canvasFromBase64Png(body.reference_base64) : null;
-        state.compare = {
-            request, key: viewKey(request), result: body.stats?.compare ?? null, stats: body.stats, image, reference,
-        };
-        const f = formatCompare(state.compare.result);
-        accuracyGui.showResult(null, f ? [
-            ...f.rows, ['frame time', formatMs(body.stats?.frame_ms)],
-            ['measured in', `${((performance.now() - started) / 1000).toFixed(1)} s`],
-        ] : [['result', 'the server sent no comparison']], f?.hint ?? null);
-        showAccuracyLine();
-        showCompareLayer();
-    } catch (e) {
-        if (e.name === 'AbortError') accuracyGui.showResult('Cancelled.');
-        else {
-            accuracyGui.showResult(`Failed: ${e.message}`);
-            showMessage(`Accuracy: ${e.message}`);
-        }
-    } finally {
-        clearInterval(timer);
-        state.compareRunning = null;
-        accuracyGui.running(null);
-    }
-}
-
-async function canvasFromBase64Png(base64) {
-    const bytes = Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
-    const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-    const canvas = document.createElement('canvas');
-    canvas.width = bitmap.width;
-    canvas.height = bitmap.height;
-    canvas.getContext('2d').drawImage(bitmap, 0, 0);
-    bitmap.close();
-    return canvas;
-}
-
-/**
- * The accuracy layer over the stream: the API render, the CPU reference, or the difference between
- * the two (without a reference: between the API render and the frame on screen).
- */
-function showCompareLayer() {
-    const view = accuracyGui.model.view;
-    const reference = state.compare?.reference ?? null;
-    const image = view === 'ref' ? reference : state.compare?.image;
-    const visible = view !== 'live' && image && !state.viewer;
-    ui.compareCanvas.hidden = !visible;
-    ui.layerLabel.hidden = !visible;
-    if (!visible) return;
-    const { width, height } = image;
-    ui.compareCanvas.width = width;
-    ui.compareCanvas.height = height;
-    const out = ui.compareCanvas.getContext('2d', { willReadFrequently: true });
-    out.drawImage(image, 0, 0);
-    if (view === 'ref') {
-        const ref = state.compare.result?.reference ?? {};
-        ui.layerLabel.textContent = `CPU reference (${ref.mode ?? '?'}, ${ref.spp ?? '?'} spp, PNG ${width}×${height})`;
-        return;
-    }
-    if (view === 'api') {
-        const error = formatCompare(state.compare.result)?.overlay ?? 'no comparison';
-        ui.layerLabel.textContent = `API render of the measured view (PNG ${width}×${height}); ${error} `
-            + `vs the ${state.compare.request.compare.mode} reference`;
-        return;
-    }
-    const a = out.getImageData(0, 0, width, height).data;
-    out.drawImage(reference ?? ui.canvas, 0, 0, width, height);
-    const b = out.getImageData(0, 0, width, height).data;
-    const diff = diffImage(a, b, accuracyGui.model.gain);
-    out.putImageData(new ImageData(diff.data, width, height), 0, 0);
-    const what = reference ? '|API render − reference|' : '|stream − API render|';
-    ui.layerLabel.textContent = `${what} × ${accuracyGui.model.gain} (mean ${diff.meanAbs.toFixed(1)} of 255)`
-        + `${!reference && accuracyGui.stale() ? '; the view has changed since the measurement' : ''}`;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Uploads
-
-async function uploadFile(file) {
-    if (state.viewer) return;
-    const name = uploadName(file?.name);
-    if (!name) {
-        showMessage(`Only binary glTF (.glb) files, or a .gltf zipped with its files (.zip), can be uploaded, not "${file?.name ?? '?'}".`);
-        return;
-    }
-    const resumeToken = state.welcome?.resume_token;
-    if (!resumeToken || !connection.isOpen) {
-        showMessage('Connect first: an upload belongs to a session.');
-        return;
-    }
-    const size = formatBytes(file.size);
-    sceneGui.progress(0, `uploading ${name} (${size})`);
-    try {
-        const answer = await uploadScene(file, name, {
-            resumeToken,
-            serverToken: page.token,
-            onProgress: (f) => sceneGui.progress(f, `uploading ${name}: ${(100 * f).toFixed(0)} % of ${size}`),
-        });
-        if (!state.uploads.includes(answer.scene)) state.uploads.push(answer.scene);
-        sceneGui.progress(1, `uploaded ${name}; loading it…`);
-        if (steer(sceneMsg(answer.scene))) state.scene = answer.scene;
-        sceneGui.setScenes();
-        setTimeout(() => sceneGui.progress(null), 3000);
-    } catch (e) {
-        sceneGui.progress(null);
-        showMessage(`Upload of ${name}: ${e.message}`);
-    }
-}
-
-function bindDragAndDrop() {
-    let depth = 0;
-    const hasFiles = (e) => [...(e.dataTransfer?.types ?? [])].includes('Files');
-    ui.viewport.addEventListener('dragenter', (e) => {
-        if (!hasFiles(e) || state.viewer) return;
-        e.preventDefault();
-        depth += 1;
-        ui.dropHint.hidden = false;
-    });
-    ui.viewport.addEventListener('dragover', (e) => {
-        if (!hasFiles(e) || state.viewer) return;
-        e.preventDefault();
-        e.dataTransfer.dropEffect = 'copy';
-    });
-    ui.viewport.addEventListener('dragleave', () => {
-        depth = Math.max(0, depth - 1);
-        if (depth === 0) ui.dropHint.hidden = true;
-    });
-    ui.viewport.addEventListener('drop', (e) => {
-        if (!hasFiles(e)) return;
-        e.preventDefault();
-        depth = 0;
-        ui.dropHint.hidden = true;
-        const file = e.dataTransfer.files?.[0];
-        if (file) uploadFile(file);
-    });
-    ui.fileInput.addEventListener('change', () => {
-        const file = ui.fileInput.files?.[0];
-        ui.fileInput.value = '';
-        if (file) uploadFile(file);
-    });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1988,11 +1181,11 @@ function start() {
     ui.backdrop.addEventListener('click', () => setSidebar(false));
     attachViewControls(ui.canvas, {
         camera,
-        getTool: () => cameraGui.tool(),
+        getTool: () => settings.tool,
         onCamera: scheduleCamera,
         onLight: onLightDrag,
         onHome: resetCamera,
-        flySpeed: () => cameraGui.speed(),
+        flySpeed: () => settings.flySpeed * camera.sceneScale,
         shortcuts: { KeyF: toggleFullscreen, Period: frameModel, NumpadDecimal: frameModel },
     });
     ui.sessionToggle.addEventListener('click', toggleSession);
@@ -2001,7 +1194,7 @@ function start() {
     ui.fullscreen.addEventListener('click', toggleFullscreen);
     ui.fullscreen.hidden = !(ui.viewport.requestFullscreen || ui.viewport.webkitRequestFullscreen);
     document.addEventListener('fullscreenchange', showFullscreenState);
-    bindDragAndDrop();
+    bindUploads(app, { isOpen: () => connection.isOpen, serverToken: page.token });
     // The viewport changes size with the window and when the sidebar opens or closes.
     new ResizeObserver(debounce(() => {
         sendResize();
