@@ -1,7 +1,7 @@
 # docs/operations.md embeds `gi-server --config-reference` (generated from the option table the
 # server parses with) between the config-reference markers, and names every Prometheus metric the
 # server exports; this fails when either is out of date.
-#   cmake -DSERVER=build/dev/bin/gi-server -DDOC=docs/operations.md -DSOURCE=server/net/WsServer.cpp \
+#   cmake -DSERVER=build/dev/bin/gi-server -DDOC=docs/operations.md -DSOURCE=server/net \
 #         [-DUPDATE=ON] -P tests/deploy/config_reference.cmake
 # UPDATE=ON rewrites the section from the binary instead of comparing.
 execute_process(COMMAND ${SERVER} --config-reference OUTPUT_VARIABLE reference RESULT_VARIABLE rc)
@@ -32,8 +32,14 @@ elseif(NOT current STREQUAL reference)
                         "  cmake -DSERVER=${SERVER} -DDOC=${DOC} -DUPDATE=ON -P ${CMAKE_CURRENT_LIST_FILE}")
 endif()
 
-# Every metric name in the server's sources appears in the metrics reference.
-file(READ ${SOURCE} source)
+# Every metric name in the server's sources (SOURCE: the server/net folder) appears in the metrics
+# reference.
+file(GLOB sources ${SOURCE}/*.cpp ${SOURCE}/*.h)
+set(source "")
+foreach(f ${sources})
+    file(READ ${f} text)
+    string(APPEND source "${text}")
+endforeach()
 string(REGEX MATCHALL "\"gis_[a-z_]+\"" metrics "${source}")
 list(REMOVE_DUPLICATES metrics)
 set(missing "")
