@@ -16,10 +16,10 @@ import { applyLightChanges, lightsOfState, newLightFor, pickSelection } from './
 import { StreamConnection, formatCountdown, pageOptions, shareLink, streamUrl } from './connection.js';
 import { block } from './controls.js';
 import { resetPlan, schemaDefaults } from './params.js';
-import { LatencyTracker, PassHistory, RateCounter, formatBytes, formatMs, networkMs } from './stats.js';
-import { DEFAULT_FRAME_TARGET_MS, InputWatch, RefineTracker, busyText, formatSeconds } from './progress.js';
+import { LatencyTracker, PassHistory, RateCounter, networkMs } from './stats.js';
+import { DEFAULT_FRAME_TARGET_MS, InputWatch, RefineTracker } from './progress.js';
 import {
-    DEFAULT_PIXEL_BUDGET, budgetLine, budgetViewport, frameTargetSupported, normalizeFrameTarget,
+    DEFAULT_PIXEL_BUDGET, budgetViewport, frameTargetSupported, normalizeFrameTarget,
     normalizePixelBudget,
 } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
@@ -30,6 +30,7 @@ import { DEFAULT_COMPARE, compareSettings } from './accuracy.js';
 import { MessageStack, describeError, noticeFor } from './messages.js';
 import { bindUploads } from './uploads.js';
 import { Store } from './store.js';
+import { createOverlay } from './overlay.js';
 import { createAccuracySection } from './sections/accuracy.js';
 import { createCameraSection } from './sections/camera.js';
 import { createLightSection } from './sections/light.js';
@@ -180,6 +181,9 @@ const refine = new RefineTracker();
 const watch = new InputWatch();
 const toasts = new MessageStack({ max: 4, ttlMs: MESSAGE_HIDE_MS });
 const chart = new PassChart(ui.ovChart, ui.ovLegend, { windowS: CHART_WINDOW_S });
+const overlay = createOverlay({ ui, state, settings, store },
+    { rate, latency, passes, chart, refine, watch, toasts, frameTargetMs });
+const { showRate, showProgress, showFrameStats } = overlay;
 const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
     onText: handleText,
@@ -799,79 +803,6 @@ function recordDraw(frame, decodeMs, frameBytes) {
     store.emit('frame', stats);
     gizmo.render();
     showProgress();
-}
-
-/** The 4-per-second tick: rate, busy badge, stale figures, chart, countdown and fading toasts. */
-function showRate() {
-    const now = performance.now();
-    const fps = rate.rate(now);
-    const lat = latency.typical;
-    ui.ovRate.textContent = `${fps.toFixed(0)} fps · input→frame ${lat === null ? '–' : formatMs(lat, 0)}`
-        + ` · decode ${formatMs(state.decodeMs)}`;
-    showProgress(now);
-    if (settings.chart && settings.overlay) {
-        const nowS = now / 1000;
-        passes.prune(nowS);
-        const end = passes.windowEnd(nowS);
-        chart.update(passes.series(), end);
-        const age = passes.ageS(nowS);
-        // A chart that stops scrolling says why instead of looking like a live one.
-        ui.ovChartNote.hidden = end === nowS && age !== null;
-        const why = state.connState !== 'open' ? ' (not connected)'
-            : watch.pending ? ' (waiting for the server)' : ' (the view is still)';
-        ui.ovChartNote.textContent = age === null ? 'no frame timings yet'
-            : `last frame ${formatSeconds(age * 1000)} ago${why}`;
-    }
-    if (state.connState === 'waiting' && state.retryAt !== null) {
-        ui.connText.textContent = `disconnected, retrying in ${formatCountdown(state.retryAt - now)}`;
-    }
-    for (const entry of toasts.expire(now)) document.querySelector(`.message[data-id="${entry.id}"]`)?.remove();
-}
-
-/**
- * The refinement line of the overlay, the busy badge and the stale mark. Stale: the figures are
- * those of a frame from before input that has waited too long for one that shows it.
- */
-function showProgress(now = performance.now()) {
-    const connected = state.connState === 'open';
-    const view = connected ? refine.view(now) : null;
-    ui.ovRefine.hidden = !view;
-    if (view) {
-        ui.ovRefine.dataset.kind = view.kind;
-        ui.ovRefineText.textContent = view.text;
-        ui.ovRefineBar.hidden = view.share === null;
-        if (view.share !== null) ui.ovRefineBar.value = view.share;
-    }
-    const late = connected && !state.viewer ? watch.lateMs(now, frameTargetMs()) : null;
-    const busy = connected ? busyText({ lateMs: late, refine: view }) : null;
-    ui.busy.hidden = busy === null;
-    ui.busy.textContent = busy ?? '';
-    ui.busy.dataset.kind = late !== null ? 'late' : 'refining';
-    const stale = connected && !state.viewer && watch.stale(now, frameTargetMs());
-    ui.overlay.classList.toggle('stale', stale);
-    ui.ovStale.hidden = !stale;
-    if (stale) {
-        ui.ovStale.textContent = `stale: figures from before your input ${formatSeconds(now - watch.pendingSince)} ago`;
-    }
-}
-
-function showFrameStats(header, stats, { decodeMs, net, bytes }) {
-    const ms = (v) => (Number.isFinite(v) ? v.toFixed(1) : '–');
-    const budget = budgetLine(stats?.budget);
-    ui.ovBudget.hidden = !budget;
-    if (budget) {
-        ui.ovBudget.textContent = budget.text;
-        ui.ovBudget.title = budget.reason;
-        ui.ovBudget.classList.toggle('capped', budget.capped);
-    }
-    ui.ovTimes.textContent = `render ${ms(stats?.frame_ms)} · encode ${ms(stats?.encode_ms)} · net ${ms(net)} ms`;
-    state.decodeMs = decodeMs;
-    ui.ovBytes.textContent = [
-        `${formatBytes(bytes)}/frame`,
-        `${header.width}×${header.height} ${stats?.codec ?? header.codec}`,
-        `${stats?.quality ?? '–'}${stats?.refined ? ' (refined)' : ''}${stats?.snapshot ? ' snapshot' : ''}`,
-    ].join(' · ');
-    store.emit('rate');
 }
 
 // ---------------------------------------------------------------------------------------------
