@@ -1,27 +1,23 @@
-// App wiring: the connection and session role, sending and the outbox, receiving, frame decode and
-// draw, the stats overlay, refinement progress and the busy badge, the light gizmo, uploads and the
-// page's state (a Store whose topics the sidebar sections in sections/ subscribe to; no section calls
-// another). The pure pieces live in their own modules (protocol, camera, light, lights, params,
-// stats, progress, budget, restore, accuracy, messages, upload, store).
+// App wiring: the connection and session role, receiving (welcome, state, errors, restores), frame
+// decode and draw, the light gizmo and view input, notices, and the page's state (a Store whose topics
+// the sidebar sections in sections/ subscribe to; no section calls another). Sending is outbox.js,
+// the overlay overlay.js, uploads uploads.js; the pure pieces live in their own modules (protocol,
+// camera, light, lights, params, stats, progress, budget, restore, accuracy, messages, upload, store).
 
 import {
-    ackMsg, cameraMsg, CLIENT_NAME, CODEC_MIME, helloMsg, lightAddMsg, lightMsg, lightRemoveMsg, paramsMsg,
-    isKnownServerMessage, parseFrameHeader, parseServerMessage, pingMsg, qualityMsg, resizeMsg, sceneMsg,
-    snapshotMsg, techniqueMsg, validateClientMessage, validateParamValues,
+    ackMsg, cameraMsg, CODEC_MIME, isKnownServerMessage, parseFrameHeader, parseServerMessage, pingMsg, sceneMsg,
+    snapshotMsg, techniqueMsg,
 } from './protocol.js';
 import { CLIENT_SCHEMAS } from './schemas.js';
 import { OrbitCamera, attachViewControls, boundsSphere, withOrbitTarget } from './camera.js';
 import { aimLight, gizmoKinds, moveLight } from './light.js';
-import { applyLightChanges, lightsOfState, newLightFor, pickSelection } from './lights.js';
+import { applyLightChanges, lightsOfState, pickSelection } from './lights.js';
 import { StreamConnection, formatCountdown, pageOptions, shareLink, streamUrl } from './connection.js';
 import { block } from './controls.js';
 import { resetPlan, schemaDefaults } from './params.js';
 import { LatencyTracker, PassHistory, RateCounter, networkMs } from './stats.js';
-import { DEFAULT_FRAME_TARGET_MS, InputWatch, RefineTracker } from './progress.js';
-import {
-    DEFAULT_PIXEL_BUDGET, budgetViewport, frameTargetSupported, normalizeFrameTarget,
-    normalizePixelBudget,
-} from './budget.js';
+import { InputWatch, RefineTracker } from './progress.js';
+import { DEFAULT_PIXEL_BUDGET, frameTargetSupported, normalizeFrameTarget, normalizePixelBudget } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
 import { enqueueFrame, patchPlacement } from './frames.js';
 import { PassChart } from './chart.js';
@@ -30,6 +26,7 @@ import { DEFAULT_COMPARE, compareSettings } from './accuracy.js';
 import { MessageStack, describeError, noticeFor } from './messages.js';
 import { bindUploads } from './uploads.js';
 import { Store } from './store.js';
+import { createOutbox } from './outbox.js';
 import { createOverlay } from './overlay.js';
 import { createAccuracySection } from './sections/accuracy.js';
 import { createCameraSection } from './sections/camera.js';
@@ -182,7 +179,7 @@ const watch = new InputWatch();
 const toasts = new MessageStack({ max: 4, ttlMs: MESSAGE_HIDE_MS });
 const chart = new PassChart(ui.ovChart, ui.ovLegend, { windowS: CHART_WINDOW_S });
 const overlay = createOverlay({ ui, state, settings, store },
-    { rate, latency, passes, chart, refine, watch, toasts, frameTargetMs });
+    { rate, latency, passes, chart, refine, watch, toasts, frameTargetMs: () => frameTargetMs() });
 const { showRate, showProgress, showFrameStats } = overlay;
 const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
@@ -227,188 +224,15 @@ const hook = {
 window.giClient = hook;
 
 // ---------------------------------------------------------------------------------------------
-// Sending
+// Sending (outbox.js)
 
-/** Validates like the server would and sends; an invalid message is shown, never sent. */
-function send(msg) {
-    const problem = validateClientMessage(msg, CLIENT_SCHEMAS);
-    if (problem) {
-        showMessage(`Not sent (${problem.code}): ${problem.where || '/'}: ${problem.message}`);
-        return false;
-    }
-    const sent = connection.send(msg);
-    if (sent && msg.type !== 'camera' && msg.type !== 'ack' && msg.type !== 'ping') {
-        hook.sent.push(structuredClone(msg));
-        if (hook.sent.length > 50) hook.sent.shift();
-    }
-    return sent;
-}
-
-/** A steering message: sent, and counted as input for the latency. */
-function steer(msg) {
-    if (state.viewer) return false;
-    const sent = send(msg);
-    if (sent) {
-        const now = performance.now();
-        latency.input(now);
-        watch.input(now);
-    }
-    return sent;
-}
-
-/** The viewport to announce: its CSS size and the device pixel ratio, capped by the pixel budget. */
-function currentViewport() {
-    return budgetViewport(ui.viewport.clientWidth, ui.viewport.clientHeight, window.devicePixelRatio,
-        settings.pixelBudget);
-}
-
-let lastSize = null; // the last viewport sent, "WxH@dpr"
-function sendResize(force = false) {
-    if (state.viewer) return;
-    const { size, dpr } = currentViewport();
-    const key = `${size[0]}x${size[1]}@${dpr}`;
-    if (!force && key === lastSize) return;
-    if (send(resizeMsg(size[0], size[1], dpr))) {
-        lastSize = key;
-        state.viewport = { size, dpr };
-        store.emit('viewport');
-    }
-}
-
-// Pointer moves and slider drags arrive faster than frames: coalesce them into one message of each
-// kind per animation frame.
-// Light changes are kept per light (key: its id, '' for protocol 1's unnamed one), so switching
-// the selected light mid-drag cannot send one light's changes to another.
-const outbox = { camera: false, lights: new Map(), params: null, frame: 0 };
-let lastFlush = -Infinity;
-function flushOutbox() {
-    outbox.frame = 0;
-    lastFlush = performance.now();
-    if (outbox.camera) {
-        outbox.camera = false;
-        steer(cameraMsg(camera.toCamera()));
-    }
-    const lightChanges = [...outbox.lights];
-    outbox.lights.clear();
-    for (const [key, changes] of lightChanges) steer(lightMsg(changes, key === '' ? null : key));
-    if (outbox.params) {
-        const values = outbox.params;
-        outbox.params = null;
-        sendParamsNow(values);
-    }
-}
-function scheduleFlush() {
-    if (outbox.frame) return;
-    // The first change after a pause goes out at once (after this task, so that what one event changes
-    // goes together): waiting for an animation frame would add up to one to the answer to input.
-    // Changes that follow within a frame are merged into one message per animation frame.
-    if (performance.now() - lastFlush > 20) {
-        outbox.frame = -1;
-        queueMicrotask(flushOutbox);
-        return;
-    }
-    outbox.frame = requestAnimationFrame(flushOutbox);
-}
-
-function scheduleCamera() {
-    if (state.viewer) return;
-    outbox.camera = true;
-    scheduleFlush();
-    gizmo.render();
-    store.emit('camera');
-}
-
-function selectedLight() {
-    return state.lights.find((l) => (l.id ?? null) === state.selectedLightId) ?? state.lights[0] ?? null;
-}
-
-/** Changes light `id` (default: the selected one) here at once and queues them for the server. */
-function changeLight(changes, id = state.selectedLightId) {
-    if (state.viewer) return;
-    let index = state.lights.findIndex((l) => (l.id ?? null) === id);
-    if (index < 0 && id === null && state.lights.length > 0) index = 0;
-    if (index < 0) return;
-    state.lights[index] = applyLightChanges(state.lights[index], changes);
-    const key = state.lights[index].id ?? '';
-    outbox.lights.set(key, { ...(outbox.lights.get(key) ?? {}), ...structuredClone(changes) });
-    scheduleFlush();
-    gizmo.render();
-    store.emit('lights');
-}
-
-function selectLight(id) {
-    state.selectedLightId = id;
-    store.emit('lights');
-    gizmo.render();
-}
-
-/** light_add for a light of `type` placed from the current view; the server's state answer selects it. */
-function addLight(type) {
-    if (state.viewer || !state.lightList) return;
-    // Queued edits go first, so the server's answer already contains them.
-    flushOutbox();
-    if (steer(lightAddMsg(newLightFor(type, camera.toCamera(), state.light)))) state.lightOps.push('add');
-}
-
-function removeSelectedLight() {
-    const id = state.light?.id;
-    if (state.viewer || !state.lightList || !id) return;
-    flushOutbox();
-    if (steer(lightRemoveMsg(id))) state.lightOps.push('remove');
-}
-
-function queueParams(values) {
-    outbox.params = { ...(outbox.params ?? {}), ...values };
-    scheduleFlush();
-}
-
-/** Parameters are checked against the welcome schemas first: an invalid value never leaves the page. */
-function sendParamsNow(values) {
-    const technique = state.techniques.get(state.technique);
-    const problem = validateParamValues(values, technique?.params_schema, state.welcome?.frame_params_schema);
-    if (problem) {
-        showMessage(`Not sent: ${problem.where}: ${problem.message}`);
-        store.emit('params', state.params, { force: true });
-        return;
-    }
-    if (steer(paramsMsg(values))) {
-        Object.assign(state.params, values);
-        for (const name of Object.keys(values)) state.explicit.add(name);
-        store.emit('params', values);
-    }
-}
-
-/** hello for this page: a viewer names the view token, a controller its viewport and a resume token if it has one. */
-function buildHello() {
-    // Patches (regions of a refining image) where this page's schema copy has the field.
-    const patches = CLIENT_SCHEMAS.hello?.properties?.patches ? true : undefined;
-    const common = { client: CLIENT_NAME, token: page.token, codecs: CODECS, max_in_flight: MAX_IN_FLIGHT, patches };
-    if (state.viewer) return helloMsg({ ...common, view: page.view });
-    const { size, dpr } = currentViewport();
-    lastSize = `${size[0]}x${size[1]}@${dpr}`;
-    state.viewport = { size, dpr };
-    // Only where this page's schema copy has the field: an older server refuses a hello with it.
-    const target = settings.frameTargetMs !== null && frameTargetSupported(null, CLIENT_SCHEMAS, 'hello')
-        ? settings.frameTargetMs : undefined;
-    return helloMsg({
-        ...common, resume: sessionStorage.getItem(RESUME_KEY) ?? undefined, size, dpr, frame_target_ms: target,
-    });
-}
-
-/** The session's frame-time target: what welcome said (or the quality control set), else the default. */
-function frameTargetMs() {
-    return state.frameTargetMs ?? state.welcome?.limits?.frame_target_ms ?? DEFAULT_FRAME_TARGET_MS;
-}
-
-/** The quality message for the current adaptive choice and, where the server takes one, the frame target. */
-function sendQuality() {
-    const adaptive = state.adaptive;
-    const target = frameTargetSupported(state.welcome, CLIENT_SCHEMAS)
-        ? settings.frameTargetMs ?? state.welcome?.limits?.frame_target_ms : undefined;
-    if (!steer(qualityMsg(adaptive, Number.isInteger(target) ? target : undefined))) return false;
-    if (Number.isInteger(target)) state.frameTargetMs = target;
-    return true;
-}
+const {
+    send, steer, currentViewport, sendResize, flushOutbox, scheduleFlush, scheduleCamera, selectedLight, changeLight, selectLight, addLight, removeSelectedLight, queueParams, sendParamsNow, buildHello, frameTargetMs, sendQuality, pendingLight,
+} = createOutbox({
+    ui, state, settings, store, camera, connection, latency, watch, sentLog: hook.sent, showMessage,
+    renderGizmo: () => gizmo.render(),
+    hello: { codecs: CODECS, maxInFlight: MAX_IN_FLIGHT, resumeKey: RESUME_KEY, page },
+});
 
 // ---------------------------------------------------------------------------------------------
 // Receiving
@@ -659,7 +483,7 @@ function applyServerState(s) {
 function showLights(lights, s, { expectAdded = false }) {
     const previousIds = state.lights.map((l) => l.id ?? null);
     state.lights = lights.map((l) => {
-        const pending = outbox.lights.get(l.id ?? '');
+        const pending = pendingLight(l.id);
         return pending ? applyLightChanges(l, pending) : l;
     });
     state.lightList = Array.isArray(s.lights);
