@@ -1,12 +1,11 @@
 // App wiring: the connection and session role, receiving (welcome, state, errors, restores), frame
-// decode and draw, the light gizmo and view input, notices, and the page's state (a Store whose topics
+// display (frame-view.js draws), the light gizmo and view input, notices, and the page's state (a Store whose topics
 // the sidebar sections in sections/ subscribe to; no section calls another). Sending is outbox.js,
 // the overlay overlay.js, uploads uploads.js; the pure pieces live in their own modules (protocol,
 // camera, light, lights, params, stats, progress, budget, restore, accuracy, messages, upload, store).
 
 import {
-    ackMsg, cameraMsg, CODEC_MIME, isKnownServerMessage, parseFrameHeader, parseServerMessage, pingMsg, sceneMsg,
-    snapshotMsg, techniqueMsg,
+    cameraMsg, isKnownServerMessage, parseServerMessage, pingMsg, sceneMsg, snapshotMsg, techniqueMsg,
 } from './protocol.js';
 import { CLIENT_SCHEMAS } from './schemas.js';
 import { OrbitCamera, attachViewControls, boundsSphere, withOrbitTarget } from './camera.js';
@@ -19,13 +18,14 @@ import { LatencyTracker, PassHistory, RateCounter, networkMs } from './stats.js'
 import { InputWatch, RefineTracker } from './progress.js';
 import { DEFAULT_PIXEL_BUDGET, frameTargetSupported, normalizeFrameTarget, normalizePixelBudget } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
-import { enqueueFrame, patchPlacement } from './frames.js';
+
 import { PassChart } from './chart.js';
 import { LightGizmo } from './gizmo.js';
 import { DEFAULT_COMPARE, compareSettings } from './accuracy.js';
 import { MessageStack, describeError, noticeFor } from './messages.js';
 import { bindUploads } from './uploads.js';
 import { Store } from './store.js';
+import { createFrameView } from './frame-view.js';
 import { createOutbox } from './outbox.js';
 import { createOverlay } from './overlay.js';
 import { createAccuracySection } from './sections/accuracy.js';
@@ -95,7 +95,6 @@ const ui = {
     dropHint: $('drop-hint'),
     fileInput: $('file-input'),
 };
-const ctx = ui.canvas.getContext('2d');
 
 const page = pageOptions(window.location);
 
@@ -184,7 +183,7 @@ const { showRate, showProgress, showFrameStats } = overlay;
 const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
     onText: handleText,
-    onBinary: handleBinary,
+    onBinary: (buffer) => frameView.handleBinary(buffer),
     onClose: handleClose,
     onState: showConnectionState,
 });
@@ -233,6 +232,7 @@ const {
     renderGizmo: () => gizmo.render(),
     hello: { codecs: CODECS, maxInFlight: MAX_IN_FLIGHT, resumeKey: RESUME_KEY, page },
 });
+const frameView = createFrameView({ ui, state, connection, send, showMessage, onDrawn: recordDraw });
 
 // ---------------------------------------------------------------------------------------------
 // Receiving
@@ -492,100 +492,6 @@ function showLights(lights, s, { expectAdded = false }) {
     store.emit('lights');
     store.emit('lighting', state.lastDrawn?.stats?.lighting ?? state.lighting);
     gizmo.render();
-}
-
-function handleBinary(buffer) {
-    const arrivedAt = performance.now();
-    let header;
-    try {
-        header = parseFrameHeader(buffer);
-    } catch (e) {
-        showMessage(`Bad frame from the server: ${e.message}`);
-        return;
-    }
-    const entry = state.statsByFrame.get(header.frame);
-    state.statsByFrame.delete(header.frame);
-    // The snapshot is saved as it arrives: the draw queue below may skip frames.
-    if (state.snapshotWanted && entry?.stats?.snapshot) {
-        state.snapshotWanted = false;
-        saveSnapshot(header, buffer);
-    }
-    const frame = { header, buffer, entry, arrivedAt, socket: connection.socket };
-    if (state.decoding) {
-        // At most one decode in flight: a whole frame replaces those that wait (acknowledged so
-        // their slots free), a patch waits its turn.
-        const { queue, dropped } = enqueueFrame(state.pending, frame);
-        dropped.forEach(acknowledge);
-        state.pending = queue;
-        return;
-    }
-    decodeAndDraw(frame);
-}
-
-async function decodeAndDraw(frame) {
-    state.decoding = true;
-    const { header, buffer } = frame;
-    try {
-        const started = performance.now();
-        const payload = new Uint8Array(buffer, header.payloadOffset);
-        // createImageBitmap decodes off the main thread; the draw below is a copy.
-        const bitmap = await createImageBitmap(new Blob([payload], { type: CODEC_MIME[header.codec] }));
-        const decodeMs = performance.now() - started;
-        if (frame.socket === connection.socket) {
-            const patch = patchPlacement(frame.entry?.stats, header);
-            if (frame.entry?.stats?.patch && !patch) {
-                // Drawn as a whole frame it would stretch a region over the view.
-                showMessage(`Frame ${header.frame}: a patch outside its image was not drawn.`);
-            } else if (patch) {
-                // A region of a refining image: the picture so far, stretched to the image's size,
-                // under it.
-                if (ui.canvas.width !== patch.width || ui.canvas.height !== patch.height) {
-                    const before = await createImageBitmap(ui.canvas);
-                    ui.canvas.width = patch.width;
-                    ui.canvas.height = patch.height;
-                    ctx.drawImage(before, 0, 0, patch.width, patch.height);
-                    before.close();
-                }
-                ctx.drawImage(bitmap, patch.x, patch.y);
-            } else {
-                if (ui.canvas.width !== header.width || ui.canvas.height !== header.height) {
-                    ui.canvas.width = header.width;
-                    ui.canvas.height = header.height;
-                }
-                ctx.drawImage(bitmap, 0, 0, header.width, header.height);
-            }
-            recordDraw(frame, decodeMs, buffer.byteLength);
-        }
-        bitmap.close();
-    } catch (e) {
-        showMessage(`Frame ${header.frame} could not be decoded: ${e.message}`);
-    } finally {
-        // Acknowledge even a frame that failed to decode, else the server would wait forever.
-        acknowledge(frame);
-        state.decoding = false;
-        const next = state.pending.shift();
-        if (next) decodeAndDraw(next);
-    }
-}
-
-function acknowledge(frame) {
-    // An ack belongs to the connection that received the frame; after a reconnect it means nothing.
-    if (frame.socket === connection.socket) send(ackMsg(frame.header.frame));
-}
-
-function saveSnapshot(header, buffer) {
-    const blob = new Blob([new Uint8Array(buffer, header.payloadOffset)], { type: CODEC_MIME[header.codec] });
-    const scene = (state.scene || 'scene').replace(/[^A-Za-z0-9_-]+/g, '-');
-    const link = Object.assign(document.createElement('a'), {
-        href: URL.createObjectURL(blob),
-        download: `gi-${scene}-${state.technique ?? 'frame'}-${header.frame}.${header.codec}`,
-    });
-    document.body.append(link);
-    link.click();
-    link.remove();
-    showMessage(`Snapshot saved: ${link.download} (${header.width}×${header.height}, lossless)`, 'info');
-    // The download has started from the object URL by the time the timer runs.
-    setTimeout(() => URL.revokeObjectURL(link.href), 1000);
 }
 
 function sendPing() {
