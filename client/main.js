@@ -1,8 +1,9 @@
-// App wiring: the connection and session role, receiving (welcome, state, errors, restores), frame
-// display (frame-view.js draws), the light gizmo and view input, notices, and the page's state (a Store whose topics
-// the sidebar sections in sections/ subscribe to; no section calls another). Sending is outbox.js,
-// the overlay overlay.js, uploads uploads.js; the pure pieces live in their own modules (protocol,
-// camera, light, lights, params, stats, progress, budget, restore, accuracy, messages, upload, store).
+// App wiring: the connection and session role, receiving (welcome, state, errors, restores), what a
+// drawn frame tells the page, the light gizmo and view input, notices, and the page's state (a Store
+// whose topics the sidebar sections in sections/ subscribe to; no section calls another). Sending is
+// outbox.js, frame display frame-view.js, the overlay overlay.js, uploads uploads.js; the pure pieces
+// live in their own modules (protocol, camera, light, lights, params, stats, progress, budget,
+// restore, accuracy, messages, upload, store).
 
 import {
     cameraMsg, isKnownServerMessage, parseServerMessage, pingMsg, sceneMsg, snapshotMsg, techniqueMsg,
