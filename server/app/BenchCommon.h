@@ -21,15 +21,6 @@ using cli::UsageError;
 /// "query" (timer queries) or "finish" (glFinish around each pass).
 bool parseTiming(const std::string& text);
 
-/// Walks argv-style arguments: `value()` returns the argument after the current flag.
-struct ArgCursor {
-    const std::vector<std::string>& args;
-    size_t i = 0;
-    const std::string& value() {
-        if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
-        return args[++i];
-    }
-};
 
 /// technique[:name=value,...] as given to --config.
 struct Config {

@@ -47,18 +47,7 @@ Presets, per technique, from the front of the points measured in every scene (me
 geometric-mean error over the scenes): interactive = the most accurate front point at most --budget-ms (the
 fastest point when none is), final = the most accurate point, balanced = the front's knee in
 log-log space (kept between the two). Errors within the references' mean noise of a more
-accurate point count as equal, and of equals the fastest is chosen.
-
-  --in DIR           sweep folder (default bench-sweep)
-  --out FILE         Markdown report (default docs/accuracy.md)
-  --images DIR       plots and their gnuplot scripts (default: images/ beside --out)
-  --presets FILE     presets written here (default presets/presets.json)
-  --budget-ms MS     frame-time budget of the interactive preset at the sweep size (default 100)
-  --final-ms MS      frame-time budget of the final preset at the sweep size (default 400: what
-                     gi-server's 30 s refinement budget affords at 960x800, 47x the pixels of
-                     128x128, with the tiles' overhead; 0 = none, the most accurate point)
-  --metric WHAT      indirect (default) or image: the error axis of the fronts and presets
-)";
+accurate point count as equal, and of equals the fastest is chosen.)";
 
 struct ReportOptions {
     std::string in = "bench-sweep", out = "docs/accuracy.md", images, presets = "presets/presets.json";
@@ -368,32 +357,31 @@ std::vector<PresetRow> choose(const Data& d, double budgetMs, double finalMs, js
 
 ReportOptions parseOptions(const std::vector<std::string>& args) {
     ReportOptions o;
-    ArgCursor c{args};
-    for (; c.i < args.size(); ++c.i) {
-        const std::string& a = args[c.i];
-        if (a == "--help" || a == "-h") {
-            std::cout << kReportUsage;
-            std::exit(0);
-        } else if (a == "--in")
-            o.in = c.value();
-        else if (a == "--out")
-            o.out = c.value();
-        else if (a == "--images")
-            o.images = c.value();
-        else if (a == "--presets")
-            o.presets = c.value();
-        else if (a == "--budget-ms")
-            o.budgetMs = cli::parseNumber("--budget-ms", c.value(), 0, 1e7);
-        else if (a == "--final-ms")
-            o.finalMs = cli::parseNumber("--final-ms", c.value(), 0, 1e7);
-        else if (a == "--metric") {
-            const std::string m = c.value();
-            if (m != "indirect" && m != "image")
-                throw UsageError("report: --metric must be indirect or image, got '" + m + "'");
-            o.indirectMetric = m == "indirect";
-        } else
-            throw UsageError("report: unknown option '" + a + "' (see gi-bench report --help)");
-    }
+    cli::OptionTable options;
+    options
+        .value("--in", "DIR", "sweep folder (default bench-sweep)", [&](const std::string& v) { o.in = v; })
+        .value("--out", "FILE", "Markdown report (default docs/accuracy.md)",
+               [&](const std::string& v) { o.out = v; })
+        .value("--images", "DIR", "plots and their gnuplot scripts (default: images/ beside --out)",
+               [&](const std::string& v) { o.images = v; })
+        .value("--presets", "FILE", "presets written here (default presets/presets.json)",
+               [&](const std::string& v) { o.presets = v; })
+        .number("--budget-ms", "MS", "frame-time budget of the interactive preset at the sweep size", 0, 1e7,
+                o.budgetMs)
+        .number(
+            "--final-ms", "MS",
+            "frame-time budget of the final preset at the sweep size (what gi-server's 30 s refinement "
+            "budget affords at 960x800, 47x the pixels of 128x128, with the tiles' overhead; 0 = none, the "
+            "most accurate point)",
+            0, 1e7, o.finalMs)
+        .value("--metric", "WHAT", "indirect (default) or image: the error axis of the fronts and presets",
+               [&](const std::string& m) {
+                   if (m != "indirect" && m != "image")
+                       throw UsageError("report: --metric must be indirect or image, got '" + m + "'");
+                   o.indirectMetric = m == "indirect";
+               });
+    if (printedHelp(args, kReportUsage, options)) std::exit(0);
+    options.parse(args);
     if (o.images.empty()) o.images = (fs::path(o.out).parent_path() / "images").string();
     if (o.images.empty()) o.images = "images";
     return o;

@@ -45,32 +45,7 @@ Skip rules (deterministic, also applied to rows read back on resume):
     warm-up is already over), and the knob's values farther from the default on that side are
     skipped;
   - a knob whose first value renders exactly the default image has no effect at the defaults (for
-    example bias-compensation settings while compensation is off): its other values are skipped.
-
-  --scenes LIST          comma-separated scenes (default builtin:cornell)
-  --techniques LIST      comma-separated techniques (default: every registered technique)
-  --size WxH             image size (default 128x128)
-  --steps N              values per numeric knob, 2..16 (default 4)
-  --knobs LIST           vary only these knobs (each must belong to a selected technique)
-  --max-points N         at most N points per technique and scene, the default point included
-  --frames N             timed frames per point after the warm-up (default 3)
-  --max-frame-ms MS      per-point frame budget for the skip rule (default 2000; 0 = none)
-  --reference MODE       reference mode (default one-bounce-unoccluded: what VPL gathering without
-                         indirect visibility converges to)
-  --spp N                reference samples per pixel at most (default 65536)
-  --noise-target R       stop each reference once the noise of its indirect light (relative to that
-                         light, estimated from the samples' spread) is at most R (default 0.015; 0 = none:
-                         exactly --spp samples)
-  --cache-dir DIR        reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)
-  --no-reference-refinement  keep each scene's reference at --noise-target; by default, when its
-                         noise exceeds a fifth of the smallest error the scene's points reach, it is
-                         rendered again to that noise (up to --spp) and the errors are measured
-                         again (the timings stand)
-  --paper-tables         also measure the configurations of the seed papers' tables (first scene
-                         only; see docs/accuracy.md)
-  --out DIR              output folder (default bench-sweep)
-  --gl egl|osmesa
-)";
+    example bias-compensation settings while compensation is off): its other values are skipped.)";
 
 struct Options {
     std::vector<std::string> scenes = {"builtin:cornell"};
@@ -236,47 +211,52 @@ Options parseOptions(const std::vector<std::string>& args) {
     // A fifth of the smallest indirect error the 128x128 sweep measures (about 0.075 on cornell).
     o.reference.noiseTarget = 0.015;
     o.reference.noiseOfIndirect = true;
-    ArgCursor c{args};
-    for (; c.i < args.size(); ++c.i) {
-        const std::string& a = args[c.i];
-        if (a == "--help" || a == "-h") {
-            std::cout << kSweepUsage;
-            std::exit(0);
-        } else if (a == "--scenes")
-            o.scenes = splitList(c.value());
-        else if (a == "--techniques")
-            o.techniques = splitList(c.value());
-        else if (a == "--size")
-            cli::parseSize("--size", c.value(), 4096, o.width, o.height);
-        else if (a == "--steps")
-            o.steps = cli::parseInteger("--steps", c.value(), 2, 16);
-        else if (a == "--knobs")
-            o.knobs = splitList(c.value());
-        else if (a == "--max-points")
-            o.maxPoints = cli::parseInteger("--max-points", c.value(), 1, 100000);
-        else if (a == "--frames")
-            o.frames = cli::parseInteger("--frames", c.value(), 1, 1000);
-        else if (a == "--max-frame-ms")
-            o.maxFrameMs = cli::parseNumber("--max-frame-ms", c.value(), 0, 1e7);
-        else if (a == "--reference")
-            o.reference.mode = c.value();
-        else if (a == "--spp")
-            o.reference.spp = cli::parseInteger("--spp", c.value(), 1, 1000000);
-        else if (a == "--noise-target")
-            o.reference.noiseTarget = cli::parseNumber("--noise-target", c.value(), 0, 0.5);
-        else if (a == "--cache-dir")
-            o.cacheDir = c.value();
-        else if (a == "--paper-tables")
-            o.paperTables = true;
-        else if (a == "--no-reference-refinement")
-            o.refineReference = false;
-        else if (a == "--out")
-            o.out = c.value();
-        else if (a == "--gl")
-            o.gl = c.value();
-        else
-            throw UsageError("sweep: unknown option '" + a + "' (see gi-bench sweep --help)");
-    }
+    cli::OptionTable options;
+    options
+        .value("--scenes", "LIST", "comma-separated scenes (default builtin:cornell)",
+               [&](const std::string& v) { o.scenes = splitList(v); })
+        .value("--techniques", "LIST", "comma-separated techniques (default: every registered technique)",
+               [&](const std::string& v) { o.techniques = splitList(v); })
+        .value("--size", "WxH", "image size, 16..4096 each (default 128x128)",
+               [&](const std::string& v) { cli::parseSize("--size", v, 4096, o.width, o.height); })
+        .integer("--steps", "N", "values per numeric knob", 2, 16, o.steps)
+        .value("--knobs", "LIST", "vary only these knobs (each must belong to a selected technique)",
+               [&](const std::string& v) { o.knobs = splitList(v); })
+        .integer("--max-points", "N",
+                 "at most N points per technique and scene, the default point included (0: all)", 0, 100000,
+                 o.maxPoints)
+        .integer("--frames", "N", "timed frames per point after the warm-up", 1, 1000, o.frames)
+        .number("--max-frame-ms", "MS", "per-point frame budget for the skip rule (0 = none)", 0, 1e7,
+                o.maxFrameMs)
+        .value(
+            "--reference", "MODE",
+            "reference mode (default one-bounce-unoccluded: what VPL gathering without indirect visibility "
+            "converges to)",
+            [&](const std::string& v) { o.reference.mode = v; })
+        .integer("--spp", "N", "reference samples per pixel at most", 1, 1000000, o.reference.spp)
+        .number("--noise-target", "R",
+                "stop each reference once the noise of its indirect light (relative to that light, estimated "
+                "from the samples' spread) is at most R (0 = none: exactly --spp samples)",
+                0, 0.5, o.reference.noiseTarget)
+        .value("--cache-dir", "DIR", "reference cache ($GI_CACHE_DIR, default ~/.cache/gi-render)",
+               [&](const std::string& v) { o.cacheDir = v; })
+        .flag("--no-reference-refinement",
+              "keep each scene's reference at --noise-target; by default, when its noise exceeds a fifth of "
+              "the "
+              "smallest error the scene's points reach, it is rendered again to that noise (up to --spp) and "
+              "the "
+              "errors are measured again (the timings stand)",
+              [&] { o.refineReference = false; })
+        .flag("--paper-tables",
+              "also measure the configurations of the seed papers' tables (first scene only; see "
+              "docs/accuracy.md)",
+              [&] { o.paperTables = true; })
+        .value("--out", "DIR", "output folder (default bench-sweep)",
+               [&](const std::string& v) { o.out = v; })
+        .value("--gl", "egl|osmesa", "headless GL backend (default: $GI_GL, else egl)",
+               [&](const std::string& v) { o.gl = v; });
+    if (printedHelp(args, kSweepUsage, options)) std::exit(0);
+    options.parse(args);
     if (o.scenes.empty()) throw UsageError("--scenes needs at least one scene");
     checkScenes(o.scenes);
     if (o.techniques.empty())

@@ -51,6 +51,9 @@ std::string joinList(const std::vector<std::string>& items, const char* separato
 }
 
 std::string numberText(double value) {
+    // Whole numbers in full (10000000, not 1e+07): help texts show ranges such as 0..10000000.
+    if (std::isfinite(value) && std::abs(value) < 1e15 && value == std::floor(value))
+        return std::to_string(static_cast<long long>(value));
     std::ostringstream s;
     s << value;
     return s.str();

@@ -45,6 +45,8 @@ TEST(CommandLine, ListsSplitAndJoin) {
     EXPECT_EQ(joinList({"a", "b"}, ","), "a,b");
     EXPECT_EQ(numberText(0.5), "0.5");
     EXPECT_EQ(numberText(8192), "8192");
+    EXPECT_EQ(numberText(1e7), "10000000") << "whole numbers in full";
+    EXPECT_EQ(numberText(-3), "-3");
 }
 
 TEST(CommandLine, OptionTableHelpAndParseComeFromOneDeclaration) {
