@@ -2,7 +2,7 @@
 // JSON-Schema subset validator. Pure functions without DOM access so node's test runner can load
 // this module as it is.
 
-import { MESSAGES, SERVER_SCHEMAS } from './schemas.js';
+import { CODEC_TABLE, MESSAGES, SERVER_SCHEMAS } from './schemas.js';
 
 export const PROTOCOL_VERSION = 2;
 export const SUBPROTOCOL = 'gi-stream';
@@ -125,8 +125,9 @@ export function viewportFor(cssWidth, cssHeight, devicePixelRatio = 1) {
 
 export const FRAME_MAGIC = 'GIFR';
 export const FRAME_HEADER_BYTES = 16;
-export const CODECS = Object.freeze({ 1: 'jpeg', 2: 'png', 3: 'webp' });
-export const CODEC_MIME = Object.freeze({ jpeg: 'image/jpeg', png: 'image/png', webp: 'image/webp' });
+// From protocol/codecs.json (through the generated schemas.js): header byte -> name, name -> MIME type.
+export const CODECS = Object.freeze(Object.fromEntries(CODEC_TABLE.map((c) => [c.id, c.name])));
+export const CODEC_MIME = Object.freeze(Object.fromEntries(CODEC_TABLE.map((c) => [c.name, c.mime])));
 
 function asDataView(buffer) {
     if (buffer instanceof ArrayBuffer) return new DataView(buffer);

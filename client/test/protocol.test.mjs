@@ -14,9 +14,10 @@ import {
 import { OrbitCamera, cameraBasis, orbitFromPosition, positionFromOrbit } from '../camera.js';
 import { backoffDelay, pageOptions, shareLink, streamUrl } from '../connection.js';
 import { niceStep, widgetKind } from '../params.js';
-import { CLIENT_SCHEMAS, MESSAGES, RENDER_REQUEST_SCHEMA, SERVER_SCHEMAS } from '../schemas.js';
+import { CLIENT_SCHEMAS, CODEC_TABLE, MESSAGES, RENDER_REQUEST_SCHEMA, SERVER_SCHEMAS } from '../schemas.js';
 import {
-    loadMessageTable, loadProtocolSchemas, loadRenderRequestSchema, loadServerSchemas, loadVectors, PROTOCOL_DIR,
+    loadCodecTable, loadMessageTable, loadProtocolSchemas, loadRenderRequestSchema, loadServerSchemas, loadVectors,
+    PROTOCOL_DIR,
 } from '../tools/protocol-files.mjs';
 
 const schemas = loadProtocolSchemas();
@@ -49,6 +50,20 @@ test('the message table names every schema, and the client carries the current t
     }
     const viewerTypes = Object.keys(table.client).filter((t) => table.client[t].viewers).sort();
     assert.deepEqual(viewerTypes, ['ack', 'hello', 'ping', 'snapshot'], 'viewers only watch, acknowledge and snapshot');
+});
+
+test('the codecs come from protocol/codecs.json: the schemas\' lists and the frame header\'s table', () => {
+    const codecs = loadCodecTable();
+    assert.deepEqual(CODEC_TABLE, codecs, 'client/schemas.js differs from protocol/codecs.json; run node client/tools/update-schemas.mjs');
+    const names = codecs.map((c) => c.name);
+    assert.deepEqual(schemas.hello.properties.codecs.items.enum, names);
+    assert.equal(schemas.hello.properties.codecs.maxItems, names.length);
+    assert.deepEqual(schemas.snapshot.properties.codec.enum, codecs.filter((c) => c.lossless).map((c) => c.name));
+    assert.deepEqual(loadRenderRequestSchema().properties.format.enum, names);
+    for (const c of codecs) {
+        assert.equal(CODECS[c.id], c.name);
+        assert.equal(CODEC_MIME[c.name], c.mime);
+    }
 });
 
 test('server messages are checked against their schemas', () => {

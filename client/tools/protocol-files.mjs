@@ -36,6 +36,11 @@ export function loadMessageTable() {
     return JSON.parse(readFileSync(path.join(PROTOCOL_DIR, 'messages.json'), 'utf8'));
 }
 
+/** protocol/codecs.json's rows: {id, name, mime, extensions, lossy, lossless}. */
+export function loadCodecTable() {
+    return JSON.parse(readFileSync(path.join(PROTOCOL_DIR, 'codecs.json'), 'utf8')).codecs;
+}
+
 /** protocol/http/render_request.json: the body of POST /api/render. */
 export function loadRenderRequestSchema() {
     return JSON.parse(readFileSync(path.join(PROTOCOL_DIR, 'http', 'render_request.json'), 'utf8'));

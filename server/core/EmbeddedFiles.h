@@ -16,6 +16,7 @@ struct EmbeddedFile {
 namespace embedded {
 std::span<const EmbeddedFile> shaders();   ///< shaders/**
 std::span<const EmbeddedFile> protocol();  ///< protocol/schema/**.json, protocol/messages.json
+std::span<const EmbeddedFile> codecs();    ///< protocol/codecs.json
 } // namespace embedded
 
 inline std::optional<std::string_view> findEmbedded(std::span<const EmbeddedFile> files, std::string_view path) {

@@ -8,12 +8,15 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 #include <png.h>
 #include <turbojpeg.h>
 #include <webp/encode.h>
 
+#include "core/EmbeddedFiles.h"
 #include "core/Error.h"
 
 namespace gis {
@@ -32,17 +35,17 @@ ImageCodec parseImageCodec(const std::string& name, const std::string& where) {
     std::string known;
     for (const CodecInfo& c : imageCodecs()) {
         if (name == c.name) return c.id;
-        known += (known.empty() ? "" : ", ") + std::string(c.name);
+        known += (known.empty() ? "" : ", ") + c.name;
     }
     throw InputError(where, "unknown image format '" + name + "' (known: " + known + ")");
 }
 
 const char* codecName(ImageCodec codec) {
-    return codecInfo(codec).name;
+    return codecInfo(codec).name.c_str();
 }
 
 const char* codecMimeType(ImageCodec codec) {
-    return codecInfo(codec).mimeType;
+    return codecInfo(codec).mimeType.c_str();
 }
 
 std::optional<ImageCodec> codecForPath(const std::string& path) {
@@ -178,35 +181,40 @@ std::vector<std::uint8_t> encodeWebpLossless(const std::uint8_t* rgba, int width
 }
 
 const std::vector<CodecInfo>& imageCodecs() {
-    static const std::vector<CodecInfo> table = {
-        {ImageCodec::Jpeg,
-         "jpeg",
-         "image/jpeg",
-         {"jpg", "jpeg"},
-         true,
-         false,
-         [](const std::uint8_t* rgba, int w, int h, int quality, bool, const ImageMetadata&) {
-             return encodeJpeg(rgba, w, h, quality);
-         }},
-        {ImageCodec::Png,
-         "png",
-         "image/png",
-         {"png"},
-         false,
-         true,
-         [](const std::uint8_t* rgba, int w, int h, int, bool, const ImageMetadata& text) {
-             return encodePng(rgba, w, h, text);
-         }},
-        {ImageCodec::Webp,
-         "webp",
-         "image/webp",
-         {"webp"},
-         true,
-         true,
-         [](const std::uint8_t* rgba, int w, int h, int quality, bool exact, const ImageMetadata&) {
-             return exact ? encodeWebpLossless(rgba, w, h) : encodeWebp(rgba, w, h, quality);
-         }},
-    };
+    static const std::vector<CodecInfo> table = [] {
+        // Each codec's encoder, by the name protocol/codecs.json gives it.
+        using Encode = decltype(CodecInfo::encode);
+        const std::map<std::string, Encode> encoders = {
+            {"jpeg", [](const std::uint8_t* rgba, int w, int h, int quality, bool,
+                        const ImageMetadata&) { return encodeJpeg(rgba, w, h, quality); }},
+            {"png", [](const std::uint8_t* rgba, int w, int h, int, bool,
+                       const ImageMetadata& text) { return encodePng(rgba, w, h, text); }},
+            {"webp",
+             [](const std::uint8_t* rgba, int w, int h, int quality, bool exact, const ImageMetadata&) {
+                 return exact ? encodeWebpLossless(rgba, w, h) : encodeWebp(rgba, w, h, quality);
+             }},
+        };
+        const auto text = findEmbedded(embedded::codecs(), "codecs.json");
+        GIS_ASSERT_MSG(text.has_value(), "protocol/codecs.json is not embedded");
+        std::vector<CodecInfo> rows;
+        const nlohmann::json doc = nlohmann::json::parse(*text); // kept: the loop reads into it
+        for (const auto& row : doc.at("codecs")) {
+            CodecInfo c{static_cast<ImageCodec>(row.at("id").get<int>()),
+                        row.at("name").get<std::string>(),
+                        row.at("mime").get<std::string>(),
+                        row.at("extensions").get<std::vector<std::string>>(),
+                        row.at("lossy").get<bool>(),
+                        row.at("lossless").get<bool>(),
+                        nullptr};
+            const auto encoder = encoders.find(c.name);
+            GIS_ASSERT_MSG(encoder != encoders.end(), "protocol/codecs.json names codec '" + c.name +
+                                                          "', which Encoder.cpp cannot encode");
+            c.encode = encoder->second;
+            rows.push_back(std::move(c));
+        }
+        GIS_ASSERT_MSG(!rows.empty(), "protocol/codecs.json lists no codecs");
+        return rows;
+    }();
     return table;
 }
 

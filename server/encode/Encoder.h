@@ -19,13 +19,14 @@ enum class ImageCodec : std::uint8_t { Jpeg = 1, Png = 2, Webp = 3 };
 /// Text chunks of a PNG file, (keyword, text) in order. Keywords: 1..79 printable Latin-1 characters.
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
-/// Everything about one codec, in one row of imageCodecs(): the encoder, the CLI's file names, the
-/// protocol's and the API's names and the HTTP type all read it. The protocol schemas' codec lists
-/// and the client's header table are checked against it (tests/unit/encode/CodecTableTest.cpp).
+/// Everything about one codec, one row of protocol/codecs.json (embedded) paired with its encoder: the
+/// encoder, the CLI's file names, the protocol's and the API's names and the HTTP type all read it;
+/// the protocol schemas' codec lists and the client's header table are generated from the same file
+/// (client/tools/update-schemas.mjs) and checked (tests/unit/encode/CodecTableTest.cpp).
 struct CodecInfo {
     ImageCodec id;                       ///< also the binary frame header's codec byte
-    const char* name;                    ///< "jpeg": hello.codecs, snapshot.codec, the API's format
-    const char* mimeType;                ///< "image/jpeg"
+    std::string name;                    ///< "jpeg": hello.codecs, snapshot.codec, the API's format
+    std::string mimeType;                ///< "image/jpeg"
     std::vector<std::string> extensions; ///< lower case, without the dot; the first is the one suggested
     bool lossy;                          ///< encodes at a quality 1..100 (what the stream uses)
     bool lossless;                       ///< can encode without loss (what a snapshot may ask for)

@@ -1,10 +1,11 @@
-// The codec table (imageCodecs) is the one place a codec is described: names, types and file
-// extensions derive from it, and the protocol's schemas and the client's frame-header table must list
-// exactly its codecs, so adding a row without them fails here, naming the file to change.
+// The codec table is protocol/codecs.json paired with Encoder.cpp's encoders: names, types and file
+// extensions derive from it, and the protocol's schemas and the client's frame-header table (written
+// from the same file by client/tools/update-schemas.mjs) must list exactly its codecs, so a row added
+// without regenerating them fails here, naming the file.
 #include <algorithm>
 #include <fstream>
 #include <iterator>
-#include <regex>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -35,13 +36,32 @@ std::set<std::string> names(bool (*keep)(const CodecInfo&)) {
     return out;
 }
 
+TEST(CodecTable, TheRowsAreProtocolCodecsJson) {
+    const auto file = nlohmann::json::parse(readSource("protocol/codecs.json"))["codecs"];
+    ASSERT_EQ(file.size(), imageCodecs().size());
+    for (std::size_t i = 0; i < file.size(); ++i) {
+        const CodecInfo& c = imageCodecs()[i];
+        EXPECT_EQ(file[i]["id"], static_cast<int>(c.id));
+        EXPECT_EQ(file[i]["name"], c.name);
+        EXPECT_EQ(file[i]["mime"], c.mimeType);
+        EXPECT_EQ(file[i]["extensions"], c.extensions);
+        EXPECT_EQ(file[i]["lossy"], c.lossy);
+        EXPECT_EQ(file[i]["lossless"], c.lossless);
+        EXPECT_NE(c.encode, nullptr);
+    }
+    // The codecs the code names exist.
+    EXPECT_EQ(codecInfo(ImageCodec::Jpeg).name, "jpeg");
+    EXPECT_EQ(codecInfo(ImageCodec::Png).name, "png");
+    EXPECT_EQ(codecInfo(ImageCodec::Webp).name, "webp");
+}
+
 TEST(CodecTable, NamesTypesAndExtensionsComeFromTheRows) {
     std::set<int> ids;
     for (const CodecInfo& c : imageCodecs()) {
         EXPECT_TRUE(ids.insert(static_cast<int>(c.id)).second) << c.name << ": ids are unique";
         EXPECT_EQ(parseImageCodec(c.name), c.id);
-        EXPECT_STREQ(codecName(c.id), c.name);
-        EXPECT_STREQ(codecMimeType(c.id), c.mimeType);
+        EXPECT_EQ(codecName(c.id), c.name);
+        EXPECT_EQ(codecMimeType(c.id), c.mimeType);
         EXPECT_TRUE(c.lossy || c.lossless) << c.name;
         ASSERT_FALSE(c.extensions.empty()) << c.name;
         for (const std::string& ext : c.extensions) {
@@ -99,21 +119,17 @@ TEST(CodecTable, ProtocolSchemasListExactlyTheTablesCodecs) {
         << "protocol/http/render_request.json: format lists every codec";
 }
 
-TEST(CodecTable, ClientDecodesEveryCodecByItsHeaderByte) {
-    // client/protocol.js: export const CODECS = Object.freeze({ 1: 'jpeg', 2: 'png', 3: 'webp' });
-    const std::string js = readSource("client/protocol.js");
-    std::smatch table;
-    ASSERT_TRUE(
-        std::regex_search(js, table, std::regex(R"(export const CODECS = Object\.freeze\(\{([^}]*)\}\))")))
-        << "client/protocol.js has no CODECS table";
-    std::map<int, std::string> client;
-    const std::string body = table[1];
-    const std::regex entry(R"((\d+)\s*:\s*'([a-z0-9]+)')");
-    for (auto it = std::sregex_iterator(body.begin(), body.end(), entry); it != std::sregex_iterator(); ++it)
-        client[std::stoi((*it)[1])] = (*it)[2];
-    std::map<int, std::string> server;
-    for (const CodecInfo& c : imageCodecs()) server[static_cast<int>(c.id)] = c.name;
-    EXPECT_EQ(client, server) << "client/protocol.js: CODECS maps each header byte to the table's name";
+TEST(CodecTable, TheClientCarriesTheCurrentTable) {
+    // client/schemas.js: export const CODEC_TABLE = Object.freeze([...]); (one line, generated)
+    const std::string js = readSource("client/schemas.js");
+    const std::string marker = "export const CODEC_TABLE = Object.freeze(";
+    const auto at = js.find(marker);
+    ASSERT_NE(at, std::string::npos)
+        << "client/schemas.js has no CODEC_TABLE: run node client/tools/update-schemas.mjs";
+    const auto end = js.find(");", at);
+    const auto table = nlohmann::json::parse(js.substr(at + marker.size(), end - at - marker.size()));
+    EXPECT_EQ(table, nlohmann::json::parse(readSource("protocol/codecs.json"))["codecs"])
+        << "client/schemas.js differs from protocol/codecs.json: run node client/tools/update-schemas.mjs";
 }
 
 } // namespace
