@@ -208,10 +208,16 @@ int WsServer::Impl::streamCallback(lws* wsi, lws_callback_reasons reason, void* 
 WsServer::WsServer(ServerConfig config) : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
     m.config = std::move(config);
-    for (const ClientMessageSpec& spec : clientMessages())
-        if (spec.connection != (Impl::connectionHandlers().count(spec.type) == 1))
+    // protocol/messages.json says who answers each message: the stream endpoint or the session.
+    const std::vector<std::string> sessionTypes = Session::messageTypes();
+    for (const ClientMessageSpec& spec : clientMessages()) {
+        const bool endpoint = Impl::connectionHandlers().count(spec.type) == 1;
+        const bool session =
+            std::find(sessionTypes.begin(), sessionTypes.end(), spec.type) != sessionTypes.end();
+        if (spec.connection != endpoint || spec.connection == session)
             throw Error("net: protocol/messages.json says '" + spec.type + "' is answered by the " +
-                        (spec.connection ? "connection" : "session") + ", and the stream endpoint disagrees");
+                        (spec.connection ? "connection" : "session") + ", and the server disagrees");
+    }
     m.sessions = std::make_unique<Directory>(
         Directory::Limits{.maxSessions = m.config.maxSessions,
                           .maxViewersPerSession = kMaxViewersPerSession,

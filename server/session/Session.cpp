@@ -251,118 +251,165 @@ void Session::ack(const std::shared_ptr<ClientLink>& link, std::uint32_t id) {
     mCv.notify_all();
 }
 
-void Session::resize(int cssWidth, int cssHeight, double dpr) {
+bool Session::resizeLocked(int cssWidth, int cssHeight, double dpr) {
     const double w = std::max(1.0, std::round(cssWidth * dpr));
     const double h = std::max(1.0, std::round(cssHeight * dpr));
     // Scale down to fit the server's limit, keeping the aspect ratio; never below the 16 px minimum.
     const double fit = std::min({1.0, mConfig.limits.maxWidth / w, mConfig.limits.maxHeight / h});
     const int width = std::clamp(static_cast<int>(std::floor(w * fit)), 16, mConfig.limits.maxWidth);
     const int height = std::clamp(static_cast<int>(std::floor(h * fit)), 16, mConfig.limits.maxHeight);
+    if (width == mDesired.width && height == mDesired.height) return false;
+    mDesired.width = width;
+    mDesired.height = height;
+    return true;
+}
+
+void Session::resize(int cssWidth, int cssHeight, double dpr) {
     {
         std::lock_guard lock(mMutex);
-        if (width == mDesired.width && height == mDesired.height) return;
-        mDesired.width = width;
-        mDesired.height = height;
+        if (!resizeLocked(cssWidth, cssHeight, dpr)) return;
         markInput();
     }
     mCv.notify_all();
 }
 
+const std::map<std::string, Session::MessageHandler>& Session::messageHandlers() {
+    static const std::map<std::string, MessageHandler> handlers = {
+        {"camera", &Session::onCamera},       {"light", &Session::onLight},
+        {"light_add", &Session::onLightAdd},  {"light_remove", &Session::onLightRemove},
+        {"technique", &Session::onTechnique}, {"params", &Session::onParams},
+        {"resize", &Session::onResize},       {"scene", &Session::onScene},
+        {"quality", &Session::onQuality},     {"snapshot", &Session::onSnapshot}};
+    return handlers;
+}
+
+std::vector<std::string> Session::messageTypes() {
+    std::vector<std::string> out;
+    for (const auto& [type, handler] : messageHandlers()) out.push_back(type);
+    return out;
+}
+
 void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from) {
     const std::string type = msg["type"];
-    if (type == "resize") {
-        resize(msg["size"][0], msg["size"][1], msg.value("dpr", 1.0));
-        return;
-    }
+    const auto handler = messageHandlers().find(type);
+    if (handler == messageHandlers().end())
+        throw ProtocolError{"unknown_type", "'" + type + "' does not steer a session", "/type", type};
     std::unique_lock lock(mMutex);
-    bool lightsChanged = false; // light_add and light_remove answer with the new state (its ids)
+    Applied applied = Applied::Nothing;
     try {
-        if (type == "camera") {
-            applyCameraJson(mDesired, msg, "");
-        } else if (type == "light") {
-            try {
-                applyLightJson(mDesired, msg, "");
-            } catch (const InputError& e) {
-                if (e.reason().rfind("no light '", 0) == 0)
-                    throw ProtocolError{"unknown_light", e.reason() + "; add one with a light_add message",
-                                        e.where(), type};
-                throw;
-            }
-        } else if (type == "light_add") {
-            addLightJson(mDesired, msg.value("light", nlohmann::json::object()), "/light");
-            lightsChanged = true;
-        } else if (type == "light_remove") {
-            try {
-                removeLight(mDesired, msg["id"].get<std::string>(), "/id");
-            } catch (const InputError& e) {
-                throw ProtocolError{"unknown_light", e.reason(), e.where(), type};
-            }
-            lightsChanged = true;
-        } else if (type == "technique") {
-            FrameState next = mDesired;
-            try {
-                setTechnique(next, msg["name"], "/name");
-            } catch (const InputError& e) {
-                throw ProtocolError{"unknown_technique", e.reason(), "/name", type};
-            }
-            if (vplEstimate(next) > mConfig.limits.maxVpls)
-                throw ProtocolError{
-                    "limit_exceeded",
-                    "technique '" + next.technique + "' asks for up to " + std::to_string(vplEstimate(next)) +
-                        " VPLs by default; the server allows " + std::to_string(mConfig.limits.maxVpls),
-                    "/name", type};
-            // Explicit technique parameters belonged to the previous technique.
-            for (auto it = mExplicit.begin(); it != mExplicit.end();)
-                it = next.frameParams.has(it.key()) ? std::next(it) : mExplicit.erase(it);
-            mDesired = std::move(next);
-        } else if (type == "params") {
-            FrameState next = mDesired;
-            try {
-                applyParams(next, msg["values"], "/values");
-            } catch (const InputError& e) {
-                throw ProtocolError{"invalid_param", e.reason(), e.where(), type};
-            }
-            if (vplEstimate(next) > mConfig.limits.maxVpls)
-                throw ProtocolError{"limit_exceeded",
-                                    "these parameters ask for up to " + std::to_string(vplEstimate(next)) +
-                                        " VPLs; the server allows " + std::to_string(mConfig.limits.maxVpls),
-                                    "/values", type};
-            mDesired = std::move(next);
-            for (const auto& [k, v] : msg["values"].items()) mExplicit[k] = v;
-        } else if (type == "scene") {
-            const std::string name = msg["name"];
-            if (mCatalog) {
-                try {
-                    (void)mCatalog->resolve(name, mUploadDir);
-                } catch (const InputError& e) {
-                    throw ProtocolError{"unknown_scene", e.reason(), "/name", type};
-                }
-            } else if (name != mConfig.scene) {
-                throw ProtocolError{"unknown_scene", "unknown scene '" + name + "'", "/name", type};
-            }
-            mSceneRequest = name;
-        } else if (type == "quality") {
-            mStream.adaptive = msg["adaptive"].get<bool>();
-            if (msg.contains("frame_target_ms")) mStream.frameTargetMs = msg["frame_target_ms"].get<int>();
-        } else if (type == "snapshot") {
-            mSnapshotFor = from;
-            // The schema admits only lossless codecs (protocol/schema/snapshot.json).
-            mSnapshotCodec = parseImageCodec(msg.value("codec", "png"), "/codec");
-            lock.unlock();
-            mCv.notify_all();
-            return;
-        } else {
-            throw ProtocolError{"unknown_type", "'" + type + "' does not steer a session", "/type", type};
-        }
+        applied = (this->*handler->second)(msg, from);
     } catch (const InputError& e) {
         throw ProtocolError{"invalid_message", e.reason(), e.where(), type};
     }
-    markInput();
+    if (applied == Applied::Nothing) return;
+    if (applied != Applied::Snapshot) markInput();
     nlohmann::json stateMsg;
-    if (lightsChanged) stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
+    // light_add and light_remove answer with the new state (its ids).
+    if (applied == Applied::InputAndLights) stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
     lock.unlock();
     mCv.notify_all();
-    if (lightsChanged) broadcastText(stateMsg);
+    if (applied == Applied::InputAndLights) broadcastText(stateMsg);
+}
+
+Session::Applied Session::onCamera(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    applyCameraJson(mDesired, msg, "");
+    return Applied::Input;
+}
+
+Session::Applied Session::onLight(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    try {
+        applyLightJson(mDesired, msg, "");
+    } catch (const InputError& e) {
+        if (e.reason().rfind("no light '", 0) == 0)
+            throw ProtocolError{"unknown_light", e.reason() + "; add one with a light_add message", e.where(),
+                                "light"};
+        throw;
+    }
+    return Applied::Input;
+}
+
+Session::Applied Session::onLightAdd(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    addLightJson(mDesired, msg.value("light", nlohmann::json::object()), "/light");
+    return Applied::InputAndLights;
+}
+
+Session::Applied Session::onLightRemove(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    try {
+        removeLight(mDesired, msg["id"].get<std::string>(), "/id");
+    } catch (const InputError& e) {
+        throw ProtocolError{"unknown_light", e.reason(), e.where(), "light_remove"};
+    }
+    return Applied::InputAndLights;
+}
+
+Session::Applied Session::onTechnique(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    FrameState next = mDesired;
+    try {
+        setTechnique(next, msg["name"], "/name");
+    } catch (const InputError& e) {
+        throw ProtocolError{"unknown_technique", e.reason(), "/name", "technique"};
+    }
+    if (vplEstimate(next) > mConfig.limits.maxVpls)
+        throw ProtocolError{"limit_exceeded",
+                            "technique '" + next.technique + "' asks for up to " +
+                                std::to_string(vplEstimate(next)) + " VPLs by default; the server allows " +
+                                std::to_string(mConfig.limits.maxVpls),
+                            "/name", "technique"};
+    // Explicit technique parameters belonged to the previous technique.
+    for (auto it = mExplicit.begin(); it != mExplicit.end();)
+        it = next.frameParams.has(it.key()) ? std::next(it) : mExplicit.erase(it);
+    mDesired = std::move(next);
+    return Applied::Input;
+}
+
+Session::Applied Session::onParams(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    FrameState next = mDesired;
+    try {
+        applyParams(next, msg["values"], "/values");
+    } catch (const InputError& e) {
+        throw ProtocolError{"invalid_param", e.reason(), e.where(), "params"};
+    }
+    if (vplEstimate(next) > mConfig.limits.maxVpls)
+        throw ProtocolError{"limit_exceeded",
+                            "these parameters ask for up to " + std::to_string(vplEstimate(next)) +
+                                " VPLs; the server allows " + std::to_string(mConfig.limits.maxVpls),
+                            "/values", "params"};
+    mDesired = std::move(next);
+    for (const auto& [k, v] : msg["values"].items()) mExplicit[k] = v;
+    return Applied::Input;
+}
+
+Session::Applied Session::onResize(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    return resizeLocked(msg["size"][0], msg["size"][1], msg.value("dpr", 1.0)) ? Applied::Input
+                                                                               : Applied::Nothing;
+}
+
+Session::Applied Session::onScene(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    const std::string name = msg["name"];
+    if (mCatalog) {
+        try {
+            (void)mCatalog->resolve(name, mUploadDir);
+        } catch (const InputError& e) {
+            throw ProtocolError{"unknown_scene", e.reason(), "/name", "scene"};
+        }
+    } else if (name != mConfig.scene) {
+        throw ProtocolError{"unknown_scene", "unknown scene '" + name + "'", "/name", "scene"};
+    }
+    mSceneRequest = name;
+    return Applied::Input;
+}
+
+Session::Applied Session::onQuality(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
+    mStream.adaptive = msg["adaptive"].get<bool>();
+    if (msg.contains("frame_target_ms")) mStream.frameTargetMs = msg["frame_target_ms"].get<int>();
+    return Applied::Input;
+}
+
+Session::Applied Session::onSnapshot(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from) {
+    mSnapshotFor = from;
+    // The schema admits only lossless codecs (protocol/schema/snapshot.json).
+    mSnapshotCodec = parseImageCodec(msg.value("codec", "png"), "/codec");
+    return Applied::Snapshot;
 }
 
 void Session::fail(const std::string& reason) {

@@ -91,9 +91,11 @@ public:
     /// Every attached client (the network layer closes them when the session ends).
     std::vector<std::shared_ptr<ClientLink>> clients() const;
 
-    /// Applies one validated steering message (camera, light, technique, params, resize, scene,
-    /// quality, snapshot) from `from`. Throws ProtocolError; the state is unchanged then.
+    /// Applies one validated steering message from `from` through its handler (messageTypes(): the
+    /// `session` rows of protocol/messages.json). Throws ProtocolError; the state is unchanged then.
     void apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    /// The message types apply() handles (gi-server checks them against protocol/messages.json).
+    static std::vector<std::string> messageTypes();
     /// Sets the viewport (CSS px x dpr, capped by the limits); throws ProtocolError.
     void resize(int cssWidth, int cssHeight, double dpr);
     /// A client acknowledged frame `id`.
@@ -145,6 +147,25 @@ private:
     int frameTargetMs(const StreamOptions& stream) const;
     nlohmann::json stateJsonLocked() const;
     void markInput(); // requires mMutex
+    /// What a message did, for apply()'s epilogue: nothing; input (the step starts again); input that
+    /// changed the light list (a state message follows); or a snapshot request (not input).
+    enum class Applied { Nothing, Input, InputAndLights, Snapshot };
+    /// One client message applied to the desired state, with mMutex held; throws ProtocolError or
+    /// InputError.
+    using MessageHandler = Applied (Session::*)(const nlohmann::json&, const std::shared_ptr<ClientLink>&);
+    static const std::map<std::string, MessageHandler>& messageHandlers();
+    Applied onCamera(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onLight(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onLightAdd(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onLightRemove(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onTechnique(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onParams(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onResize(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onScene(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onQuality(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    Applied onSnapshot(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    /// The viewport (requires mMutex); false when the size did not change.
+    bool resizeLocked(int cssWidth, int cssHeight, double dpr);
     bool readyLocked(std::chrono::steady_clock::time_point now) const;
     /// Input, or an adaptive step due (readyLocked less snapshots and whole images sent again).
     bool stepReadyLocked(std::chrono::steady_clock::time_point now) const;

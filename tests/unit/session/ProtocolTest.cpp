@@ -8,6 +8,7 @@
 
 #include "core/JsonSchema.h"
 #include "session/ProtocolMessages.h"
+#include "session/Session.h"
 
 namespace fs = std::filesystem;
 
@@ -166,4 +167,14 @@ TEST(Protocol, ServerMessagesAreCheckedAgainstTheirSchemas) {
               "");
     EXPECT_NE(gis::checkServerMessage({{"type", "progress"}, {"state", "rendering"}}), "");
     EXPECT_NE(gis::checkServerMessage({{"type", "camera"}}).find("not a server message"), std::string::npos);
+}
+
+TEST(Protocol, TheSessionHandlesExactlyTheSessionRows) {
+    std::vector<std::string> rows;
+    for (const auto& m : gis::clientMessages())
+        if (!m.connection) rows.push_back(m.type);
+    std::sort(rows.begin(), rows.end());
+    auto handled = gis::Session::messageTypes();
+    std::sort(handled.begin(), handled.end());
+    EXPECT_EQ(handled, rows) << "protocol/messages.json's session rows and Session's handlers";
 }
