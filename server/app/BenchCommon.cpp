@@ -56,9 +56,7 @@ void addRunOptions(cli::OptionTable& table, RunOptions& o, const std::string& co
 
 bool printedHelp(const std::vector<std::string>& args, const std::string& what,
                  const cli::OptionTable& options) {
-    if (std::find(args.begin(), args.end(), "--help") == args.end() &&
-        std::find(args.begin(), args.end(), "-h") == args.end())
-        return false;
+    if (!cli::OptionTable::asksForHelp(args)) return false;
     std::cout << what << "\n\n" << options.usage();
     return true;
 }

@@ -347,8 +347,7 @@ int run(int argc, char** argv) {
     const std::vector<std::string> args(argv + 1, argv + argc);
     const gis::cli::OptionTable options = optionTable(o, action, listParamsOf);
     // Help wins over everything else on the line, mistakes included.
-    if (std::find(args.begin(), args.end(), "--help") != args.end() ||
-        std::find(args.begin(), args.end(), "-h") != args.end()) {
+    if (gis::cli::OptionTable::asksForHelp(args)) {
         std::cout << kUsageHead << options.usage() << kUsageTail;
         return 0;
     }

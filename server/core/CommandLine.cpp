@@ -1,5 +1,6 @@
 #include "core/CommandLine.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -152,6 +153,11 @@ std::string OptionTable::usage(int width) const {
         out += head + wrapped(o.help, kColumn, static_cast<std::size_t>(width)) + "\n";
     }
     return out;
+}
+
+bool OptionTable::asksForHelp(const std::vector<std::string>& args) {
+    return std::any_of(args.begin(), args.end(),
+                       [](const std::string& a) { return a == "--help" || a == "-h"; });
 }
 
 bool OptionTable::has(const std::string& name) const {

@@ -57,6 +57,8 @@ public:
 
     /// The options' help: "  --flag VALUE   help", the help wrapped at `width` columns.
     std::string usage(int width = 100) const;
+    /// Whether `args` hold --help or -h anywhere: help wins over everything else on the line.
+    static bool asksForHelp(const std::vector<std::string>& args);
     /// Applies `args` in order. Unknown flags and missing values throw UsageError / InputError.
     void parse(const std::vector<std::string>& args) const;
     bool has(const std::string& name) const;

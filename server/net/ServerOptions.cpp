@@ -254,6 +254,8 @@ std::vector<ServerOption> buildOptions() {
     return t;
 }
 
+#undef GIS_FIELD
+
 const ServerOption* findOption(const std::string& flag) {
     for (const auto& o : serverOptions())
         if (o.flag == flag) return &o;

@@ -28,6 +28,11 @@ const nlohmann::json* schemaFor(const std::string& name) {
     return it == schemas.end() ? nullptr : &it->second;
 }
 
+/// "/pointer: message", or the message alone at the root.
+std::string violationText(const SchemaViolation& v) {
+    return (v.pointer.empty() ? "" : v.pointer + ": ") + v.message;
+}
+
 const nlohmann::json& messageTable() {
     static const nlohmann::json table = [] {
         const auto text = findEmbedded(embedded::protocol(), "messages.json");
@@ -85,8 +90,7 @@ std::string checkServerMessage(const nlohmann::json& message) {
         return "'" + type + "' is not a server message in protocol/messages.json";
     const nlohmann::json* schema = schemaFor("server/" + type);
     if (!schema) return "protocol/schema/server/" + type + ".json is missing";
-    if (auto v = validateJson(message, *schema))
-        return (v->pointer.empty() ? "" : v->pointer + ": ") + v->message;
+    if (auto v = validateJson(message, *schema)) return violationText(*v);
     return {};
 }
 
@@ -118,9 +122,7 @@ nlohmann::json parseClientMessage(std::string_view text) {
             rest["values"] = nlohmann::json::object();
             tablesJudge = !validateJson(rest, *schema).has_value();
         }
-        if (!tablesJudge)
-            throw ProtocolError{"invalid_message", (v->pointer.empty() ? "" : v->pointer + ": ") + v->message,
-                                v->pointer, t};
+        if (!tablesJudge) throw ProtocolError{"invalid_message", violationText(*v), v->pointer, t};
     }
     return msg;
 }

@@ -311,6 +311,16 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
     if (applied == Applied::InputAndLights) broadcastText(stateMsg);
 }
 
+void Session::checkVplLimit(const FrameState& next, const std::string& who, const std::string& how,
+                            const std::string& where, const std::string& request) const {
+    const long vpls = vplEstimate(next);
+    if (vpls > mConfig.limits.maxVpls)
+        throw ProtocolError{"limit_exceeded",
+                            who + " for up to " + std::to_string(vpls) + " VPLs" + how +
+                                "; the server allows " + std::to_string(mConfig.limits.maxVpls),
+                            where, request};
+}
+
 Session::Applied Session::onCamera(const nlohmann::json& msg, const std::shared_ptr<ClientLink>&) {
     applyCameraJson(mDesired, msg, "");
     return Applied::Input;
@@ -349,12 +359,7 @@ Session::Applied Session::onTechnique(const nlohmann::json& msg, const std::shar
     } catch (const InputError& e) {
         throw ProtocolError{"unknown_technique", e.reason(), "/name", "technique"};
     }
-    if (vplEstimate(next) > mConfig.limits.maxVpls)
-        throw ProtocolError{"limit_exceeded",
-                            "technique '" + next.technique + "' asks for up to " +
-                                std::to_string(vplEstimate(next)) + " VPLs by default; the server allows " +
-                                std::to_string(mConfig.limits.maxVpls),
-                            "/name", "technique"};
+    checkVplLimit(next, "technique '" + next.technique + "' asks", " by default", "/name", "technique");
     // Explicit technique parameters belonged to the previous technique.
     for (auto it = mExplicit.begin(); it != mExplicit.end();)
         it = next.frameParams.has(it.key()) ? std::next(it) : mExplicit.erase(it);
@@ -369,11 +374,7 @@ Session::Applied Session::onParams(const nlohmann::json& msg, const std::shared_
     } catch (const InputError& e) {
         throw ProtocolError{"invalid_param", e.reason(), e.where(), "params"};
     }
-    if (vplEstimate(next) > mConfig.limits.maxVpls)
-        throw ProtocolError{"limit_exceeded",
-                            "these parameters ask for up to " + std::to_string(vplEstimate(next)) +
-                                " VPLs; the server allows " + std::to_string(mConfig.limits.maxVpls),
-                            "/values", "params"};
+    checkVplLimit(next, "these parameters ask", "", "/values", "params");
     mDesired = std::move(next);
     for (const auto& [k, v] : msg["values"].items()) mExplicit[k] = v;
     return Applied::Input;

@@ -164,6 +164,10 @@ private:
     Applied onScene(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
     Applied onQuality(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
     Applied onSnapshot(const nlohmann::json& msg, const std::shared_ptr<ClientLink>& from);
+    /// Throws limit_exceeded ("WHO for up to N VPLsHOW; the server allows M") when `next` asks for more
+    /// VPLs than the server allows.
+    void checkVplLimit(const FrameState& next, const std::string& who, const std::string& how,
+                       const std::string& where, const std::string& request) const;
     /// The viewport (requires mMutex); false when the size did not change.
     bool resizeLocked(int cssWidth, int cssHeight, double dpr);
     bool readyLocked(std::chrono::steady_clock::time_point now) const;

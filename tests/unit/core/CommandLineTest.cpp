@@ -65,6 +65,8 @@ TEST(CommandLine, OptionTableHelpAndParseComeFromOneDeclaration) {
         << usage;
     EXPECT_NE(usage.find("size factor, 0.1..1 (default 0.5)"), std::string::npos) << usage;
     EXPECT_NE(usage.find("\nQuiet:\n  --quiet"), std::string::npos) << usage;
+    EXPECT_TRUE(OptionTable::asksForHelp({"--frames", "0", "-h"})) << "help wins over a bad value";
+    EXPECT_FALSE(OptionTable::asksForHelp({"--scene", "help"}));
     EXPECT_TRUE(t.has("--quiet"));
     EXPECT_FALSE(t.has("Quiet:"));
 
