@@ -97,6 +97,17 @@ const ParamTable& frameParamTable() {
          .help = "GGX-lobe samples per texel when prefiltering each roughness level",
          .source = "004 §2.2.2",
          .logScale = true},
+        {.name = "env_budget_ms",
+         .type = ParamType::Float,
+         .defaultValue = 0,
+         .min = 0,
+         .max = 10000,
+         .unit = "ms",
+         .help = "time the environment probes may take in a frame that renders them again (the lights or "
+                 "the scene changed): fewer local probes and smaller faces, chosen from their measured "
+                 "cost; 0 renders env_size and every probe as asked. The live view sets it from its frame "
+                 "target",
+         .source = "eng"},
         {.name = "env_parallax",
          .type = ParamType::Enum,
          .defaultValue = 0,
@@ -168,8 +179,7 @@ const ParamTable& frameParamTable() {
         {.name = "effect_specular",
          .type = ParamType::Enum,
          .defaultValue = 0,
-         .help =
-             "direct specular highlights from the lights: auto = on when a material has a specular lobe",
+         .help = "direct specular highlights from the lights: auto = on when a material has a specular lobe",
          .source = "eng",
          .options = {"auto", "on", "off"}},
         {.name = "effect_glossy",

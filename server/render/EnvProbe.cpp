@@ -14,6 +14,7 @@
 #include "gl/Pass.h"
 #include "gl/ShaderShared.h"
 #include "gl/Shader.h"
+#include "render/EnvProbeBudget.h"
 
 namespace gis {
 namespace {
@@ -29,9 +30,16 @@ int log2Floor(int v) {
 
 struct EnvProbe::Impl {
     ForwardProgram forward;
-    /// What the prefiltered cubes were rendered with (probes, sizes, shading switches, the scene);
-    /// with the light views reused and the same key, a frame keeps them.
+    /// What the prefiltered cubes were asked for (probes, sizes, budget, shading switches, the
+    /// scene); with the light views reused and the same key, a frame keeps them and their plan.
     std::string cubesKey;
+    /// The probes' measured cost (env_budget_ms), for the scene it was measured on.
+    EnvProbeCostModel cost;
+    const void* costScene = nullptr;
+    EnvProbePlan plan;
+    /// Set by a frame that rendered its cubes: what noteTimings() attributes the pass times to.
+    int renderedSize = 0, renderedProbes = 0;
+    long rendersSeen = 0;
     /// shaders/render/env_prefilter.comp: one roughness level of a cube from the source's mips.
     struct PrefilterPass {
         gl::Program program;
@@ -150,14 +158,57 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     const gl::Texture* shadowMap = in.find("lights.shadow");
     if (!in.scene || !in.sceneGpu || !gPosition || !gNormal || !gSpecular || in.width <= 0 || in.height <= 0)
         return;
-    const int size = std::clamp(fp.getInt("env_size"), 8, 512);
+    const int requestedSize = std::clamp(fp.getInt("env_size"), 8, 512);
     const int samples = std::clamp(fp.getInt("env_samples"), 1, 256);
     const bool parallax = fp.getEnum("env_parallax") == "box";
     const bool phong = fp.getEnum("specular_lobe") == "phong";
+    const double budgetMs = fp.has("env_budget_ms") ? fp.getFloat("env_budget_ms") : 0.0;
+    m.renderedSize = m.renderedProbes = 0;
+
+    const Bounds& bounds = in.scene->bounds;
+    // Probe 0 sees the whole scene from the centre of the bounds; probe k >= 1 sits at the centre
+    // of local object k - 1 and does not draw it (ReflectionInputs::envObjects).
+    struct ProbeSpec {
+        glm::vec3 position;
+        int skipMesh;
+    };
+    std::vector<ProbeSpec> probes{{probePosition(bounds), -1}};
+    if (in.envObjects)
+        for (const EnvObject& o : *in.envObjects)
+            if (static_cast<int>(probes.size()) < 1 + kMaxLocalProbes) probes.push_back({o.centre, o.mesh});
+    const int wantedProbes = static_cast<int>(probes.size());
+
+    std::ostringstream keyText;
+    keyText << in.scene << '/' << requestedSize << '/' << samples << '/' << phong << '/' << budgetMs;
+    for (const ProbeSpec& p : probes)
+        keyText << '/' << p.position.x << ',' << p.position.y << ',' << p.position.z << ',' << p.skipMesh;
+    if (in.frame)
+        keyText << '/' << in.frame->rsmInfo.z << '/' << in.frame->rsmInfo.w << '/' << in.frame->toneInfo.z
+                << '/' << in.frame->shadingInfo.x << '/' << in.frame->shadingInfo.z;
+    const std::string key = keyText.str();
+    const bool keepCubes = in.lightViewsReused && key == m.cubesKey && m.plan.size == m.size && m.fboOk;
+    m.cubesKey = key;
+    if (!keepCubes) {
+        // The cost model belongs to one scene (its draws are most of a probe's cost). The plan
+        // changes only here, when the cubes are rendered anyway.
+        if (m.costScene != static_cast<const void*>(in.scene)) {
+            m.cost.clear();
+            m.costScene = in.scene;
+        }
+        m.plan = planEnvProbes(requestedSize, wantedProbes, budgetMs, m.cost);
+    }
+    probes.resize(static_cast<size_t>(std::clamp(m.plan.probes, 1, wantedProbes)));
+    const int size = std::clamp(m.plan.size, 8, 512);
     const int levels = levelCount(size);
     counters["env_size"] = size;
+    counters["env_size_requested"] = requestedSize;
     counters["env_samples"] = samples;
     counters["env_levels"] = levels;
+    counters["env_probes"] = static_cast<double>(probes.size());
+    counters["env_probes_wanted"] = wantedProbes;
+    counters["env_budget_ms"] = budgetMs;
+    if (m.plan.predictedMs >= 0.0) counters["env_predicted_ms"] = m.plan.predictedMs;
+    counters["env_cubes_reused"] = keepCubes ? 1 : 0;
 
     if (size != m.size) {
         m.source = gl::Texture::createCube(GL_RGBA16F, size, log2Floor(size) + 1);
@@ -175,35 +226,16 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
         m.size = size;
     }
     if (!m.fboOk) return;
-
-    const Bounds& bounds = in.scene->bounds;
-    // Probe 0 sees the whole scene from the centre of the bounds; probe k >= 1 sits at the centre
-    // of local object k - 1 and does not draw it (ReflectionInputs::envObjects).
-    struct ProbeSpec {
-        glm::vec3 position;
-        int skipMesh;
-    };
-    std::vector<ProbeSpec> probes{{probePosition(bounds), -1}};
-    if (in.envObjects)
-        for (const EnvObject& o : *in.envObjects)
-            if (static_cast<int>(probes.size()) < 1 + kMaxLocalProbes) probes.push_back({o.centre, o.mesh});
-    counters["env_probes"] = static_cast<double>(probes.size());
+    // The first render compiles the forward program's variants on first draw (about twice a
+    // probe's cost on llvmpipe): not a measurement of what the next one will cost.
+    if (!keepCubes && m.rendersSeen++ > 0) {
+        m.renderedSize = size;
+        m.renderedProbes = static_cast<int>(probes.size());
+    }
     // Depth range (m): everything in the bounds is within their diagonal of a probe inside them; the
     // near plane at 1e-3 of it (at least 0.1 mm) keeps 32-bit float depth well resolved.
     const float extent = std::max(glm::length(bounds.max - bounds.min), 1e-3f);
     const float zNear = std::max(1e-3f * extent, 1e-4f), zFar = 1.01f * extent + zNear;
-
-    std::ostringstream keyText;
-    keyText << in.scene << '/' << size << '/' << samples << '/' << phong;
-    for (const ProbeSpec& p : probes)
-        keyText << '/' << p.position.x << ',' << p.position.y << ',' << p.position.z << ',' << p.skipMesh;
-    if (in.frame)
-        keyText << '/' << in.frame->rsmInfo.z << '/' << in.frame->rsmInfo.w << '/' << in.frame->toneInfo.z
-                << '/' << in.frame->shadingInfo.x << '/' << in.frame->shadingInfo.z;
-    const std::string key = keyText.str();
-    const bool keepCubes = in.lightViewsReused && key == m.cubesKey;
-    counters["env_cubes_reused"] = keepCubes ? 1 : 0;
-    m.cubesKey = key;
 
     for (size_t p = 0; p < probes.size() && !keepCubes; ++p) {
         const glm::vec3 probe = probes[p].position;
@@ -284,6 +316,22 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
         .set(a.maxLod, static_cast<float>(levels - 1))
         .set(a.skipMirrors, in.mirrorPass ? 1 : 0);
     pass.drawFullscreen(m.emptyVao);
+}
+
+void EnvProbe::noteTimings(const std::vector<gl::PassTiming>& passes) {
+    Impl& m = *mImpl;
+    if (m.renderedProbes <= 0) return;
+    double ms = 0.0;
+    for (const gl::PassTiming& p : passes)
+        if (p.name == "env_render" || p.name == "env_prefilter" || p.name == "env_render_local" ||
+            p.name == "env_prefilter_local")
+            ms += p.gpuMs;
+    m.cost.record(m.renderedSize, m.renderedProbes, ms);
+    m.renderedSize = m.renderedProbes = 0;
+}
+
+const std::string& EnvProbe::planReason() const {
+    return mImpl->plan.reason;
 }
 
 } // namespace gis

@@ -21,8 +21,10 @@
 //      intersected with the scene bounds and the cube read towards the hit point from the probe.
 // The cube map is sampled with GL_TEXTURE_CUBE_MAP_SEAMLESS (enabled when the probe is created).
 // Parameters (frame table): env_size (8-512 texels per face), env_samples (1-256), env_parallax,
-// specular_lobe. Timer passes env_render, env_prefilter, env_apply; counters env_size, env_samples,
-// env_levels.
+// specular_lobe, env_budget_ms (0: none; else the probe count and face size are planned from the
+// probes' measured cost to fit it, render/EnvProbeBudget.h). Timer passes env_render,
+// env_prefilter, env_apply; counters env_size (rendered), env_size_requested, env_probes,
+// env_probes_wanted, env_budget_ms, env_predicted_ms, env_samples, env_levels, env_cubes_reused.
 // Probes: the room probe at the centre of the scene bounds, and one local probe per
 // ReflectionInputs::envObjects entry (at most kMaxLocalProbes curved objects), at the object's
 // centre and blind to it, read by the pixels whose G-buffer id is -(k + 1).
@@ -32,6 +34,8 @@
 #pragma once
 
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -57,6 +61,12 @@ public:
     /// Never throws; leaves blending and depth testing off and the viewport at in.width x in.height.
     void execute(const ReflectionInputs& in, const ParamSet& frameParams, const gl::Framebuffer& target,
                  gl::PassTimer& timer, Counters& counters);
+
+    /// The frame's resolved pass times: the probe passes' share becomes the cost model's measurement
+    /// for the size and probe count this frame rendered (nothing when it kept its cubes).
+    void noteTimings(const std::vector<gl::PassTiming>& passes);
+    /// The last plan in words ("env_size 64, 1 probe: predicted ... within the ... budget").
+    const std::string& planReason() const;
 
     /// Prefiltered levels for a cube of `envSize` texels per face.
     static int levelCount(int envSize);

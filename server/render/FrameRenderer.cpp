@@ -608,6 +608,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     }
     std::vector<gl::PassTiming> passes = mTimer.resolve();
     gl::logErrors("frame");
+    mReflections.noteTimings(passes);
 
     nlohmann::json passJson = nlohmann::json::array();
     double techniqueMs = 0.0;
@@ -630,6 +631,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         {"params", std::move(params)}};
     if (!state.plan.is_null()) out.stats["plan"] = state.plan;
     out.stats["nondiffuse"] = nonDiffuse.reasons;
+    if (nonDiffuse.env && nonDiffuse.reasons.contains("env"))
+        out.stats["nondiffuse"]["env"] =
+            nonDiffuse.reasons["env"].get<std::string>() + "; " + mReflections.envPlanReason();
     out.stats["lighting"] = lightingStats(state, lightSet, viewFlux);
     if (!mNotShown.empty()) out.stats["not_shown"] = mNotShown;
     return out;

@@ -178,4 +178,12 @@ const gl::Texture* Reflections::execute(const Decision& d, ReflectionInputs in, 
     return &mOutput;
 }
 
+void Reflections::noteTimings(const std::vector<gl::PassTiming>& passes) {
+    if (mEnv) mEnv->noteTimings(passes);
+}
+
+std::string Reflections::envPlanReason() const {
+    return mEnv ? mEnv->planReason() : std::string();
+}
+
 } // namespace gis

@@ -111,6 +111,11 @@ public:
     const gl::Texture* execute(const Decision& decision, ReflectionInputs in, const ParamSet& frameParams,
                                gl::PassTimer& timer, Counters& counters);
 
+    /// After the frame's timings are resolved: the environment probes measure their cost from them.
+    void noteTimings(const std::vector<gl::PassTiming>& passes);
+    /// The environment probes' last plan in words; empty before they first ran.
+    std::string envPlanReason() const;
+
     const std::vector<MirrorPlane>& mirrors() const { return mMirrors; }
     const std::vector<EnvObject>& envObjects() const { return mEnvObjects; }
 

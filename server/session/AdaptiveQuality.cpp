@@ -128,9 +128,19 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
         if (p.state.frameParams.has("effect_occlusion") && !explicitParams.contains("effect_occlusion"))
             p.state.frameParams.set("effect_occlusion", "off");
     }
+    // Interactive and balanced frames share one environment-probe budget, so that the probes a light
+    // change renders within it are kept until the final step renders them again within a whole frame
+    // (its first tile would otherwise hold input back for as long as every probe at env_size takes).
+    const double envBudgetMs = envProbeBudgetMs(frameTargetMs, p.step);
+    const bool budgetProbes = !snapshot && envBudgetMs > 0.0 && p.state.frameParams.has("env_budget_ms") &&
+                              !explicitParams.contains("env_budget_ms");
+    if (budgetProbes) p.state.frameParams.set("env_budget_ms", envBudgetMs);
     if (p.step != QualityStep::Interactive && !snapshot && mLimits.refineBudgetMs > 0)
         planRefinement(sceneName, requested, explicitParams, p);
-    if (p.step == QualityStep::Interactive && !snapshot) planInteractive(frameTargetMs, p);
+    if (p.step == QualityStep::Interactive && !snapshot) {
+        planInteractive(frameTargetMs, p);
+        if (budgetProbes) p.budget["env_budget_ms"] = envBudgetMs;
+    }
     return p;
 }
 

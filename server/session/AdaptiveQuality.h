@@ -4,7 +4,9 @@
 //   - a snapshot renders the best step predicted to fit the snapshot budget;
 //   - a refinement step predicted over the refinement budget, or whose smallest tile would overrun a
 //     slice, renders fewer VPLs where the technique can take them, else it is skipped, with the reason;
-//   - an interactive frame's size and VPL cap come from the frame budget (session/FrameBudget.h).
+//   - an interactive frame's size and VPL cap come from the frame budget (session/FrameBudget.h);
+//   - the environment probes get a share of the frame target (env_budget_ms; a whole one in the
+//     final step), unless the client set it.
 // It keeps what it measured: each step's cost per pixel by scene and technique, the smallest tile's
 // cost per VPL where one overran its slice, and the frame budget's rates. Session's worker owns one
 // and asks it before every frame; tests drive it directly (tests/unit/session/AdaptiveQualityTest.cpp).
@@ -24,6 +26,15 @@ namespace gis {
 /// The live view's steps; Fixed frames (adaptive off) are rendered as asked.
 enum class QualityStep : int { Fixed = -1, Interactive = 0, Balanced = 1, Final = 2 };
 const char* qualityStepName(QualityStep step); ///< "interactive", "balanced", "final", "fixed"
+
+/// The share of the interactive frame target that an interactive or balanced frame rendering the
+/// environment probes again may spend on them; the final step may spend a whole frame target.
+constexpr double kEnvProbeShareOfFrame = 0.25;
+/// env_budget_ms of `step` for a frame target (0: none).
+inline double envProbeBudgetMs(int frameTargetMs, QualityStep step) {
+    if (frameTargetMs <= 0 || step == QualityStep::Fixed) return 0.0;
+    return (step == QualityStep::Final ? 1.0 : kEnvProbeShareOfFrame) * frameTargetMs;
+}
 
 /// The smallest refinement tile side (px): a few ms of fixed cost per tile on llvmpipe, so smaller
 /// ones would mostly repeat it.

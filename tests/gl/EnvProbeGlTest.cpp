@@ -43,7 +43,6 @@ const Scene& galleryScene() {
     return scene;
 }
 
-
 // Mean linear RGB over the (2r+1)^2 block around pixel p (top-left origin).
 glm::dvec3 blockMean(const FrameOutput& f, glm::ivec2 p, int r) {
     glm::dvec3 sum(0.0);
@@ -327,7 +326,10 @@ TEST(EnvProbeGl, ReflectionsConvergeToTheReferenceWithEnvSize) {
         FrameState s = state;
         applyParams(s, {{"env_size", size}, {"env_samples", 64}}, "test");
         const FrameOutput f = renderer->render(s, true);
-        EXPECT_EQ(f.stats["nondiffuse"]["env"], "on: 1 smooth specular materials outside planar mirrors");
+        EXPECT_EQ(f.stats["nondiffuse"]["env"].get<std::string>().rfind(
+                      "on: 1 smooth specular materials outside planar mirrors; env_size", 0),
+                  0u)
+            << f.stats["nondiffuse"]["env"];
         double num = 0.0, den = 0.0;
         for (int i : pixels)
             for (int ch = 0; ch < 3; ++ch) {
@@ -345,4 +347,62 @@ TEST(EnvProbeGl, ReflectionsConvergeToTheReferenceWithEnvSize) {
     EXPECT_LT(errors.back(), 0.6 * errors.front());
     for (size_t i = 1; i < errors.size(); ++i)
         EXPECT_LT(errors[i], errors[i - 1] * 1.05 + 0.005) << "env_size step " << i;
+}
+
+// env_budget_ms plans the probes from their measured cost: as asked without a budget or before a
+// measurement, the room probe alone at the smallest faces when nothing fits, fewer probes or smaller
+// faces within a budget that one full-size probe fits, and the choice stated in the frame's stats.
+TEST(EnvProbeGl, ProbeBudgetPlansFromMeasuredCost) {
+    test::sharedContext();
+    // Its own renderer and scene: the cost model starts empty.
+    auto scene = std::make_shared<Scene>(loadScene(kScene));
+    FrameRenderer renderer;
+    renderer.setScene(scene);
+    auto frame = [&](double budgetMs) {
+        FrameState s = makeFrameState(*scene, "none");
+        s.width = 64;
+        s.height = 48;
+        applyParams(s, {{"effect_env", "on"}, {"env_size", 128}, {"env_budget_ms", budgetMs}}, "test");
+        return renderer.render(s, true);
+    };
+    auto probeMs = [](const FrameOutput& f) {
+        double ms = 0.0;
+        for (const char* pass : {"env_render", "env_prefilter", "env_render_local", "env_prefilter_local"})
+            ms += std::max(0.0, passMs(f, pass));
+        return ms / std::max(1.0, counter(f, "env_probes"));
+    };
+    auto reason = [](const FrameOutput& f) { return f.stats["nondiffuse"]["env"].get<std::string>(); };
+
+    // The first render compiles shaders and is not a measurement: two renders as asked.
+    frame(20.0);
+    const FrameOutput first = frame(20.0);
+    const double wanted = counter(first, "env_probes_wanted");
+    ASSERT_GE(wanted, 2.0) << "the room probe and the gold sphere's";
+    EXPECT_EQ(counter(first, "env_probes"), wanted) << "not measured yet: as asked";
+    EXPECT_EQ(counter(first, "env_size"), 128.0);
+    EXPECT_NE(reason(first).find("not measured yet"), std::string::npos) << reason(first);
+
+    const FrameOutput tiny = frame(0.001);
+    EXPECT_EQ(counter(tiny, "env_probes"), 1.0);
+    EXPECT_EQ(counter(tiny, "env_size"), 16.0);
+    EXPECT_EQ(counter(tiny, "env_size_requested"), 128.0);
+    EXPECT_NE(reason(tiny).find("over budget"), std::string::npos) << reason(tiny);
+    EXPECT_EQ(badValues(tiny), 0u);
+
+    const FrameOutput generous = frame(10000.0);
+    EXPECT_EQ(counter(generous, "env_probes"), wanted);
+    EXPECT_EQ(counter(generous, "env_size"), 128.0);
+    EXPECT_GT(counter(generous, "env_predicted_ms"), 0.0);
+    EXPECT_NE(reason(generous).find("within"), std::string::npos) << reason(generous);
+
+    // The model's full-size cost is the median (here the mean) of the two measured full-size
+    // renders, so every probe at full size is predicted over a budget of 1.2 probes at the cheaper.
+    const double budget = 1.2 * std::min(probeMs(first), probeMs(generous));
+    const FrameOutput planned = frame(budget);
+    EXPECT_TRUE(counter(planned, "env_probes") < wanted || counter(planned, "env_size") < 128.0)
+        << reason(planned);
+    EXPECT_LE(counter(planned, "env_predicted_ms"), budget + 1e-9) << reason(planned);
+    EXPECT_EQ(badValues(planned), 0u);
+    std::printf("[env] budget %.1f ms: %s (a probe at 128 measured %.1f / %.1f ms)\n", budget,
+                reason(planned).c_str(), probeMs(first), probeMs(generous));
 }

@@ -160,3 +160,41 @@ TEST(AdaptiveQuality, InteractiveFramesFollowTheFrameBudget) {
 
 } // namespace
 } // namespace gis
+
+namespace gis {
+namespace {
+
+TEST(AdaptiveQuality, RefinementStepsBudgetTheEnvironmentProbes) {
+    AdaptiveQuality q(limits(), presets());
+    const nlohmann::json none = nlohmann::json::object();
+    const double share = envProbeBudgetMs(80, QualityStep::Interactive);
+    EXPECT_DOUBLE_EQ(share, 20.0);
+    EXPECT_DOUBLE_EQ(envProbeBudgetMs(80, QualityStep::Final), 80.0);
+    EXPECT_DOUBLE_EQ(envProbeBudgetMs(80, QualityStep::Fixed), 0.0);
+    const AdaptiveQuality::Plan interactive =
+        q.plan("cornell", requested(), none, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(interactive.state.frameParams.getFloat("env_budget_ms"), share);
+    EXPECT_DOUBLE_EQ(interactive.budget.at("env_budget_ms").get<double>(), share) << "shown in stats.budget";
+    const AdaptiveQuality::Plan balanced =
+        q.plan("cornell", requested(), none, QualityStep::Balanced, false, 80);
+    EXPECT_DOUBLE_EQ(balanced.state.frameParams.getFloat("env_budget_ms"), share)
+        << "the same budget: the probes rendered for interactive frames are kept";
+    const AdaptiveQuality::Plan final = q.plan("cornell", requested(), none, QualityStep::Final, false, 80);
+    EXPECT_DOUBLE_EQ(final.state.frameParams.getFloat("env_budget_ms"), 80.0)
+        << "the final step: within one frame, so that its first tile holds input back no longer";
+    const AdaptiveQuality::Plan snapshot =
+        q.plan("cornell", requested(), none, QualityStep::Balanced, true, 80);
+    EXPECT_DOUBLE_EQ(snapshot.state.frameParams.getFloat("env_budget_ms"), 0.0) << "snapshots as asked";
+    const AdaptiveQuality::Plan untargeted =
+        q.plan("cornell", requested(), none, QualityStep::Interactive, false, 0);
+    EXPECT_DOUBLE_EQ(untargeted.state.frameParams.getFloat("env_budget_ms"), 0.0) << "no target, no budget";
+
+    FrameState asked = requested();
+    asked.frameParams.set("env_budget_ms", 500.0);
+    const AdaptiveQuality::Plan own =
+        q.plan("cornell", asked, {{"env_budget_ms", 500.0}}, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(own.state.frameParams.getFloat("env_budget_ms"), 500.0) << "the client's value wins";
+}
+
+} // namespace
+} // namespace gis
