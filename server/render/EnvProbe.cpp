@@ -258,6 +258,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
                     in.sceneGpu->draw(fw.program, &fw.materials, 1, probes[p].skipMesh, &face, true);
                 counters["triangles_env"] += static_cast<double>(drawn.drawn);
                 counters["triangles_env_culled"] += static_cast<double>(drawn.culled);
+                counters["draw_calls_env"] += static_cast<double>(drawn.calls);
             }
             m.source.generateMipmap();
         }

@@ -523,6 +523,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     counters["triangles_gbuffer_culled"] = static_cast<double>(eyeDraws.culled);
     counters["triangles_light_views"] = static_cast<double>(lightDraws.drawn);
     counters["triangles_light_views_culled"] = static_cast<double>(lightDraws.culled);
+    counters["draw_runs_gbuffer"] = static_cast<double>(eyeDraws.runs);
+    counters["draw_calls_gbuffer"] = static_cast<double>(eyeDraws.calls);
+    counters["draw_runs_light_views"] = static_cast<double>(lightDraws.runs);
+    counters["draw_calls_light_views"] = static_cast<double>(lightDraws.calls);
     FrameInputs in;
     in.width = state.width;
     in.height = state.height;

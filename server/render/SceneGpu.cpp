@@ -104,6 +104,9 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         t.setWrap(GL_REPEAT);
         mTextures.push_back(std::move(t));
     }
+    mCommands = gl::Buffer::create(static_cast<GLsizeiptr>(std::max<std::size_t>(mDraws.size(), 1) *
+                                                           kCommandSlots * sizeof(IndirectCommand)));
+    mCommandScratch.reserve(mDraws.size());
     gl::checkErrors("scene upload");
 }
 
@@ -153,8 +156,27 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
     const std::optional<Frustum> frustum =
         cullViewProj ? std::optional<Frustum>(Frustum(*cullViewProj)) : std::nullopt;
     DrawCount count;
-    int uniformsOf = -1;  // the mesh whose material uniforms are set (a mesh's runs share them)
-    bool culling = false; // GL_CULL_FACE is off in every pass (FrameRenderer::render) until set here
+
+    // 1. The visible runs as draw commands, cut into batches wherever the state changes.
+    struct Batch {
+        std::size_t first = 0, count = 0;
+        const Draw* head = nullptr; ///< the first run: its material, ids and face culling
+        bool oneSided = false;
+    };
+    std::vector<Batch> batches;
+    std::vector<IndirectCommand>& commands = mCommandScratch;
+    commands.clear();
+    auto oneSidedOf = [&](const Draw& d) {
+        return cullBackFaces && d.material >= 0 && static_cast<std::size_t>(d.material) < mMaterials.size() &&
+               !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
+    };
+    // Runs of one mesh share its uniforms; different meshes share them when their material, surface
+    // id and vertex colours agree.
+    auto sameState = [&](const Draw& a, const Draw& b) {
+        if (oneSidedOf(a) != oneSidedOf(b)) return false;
+        return !materials || a.mesh == b.mesh ||
+               (a.material == b.material && a.surfaceId == b.surfaceId && a.colored == b.colored);
+    };
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
         const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
@@ -163,22 +185,35 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
             continue;
         }
         count.drawn += triangles;
-        if (cullBackFaces) {
-            const bool oneSided = d.material >= 0 &&
-                                  static_cast<std::size_t>(d.material) < mMaterials.size() &&
-                                  !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
-            if (oneSided != culling) {
-                if (oneSided) {
-                    glCullFace(GL_BACK);
-                    glEnable(GL_CULL_FACE);
-                } else {
-                    glDisable(GL_CULL_FACE);
-                }
-                culling = oneSided;
+        if (batches.empty() || !sameState(*batches.back().head, d))
+            batches.push_back({commands.size(), 0, &d, oneSidedOf(d)});
+        commands.push_back({static_cast<GLuint>(d.indexCount), static_cast<GLuint>(std::max(instances, 1)),
+                            static_cast<GLuint>(d.firstIndex), d.baseVertex, 0});
+        ++batches.back().count;
+    }
+    count.runs = commands.size();
+    count.calls = batches.size();
+    if (commands.empty()) return count;
+
+    // 2. This call's region of the command buffer, then one multi-draw per batch.
+    const std::size_t slotBytes = std::max<std::size_t>(mDraws.size(), 1) * sizeof(IndirectCommand);
+    const std::size_t base = (mCommandSlot++ % kCommandSlots) * slotBytes;
+    mCommands.upload(static_cast<GLintptr>(base),
+                     static_cast<GLsizeiptr>(commands.size() * sizeof(IndirectCommand)), commands.data());
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCommands.id());
+    bool culling = false; // GL_CULL_FACE is off in every pass (FrameRenderer::render) until set here
+    for (const Batch& b : batches) {
+        if (cullBackFaces && b.oneSided != culling) {
+            if (b.oneSided) {
+                glCullFace(GL_BACK);
+                glEnable(GL_CULL_FACE);
+            } else {
+                glDisable(GL_CULL_FACE);
             }
+            culling = b.oneSided;
         }
-        if (materials && uniformsOf != d.mesh) {
-            uniformsOf = d.mesh;
+        if (materials) {
+            const Draw& d = *b.head;
             const MaterialSlots& s = *materials;
             const Material& m = mMaterials[static_cast<size_t>(d.material)];
             glUniform4f(s.baseColor.location, m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a);
@@ -203,11 +238,12 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
                         std::isfinite(m.occlusionStrength) ? m.occlusionStrength : 1.0f);
             glUniform1f(s.normalScale.location, std::isfinite(m.normalScale) ? m.normalScale : 1.0f);
         }
-        glDrawElementsInstancedBaseVertex(
-            GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
-            reinterpret_cast<const void*>(static_cast<uintptr_t>(d.firstIndex) * 4), std::max(instances, 1),
-            d.baseVertex);
+        glMultiDrawElementsIndirect(
+            GL_TRIANGLES, GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(static_cast<uintptr_t>(base + b.first * sizeof(IndirectCommand))),
+            static_cast<GLsizei>(b.count), 0);
     }
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     if (culling) glDisable(GL_CULL_FACE);
     return count;
 }

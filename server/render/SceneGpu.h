@@ -25,12 +25,16 @@ struct MaterialSlots {
     static MaterialSlots of(const gl::Program& program, bool complete = false);
 };
 
-/// Triangles one draw loop sent and left out (frustum culling's measure, per pass in the stats).
+/// Triangles one draw loop sent and left out (frustum culling's measure, per pass in the stats), and
+/// the GL draw calls it took for its runs.
 struct DrawCount {
     std::size_t drawn = 0, culled = 0;
+    std::size_t runs = 0, calls = 0; ///< runs drawn; glMultiDrawElementsIndirect calls they took
     DrawCount& operator+=(const DrawCount& o) {
         drawn += o.drawn;
         culled += o.culled;
+        runs += o.runs;
+        calls += o.calls;
         return *this;
     }
 };
@@ -52,6 +56,8 @@ public:
     /// With `cullBackFaces` (the views that show surfaces: the G-buffer, environment-probe faces and
     /// mirrored views), single-sided materials (Material::doubleSided false) are drawn with back faces
     /// culled (front faces as the pass's glFrontFace says: CCW, as glTF, unless mirrored).
+    /// Consecutive runs that need the same state (material uniforms and textures, face culling) go
+    /// out as one glMultiDrawElementsIndirect, in scene order, so images do not change.
     DrawCount draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
                    int skipMesh = -1, const glm::mat4* cullViewProj = nullptr,
                    bool cullBackFaces = false) const;
@@ -73,8 +79,20 @@ private:
         bool colored = false;                       ///< the mesh has COLOR_0 (uHasVertexColor)
         glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< world space, of this run's triangles
     };
+    /// Draw commands, kCommandSlots regions of one command per run, used in turn by successive
+    /// draw() calls (a region is rewritten only after the calls of the other regions were issued).
+    static constexpr std::size_t kCommandSlots = 16;
+    struct IndirectCommand {
+        GLuint count, instanceCount, firstIndex;
+        GLint baseVertex;
+        GLuint baseInstance;
+    };
+    static_assert(sizeof(IndirectCommand) == 20, "glMultiDrawElementsIndirect's command layout");
     gl::Buffer mVertices;
     gl::Buffer mIndices;
+    mutable gl::Buffer mCommands;
+    mutable std::size_t mCommandSlot = 0;
+    mutable std::vector<IndirectCommand> mCommandScratch;
     gl::VertexArray mVao;
     std::vector<Draw> mDraws;
     std::vector<Material> mMaterials;

@@ -6,6 +6,7 @@
 #include "GlTestSupport.h"
 #include "core/Error.h"
 #include "gl/ShaderShared.h"
+#include "scene/SceneLoader.h"
 #include <unistd.h>
 
 using namespace gis;
@@ -223,4 +224,32 @@ TEST(Pipeline, TotalVplFluxEqualsRsmFlux) {
         sf += fine.linear[i] + fine.linear[i + 1] + fine.linear[i + 2];
     }
     EXPECT_NEAR(sc / sf, 1.0, 0.15);
+}
+
+// Consecutive runs that need the same state go out as one multi-draw (SceneGpu::draw): six quads of
+// materials A A A B A A take three G-buffer draw calls, and what each draws is unchanged (the frame
+// hashes of every built-in scene hold, FrameHashGlTest).
+TEST(Pipeline, RunsOfOneStateAreOneDrawCall) {
+    Scene scene = loadScene("builtin:cornell-empty");
+    ASSERT_GE(scene.materials.size(), 2u);
+    scene.meshes.clear();
+    const int materialOf[6] = {0, 0, 0, 1, 0, 0};
+    for (int i = 0; i < 6; ++i) {
+        Mesh quad{.name = "quad" + std::to_string(i), .material = materialOf[i]};
+        const float x = -0.75f + 0.3f * static_cast<float>(i);
+        for (const glm::vec2 c :
+             {glm::vec2(0, 0), glm::vec2(0.2f, 0), glm::vec2(0.2f, 0.2f), glm::vec2(0, 0.2f)}) {
+            quad.positions.emplace_back(x + c.x, 0.9f + c.y, 0.5f);
+            quad.normals.emplace_back(0.0f, 0.0f, 1.0f);
+        }
+        quad.indices = {0, 1, 2, 0, 2, 3};
+        scene.meshes.push_back(quad);
+    }
+    scene.updateBounds();
+    finalizeScene(scene, "test:quads");
+    const FrameOutput f = renderScene(scene, "none", 64, 48);
+    EXPECT_EQ(test::counter(f, "triangles_gbuffer"), 12.0);
+    EXPECT_EQ(test::counter(f, "draw_runs_gbuffer"), 6.0);
+    EXPECT_EQ(test::counter(f, "draw_calls_gbuffer"), 3.0);
+    EXPECT_EQ(test::badValues(f), 0u);
 }
