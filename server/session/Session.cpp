@@ -697,7 +697,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
                 skippedOneTimeWork = true;
                 measureTile = false;
             }
-            if (planned && !oneTime) partPlanner.record(tilePixels, parts, rendered.renderMs, part == 0);
+            if (planned && !oneTime) partPlanner.record(tilePixels, parts, rendered.renderMs);
             renderedMs += rendered.renderMs;
             pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
             unsent = unite(unsent, clipToImage(rect, full.width, full.height));

@@ -42,51 +42,23 @@ int VplPartPlanner::rungOf(double pixels) const {
     return static_cast<int>(std::clamp(steps, 0.0, static_cast<double>(mLowestRung)));
 }
 
-double VplPartPlanner::firstExtra(const Rung& rung) const {
-    double weighted = 0, weights = 0;
-    for (const auto& [parts, first] : rung.firstByParts) {
-        const auto later = rung.byParts.find(parts);
-        if (later == rung.byParts.end()) continue;
-        const double weight = std::min({first.samples, later->second.samples, 8});
-        weighted += weight * (first.ms - later->second.ms);
-        weights += weight;
-    }
-    return weights > 0 ? std::max(0.0, weighted / weights) : 0.0;
-}
-
-bool VplPartPlanner::fit(int rung, double& fixedMs, double& vplMs, double* firstExtraMs) const {
+bool VplPartPlanner::fit(int rung, double& fixedMs, double& vplMs) const {
     const auto found = mRungs.find(rung);
-    if (found == mRungs.end()) return false;
-    const Rung& r = found->second;
-    const double extra = firstExtra(r);
-    if (firstExtraMs) *firstExtraMs = extra;
-    // Every part count as a later part: first parts less the extra work.
-    std::map<int, std::pair<double, double>> counts; // parts -> (weight, weighted ms)
-    for (const auto& [parts, mean] : r.byParts) {
-        const double weight = std::min(mean.samples, 8);
-        counts[parts].first += weight;
-        counts[parts].second += weight * mean.ms;
-    }
-    for (const auto& [parts, mean] : r.firstByParts) {
-        const double weight = std::min(mean.samples, 8);
-        counts[parts].first += weight;
-        counts[parts].second += weight * (mean.ms - extra);
-    }
-    if (counts.size() < 2) return false;
+    if (found == mRungs.end() || found->second.byParts.size() < 2) return false;
     // Part counts too close together cannot tell fixed work from VPL work.
+    const auto& counts = found->second.byParts;
     if (counts.rbegin()->first < kDistinctCounts * counts.begin()->first) return false;
     // Weighted least squares of ms = fixed + vpl x with x = 1 / parts; weights cap at 8 samples so that
     // one long-used count does not drown a newly tried one.
     double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (const auto& [parts, sums] : counts) {
-        const double weight = std::min(sums.first, 8.0);
-        const double ms = sums.second / sums.first;
+    for (const auto& [parts, mean] : found->second.byParts) {
+        const double weight = std::min(mean.samples, 8);
         const double x = 1.0 / parts;
         sw += weight;
         sx += weight * x;
-        sy += weight * ms;
+        sy += weight * mean.ms;
         sxx += weight * x * x;
-        sxy += weight * x * ms;
+        sxy += weight * x * mean.ms;
     }
     const double det = sw * sxx - sx * sx;
     if (!(det > 1e-12 * sw * sw)) return false;
@@ -102,47 +74,43 @@ bool VplPartPlanner::fit(int rung, double& fixedMs, double& vplMs, double* first
     return std::isfinite(fixedMs) && std::isfinite(vplMs);
 }
 
-bool VplPartPlanner::fitted(double& fixedMs, double& vplMs, double* firstExtraMs) const {
-    return fit(mRung, fixedMs, vplMs, firstExtraMs);
+bool VplPartPlanner::fitted(double& fixedMs, double& vplMs) const {
+    return fit(mRung, fixedMs, vplMs);
 }
 
 VplPartPlan VplPartPlanner::plan(long vpls, double allVplRate) {
     const int maxParts =
         static_cast<int>(std::clamp(vpls, 1L, static_cast<long>(std::max(1, mLimits.maxParts))));
     const double target = std::max(mLimits.targetMs, 1e-3);
-    // The first part carries the extra work, so it is the one that must fit.
-    auto partsFor = [&](double fixedMs, double vplMs, double extraMs) {
-        const double headroom = std::max(target - fixedMs - extraMs, kVplShareOverFixedWork * target);
+    auto partsFor = [&](double fixedMs, double vplMs) {
+        const double headroom = std::max(target - fixedMs, kVplShareOverFixedWork * target);
         return clampParts(std::ceil(vplMs / headroom), maxParts);
     };
     VplPartPlan out;
-    double fixedMs = 0, vplMs = 0, extraMs = 0;
-    if (fit(mRung, fixedMs, vplMs, &extraMs)) {
-        if (fixedMs + extraMs > kFixedShareBeforeShrink * target && mRung < mLowestRung && !mShrinkFutile) {
+    double fixedMs = 0, vplMs = 0;
+    if (fit(mRung, fixedMs, vplMs)) {
+        if (fixedMs > kFixedShareBeforeShrink * target && mRung < mLowestRung && !mShrinkFutile) {
             // A rung down: its own fit if it has one, else this one's scaled by the pixels.
             const double scale = rungPixels(mRung + 1) / rungPixels(mRung);
             ++mRung;
             out.pixels = rungPixels(mRung);
-            double lowerFixed = 0, lowerVpl = 0, lowerExtra = 0;
-            out.parts = fit(mRung, lowerFixed, lowerVpl, &lowerExtra)
-                            ? partsFor(lowerFixed, lowerVpl, lowerExtra)
-                            : partsFor(fixedMs * scale, vplMs * scale, extraMs * scale);
+            double lowerFixed = 0, lowerVpl = 0;
+            out.parts = fit(mRung, lowerFixed, lowerVpl) ? partsFor(lowerFixed, lowerVpl)
+                                                         : partsFor(fixedMs * scale, vplMs * scale);
             return out;
         }
         out.pixels = rungPixels(mRung);
-        out.parts = partsFor(fixedMs, vplMs, extraMs);
+        out.parts = partsFor(fixedMs, vplMs);
         return out;
     }
     out.pixels = rungPixels(mRung);
     const auto found = mRungs.find(mRung);
-    if (found != mRungs.end() && !(found->second.byParts.empty() && found->second.firstByParts.empty())) {
+    if (found != mRungs.end() && !found->second.byParts.empty()) {
         // One count measured: as if all of it were VPL work (pessimistic for fewer parts, optimistic
-        // for more, which the next tile's measurement corrects), from its first parts where measured
-        // (they must fit too).
+        // for more, which the next tile's measurement corrects).
         const Rung& rung = found->second;
-        const std::map<int, Mean>& means = rung.firstByParts.empty() ? rung.byParts : rung.firstByParts;
-        const auto last = means.find(rung.lastParts);
-        const auto& [parts, mean] = last != means.end() ? *last : *means.begin();
+        const auto last = rung.byParts.find(rung.lastParts);
+        const auto& [parts, mean] = last != rung.byParts.end() ? *last : *rung.byParts.begin();
         out.parts = clampParts(std::ceil(parts * mean.ms / target), maxParts);
         return out;
     }
@@ -154,11 +122,8 @@ VplPartPlanner::Memory VplPartPlanner::remember(long vpls) const {
     Memory m;
     const double count = static_cast<double>(std::max(vpls, 1L));
     for (const auto& [rung, data] : mRungs) {
-        double fixedMs = 0, vplMs = 0, extraMs = 0;
-        if (fit(rung, fixedMs, vplMs, &extraMs)) {
-            m.fixedAndPerVpl[rung] = {fixedMs, vplMs / count};
-            if (extraMs > 0.0) m.firstExtra[rung] = extraMs;
-        }
+        double fixedMs = 0, vplMs = 0;
+        if (fit(rung, fixedMs, vplMs)) m.fixedAndPerVpl[rung] = {fixedMs, vplMs / count};
     }
     m.shrinkFutile = mShrinkFutile;
     return m;
@@ -176,9 +141,6 @@ void VplPartPlanner::recall(const Memory& memory, long vpls) {
         Rung& r = mRungs[rung];
         r.byParts[kFew] = {costs.first + vplMs / kFew, 1};
         r.byParts[kMany] = {costs.first + vplMs / kMany, 1};
-        if (const auto extra = memory.firstExtra.find(rung);
-            extra != memory.firstExtra.end() && std::isfinite(extra->second) && extra->second > 0.0)
-            r.firstByParts[kMany] = {costs.first + vplMs / kMany + extra->second, 1};
         r.lastParts = kMany;
     }
     // The tile size is chosen again from the largest: the last step may have shrunk its tiles for a
@@ -186,11 +148,11 @@ void VplPartPlanner::recall(const Memory& memory, long vpls) {
     mShrinkFutile = memory.shrinkFutile;
 }
 
-void VplPartPlanner::record(double pixels, int parts, double ms, bool firstPart) {
+void VplPartPlanner::record(double pixels, int parts, double ms) {
     if (!(pixels > 0.0) || parts < 1 || !std::isfinite(ms) || ms < 0.0) return;
     const int rungIndex = rungOf(pixels);
     Rung& rung = mRungs[rungIndex];
-    Mean& mean = firstPart ? rung.firstByParts[parts] : rung.byParts[parts];
+    Mean& mean = rung.byParts[parts];
     mean.ms = mean.samples == 0 ? ms : (1.0 - kMeanWeight) * mean.ms + kMeanWeight * ms;
     ++mean.samples;
     rung.lastParts = parts;

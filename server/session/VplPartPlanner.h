@@ -2,13 +2,10 @@
 // that one part fits a slice without repeating the part's fixed work more often than it must.
 //
 // Model, per tile size (a ladder of halvings from the largest tile), for a tile split into P parts:
-//   later parts: ms(P) = fixedMs + vplMs / P;  first part: ms(P) + firstExtraMs
-// fixedMs: what every part repeats whatever its VPLs (composite, read-back, the VPL setup); vplMs: the
-// tile's whole VPL work, shared among its parts; firstExtraMs: what only a tile's first part draws
-// and later parts keep (G-buffer, direct light, the eye hierarchy). Each part count keeps exponential
-// means of its first and of its later parts; firstExtraMs is the mean gap between the two where a
-// count has both, and the first parts less that gap join the later ones in a least-squares fit of
-// fixedMs and vplMs over two or more counts. Parts are sized so that the first one fits too. With one count
+//   ms(P) = fixedMs + vplMs / P
+// fixedMs: what every part repeats whatever its VPLs (G-buffer, direct light, the eye hierarchy,
+// composite, read-back); vplMs: the tile's whole VPL work, shared among its parts. Each part count keeps
+// an exponential mean of its parts; two or more counts give a least-squares fit. With one count
 // measured the cost counts as all VPLs, so an overrun asks for more parts (which certainly helps if it
 // is VPL work) and the next tiles tell the two apart. Where fixed work alone fills most of the target
 // the tile shrinks a rung, unless the smaller tile's fixed work turned out no smaller (costs per pass,
@@ -38,20 +35,18 @@ public:
     /// The next tile's size and parts. `allVplRate`: before anything ran, ms per pixel of a tile's
     /// VPLs unsplit (a prediction).
     VplPartPlan plan(long vpls, double allVplRate);
-    /// One rendered part of a tile of `pixels` split in `parts`, which took `ms`; `firstPart`: the
-    /// tile's first (a whole tile when `parts` is 1), which also drew what later parts keep.
-    void record(double pixels, int parts, double ms, bool firstPart = false);
+    /// One rendered part of a tile of `pixels` split in `parts`, which took `ms`.
+    void record(double pixels, int parts, double ms);
 
     /// The fitted costs (ms) of the tile size `plan` would use now; false while fewer than two part
-    /// counts were measured at it. `firstExtraMs` (optional): the first part's extra work.
-    bool fitted(double& fixedMs, double& vplMs, double* firstExtraMs = nullptr) const;
+    /// counts were measured at it.
+    bool fitted(double& fixedMs, double& vplMs) const;
 
     /// What a step learned, for the next step with the same tiles: per tile size with a fit, its fixed
     /// ms and its VPL ms per VPL (the next step may have another VPL count), and whether smaller tiles
     /// proved no cheaper.
     struct Memory {
         std::map<int, std::pair<double, double>> fixedAndPerVpl; ///< by rung
-        std::map<int, double> firstExtra;                        ///< by rung, ms
         bool shrinkFutile = false;
         bool empty() const { return fixedAndPerVpl.empty(); }
     };
@@ -67,15 +62,12 @@ private:
         int samples = 0;
     };
     struct Rung {
-        std::map<int, Mean> byParts;      ///< later parts (and parts not marked first)
-        std::map<int, Mean> firstByParts; ///< first parts
+        std::map<int, Mean> byParts;
         int lastParts = 0;
     };
     double rungPixels(int rung) const;
     int rungOf(double pixels) const;
-    /// The first part's extra ms at `rung` (0 until a count has both kinds of part).
-    double firstExtra(const Rung& rung) const;
-    bool fit(int rung, double& fixedMs, double& vplMs, double* firstExtraMs = nullptr) const;
+    bool fit(int rung, double& fixedMs, double& vplMs) const;
 
     Limits mLimits;
     int mLowestRung = 0;

@@ -160,78 +160,9 @@ TEST(VplPartPlanner, RemembersItsFitsForTheNextStep) {
     bigger.recall(memory, 6400);
     ASSERT_TRUE(bigger.fitted(fixedMs, vplMs));
     EXPECT_NEAR(vplMs, 4.0 * 4.0 * settled.pixels / 4096, 0.2);
-    EXPECT_LE(
-        partMs(bigger.plan(6400, 1.0).pixels, bigger.plan(6400, 1.0).parts, fixedPerPixel, 4.0 * vplPerPixel),
-        14.0 + 1e-9);
-}
-
-} // namespace
-} // namespace gis
-
-namespace gis {
-namespace {
-
-// A tile's first part also draws what its later parts keep (G-buffer, direct light, eye hierarchy):
-// the planner tells that extra work from the fixed and VPL work and sizes the parts so that the first
-// one fits the target too.
-TEST(VplPartPlanner, FirstPartsExtraWorkIsFittedAndTheFirstPartFits) {
-    // Full-size tile: 2 ms fixed a part, 5 ms more in the first, 40 ms of VPL work.
-    const double fixedMs = 2.0, extraMs = 5.0, vplMs = 40.0;
-    auto run = [&](VplPartPlanner& planner, bool markFirst, double& firstMs, double& laterMs) {
-        VplPartPlan plan;
-        for (int tile = 0; tile < 12; ++tile) {
-            plan = planner.plan(4000, 40.0 / 4096);
-            const double scale = plan.pixels / 4096;
-            laterMs = scale * (fixedMs + vplMs / plan.parts);
-            firstMs = laterMs + scale * extraMs;
-            planner.record(plan.pixels, plan.parts, firstMs, markFirst);
-            for (int part = 1; part < std::min(plan.parts, 20); ++part)
-                planner.record(plan.pixels, plan.parts, laterMs);
-        }
-        return plan;
-    };
-    double firstMs = 0, laterMs = 0;
-    VplPartPlanner planner(limits());
-    const VplPartPlan plan = run(planner, true, firstMs, laterMs);
-    EXPECT_EQ(plan.pixels, 4096);
-    EXPECT_EQ(plan.parts, 6); // ceil(40 / (14 - 2 - 5))
-    EXPECT_LE(firstMs, 14.0);
-    double f = 0, v = 0, e = 0;
-    ASSERT_TRUE(planner.fitted(f, v, &e));
-    EXPECT_NEAR(e, extraMs, 1e-6);
-    EXPECT_NEAR(f, fixedMs, 1e-6);
-    EXPECT_NEAR(v, vplMs, 1e-6);
-
-    // Without telling first parts apart, the extra work is averaged in and the first part overruns.
-    VplPartPlanner averaging(limits());
-    double averagedFirstMs = 0;
-    run(averaging, false, averagedFirstMs, laterMs);
-    EXPECT_GT(averagedFirstMs, 14.0);
-
-    // The next step starts from the same fit, extra work included.
-    const VplPartPlanner::Memory memory = planner.remember(4000);
-    ASSERT_EQ(memory.firstExtra.size(), 1u);
-    VplPartPlanner next(limits());
-    next.recall(memory, 4000);
-    double e2 = 0;
-    ASSERT_TRUE(next.fitted(f, v, &e2));
-    EXPECT_NEAR(e2, extraMs, 1e-6);
-    EXPECT_EQ(next.plan(4000, 1.0).parts, 6);
-}
-
-// Whole tiles (one part each, so every part is a first part) fit as before: no extra work is
-// inferred without later parts to compare with.
-TEST(VplPartPlanner, WholeTilesInferNoExtraWork) {
-    VplPartPlanner planner(limits());
-    for (int i = 0; i < 4; ++i) {
-        planner.record(4096, 1, 20.0, true);
-        planner.record(4096, 4, 8.0, true); // a first part only: no later part of 4 to compare
-    }
-    double f = 0, v = 0, e = -1;
-    ASSERT_TRUE(planner.fitted(f, v, &e));
-    EXPECT_EQ(e, 0.0);
-    EXPECT_NEAR(f, 4.0, 1e-6); // 20 = f + v, 8 = f + v / 4
-    EXPECT_NEAR(v, 16.0, 1e-6);
+    EXPECT_LE(partMs(bigger.plan(6400, 1.0).pixels, bigger.plan(6400, 1.0).parts, fixedPerPixel,
+                     4.0 * vplPerPixel),
+              14.0 + 1e-9);
 }
 
 } // namespace
