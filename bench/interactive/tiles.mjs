@@ -1,7 +1,8 @@
 // Refinement tile benchmark (not a test): starts gi-server with its defaults, connects one WebSocket
 // client with a 960x800 view, optionally sets a technique and parameters, leaves the view still and
 // reports the render time of the refinement tiles it was sent (p50, p95, max) against --slice-ms, the
-// steps' VPL counts and the most VPL parts a tile was split into.
+// steps' VPL counts and the most VPL parts a tile was split into; the first parts of split tiles
+// (which also draw what later parts keep) and their later parts apart.
 // usage: node bench/interactive/tiles.mjs [--server build/ci/bin/gi-server] [--scene builtin:NAME] [--technique T]
 //        [--params '{"vpl_grid": 256}'] [--seconds 15] [--server-args "--slice-ms 20"] [--whole 1] [--nudge 8]
 // --whole 1 asks for whole images instead of patches (as a client that does not draw patches); --verbose 1
@@ -66,7 +67,7 @@ ws.on('message', (data, isBinary) => {
             parts: `${stats.refine.vpl_parts_done}/${stats.refine.vpl_parts}`, tile: stats.tile?.size, ms: +stats.frame_ms.toFixed(1),
             passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(1)])) }));
         tiles.push({ round, share: stats.refine.share, ms: stats.frame_ms, encodeMs: stats.encode_ms ?? 0, bytes: stats.bytes ?? 0, vpls: stats.counts?.vpl_count ?? 0, step: stats.quality,
-            parts: stats.refine.vpl_parts ?? 1, index: tiles.length, tile: stats.tile?.size,
+            parts: stats.refine.vpl_parts ?? 1, partsDone: stats.refine.vpl_parts_done ?? 1, index: tiles.length, tile: stats.tile?.size,
             passes: Object.fromEntries((stats.passes ?? []).map((x) => [x.name, +x.cpu_ms.toFixed(2)])) });
     }
 });
@@ -91,6 +92,11 @@ setTimeout(() => {
     const bytes = tiles.map((t) => t.bytes).sort((a, b) => a - b);
     console.log(JSON.stringify({ technique: opts.technique || 'default', params: opts.params || null,
         tiles_sent: ms.length, tile_ms: { p50: p(0.5), p95: p(0.95), max: p(1) },
+        // A split tile's first part also draws what its later parts keep: the two apart.
+        first_part_ms: (() => { const v = tiles.filter((t) => t.parts > 1 && t.partsDone === 1).map((t) => t.ms).sort((a, b) => a - b);
+            return { sent: v.length, p50: p(0.5, v), p95: p(0.95, v), max: p(1, v) }; })(),
+        later_part_ms: (() => { const v = tiles.filter((t) => t.parts > 1 && t.partsDone > 1).map((t) => t.ms).sort((a, b) => a - b);
+            return { sent: v.length, p50: p(0.5, v), p95: p(0.95, v), max: p(1, v) }; })(),
         encode_ms: { p50: p(0.5, enc), p95: p(0.95, enc), max: p(1, enc) }, bytes_p50: p(0.5, bytes),
         balanced_vpls: tiles.filter((t) => t.step === 'balanced').at(-1)?.vpls ?? null,
         final_vpls: tiles.filter((t) => t.step === 'final').at(-1)?.vpls ?? null,
