@@ -799,15 +799,19 @@ int report(const std::vector<std::string>& args) {
           "- Plots and their gnuplot scripts: `"
        << rel(o.images, o.out) << "/accuracy_*.{png,gp}`.\n";
 
-    // The non-diffuse section comes from another benchmark (bench/nondiffuse/run.sh): kept as it is.
+    // Sections that come from elsewhere are kept as they are: the list of reruns at other sizes and
+    // the non-diffuse table (bench/nondiffuse/run.sh).
     std::string kept;
     {
         std::ifstream previous(o.out);
         const std::string text((std::istreambuf_iterator<char>(previous)), std::istreambuf_iterator<char>());
-        const std::string begin = "<!-- nondiffuse:begin -->", end = "<!-- nondiffuse:end -->";
-        const size_t b = text.find(begin), e = text.find(end);
-        if (b != std::string::npos && e != std::string::npos && e > b)
-            kept = "\n" + text.substr(b, e + end.size() - b) + "\n";
+        for (const char* name : {"reruns", "nondiffuse"}) {
+            const std::string begin = std::string("<!-- ") + name + ":begin -->";
+            const std::string end = std::string("<!-- ") + name + ":end -->";
+            const size_t b = text.find(begin), e = text.find(end);
+            if (b != std::string::npos && e != std::string::npos && e > b)
+                kept += "\n" + text.substr(b, e + end.size() - b) + "\n";
+        }
     }
     fs::path op(o.out);
     if (op.has_parent_path()) fs::create_directories(op.parent_path());
