@@ -6,6 +6,7 @@
 #include <span>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -35,7 +36,7 @@ struct EnvProbe::Impl {
     std::string cubesKey;
     /// The probes' measured cost (env_budget_ms), for the scene it was measured on.
     EnvProbeCostModel cost;
-    const void* costScene = nullptr;
+    std::pair<const void*, std::size_t> costScene{nullptr, 0};
     EnvProbePlan plan;
     /// Set by a frame that rendered its cubes: what noteTimings() attributes the pass times to.
     int renderedSize = 0, renderedProbes = 0;
@@ -191,9 +192,12 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     if (!keepCubes) {
         // The cost model belongs to one scene (its draws are most of a probe's cost). The plan
         // changes only here, when the cubes are rendered anyway.
-        if (m.costScene != static_cast<const void*>(in.scene)) {
+        // The upload identifies the scene (a new scene gets a new upload; its triangle count guards
+        // against an address reused after the old one was freed).
+        const std::pair<const void*, std::size_t> sceneId{in.sceneGpu, in.sceneGpu->triangleCount()};
+        if (m.costScene != sceneId) {
             m.cost.clear();
-            m.costScene = in.scene;
+            m.costScene = sceneId;
         }
         m.plan = planEnvProbes(requestedSize, wantedProbes, budgetMs, m.cost);
     }
