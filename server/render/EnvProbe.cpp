@@ -23,6 +23,10 @@ namespace {
 // Samples per texel of the environment-BRDF table (computed once; 32 x 32 x 1024 lobe samples).
 constexpr int kBrdfTableSamples = 1024;
 
+// The probe passes' timer names (the room probe's, a local probe's): noteTimings() sums them.
+constexpr const char* kRenderPass[2] = {"env_render", "env_render_local"};
+constexpr const char* kPrefilterPass[2] = {"env_prefilter", "env_prefilter_local"};
+
 int log2Floor(int v) {
     return v > 1 ? std::bit_width(static_cast<unsigned>(v)) - 1 : 0;
 }
@@ -163,7 +167,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     const int samples = std::clamp(fp.getInt("env_samples"), 1, 256);
     const bool parallax = fp.getEnum("env_parallax") == "box";
     const bool phong = fp.getEnum("specular_lobe") == "phong";
-    const double budgetMs = fp.has("env_budget_ms") ? fp.getFloat("env_budget_ms") : 0.0;
+    const double budgetMs = fp.getFloat("env_budget_ms");
     m.renderedSize = m.renderedProbes = 0;
 
     const Bounds& bounds = in.scene->bounds;
@@ -230,8 +234,8 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
         m.size = size;
     }
     if (!m.fboOk) return;
-    // The first render compiles the forward program's variants on first draw (about twice a
-    // probe's cost on llvmpipe): not a measurement of what the next one will cost.
+    // The first render also compiles the forward program's variants (llvmpipe compiles on first
+    // draw): not a measurement of what the next one will cost.
     if (!keepCubes && m.rendersSeen++ > 0) {
         m.renderedSize = size;
         m.renderedProbes = static_cast<int>(probes.size());
@@ -248,7 +252,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
         // 1. Six faces, then the source mip chain.
         {
             const ForwardProgram& fw = m.forward;
-            gl::Pass pass(timer, p == 0 ? "env_render" : "env_render_local");
+            gl::Pass pass(timer, kRenderPass[p == 0 ? 0 : 1]);
             pass.depthTest(GL_LESS)
                 .use(fw.program)
                 .set(fw.clipPlane, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f))
@@ -270,7 +274,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
         // 2. Prefilter: level 0 is the source itself, levels >= 1 one dispatch each.
         {
             const Impl::PrefilterPass& f = m.prefilter;
-            gl::Pass pass(timer, p == 0 ? "env_prefilter" : "env_prefilter_local");
+            gl::Pass pass(timer, kPrefilterPass[p == 0 ? 0 : 1]);
             glCopyImageSubData(m.source.id(), GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, prefiltered.id(),
                                GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, size, size, 6);
             pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT)
@@ -328,9 +332,8 @@ void EnvProbe::noteTimings(const std::vector<gl::PassTiming>& passes) {
     if (m.renderedProbes <= 0) return;
     double ms = 0.0;
     for (const gl::PassTiming& p : passes)
-        if (p.name == "env_render" || p.name == "env_prefilter" || p.name == "env_render_local" ||
-            p.name == "env_prefilter_local")
-            ms += p.gpuMs;
+        for (int k = 0; k < 2; ++k)
+            if (p.name == kRenderPass[k] || p.name == kPrefilterPass[k]) ms += p.gpuMs;
     m.cost.record(m.renderedSize, m.renderedProbes, ms);
     m.renderedSize = m.renderedProbes = 0;
 }

@@ -157,26 +157,13 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
         cullViewProj ? std::optional<Frustum>(Frustum(*cullViewProj)) : std::nullopt;
     DrawCount count;
 
-    // 1. The visible runs as draw commands, cut into batches wherever the state changes.
-    struct Batch {
-        std::size_t first = 0, count = 0;
-        const Draw* head = nullptr; ///< the first run: its material, ids and face culling
-        bool oneSided = false;
-    };
-    std::vector<Batch> batches;
+    // 1. The visible runs as draw commands, cut into batches wherever the state changes. Runs of one
+    // mesh share its uniforms; different meshes share them when their material, surface id and
+    // vertex colours agree.
+    std::vector<Batch>& batches = mBatchScratch;
     std::vector<IndirectCommand>& commands = mCommandScratch;
+    batches.clear();
     commands.clear();
-    auto oneSidedOf = [&](const Draw& d) {
-        return cullBackFaces && d.material >= 0 && static_cast<std::size_t>(d.material) < mMaterials.size() &&
-               !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
-    };
-    // Runs of one mesh share its uniforms; different meshes share them when their material, surface
-    // id and vertex colours agree.
-    auto sameState = [&](const Draw& a, const Draw& b) {
-        if (oneSidedOf(a) != oneSidedOf(b)) return false;
-        return !materials || a.mesh == b.mesh ||
-               (a.material == b.material && a.surfaceId == b.surfaceId && a.colored == b.colored);
-    };
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
         const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
@@ -185,8 +172,15 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
             continue;
         }
         count.drawn += triangles;
-        if (batches.empty() || !sameState(*batches.back().head, d))
-            batches.push_back({commands.size(), 0, &d, oneSidedOf(d)});
+        const bool oneSided = cullBackFaces && d.material >= 0 &&
+                              static_cast<std::size_t>(d.material) < mMaterials.size() &&
+                              !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
+        const Draw* head = batches.empty() ? nullptr : batches.back().head;
+        const bool sameState =
+            head && batches.back().oneSided == oneSided &&
+            (!materials || head->mesh == d.mesh ||
+             (head->material == d.material && head->surfaceId == d.surfaceId && head->colored == d.colored));
+        if (!sameState) batches.push_back({commands.size(), 0, &d, oneSided});
         commands.push_back({static_cast<GLuint>(d.indexCount), static_cast<GLuint>(std::max(instances, 1)),
                             static_cast<GLuint>(d.firstIndex), d.baseVertex, 0});
         ++batches.back().count;

@@ -92,7 +92,14 @@ private:
     gl::Buffer mIndices;
     mutable gl::Buffer mCommands;
     mutable std::size_t mCommandSlot = 0;
-    mutable std::vector<IndirectCommand> mCommandScratch;
+    /// Consecutive commands of one state (draw()'s batches): one multi-draw each.
+    struct Batch {
+        std::size_t first = 0, count = 0;
+        const Draw* head = nullptr; ///< the first run: its material, ids and face culling
+        bool oneSided = false;
+    };
+    mutable std::vector<IndirectCommand> mCommandScratch; ///< reused by draw(): no per-call allocation
+    mutable std::vector<Batch> mBatchScratch;
     gl::VertexArray mVao;
     std::vector<Draw> mDraws;
     std::vector<Material> mMaterials;
