@@ -10,44 +10,16 @@
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
 //        [--orbit-s 6] [--still-s 3] [--chromium /usr/bin/chromium] [--out report.json]
 //        [--server-args "--slice-ms 20"]
-import { spawn } from 'node:child_process';
 import { writeFileSync } from 'node:fs';
-import net from 'node:net';
-import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const opts = { server: path.join(root, 'build/ci/bin/gi-server'), scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
-    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0 };
-const argv = process.argv.slice(2);
-for (let i = 0; i < argv.length; i++) {
-    const key = argv[i].replace(/^--/, '');
-    if (key === 'help') {
-        console.log('usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"]');
-        process.exit(0);
-    }
-    if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
-    opts[key] = typeof opts[key] === 'number' ? Number(argv[++i]) : argv[++i];
-}
+import { DEFAULT_SERVER, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
-const freePort = () => new Promise((resolve) => {
-    const s = net.createServer().listen(0, '127.0.0.1', () => { const { port } = s.address(); s.close(() => resolve(port)); });
-});
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-const percentile = (values, p) => {
-    if (!values.length) return null;
-    const v = [...values].sort((a, b) => a - b);
-    return v[Math.min(v.length - 1, Math.floor(p * v.length))];
-};
+const opts = parseOptions({ server: DEFAULT_SERVER, scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
+    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0 },
+'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"]');
 
-const port = await freePort();
 const serverArgs = opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : [];
-const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client'), ...serverArgs],
-    { stdio: ['ignore', 'ignore', 'pipe'] });
-let serverLog = '';
-server.stderr.on('data', (d) => { serverLog += d; });
-for (let i = 0; i < 100 && !serverLog.includes('listening'); i++) await sleep(100);
-if (!serverLog.includes('listening')) throw new Error(`gi-server did not start:\n${serverLog}`);
+const { server, port, log: serverLog } = await startServer(opts.server, serverArgs);
 
 const { chromium } = await import('playwright-core');
 const browser = await chromium.launch({ executablePath: opts.chromium,
@@ -201,6 +173,6 @@ for (const [technique, params] of [['rsm_gather', { vpl_grid: 256 }], ['hier_isr
     console.log(JSON.stringify(r));
 }
 if (opts.out) writeFileSync(opts.out, JSON.stringify(report, null, 2));
-if (process.env.GI_SERVER_LOG) writeFileSync(process.env.GI_SERVER_LOG, serverLog);
+if (process.env.GI_SERVER_LOG) writeFileSync(process.env.GI_SERVER_LOG, serverLog());
 await browser.close();
 server.kill('SIGINT');

@@ -10,31 +10,14 @@
 // --nudge S sends the same camera again every S seconds (input, then a still view again): each
 // refinement round is reported apart (its first tile's parts, the share it reached), which shows what a
 // round learns from the ones before.
-import { spawn } from 'node:child_process';
-import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 import WebSocket from 'ws';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const opts = { server: path.join(root, 'build/ci/bin/gi-server'), technique: '', params: '', seconds: 15,
-    'server-args': '', whole: 0, scene: '', verbose: 0, nudge: 0 };
-const argv = process.argv.slice(2);
-for (let i = 0; i < argv.length; i++) {
-    const key = argv[i].replace(/^--/, '');
-    if (key === 'help') {
-        console.log('usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1] [--verbose 1] [--nudge S]');
-        process.exit(0);
-    }
-    if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
-    opts[key] = typeof opts[key] === 'number' ? Number(argv[++i]) : argv[++i];
-}
-const port = 20000 + Math.floor(Math.random() * 20000);
-const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client'),
-    ...opts['server-args'].split(' ').filter(Boolean)], { stdio: ['ignore', 'ignore', 'pipe'] });
-let log = '';
-server.stderr.on('data', (d) => { log += d; });
-for (let i = 0; i < 100 && !log.includes('listening'); i++) await new Promise((r) => setTimeout(r, 100));
-if (!log.includes('listening')) throw new Error(`gi-server did not start:\n${log}`);
+import { DEFAULT_SERVER, parseOptions, startServer } from '../lib.mjs';
+
+const opts = parseOptions({ server: DEFAULT_SERVER, technique: '', params: '', seconds: 15,
+    'server-args': '', whole: 0, scene: '', verbose: 0, nudge: 0 },
+'usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1] [--verbose 1] [--nudge S]');
+const { server, port } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 
 const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
 let stats = null;

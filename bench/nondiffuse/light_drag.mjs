@@ -7,31 +7,14 @@
 //
 // usage: node bench/nondiffuse/light_drag.mjs [--server build/ci/bin/gi-server] [--scene builtin:gallery]
 //        [--technique none] [--seconds 8] [--interval-ms 120] [--rounds 2]
-import { spawn } from 'node:child_process';
-import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 import WebSocket from 'ws';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const opts = { server: path.join(root, 'build/ci/bin/gi-server'), scene: 'builtin:gallery', technique: 'none',
-    seconds: 8, 'interval-ms': 120, rounds: 2 };
-const argv = process.argv.slice(2);
-for (let i = 0; i < argv.length; i++) {
-    const key = argv[i].replace(/^--/, '');
-    if (key === 'help') {
-        console.log('usage: node bench/nondiffuse/light_drag.mjs [--server PATH] [--scene S] [--technique T] [--seconds S] [--interval-ms MS] [--rounds N]');
-        process.exit(0);
-    }
-    if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
-    opts[key] = typeof opts[key] === 'number' ? Number(argv[++i]) : argv[++i];
-}
-const port = 20000 + Math.floor(Math.random() * 20000);
-const server = spawn(opts.server, ['--port', String(port), '--client-dir', path.join(root, 'client'),
-    '--scene', opts.scene, '--technique', opts.technique], { stdio: ['ignore', 'ignore', 'pipe'] });
-let log = '';
-server.stderr.on('data', (d) => { log += d; });
-for (let i = 0; i < 100 && !log.includes('listening'); i++) await new Promise((r) => setTimeout(r, 100));
-if (!log.includes('listening')) throw new Error(`gi-server did not start:\n${log}`);
+import { DEFAULT_SERVER, parseOptions, percentile, startServer } from '../lib.mjs';
+
+const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:gallery', technique: 'none',
+    seconds: 8, 'interval-ms': 120, rounds: 2 },
+'usage: node bench/nondiffuse/light_drag.mjs [--server PATH] [--scene S] [--technique T] [--seconds S] [--interval-ms MS] [--rounds N]');
+const { server, port } = await startServer(opts.server, ['--scene', opts.scene, '--technique', opts.technique]);
 
 const probePasses = /^env_(render|prefilter)/;
 
@@ -78,8 +61,8 @@ function drag(arm) {
 }
 
 const q = (v, p) => {
-    const s = [...v].sort((a, b) => a - b);
-    return s.length ? +s[Math.min(s.length - 1, Math.floor(p * s.length))].toFixed(1) : null;
+    const x = percentile(v, p);
+    return x === null ? null : +x.toFixed(1);
 };
 const results = { budget: [], none: [] };
 for (let r = 0; r < opts.rounds; r++)

@@ -1,0 +1,58 @@
+// What the node benchmarks that drive a gi-server share: their `--name value` options, starting the
+// server on a free loopback port, and percentiles.
+import { spawn } from 'node:child_process';
+import net from 'node:net';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+export const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+export const DEFAULT_SERVER = path.join(ROOT, 'build/ci/bin/gi-server');
+
+/**
+ * `--name value` pairs over `defaults` (a number default makes the value a number); `--help` prints
+ * `usage` and exits; an unknown name or a missing value throws.
+ */
+export function parseOptions(defaults, usage, argv = process.argv.slice(2)) {
+    const opts = { ...defaults };
+    for (let i = 0; i < argv.length; i++) {
+        const key = argv[i].replace(/^--/, '');
+        if (key === 'help') {
+            console.log(usage);
+            process.exit(0);
+        }
+        if (!(key in opts) || argv[i + 1] === undefined) throw new Error(`unknown option or missing value: ${argv[i]}`);
+        opts[key] = typeof opts[key] === 'number' ? Number(argv[++i]) : argv[++i];
+    }
+    return opts;
+}
+
+export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+export const freePort = () => new Promise((resolve) => {
+    const s = net.createServer().listen(0, '127.0.0.1', () => {
+        const { port } = s.address();
+        s.close(() => resolve(port));
+    });
+});
+
+/**
+ * Starts `serverPath` with the repository's client on a free port and `args`; resolves once it
+ * listens (10 s at most) with {server (the child process), port, log () => its stderr so far}.
+ */
+export async function startServer(serverPath, args = []) {
+    const port = await freePort();
+    const server = spawn(serverPath, ['--port', String(port), '--client-dir', path.join(ROOT, 'client'), ...args],
+        { stdio: ['ignore', 'ignore', 'pipe'] });
+    let log = '';
+    server.stderr.on('data', (d) => { log += d; });
+    for (let i = 0; i < 100 && !log.includes('listening'); i++) await sleep(100);
+    if (!log.includes('listening')) throw new Error(`gi-server did not start:\n${log}`);
+    return { server, port, log: () => log };
+}
+
+/** The p-quantile (0..1) of `values` (nearest rank, rounded down); null when there are none. */
+export function percentile(values, p) {
+    if (!values.length) return null;
+    const v = [...values].sort((a, b) => a - b);
+    return v[Math.min(v.length - 1, Math.floor(p * v.length))];
+}
