@@ -182,3 +182,10 @@ export function formatBytes(n) {
     if (n < 1024 * 1024) return `${(n / 1024).toFixed(1)} KB`;
     return `${(n / 1024 / 1024).toFixed(2)} MB`;
 }
+
+/** Drawn triangles; for a scene with instanced meshes also how many are held, in how many placements. */
+export function trianglesText(counts) {
+    if (counts?.triangles === undefined) return '–';
+    if (!counts.instances) return String(counts.triangles);
+    return `${counts.triangles} (${counts.triangles_stored} held, ${counts.instances} instances)`;
+}

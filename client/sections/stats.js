@@ -3,7 +3,7 @@
 import { budgetLine } from '../budget.js';
 import { addBlock, block, describe, makeSection } from '../controls.js';
 import { presetChanges } from '../params.js';
-import { formatMs } from '../stats.js';
+import { formatMs, trianglesText } from '../stats.js';
 
 export function createStatsSection({ ui, state, settings, saveSettings, store, chart }) {
     const gui = makeSection(ui.sections, 'Stats', { id: 'stats' });
@@ -54,7 +54,7 @@ export function createStatsSection({ ui, state, settings, saveSettings, store, c
                 row('readback', formatMs(stats.readback_ms)),
                 row('timing', stats.timing ?? '–'),
                 row('VPLs', String(stats.counts?.vpl_count ?? '–')),
-                row('triangles', String(stats.counts?.triangles ?? '–')),
+                row('triangles', trianglesText(stats.counts)),
                 row('dropped', String(stats.dropped_frames ?? 0)),
                 row('viewers', String(stats.viewers ?? 0)),
                 row('round trip', formatMs(state.rttMs)),

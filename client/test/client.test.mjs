@@ -18,7 +18,7 @@ import {
     newLightFor, pickSelection, requestLight,
 } from '../lights.js';
 import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
-import { LatencyTracker, PassHistory, RateCounter, formatBytes, networkMs, passMs, stackSeries } from '../stats.js';
+import { LatencyTracker, PassHistory, RateCounter, formatBytes, networkMs, passMs, stackSeries, trianglesText } from '../stats.js';
 import {
     DEFAULT_COMPARE, buildCompareRequest, canCompare, compareSettings, compareSize, diffImage, formatCompare, percent,
     referenceLabel, validateCompareRequest, viewKey,
@@ -573,4 +573,11 @@ test('not shown: the file\'s unshown features as lines, malformed entries left o
     assert.equal(notShownSummary([]), '');
     assert.match(notShownSummary(lines), /2 features this renderer does not show/);
     assert.match(notShownSummary(lines.slice(0, 1)), /1 feature this renderer/);
+});
+
+test('the triangle count says what instancing holds back', () => {
+    assert.equal(trianglesText(undefined), '–');
+    assert.equal(trianglesText({ triangles: 1164 }), '1164');
+    assert.equal(trianglesText({ triangles: 1106, triangles_stored: 94, instances: 12 }),
+        '1106 (94 held, 12 instances)');
 });

@@ -173,7 +173,7 @@ int pointShadows(const std::vector<std::string>& args) {
     // Visibility at points over the surfaces, against rays.
     std::vector<glm::vec4> points;
     std::vector<glm::vec3> normals;
-    samplePoints(scene, samples, points, normals);
+    samplePoints(flattenInstances(scene), samples, points, normals); // world-space triangles
     const reference::RayScene rays(scene);
     const float eps = rays.epsilon();
     std::vector<int> exact(points.size());

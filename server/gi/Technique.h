@@ -60,8 +60,9 @@ struct FrameInputs {
     /// derived from them alone (the extracted VPLs) still holds.
     bool lightViewsReused = false;
     const shader::FrameUniforms* frame = nullptr; ///< CPU copy of the bound gFrame block
-    /// Draws the scene's triangles (world-space positions at attribute 0, texture coordinates at 2,
-    /// vertex colours at 4) with `program` bound, `instances` times; techniques see geometry only
+    /// Draws the scene's triangles (positions at attribute 0, placed in the world by
+    /// render/instance.glsl's placedPosition(); texture coordinates at 2, vertex colours at 4) with
+    /// `program` bound, `instances` times; techniques see geometry only
     /// through this (VPL shadow maps). With sceneCutsOut it also sets the material uniforms of
     /// render/material.glsl that `program` declares, for its cutout test.
     std::function<void(const gl::Program& program, int instances)> drawGeometry;

@@ -43,6 +43,11 @@ std::string sceneDigest(const Scene& scene) {
         h.value(m.indices.size());
         h.bytes(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
         h.value(m.material);
+        // Only instanced meshes add to the digest, so the cache keys of flattened scenes hold.
+        if (m.instanced()) {
+            h.value(m.instances.size());
+            h.bytes(m.instances.data(), m.instances.size() * sizeof(glm::mat4));
+        }
     }
     h.value(scene.materials.size());
     for (const Material& m : scene.materials) {

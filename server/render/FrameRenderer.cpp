@@ -623,6 +623,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     }
     nlohmann::json countJson = nlohmann::json::object();
     countJson["triangles"] = mSceneGpu->triangleCount();
+    if (mSceneGpu->instanceCount() > 0) {
+        countJson["triangles_stored"] = mSceneGpu->storedTriangleCount();
+        countJson["instances"] = mSceneGpu->instanceCount();
+    }
     countJson["pixels"] = state.width * state.height;
     if (reuseLights) countJson["light_views_reused"] = views;
     for (const auto& [k, v] : counters) countJson[k] = v;

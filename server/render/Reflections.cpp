@@ -70,7 +70,8 @@ Reflections::Decision Reflections::decide(const Scene& scene, SceneGpu& sceneGpu
         for (size_t i = 0; i < scene.meshes.size(); ++i) {
             const Mesh& mesh = scene.meshes[i];
             const Material* material = meshMaterial(scene, mesh);
-            if (idOfMesh[i] != 0 || mesh.positions.empty() || !material) continue;
+            // An instanced mesh is several objects: none gets a probe of its own (the room's serves).
+            if (idOfMesh[i] != 0 || mesh.positions.empty() || mesh.instanced() || !material) continue;
             const Material& mat = *material;
             if (!specularWorthAPass(mat, split) || !(mat.roughness < split || !techniqueHasGlossy)) continue;
             const Flatness f = flatness(mesh);

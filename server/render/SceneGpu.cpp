@@ -5,6 +5,8 @@
 #include <limits>
 #include <optional>
 
+#include <glm/gtc/matrix_inverse.hpp>
+
 #include "core/Error.h"
 #include "scene/Frustum.h"
 
@@ -20,23 +22,36 @@ struct Vertex {
 static_assert(sizeof(Vertex) == 64);
 } // namespace
 
+SceneGpu::InstanceTransform SceneGpu::InstanceTransform::of(const glm::mat4& toWorld) {
+    InstanceTransform t;
+    t.toWorld = toWorld;
+    const glm::mat3 normalToWorld = glm::inverseTranspose(glm::mat3(toWorld));
+    for (int c = 0; c < 3; ++c) t.normalToWorld[c] = glm::vec4(normalToWorld[c], 0.0f);
+    return t;
+}
+
 SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
     std::vector<Vertex> vertices;
     std::vector<std::uint32_t> indices;
+    // Placement 0 is the identity that every world-space mesh is drawn with.
+    std::vector<InstanceTransform> placements{InstanceTransform::of(glm::mat4(1.0f))};
     for (const Mesh& mesh : scene.meshes) {
         Draw d;
         d.baseVertex = static_cast<GLint>(vertices.size());
         d.material = mesh.material;
         d.mesh = static_cast<int>(&mesh - scene.meshes.data());
         d.colored = !mesh.colors.empty();
-        // Runs of consecutive triangles with their bounds (meshes are in world space). Indices were
+        // Runs of consecutive triangles with their bounds in the mesh's space. Indices were
         // validated at load; a bad one is skipped here rather than read out of range.
+        struct Chunk {
+            GLint firstIndex;
+            GLsizei indexCount;
+            glm::vec3 lo, hi;
+        };
+        std::vector<Chunk> chunks;
         const std::size_t meshFirst = indices.size();
         for (std::size_t t0 = 0; t0 + 3 <= mesh.indices.size(); t0 += 3 * kChunkTriangles) {
             const std::size_t t1 = std::min(mesh.indices.size() / 3 * 3, t0 + 3 * kChunkTriangles);
-            Draw run = d;
-            run.firstIndex = static_cast<GLint>(meshFirst + t0);
-            run.indexCount = static_cast<GLsizei>(t1 - t0);
             glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
             for (std::size_t i = t0; i < t1; ++i) {
                 const std::uint32_t v = mesh.indices[i];
@@ -44,9 +59,38 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
                 lo = glm::min(lo, mesh.positions[v]);
                 hi = glm::max(hi, mesh.positions[v]);
             }
-            run.boundsMin = lo;
-            run.boundsMax = hi;
-            if (run.indexCount > 0) mDraws.push_back(run);
+            if (t1 > t0)
+                chunks.push_back({static_cast<GLint>(meshFirst + t0), static_cast<GLsizei>(t1 - t0), lo, hi});
+        }
+        // One run per chunk and placement, placement by placement: runs of one mesh share its state,
+        // so all its placements go out in one multi-draw.
+        for (std::size_t k = 0; k < mesh.placements(); ++k) {
+            Draw placed = d;
+            if (mesh.instanced()) {
+                placed.instance = static_cast<GLuint>(placements.size());
+                placements.push_back(InstanceTransform::of(mesh.instances[k]));
+            }
+            for (const Chunk& c : chunks) {
+                Draw run = placed;
+                run.firstIndex = c.firstIndex;
+                run.indexCount = c.indexCount;
+                run.boundsMin = c.lo;
+                run.boundsMax = c.hi;
+                if (mesh.instanced()) {
+                    // The world box around the placed corners: culling stays conservative.
+                    const glm::mat4& toWorld = mesh.instances[k];
+                    run.boundsMin = glm::vec3(std::numeric_limits<float>::max());
+                    run.boundsMax = glm::vec3(-std::numeric_limits<float>::max());
+                    for (int corner = 0; corner < 8; ++corner) {
+                        const glm::vec3 p(toWorld * glm::vec4(corner & 1 ? c.hi.x : c.lo.x,
+                                                              corner & 2 ? c.hi.y : c.lo.y,
+                                                              corner & 4 ? c.hi.z : c.lo.z, 1.0f));
+                        run.boundsMin = glm::min(run.boundsMin, p);
+                        run.boundsMax = glm::max(run.boundsMax, p);
+                    }
+                }
+                mDraws.push_back(run);
+            }
         }
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
@@ -68,8 +112,10 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
             vertices.push_back(v);
         }
         indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
-        mTriangles += mesh.indices.size() / 3;
+        mTriangles += mesh.indices.size() / 3 * mesh.placements();
+        mStoredTriangles += mesh.indices.size() / 3;
     }
+    mInstances = placements.size() - 1;
     if (vertices.empty() || indices.empty())
         throw Error("render: scene '" + scene.name + "' has no triangles");
 
@@ -89,6 +135,29 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         glEnableVertexArrayAttrib(vao, a);
         glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
         glVertexArrayAttribBinding(vao, a, 0);
+    }
+    // The placement's matrices (shaders/render/instance.glsl), one per draw command: with a divisor
+    // no instance count reaches, every instance of a command reads element baseInstance, so the
+    // passes that draw instanced for their own reasons (cube faces per VPL) keep gl_InstanceID.
+    mPlacements = gl::Buffer::create(static_cast<GLsizeiptr>(placements.size() * sizeof(InstanceTransform)),
+                                     placements.data(), 0);
+    glVertexArrayVertexBuffer(vao, 1, mPlacements.id(), 0, sizeof(InstanceTransform));
+    glVertexArrayBindingDivisor(vao, 1, kPlacementDivisor);
+    for (GLuint column = 0; column < 4; ++column) {
+        const GLuint toWorld = kToWorldAttribute + column;
+        glEnableVertexArrayAttrib(vao, toWorld);
+        glVertexArrayAttribFormat(
+            vao, toWorld, 4, GL_FLOAT, GL_FALSE,
+            static_cast<GLuint>(offsetof(InstanceTransform, toWorld) + column * sizeof(glm::vec4)));
+        glVertexArrayAttribBinding(vao, toWorld, 1);
+    }
+    for (GLuint column = 0; column < 3; ++column) {
+        const GLuint normal = kNormalToWorldAttribute + column;
+        glEnableVertexArrayAttrib(vao, normal);
+        glVertexArrayAttribFormat(
+            vao, normal, 3, GL_FLOAT, GL_FALSE,
+            static_cast<GLuint>(offsetof(InstanceTransform, normalToWorld) + column * sizeof(glm::vec4)));
+        glVertexArrayAttribBinding(vao, normal, 1);
     }
 
     for (const TextureImage& image : scene.textures) {
@@ -182,7 +251,7 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
              (head->material == d.material && head->surfaceId == d.surfaceId && head->colored == d.colored));
         if (!sameState) batches.push_back({commands.size(), 0, &d, oneSided});
         commands.push_back({static_cast<GLuint>(d.indexCount), static_cast<GLuint>(std::max(instances, 1)),
-                            static_cast<GLuint>(d.firstIndex), d.baseVertex, 0});
+                            static_cast<GLuint>(d.firstIndex), d.baseVertex, d.instance});
         ++batches.back().count;
     }
     count.runs = commands.size();

@@ -61,8 +61,16 @@ public:
     DrawCount draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
                    int skipMesh = -1, const glm::mat4* cullViewProj = nullptr,
                    bool cullBackFaces = false) const;
+    /// Triangles drawn (an instanced mesh's once per placement) and stored.
     std::size_t triangleCount() const { return mTriangles; }
+    std::size_t storedTriangleCount() const { return mStoredTriangles; }
+    /// Placements of instanced meshes (Mesh::instances).
+    std::size_t instanceCount() const { return mInstances; }
     std::size_t drawCount() const { return mDraws.size(); }
+
+    /// Vertex attributes of the placement matrices (shaders/render/instance.glsl): the object ->
+    /// world matrix's four columns and the normal matrix's three.
+    static constexpr GLuint kToWorldAttribute = 5, kNormalToWorldAttribute = 9;
     /// The reflector id of each mesh, written by the G-buffer into the normal's w
     /// (shaders/render/gbuffer.frag): k + 1 for planar mirror k, -(k + 1) for the object of local
     /// environment probe k, 0 for none (render/Reflections).
@@ -76,6 +84,7 @@ private:
         int material = 0;
         int mesh = 0;                               ///< index into Scene::meshes
         int surfaceId = 0;                          ///< reflector id (setSurfaceIds)
+        GLuint instance = 0;                        ///< placement (mPlacements index; 0: identity)
         bool colored = false;                       ///< the mesh has COLOR_0 (uHasVertexColor)
         glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< world space, of this run's triangles
     };
@@ -88,8 +97,18 @@ private:
         GLuint baseInstance;
     };
     static_assert(sizeof(IndirectCommand) == 20, "glMultiDrawElementsIndirect's command layout");
+    /// One placement's matrices as the vertex stage reads them (columns; normalToWorld's w unused).
+    struct InstanceTransform {
+        glm::mat4 toWorld{1.0f};
+        glm::vec4 normalToWorld[3]{};
+        static InstanceTransform of(const glm::mat4& toWorld);
+    };
+    static_assert(sizeof(InstanceTransform) == 112, "instance.glsl's attribute layout");
+    /// Larger than any instance count a pass draws, so a command's instances all read its placement.
+    static constexpr GLuint kPlacementDivisor = 1u << 30;
     gl::Buffer mVertices;
     gl::Buffer mIndices;
+    gl::Buffer mPlacements;
     mutable gl::Buffer mCommands;
     mutable std::size_t mCommandSlot = 0;
     /// Consecutive commands of one state (draw()'s batches): one multi-draw each.
@@ -104,7 +123,7 @@ private:
     std::vector<Draw> mDraws;
     std::vector<Material> mMaterials;
     std::vector<gl::Texture> mTextures;
-    std::size_t mTriangles = 0;
+    std::size_t mTriangles = 0, mStoredTriangles = 0, mInstances = 0;
 };
 
 } // namespace gis

@@ -31,6 +31,7 @@ namespace gis {
 namespace {
 
 constexpr const char* kLightsExtension = "KHR_lights_punctual";
+constexpr const char* kGpuInstancingExtension = "EXT_mesh_gpu_instancing";
 constexpr const char* kEmissiveStrengthExtension = "KHR_materials_emissive_strength";
 constexpr const char* kSpecularExtension = "KHR_materials_specular";
 constexpr const char* kTextureTransformExtension = "KHR_texture_transform";
@@ -360,6 +361,7 @@ public:
         readMaterials();
         collectNotShown();
         for (int root : rootNodes()) visitNode(root, glm::mat4(1.0f));
+        addPlacedMeshes();
         mScene.name = mPath;
         mScene.updateBounds();
         closeInfiniteFarPlanes();
@@ -407,7 +409,12 @@ private:
         mOnPath[i] = true;
         const tinygltf::Node& node = mModel.nodes[i];
         const glm::mat4 world = parent * localMatrix(node);
-        if (node.mesh >= 0) addMesh(node.mesh, world);
+        if (node.mesh >= 0) {
+            if (const auto ext = node.extensions.find(kGpuInstancingExtension); ext != node.extensions.end())
+                addGpuInstances(index, world, ext->second);
+            else
+                mPlacements.push_back({node.mesh, world});
+        }
         if (node.camera >= 0) addCamera(node, index, world);
         addNodeLight(node, index, world);
         for (int child : node.children) visitNode(child, world);
@@ -636,7 +643,6 @@ private:
             {"KHR_materials_variants", "only each primitive's default material is shown"},
             {"KHR_materials_pbrSpecularGlossiness",
              "specular-glossiness materials show their metallic-roughness values (often the defaults)"},
-            {"EXT_mesh_gpu_instancing", "instances are not drawn: each instanced mesh appears once"},
             {"KHR_animation_pointer", "animations are not played"},
         };
         const auto found = effects.find(name);
@@ -789,9 +795,106 @@ private:
 
     // ---- meshes ----------------------------------------------------------------------------------
 
+    /// EXT_mesh_gpu_instancing: the node's mesh placed once per element of its TRANSLATION, ROTATION
+    /// and SCALE accessors (each optional, all of one count), each placement the node's world
+    /// matrix times T * R * S.
+    void addGpuInstances(int nodeIndex, const glm::mat4& world, const tinygltf::Value& ext) {
+        const std::string where = "node " + std::to_string(nodeIndex) + ": " + kGpuInstancingExtension;
+        if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject())
+            fail(where + " needs an 'attributes' object");
+        const tinygltf::Value& attributes = ext.Get("attributes");
+        const auto accessorOf = [&](const char* name) {
+            if (!attributes.Has(name)) return -1;
+            const tinygltf::Value& v = attributes.Get(name);
+            if (!v.IsNumber()) fail(where + ": attributes." + name + " must be an accessor index");
+            return v.GetNumberAsInt();
+        };
+        const int t = accessorOf("TRANSLATION"), r = accessorOf("ROTATION"), sc = accessorOf("SCALE");
+        if (t < 0 && r < 0 && sc < 0) { // the extension needs one; the node alone is what is left
+            warn(where + " has no TRANSLATION, ROTATION or SCALE; the mesh is drawn once, at the node");
+            mPlacements.push_back({mModel.nodes[static_cast<std::size_t>(nodeIndex)].mesh, world});
+            return;
+        }
+        const std::vector<glm::vec3> translations =
+            t >= 0 ? readVectors<3>(t, TINYGLTF_TYPE_VEC3, where + " TRANSLATION") : std::vector<glm::vec3>{};
+        const std::vector<glm::vec4> rotations =
+            r >= 0 ? readVectors<4>(r, TINYGLTF_TYPE_VEC4, where + " ROTATION") : std::vector<glm::vec4>{};
+        const std::vector<glm::vec3> scales =
+            sc >= 0 ? readVectors<3>(sc, TINYGLTF_TYPE_VEC3, where + " SCALE") : std::vector<glm::vec3>{};
+        const std::size_t count = std::max({translations.size(), rotations.size(), scales.size()});
+        if ((t >= 0 && translations.size() != count) || (r >= 0 && rotations.size() != count) ||
+            (sc >= 0 && scales.size() != count))
+            fail(where + ": TRANSLATION, ROTATION and SCALE have different counts (" +
+                 std::to_string(translations.size()) + ", " + std::to_string(rotations.size()) + ", " +
+                 std::to_string(scales.size()) + "); the extension needs one count");
+        for (std::size_t i = 0; i < count; ++i) {
+            glm::mat4 m = world;
+            if (t >= 0) m = glm::translate(m, translations[i]);
+            if (r >= 0) {
+                const glm::vec4 q = rotations[i];
+                const float length = glm::length(q);
+                // An unnormalised quaternion is normalised; a zero or non-finite one means no rotation.
+                if (std::isfinite(length) && length > 1e-12f)
+                    m *= glm::mat4_cast(glm::quat(q.w / length, q.x / length, q.y / length, q.z / length));
+            }
+            if (sc >= 0) m = glm::scale(m, scales[i]);
+            mPlacements.push_back({mModel.nodes[static_cast<std::size_t>(nodeIndex)].mesh, m});
+        }
+    }
+
+    /// Whether a placement can be drawn through an instance matrix (Mesh::instances): finite, with a
+    /// positive determinant and a finite inverse. Mirrored or collapsed placements are flattened.
+    static bool instanceable(const glm::mat4& world) {
+        for (int c = 0; c < 4; ++c)
+            if (!isFinite(world[c])) return false;
+        const float det = glm::determinant(glm::mat3(world));
+        if (!std::isfinite(det) || det <= 0.0f) return false;
+        const glm::mat3 normalMatrix = glm::inverseTranspose(glm::mat3(world));
+        for (int c = 0; c < 3; ++c)
+            if (!isFinite(normalMatrix[c])) return false;
+        return true;
+    }
+
+    /// The meshes of the nodes walked, in walk order. A glTF mesh that two or more nodes place, each
+    /// instanceably, is read once in its own space and keeps one matrix per node; any other
+    /// placement is flattened to world space (a small file can name one mesh a million times: an
+    /// instance costs 64 bytes, a flattened copy the whole mesh).
+    void addPlacedMeshes() {
+        std::vector<int> uses(mModel.meshes.size(), 0);
+        std::vector<bool> flatten(mModel.meshes.size(), false);
+        for (const auto& [meshIndex, world] : mPlacements) {
+            if (meshIndex >= static_cast<int>(mModel.meshes.size()))
+                fail("mesh " + std::to_string(meshIndex) + " does not exist");
+            const auto m = static_cast<std::size_t>(meshIndex);
+            ++uses[m];
+            if (!instanceable(world)) flatten[m] = true;
+        }
+        // Scene meshes [first, end) read from each instanced glTF mesh; first == -1 until read.
+        std::vector<std::pair<int, int>> readAs(mModel.meshes.size(), {-1, -1});
+        for (const auto& [meshIndex, world] : mPlacements) {
+            const auto m = static_cast<std::size_t>(meshIndex);
+            if (uses[m] < 2 || flatten[m]) {
+                addMesh(meshIndex, world);
+                continue;
+            }
+            if (readAs[m].first < 0) {
+                const int first = static_cast<int>(mScene.meshes.size());
+                addMesh(meshIndex, glm::mat4(1.0f));
+                readAs[m] = {first, static_cast<int>(mScene.meshes.size())};
+            } else {
+                mContext.report(SceneLoadProgress::Stage::Meshes,
+                                mPrimitivesRead += mModel.meshes[m].primitives.size(), mPrimitivesTotal);
+            }
+            for (int k = readAs[m].first; k < readAs[m].second; ++k) {
+                Mesh& mesh = mScene.meshes[static_cast<std::size_t>(k)];
+                if (!mContext.spend(sizeof(glm::mat4), "an instance of mesh '" + mesh.name + "'"))
+                    fail(mContext.refusal);
+                mesh.instances.push_back(world);
+            }
+        }
+    }
+
     void addMesh(int meshIndex, const glm::mat4& world) {
-        if (meshIndex >= static_cast<int>(mModel.meshes.size()))
-            fail("mesh " + std::to_string(meshIndex) + " does not exist");
         const tinygltf::Mesh& mesh = mModel.meshes[static_cast<std::size_t>(meshIndex)];
         for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
             addPrimitive(mesh, meshIndex, static_cast<int>(p), world);
@@ -899,28 +1002,12 @@ private:
             return;
         }
 
-        const glm::mat3 linear(world);
-        const glm::mat3 normalMatrix = glm::inverseTranspose(linear);
-        for (auto& p : mesh.positions) p = glm::vec3(world * glm::vec4(p, 1.0f));
-        // Zero results are left for finalizeScene, which replaces them with face normals.
-        for (auto& n : mesh.normals) n = safeNormalize(normalMatrix * n, glm::vec3(0.0f));
-        // Tangents follow the surface (the linear part); a mirror flips the bitangent's handedness.
-        // One that is zero or not finite stays zero: that vertex's normal is left unmapped.
-        const float handedness = glm::determinant(linear) < 0.0f ? -1.0f : 1.0f;
-        for (auto& t : mesh.tangents) {
-            const glm::vec3 v = safeNormalize(linear * glm::vec3(t), glm::vec3(0.0f));
-            t = v == glm::vec3(0.0f) ? glm::vec4(0.0f)
-                                     : glm::vec4(v, (t.w < 0.0f ? -1.0f : 1.0f) * handedness);
-        }
-        // A mirroring transform turns CCW into CW; swap to keep front faces CCW (glTF 3.7.4).
-        if (glm::determinant(linear) < 0.0f)
-            for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
-                std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+        // Zero normals are left for finalizeScene, which replaces them with face normals.
+        transformMesh(mesh, world);
 
         if (prim.material >= static_cast<int>(mModel.materials.size()))
             fail(context + ": material " + std::to_string(prim.material) + " does not exist");
         mesh.material = prim.material >= 0 ? prim.material : defaultMaterial();
-        // Instances are flattened: a small file can name one mesh a million times through its nodes.
         const std::uint64_t bytes =
             mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
             mesh.texcoords.size() * sizeof(glm::vec2) + mesh.colors.size() * sizeof(glm::vec4) +
@@ -1013,6 +1100,8 @@ private:
     std::vector<int> mImageTexture;       ///< glTF image -> Scene::textures index, kNotConverted, or -1
     std::vector<int> mLinearImageTexture; ///< the same for images read as linear data
     std::vector<bool> mOnPath;            ///< nodes on the current root-to-node path, to reject cycles
+    /// (glTF mesh, object -> world) of every node that has a mesh, in walk order (addPlacedMeshes).
+    std::vector<std::pair<int, glm::mat4>> mPlacements;
     int mDefaultMaterial = -1;
 };
 

@@ -253,9 +253,10 @@ const std::vector<std::string>& gltfReadableExtensions() {
     // KHR_mesh_quantization: quantized attributes are non-float component types, which the accessor
     // reader handles.
     // KHR_texture_transform: applied to the base colour texture, the one the renderer samples.
-    static const std::vector<std::string> names = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                                   "KHR_materials_specular", "KHR_mesh_quantization",
-                                                   "KHR_texture_transform"};
+    // EXT_mesh_gpu_instancing: each instance is a placement of the node's mesh (Mesh::instances).
+    static const std::vector<std::string> names = {
+        "KHR_lights_punctual",   "KHR_materials_emissive_strength", "KHR_materials_specular",
+        "KHR_mesh_quantization", "KHR_texture_transform",           "EXT_mesh_gpu_instancing"};
     return names;
 }
 

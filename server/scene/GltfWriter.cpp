@@ -175,7 +175,19 @@ void writeGlb(const Scene& scene, const std::string& path) {
         if (mesh.material >= 0 && mesh.material < static_cast<int>(scene.materials.size()))
             primitive["material"] = mesh.material;
         doc["meshes"].push_back({{"name", mesh.name}, {"primitives", {primitive}}});
-        addNode({{"name", mesh.name}, {"mesh", doc["meshes"].size() - 1}});
+        if (!mesh.instanced()) {
+            addNode({{"name", mesh.name}, {"mesh", doc["meshes"].size() - 1}});
+            continue;
+        }
+        // One node per placement, all naming the same mesh: the file keeps the instancing.
+        for (std::size_t k = 0; k < mesh.instances.size(); ++k) {
+            nlohmann::json matrix = nlohmann::json::array();
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) matrix.push_back(mesh.instances[k][c][r]);
+            addNode({{"name", mesh.name + "@" + std::to_string(k)},
+                     {"mesh", doc["meshes"].size() - 1},
+                     {"matrix", matrix}});
+        }
     }
 
     for (const Light& l : scene.lights) {

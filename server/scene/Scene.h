@@ -1,6 +1,7 @@
 // Scene: the renderer-neutral description every layer above works on (GL pipeline, reference
-// renderer, analysis). Geometry is flattened to world space at load time: the node hierarchy is
-// applied once, so consumers never walk a graph.
+// renderer, analysis). The node hierarchy is applied once at load time, so consumers never walk a
+// graph: a mesh is either in world space (drawn once) or in its own space with one object-to-world
+// matrix per placement (Mesh::instances: a glTF mesh that several nodes share is stored once).
 //
 // Units: lengths in metres; punctual light intensity in candela (lm/sr, glTF's
 // KHR_lights_punctual convention); colours linear RGB.
@@ -67,7 +68,7 @@ struct Material {
     bool doubleSided = true;
 };
 
-/// One triangle list in world space. Every vertex attribute array has positions.size() entries.
+/// One triangle list. Every vertex attribute array has positions.size() entries.
 struct Mesh {
     std::string name;
     std::vector<glm::vec3> positions;
@@ -82,6 +83,14 @@ struct Mesh {
     /// its alpha, for cutouts). Empty when the source has none.
     std::vector<glm::vec4> colors;
     int material = 0; ///< index into Scene::materials
+    /// Empty: the attributes above are in world space and the mesh is drawn once. Otherwise they are
+    /// in the mesh's own space and it is drawn once per matrix (object -> world; each finite with a
+    /// positive determinant, so winding and tangent handedness hold: the loader flattens mirrored and
+    /// singular placements instead). Instanced meshes are never mirrors or local-probe objects.
+    std::vector<glm::mat4> instances;
+    bool instanced() const { return !instances.empty(); }
+    /// How many times the mesh is drawn.
+    std::size_t placements() const { return instances.empty() ? 1 : instances.size(); }
 };
 
 enum class LightType { Spot, Point, Directional };
@@ -137,9 +146,26 @@ struct Scene {
     Bounds bounds;
     std::vector<NotShown> notShown; ///< what the file uses and the renderer does not show
 
+    /// Triangles drawn (an instanced mesh counts once per placement).
     std::size_t triangleCount() const;
-    /// Recomputes bounds from all mesh positions.
+    /// Triangles stored (an instanced mesh counts once): what the scene costs in memory.
+    std::size_t storedTriangleCount() const;
+    /// Placements of instanced meshes (0 when nothing is instanced).
+    std::size_t instanceCount() const;
+    /// Recomputes bounds from all mesh positions (instanced meshes: their own-space bounds' corners,
+    /// placed; a little loose for rotated placements).
     void updateBounds();
 };
+
+/// `scene` with every instanced mesh replaced by one world-space copy per placement, for consumers
+/// that need world-space triangles (the reference's BVH). `sourceMesh`, when given, receives for each
+/// mesh of the result the index of the mesh of `scene` it came from.
+Scene flattenInstances(const Scene& scene, std::vector<int>* sourceMesh = nullptr);
+
+/// Moves `mesh`'s attributes by `toWorld` (object -> world): positions by it, normals by its
+/// inverse transpose (unit length; a zero or non-finite result stays zero for finalizeScene to
+/// replace), tangents by its linear part. A mirroring matrix (negative determinant) also swaps each
+/// triangle's winding and the tangents' handedness, so front faces stay CCW (glTF 3.7.4).
+void transformMesh(Mesh& mesh, const glm::mat4& toWorld);
 
 } // namespace gis

@@ -101,6 +101,17 @@ private:
         if (m.material < 0 || m.material >= static_cast<int>(mScene.materials.size()))
             fail(what + ": material " + std::to_string(m.material) + " does not exist (" +
                  std::to_string(mScene.materials.size()) + " materials)");
+        for (std::size_t k = 0; k < m.instances.size(); ++k) {
+            const glm::mat4& toWorld = m.instances[k];
+            bool finite = true;
+            for (int c = 0; c < 4; ++c) finite = finite && isFinite(toWorld[c]);
+            // The vertex stage transforms normals by the inverse transpose and keeps the winding.
+            const float det = glm::determinant(glm::mat3(toWorld));
+            if (!finite || !std::isfinite(det) || !(det > 0.0f))
+                fail(what + ": instance " + std::to_string(k) +
+                     "'s matrix is not finite or does not have a positive determinant (mirrored or "
+                     "collapsed placements must be flattened)");
+        }
     }
 
     void checkLight(std::size_t i) const {

@@ -74,6 +74,8 @@ std::vector<MirrorPlane> findPlanarMirrors(const Scene& scene, float maxRoughnes
         if (!material) continue;
         const Material& mat = *material;
         const Mesh& mesh = scene.meshes[mi];
+        // An instanced mesh is several planes: none of them is a mirror (they read the room probe).
+        if (mesh.instanced()) continue;
         if (mat.metallic < kMirrorMinMetallic || mat.roughness > maxRoughness) continue;
         const Flatness f = flatness(mesh);
         if (!f.flat) continue;

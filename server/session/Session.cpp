@@ -924,7 +924,9 @@ void Session::workerMain() {
                 const nlohmann::json loadInfo = {
                     {"ms", loadMs},
                     {"bytes", sizeError ? nlohmann::json(nullptr) : nlohmann::json(bytes)},
-                    {"triangles", next->triangleCount()}};
+                    {"triangles", next->triangleCount()},
+                    {"triangles_stored", next->storedTriangleCount()},
+                    {"instances", next->instanceCount()}};
                 w.renderer->setScene(next);
                 w.scene = next;
                 nlohmann::json stateMsg;

@@ -4,11 +4,12 @@
 // vertices are only right for triangles small against their distance to the light: what the
 // benchmark measures against the cube map.
 layout(location = 0) in vec3 inPosition;
+#include "render/instance.glsl"
 uniform mat4 uLightView;   // world -> light space, hemisphere 0 around -z
 uniform float uHemisphere; // 1: the -z hemisphere; -1: the +z one
 uniform vec2 uDepthRange;  // near, far (m): radial distance mapped to [0, 1]
 void main() {
-    vec3 v = (uLightView * vec4(inPosition, 1.0)).xyz;
+    vec3 v = (uLightView * vec4(placedPosition(inPosition), 1.0)).xyz;
     v.z *= uHemisphere;
     float d = length(v);
     vec3 n = v / max(d, 1e-20);

@@ -2,6 +2,7 @@
 // Forward render of the scene from a viewpoint other than the eye camera (environment-probe faces,
 // mirrored views): world position through uViewProj, with one user clip plane.
 #include "common.glsl"
+#include "render/instance.glsl"
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
@@ -19,11 +20,11 @@ out vec4 vTangent;
 out vec4 vColor;
 
 void main() {
-    vWorldPos = inPosition;
-    vNormal = inNormal;
+    vWorldPos = placedPosition(inPosition);
+    vNormal = placedNormal(inNormal);
     vTexcoord = inTexcoord;
-    vTangent = inTangent;
+    vTangent = placedTangent(inTangent);
     vColor = inColor;
-    gl_ClipDistance[0] = dot(uClipPlane.xyz, inPosition) + uClipPlane.w;
-    gl_Position = uViewProj * vec4(inPosition, 1.0);
+    gl_ClipDistance[0] = dot(uClipPlane.xyz, vWorldPos) + uClipPlane.w;
+    gl_Position = uViewProj * vec4(vWorldPos, 1.0);
 }

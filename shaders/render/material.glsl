@@ -45,7 +45,8 @@ vec3 materialNormal(vec3 n, vec3 interpolated, vec4 tangent, vec2 uv) {
     vec3 base = side * n;
     vec3 t = tangent.xyz - base * dot(base, tangent.xyz);
     float t2 = dot(t, t);
-    if (!(t2 > 1e-12)) return n;
+    // Relative to the tangent's own length, which a placement's scale changes (render/instance.glsl).
+    if (!(t2 > 1e-12 * dot(tangent.xyz, tangent.xyz))) return n;
     t *= inversesqrt(t2);
     vec3 b = cross(base, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
     vec3 m = texture(uNormalTex, uv).xyz * 2.0 - 1.0;

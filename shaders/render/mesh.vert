@@ -1,5 +1,6 @@
 #version 450 core
 #include "common.glsl"
+#include "render/instance.glsl"
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
@@ -17,10 +18,10 @@ out vec4 vTangent;
 out vec4 vColor;
 
 void main() {
-    vWorldPos = inPosition;
-    vNormal = inNormal;
+    vWorldPos = placedPosition(inPosition);
+    vNormal = placedNormal(inNormal);
     vTexcoord = inTexcoord;
-    vTangent = inTangent;
+    vTangent = placedTangent(inTangent);
     vColor = inColor;
-    gl_Position = (uView < 0 ? gFrame.viewProj : gLights.views[uView].viewProj) * vec4(inPosition, 1.0);
+    gl_Position = (uView < 0 ? gFrame.viewProj : gLights.views[uView].viewProj) * vec4(vWorldPos, 1.0);
 }

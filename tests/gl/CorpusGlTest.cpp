@@ -85,3 +85,27 @@ TEST(Corpus, CompressedCopiesRenderAsTheirOriginals) {
         }
     }
 }
+
+// Blender's linked duplicates (colonnade.glb: one column mesh placed by twelve nodes) load as one
+// instanced mesh and render as their flattened copies do, with every technique family.
+TEST(Corpus, LinkedDuplicatesStayInstancedAndRenderAsFlattened) {
+    const Scene scene = loadScene(std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/colonnade.glb");
+    const auto column = std::find_if(scene.meshes.begin(), scene.meshes.end(),
+                                     [](const Mesh& m) { return m.instances.size() == 12; });
+    ASSERT_NE(column, scene.meshes.end()) << "the column is not one mesh with twelve instances";
+    EXPECT_EQ(scene.instanceCount(), 12u);
+    EXPECT_LT(scene.storedTriangleCount() * 5, scene.triangleCount());
+    const Scene flat = flattenInstances(scene);
+    for (const char* technique : {"none", "rsm_gather", "hier_isr"}) {
+        SCOPED_TRACE(technique);
+        const FrameOutput a = renderScene(scene, technique, 96, 72, {{"exposure", -10}});
+        const FrameOutput b = renderScene(flat, technique, 96, 72, {{"exposure", -10}});
+        EXPECT_EQ(gis::test::badValues(a), 0u);
+        EXPECT_GT(meanRadiance(a), 1e-3);
+        EXPECT_EQ(gis::test::counter(a, "instances"), 12.0);
+        const double error = gis::test::relativeRmseOf(a, b);
+        std::printf("[corpus] colonnade %s instanced against flattened: relative RMSE %.5f\n", technique,
+                    error);
+        EXPECT_LT(error, 2e-3);
+    }
+}

@@ -1,7 +1,10 @@
 // Frame pipeline on a real GL context (llvmpipe in CI), once per backend.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "GlTestSupport.h"
 #include "core/Error.h"
@@ -252,4 +255,47 @@ TEST(Pipeline, RunsOfOneStateAreOneDrawCall) {
     EXPECT_EQ(test::counter(f, "draw_runs_gbuffer"), 6.0);
     EXPECT_EQ(test::counter(f, "draw_calls_gbuffer"), 3.0);
     EXPECT_EQ(test::badValues(f), 0u);
+}
+
+// A mesh drawn through instance matrices (Mesh::instances) gives the image of its flattened copies,
+// in every pass (shadow maps, RSMs, G-buffer, VPL gathers), and the stats say what was instanced.
+TEST(Pipeline, InstancedMeshesDrawLikeTheirFlattenedCopies) {
+    Scene instanced = loadScene("builtin:cornell");
+    auto tall = std::find_if(instanced.meshes.begin(), instanced.meshes.end(),
+                             [](const Mesh& m) { return m.name == "tall_box"; });
+    ASSERT_NE(tall, instanced.meshes.end());
+    // The box's own space is its world placement undone; a second, smaller copy stands by the wall.
+    const glm::mat4 original = glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(-0.35f, 0.6f, -0.35f)),
+                                           glm::radians(17.0f), glm::vec3(0, 1, 0));
+    const glm::mat4 copy =
+        glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(0.55f, 0.3f, -0.6f)),
+                               glm::radians(-40.0f), glm::vec3(0, 1, 0)),
+                   glm::vec3(0.5f));
+    transformMesh(*tall, glm::inverse(original));
+    tall->instances = {original, copy};
+    instanced.updateBounds();
+    const Scene flat = flattenInstances(instanced);
+    ASSERT_EQ(flat.meshes.size(), instanced.meshes.size() + 1);
+
+    for (const char* technique : {"none", "rsm_gather", "multires_gather"}) {
+        SCOPED_TRACE(technique);
+        // VPL shadow maps draw the scene instanced per VPL face: the placement must survive that.
+        const nlohmann::json params = std::string(technique) == "rsm_gather"
+                                          ? nlohmann::json{{"vpl_shadows", true}}
+                                          : nlohmann::json::object();
+        const FrameOutput a = renderScene(instanced, technique, 96, 72, params);
+        const FrameOutput b = renderScene(flat, technique, 96, 72, params);
+        EXPECT_EQ(test::badValues(a), 0u);
+        EXPECT_EQ(test::counter(a, "instances"), 2.0);
+        EXPECT_EQ(test::counter(a, "triangles"), test::counter(b, "triangles"));
+        EXPECT_LT(test::counter(a, "triangles_stored"), test::counter(a, "triangles"));
+        // Float rounding of the placed positions only (the vertex stage against the CPU).
+        EXPECT_LT(test::relativeRmseOf(a, b), 2e-3);
+    }
+    // The copy is really drawn: without it the image differs.
+    Scene single = instanced;
+    for (Mesh& m : single.meshes)
+        if (m.name == "tall_box") m.instances.pop_back();
+    EXPECT_GT(test::relativeRmseOf(renderScene(single, "none", 96, 72), renderScene(flat, "none", 96, 72)),
+              0.02);
 }

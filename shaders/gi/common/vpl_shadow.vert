@@ -4,6 +4,7 @@
 // uFirstVpl + i / 6 into layer i (vertex-shader layer selection).
 #include "shared/FrameData.h"
 #include "gi/common/vpl_shadow.glsl"
+#include "render/instance.glsl"
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 2) in vec2 inTexcoord; // for alpha cutouts (vpl_shadow.frag)
@@ -20,7 +21,7 @@ out vec4 vColor;
 
 void main() {
     int face = gl_InstanceID % 6;
-    vec3 p = inPosition - gVpls[uFirstVpl + gl_InstanceID / 6].position.xyz;
+    vec3 p = placedPosition(inPosition) - gVpls[uFirstVpl + gl_InstanceID / 6].position.xyz;
     vFromVpl = p;
     vTexcoord = inTexcoord;
     vColor = inColor;

@@ -9,13 +9,20 @@
 #   textured_box.glb   a bevelled box with a generated 64x64 checker texture, no lights
 #   millimetres.glb    a bracket modelled in millimetres (about 400 units across), no lights
 #   point_lamps.glb    a table with two point lamps and a sun (KHR_lights_punctual), no camera
+#   colonnade.glb      twelve linked duplicates of one fluted column (one mesh, twelve nodes), a
+#                      floor and a sun: the loader keeps the column as one mesh with twelve instances
+#
+# Names after the output folder regenerate only those files (for example `-- tests/data/corpus
+# colonnade`).
 import math
 import os
 import sys
 
 import bpy
 
-out_dir = sys.argv[sys.argv.index("--") + 1] if "--" in sys.argv else "."
+args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+out_dir = args[0] if args else "."
+wanted = set(args[1:])
 
 
 def reset():
@@ -120,7 +127,40 @@ def point_lamps():
     export("point_lamps.glb")
 
 
-suzanne()
-textured_box()
-millimetres()
-point_lamps()
+def colonnade():
+    reset()
+    bpy.ops.mesh.primitive_cylinder_add(vertices=24, radius=0.25, depth=3.0, location=(0.0, 0.0, 1.5))
+    column = bpy.context.active_object
+    column.data.materials.append(material("limestone", (0.8, 0.76, 0.68, 1.0), roughness=0.7))
+    # Flutes: every other rim vertex pulled in, then smooth shading.
+    for i, v in enumerate(column.data.vertices):
+        if (i // 2) % 2 == 1:
+            v.co.x *= 0.88
+            v.co.y *= 0.88
+    bpy.ops.object.shade_smooth()
+    # Linked duplicates (Alt+D): twelve objects sharing the column's mesh data, two rows of six,
+    # every other one turned and one scaled, as a scene built by hand would have them.
+    for i in range(1, 12):
+        dup = column.copy()  # shares column.data
+        dup.location = (-3.75 + 1.5 * (i % 6), -1.5 if i < 6 else 1.5, 1.5)
+        dup.rotation_euler = (0.0, 0.0, math.radians(15.0 * (i % 2)))
+        if i == 7:
+            dup.scale = (1.2, 1.2, 1.2)
+        bpy.context.collection.objects.link(dup)
+    column.location = (-3.75, -1.5, 1.5)
+    bpy.ops.mesh.primitive_plane_add(size=12.0)
+    bpy.context.active_object.data.materials.append(material("paving", (0.55, 0.55, 0.52, 1.0), roughness=0.8))
+    sun = bpy.data.lights.new("sun", "SUN")
+    sun.energy = 3.0
+    sun_obj = bpy.data.objects.new("sun", sun)
+    sun_obj.rotation_euler = (math.radians(50.0), 0.0, math.radians(35.0))
+    bpy.context.collection.objects.link(sun_obj)
+    # No modifier to apply, so the exporter keeps the shared mesh shared.
+    path = os.path.join(out_dir, "colonnade.glb")
+    bpy.ops.export_scene.gltf(filepath=path, export_format="GLB", export_lights=True, export_cameras=True)
+    print("wrote", path, os.path.getsize(path), "bytes")
+
+
+for make in (suzanne, textured_box, millimetres, point_lamps, colonnade):
+    if not wanted or make.__name__ in wanted:
+        make()

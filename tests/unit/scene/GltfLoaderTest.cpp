@@ -118,6 +118,108 @@ TEST(GltfLoader, MirroredNodeKeepsCounterClockwiseFrontFaces) {
     expectNear(m.normals[0], {0, 1, 0});
 }
 
+TEST(GltfLoader, MeshSharedByNodesIsStoredOnceWithOneMatrixPerNode) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const int mesh = b.addMesh("shared_tri", {{"attributes", {{"POSITION", pos}}}});
+    const int a = b.addNode({{"mesh", mesh}, {"translation", {10, 0, 0}}});
+    const int c = b.addNode({{"mesh", mesh}, {"scale", {2, 2, 2}}});
+    const int d = b.addNode({{"mesh", mesh}, {"rotation", {0, 0.7071068, 0, 0.7071068}}});
+    b.setScene({a, c, d});
+    const Scene s = loadGltf(b.writeGlb(dir, "shared.glb"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    const Mesh& m = s.meshes[0];
+    ASSERT_EQ(m.instances.size(), 3u);
+    expectNear(m.positions[1], {1, 0, 0}); // the mesh's own space
+    expectNear(glm::vec3(m.instances[0] * glm::vec4(m.positions[1], 1.0f)), {11, 0, 0});
+    expectNear(glm::vec3(m.instances[1] * glm::vec4(m.positions[1], 1.0f)), {2, 0, 0});
+    expectNear(glm::vec3(m.instances[2] * glm::vec4(m.positions[1], 1.0f)), {0, 0, -1});
+    EXPECT_EQ(s.triangleCount(), 3u);
+    EXPECT_EQ(s.storedTriangleCount(), 1u);
+    EXPECT_EQ(s.instanceCount(), 3u);
+    // Bounds cover every placement.
+    expectNear(s.bounds.max, {11, 0, 0});
+    expectNear(s.bounds.min, {-1, 0, -2});
+
+    // Flattened, each placement is a world-space mesh like a single-use node would give.
+    std::vector<int> source;
+    const Scene flat = flattenInstances(s, &source);
+    ASSERT_EQ(flat.meshes.size(), 3u);
+    EXPECT_EQ(source, (std::vector<int>{0, 0, 0}));
+    expectNear(flat.meshes[1].positions[2], {0, 0, -2});
+    EXPECT_TRUE(flat.meshes[1].instances.empty());
+    EXPECT_EQ(flat.triangleCount(), 3u);
+}
+
+TEST(GltfLoader, GpuInstancingExtensionPlacesTheMeshPerElement) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const int mesh = b.addMesh("blade", {{"attributes", {{"POSITION", pos}}}});
+    const int translation = b.addVec3s({{0, 0, 0}, {5, 0, 0}, {0, 0, 5}});
+    const int scale = b.addVec3s({{1, 1, 1}, {2, 2, 2}, {1, 3, 1}});
+    const int node = b.addNode({{"mesh", mesh},
+                                {"translation", {0, 1, 0}},
+                                {"extensions",
+                                 {{"EXT_mesh_gpu_instancing",
+                                   {{"attributes", {{"TRANSLATION", translation}, {"SCALE", scale}}}}}}}});
+    b.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+    b.doc["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+    b.setScene({node});
+    const Scene s = loadGltf(b.writeGlb(dir, "field.glb"));
+    EXPECT_TRUE(s.notShown.empty());
+    ASSERT_EQ(s.meshes.size(), 1u);
+    ASSERT_EQ(s.meshes[0].instances.size(), 3u);
+    // The node's own transform, then the instance's translation and scale.
+    expectNear(glm::vec3(s.meshes[0].instances[1] * glm::vec4(1, 0, 0, 1)), {7, 1, 0});
+    expectNear(glm::vec3(s.meshes[0].instances[2] * glm::vec4(0, 0, -1, 1)), {0, 1, 4});
+
+    // Counts that differ are refused with the node and the extension named.
+    b.doc["accessors"][scale]["count"] = 2;
+    try {
+        loadGltf(b.writeGlb(dir, "uneven.glb"));
+        FAIL() << "uneven instance attributes were accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("node 0: EXT_mesh_gpu_instancing"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(GltfLoader, SharedMeshWithAMirroredPlacementIsFlattened) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const int mesh = b.addMesh("shared_tri", {{"attributes", {{"POSITION", pos}}}});
+    const int a = b.addNode({{"mesh", mesh}});
+    const int mirrored = b.addNode({{"mesh", mesh}, {"scale", {-1, 1, 1}}});
+    b.setScene({a, mirrored});
+    const Scene s = loadGltf(b.writeGlb(dir, "mirrored.glb"));
+    ASSERT_EQ(s.meshes.size(), 2u);
+    EXPECT_TRUE(s.meshes[0].instances.empty());
+    EXPECT_TRUE(s.meshes[1].instances.empty());
+    expectNear(s.meshes[1].positions[1], {-1, 0, 0});
+}
+
+TEST(GltfLoader, InstanceWithANonFiniteMatrixIsRefusedByValidation) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const int mesh = b.addMesh("shared_tri", {{"attributes", {{"POSITION", pos}}}});
+    b.setScene({b.addNode({{"mesh", mesh}}), b.addNode({{"mesh", mesh}, {"translation", {1, 0, 0}}})});
+    Scene s = loadGltf(b.writeGlb(dir, "two.glb"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    ASSERT_EQ(s.meshes[0].instances.size(), 2u);
+    EXPECT_NO_THROW(validateScene(s, "two.glb"));
+    s.meshes[0].instances[1][3][0] = std::nanf("");
+    try {
+        validateScene(s, "two.glb");
+        FAIL() << "a NaN instance matrix was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("instance 1"), std::string::npos) << e.what();
+    }
+}
+
 TEST(GltfLoader, MissingNormalsAreGeneratedUnitLengthOnTheCounterClockwiseSide) {
     TempDir dir;
     GltfBuilder b;
@@ -281,18 +383,16 @@ TEST(GltfLoader, FeaturesTheRendererDoesNotShowAreListed) {
                            {"occlusionTexture", {{"index", 0}}},
                            {"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}}}}}},
                           {{"name", "bark"}, {"occlusionTexture", {{"index", 0}}}}};
-    b.doc["nodes"][tri]["extensions"] = {
-        {"EXT_mesh_gpu_instancing", {{"attributes", nlohmann::json::object()}}}};
-    b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "EXT_mesh_gpu_instancing", "KHR_lights_punctual"};
+    b.doc["nodes"][tri]["extensions"] = {{"MSFT_lod", {{"ids", nlohmann::json::array()}}}};
+    b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "MSFT_lod", "KHR_lights_punctual"};
     b.setScene({tri});
     const Scene s = loadGltf(b.writeGlb(dir, "unshown.glb"));
     std::map<std::string, std::string> listed;
     for (const NotShown& n : s.notShown) listed[n.feature] = n.detail;
-    EXPECT_EQ(listed.size(), 3u) << "clearcoat, instancing, BLEND";
+    EXPECT_EQ(listed.size(), 3u) << "clearcoat, level of detail, BLEND";
     EXPECT_EQ(listed["KHR_materials_clearcoat"],
               "1 material ('foliage'): clear coat is not rendered: the base layer shows alone");
-    EXPECT_NE(listed["EXT_mesh_gpu_instancing"].find("1 node ('node 0')"), std::string::npos)
-        << listed["EXT_mesh_gpu_instancing"];
+    EXPECT_NE(listed["MSFT_lod"].find("1 node ('node 0')"), std::string::npos) << listed["MSFT_lod"];
     EXPECT_FALSE(listed.count("occlusionTexture")) << "occlusion maps are applied";
     EXPECT_NE(listed["alphaMode BLEND"].find("approximated as a cutout"), std::string::npos);
     EXPECT_EQ(s.materials[0].alphaMode, Material::Alpha::Blend);

@@ -22,6 +22,18 @@ Scene roundTrip(const Scene& scene, const test::TempDir& dir) {
     return loadScene(path);
 }
 
+TEST(GltfWriter, InstancesStayInstances) {
+    const test::TempDir dir;
+    const Scene original = loadScene(std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/colonnade.glb");
+    ASSERT_EQ(original.instanceCount(), 12u);
+    const Scene back = roundTrip(original, dir);
+    EXPECT_EQ(back.instanceCount(), 12u);
+    EXPECT_EQ(back.storedTriangleCount(), original.storedTriangleCount());
+    EXPECT_EQ(back.triangleCount(), original.triangleCount());
+    expectNear(back.bounds.min, original.bounds.min, 1e-5f, "bounds min");
+    expectNear(back.bounds.max, original.bounds.max, 1e-5f, "bounds max");
+}
+
 TEST(GltfWriter, BuiltinScenesReadBackTheSame) {
     for (const char* name : {"builtin:cornell-colored", "builtin:gallery", "builtin:atrium-10k"}) {
         SCOPED_TRACE(name);
