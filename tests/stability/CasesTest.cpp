@@ -628,6 +628,20 @@ TEST_P(S4, C14_ScaleAndLinearity) {
     if (findTechnique(t).info.params.find("clamp_b") != nullptr && t != "ssbc") {
         variants.push_back({{"vpl_grid", 8}, {"clamp_b", 40.0}});
     }
+    // The same through instance matrices: the placements scale, the own-space geometry does not.
+    const auto placed = sc::instanced(cornell, "stability:cornell-instanced");
+    for (float s : {1e-3f, 1e4f}) {
+        SCOPED_TRACE(s);
+        const nlohmann::json p = variants.front();
+        const Frame ref = render(spec(placed, p));
+        const Frame f =
+            render(spec(sc::transformed(placed, s, glm::vec3(0.0f), "stability:cornell-instanced-x"), p));
+        EXPECT_EQ(f.counter("instances"), static_cast<double>(cornell->meshes.size()));
+        const double err = relativeRmse(ref.out.linear, f.out.linear);
+        note((s < 1 ? "rel. RMSE instanced, scale 1e-3 " : "rel. RMSE instanced, scale 1e4 ") + p.dump(),
+             err);
+        EXPECT_LT(err, 2e-2);
+    }
     for (const nlohmann::json& p : variants) {
         SCOPED_TRACE(p.dump());
         Frame ref = render(spec(cornell, p));

@@ -7,6 +7,7 @@
 #include <map>
 
 #include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "scene/SceneLoader.h"
 
@@ -237,8 +238,14 @@ ScenePtr degenerate(bool nanPosition) {
 ScenePtr transformed(const ScenePtr& base, float scale, glm::vec3 translate, const std::string& name) {
     Scene s = *base;
     auto map = [&](glm::vec3 p) { return p * scale + translate; };
-    for (Mesh& m : s.meshes)
+    const glm::mat4 toScaled = glm::scale(glm::translate(glm::mat4(1.0f), translate), glm::vec3(scale));
+    for (Mesh& m : s.meshes) {
+        if (m.instanced()) { // own-space geometry: the placements move instead
+            for (glm::mat4& placement : m.instances) placement = toScaled * placement;
+            continue;
+        }
         for (glm::vec3& p : m.positions) p = map(p);
+    }
     for (Light& l : s.lights) {
         l.position = map(l.position);
         l.intensity *= scale * scale;
@@ -248,6 +255,23 @@ ScenePtr transformed(const ScenePtr& base, float scale, glm::vec3 translate, con
         c.target = map(c.target);
         c.znear *= scale;
         c.zfar *= scale;
+    }
+    s.updateBounds();
+    s.name = name;
+    return std::make_shared<const Scene>(std::move(s));
+}
+
+ScenePtr instanced(const ScenePtr& base, const std::string& name) {
+    Scene s = *base;
+    for (Mesh& m : s.meshes) {
+        if (m.instanced() || m.positions.empty()) continue;
+        glm::vec3 centre(0.0f);
+        for (const glm::vec3& p : m.positions) centre += p;
+        centre /= static_cast<float>(m.positions.size());
+        const glm::mat4 placement =
+            glm::rotate(glm::translate(glm::mat4(1.0f), centre), glm::radians(30.0f), glm::vec3(0, 1, 0));
+        transformMesh(m, glm::inverse(placement));
+        m.instances = {placement};
     }
     s.updateBounds();
     s.name = name;

@@ -58,6 +58,9 @@ ScenePtr transformed(const ScenePtr& base, float scale, glm::vec3 translate, con
 
 /// `base` with every material's albedo set to `albedo` (grey).
 ScenePtr withAlbedo(const ScenePtr& base, float albedo, const std::string& name);
+/// `base` with every mesh held in its own space (centred, turned 30 degrees about y) and placed by
+/// one instance matrix (Mesh::instances), so the placement path carries the whole scene.
+ScenePtr instanced(const ScenePtr& base, const std::string& name);
 
 /// cornell-empty with a thin occluder 5 cm in front of the back wall (negative lights exceed
 /// positive ones behind it, digest S.4 case 19b), or (offscreen) a panel beside the right wall that
