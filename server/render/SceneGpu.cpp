@@ -62,35 +62,40 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
             if (t1 > t0)
                 chunks.push_back({static_cast<GLint>(meshFirst + t0), static_cast<GLsizei>(t1 - t0), lo, hi});
         }
-        // One run per chunk and placement, placement by placement: runs of one mesh share its state,
-        // so all its placements go out in one multi-draw.
-        for (std::size_t k = 0; k < mesh.placements(); ++k) {
-            Draw placed = d;
-            if (mesh.instanced()) {
-                placed.instance = static_cast<GLuint>(placements.size());
-                placements.push_back(InstanceTransform::of(mesh.instances[k]));
-            }
-            for (const Chunk& c : chunks) {
-                Draw run = placed;
-                run.firstIndex = c.firstIndex;
-                run.indexCount = c.indexCount;
-                run.boundsMin = c.lo;
-                run.boundsMax = c.hi;
-                if (mesh.instanced()) {
-                    // The world box around the placed corners: culling stays conservative.
-                    const glm::mat4& toWorld = mesh.instances[k];
-                    run.boundsMin = glm::vec3(std::numeric_limits<float>::max());
-                    run.boundsMax = glm::vec3(-std::numeric_limits<float>::max());
+        // One run per chunk, covering all the mesh's placements, each with its world box: draw()
+        // sends a run's visible placements as instanced commands.
+        GLuint firstPlacement = 0;
+        if (mesh.instanced()) {
+            firstPlacement = static_cast<GLuint>(placements.size());
+            for (const glm::mat4& toWorld : mesh.instances)
+                placements.push_back(InstanceTransform::of(toWorld));
+        }
+        for (const Chunk& c : chunks) {
+            Draw run = d;
+            run.firstIndex = c.firstIndex;
+            run.indexCount = c.indexCount;
+            run.instance = firstPlacement;
+            run.placements = static_cast<GLuint>(mesh.placements());
+            run.firstBounds = mRunBounds.size();
+            if (!mesh.instanced()) {
+                mRunBounds.push_back({c.lo, c.hi});
+            } else {
+                // The world box around the placed corners: culling stays conservative.
+                for (const glm::mat4& toWorld : mesh.instances) {
+                    RunBounds b{glm::vec3(std::numeric_limits<float>::max()),
+                                glm::vec3(-std::numeric_limits<float>::max())};
                     for (int corner = 0; corner < 8; ++corner) {
                         const glm::vec3 p(toWorld * glm::vec4(corner & 1 ? c.hi.x : c.lo.x,
                                                               corner & 2 ? c.hi.y : c.lo.y,
                                                               corner & 4 ? c.hi.z : c.lo.z, 1.0f));
-                        run.boundsMin = glm::min(run.boundsMin, p);
-                        run.boundsMax = glm::max(run.boundsMax, p);
+                        b.lo = glm::min(b.lo, p);
+                        b.hi = glm::max(b.hi, p);
                     }
+                    mRunBounds.push_back(b);
                 }
-                mDraws.push_back(run);
             }
+            mMaxCommands += run.placements;
+            mDraws.push_back(run);
         }
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
@@ -173,10 +178,20 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         t.setWrap(GL_REPEAT);
         mTextures.push_back(std::move(t));
     }
-    mCommands = gl::Buffer::create(static_cast<GLsizeiptr>(std::max<std::size_t>(mDraws.size(), 1) *
-                                                           kCommandSlots * sizeof(IndirectCommand)));
+    reserveCommands(std::max<std::size_t>(mDraws.size(), 1));
     mCommandScratch.reserve(mDraws.size());
     gl::checkErrors("scene upload");
+}
+
+void SceneGpu::reserveCommands(std::size_t commands) const {
+    // Up to kCommandSlots regions, fewer where a region is large (a scene of many placements): the
+    // ring only spares the driver waits, the regions' total stays within kCommandBytes.
+    mCommandCapacity = commands;
+    const std::size_t regionBytes = commands * sizeof(IndirectCommand);
+    mCommandSlots =
+        std::clamp<std::size_t>(kCommandBytes / std::max<std::size_t>(regionBytes, 1), 1, kCommandSlots);
+    mCommands = gl::Buffer::create(static_cast<GLsizeiptr>(regionBytes * mCommandSlots));
+    mCommandSlot = 0;
 }
 
 void SceneGpu::setSurfaceIds(const std::vector<int>& idOfMesh) {
@@ -233,34 +248,53 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
     std::vector<IndirectCommand>& commands = mCommandScratch;
     batches.clear();
     commands.clear();
+    // A pass that draws instanced for its own reasons (cube faces per VPL) gets one command per
+    // placement, all of whose instances read it; any other pass draws each run of visible
+    // consecutive placements as one instanced command, a placement per instance.
+    const bool commandPerPlacement = instances > 1;
+    glVertexArrayBindingDivisor(mVao.id(), 1, commandPerPlacement ? kPlacementDivisor : 1u);
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
         const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
-        if (frustum && frustum->outside(d.boundsMin, d.boundsMax)) {
-            count.culled += triangles;
-            continue;
+        bool open = false; // the last command takes the next placement as one more instance
+        for (GLuint k = 0; k < d.placements; ++k) {
+            const RunBounds& b = mRunBounds[d.firstBounds + k];
+            if (frustum && frustum->outside(b.lo, b.hi)) {
+                count.culled += triangles;
+                open = false;
+                continue;
+            }
+            count.drawn += triangles;
+            if (open) {
+                ++commands.back().instanceCount;
+                continue;
+            }
+            if (k == 0 || batches.empty() || batches.back().head != &d) {
+                const bool oneSided = cullBackFaces && d.material >= 0 &&
+                                      static_cast<std::size_t>(d.material) < mMaterials.size() &&
+                                      !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
+                const Draw* head = batches.empty() ? nullptr : batches.back().head;
+                const bool sameState = head && batches.back().oneSided == oneSided &&
+                                       (!materials || head->mesh == d.mesh ||
+                                        (head->material == d.material && head->surfaceId == d.surfaceId &&
+                                         head->colored == d.colored));
+                if (!sameState) batches.push_back({commands.size(), 0, &d, oneSided});
+            }
+            commands.push_back({static_cast<GLuint>(d.indexCount),
+                                static_cast<GLuint>(commandPerPlacement ? instances : 1),
+                                static_cast<GLuint>(d.firstIndex), d.baseVertex, d.instance + k});
+            ++batches.back().count;
+            open = !commandPerPlacement;
         }
-        count.drawn += triangles;
-        const bool oneSided = cullBackFaces && d.material >= 0 &&
-                              static_cast<std::size_t>(d.material) < mMaterials.size() &&
-                              !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
-        const Draw* head = batches.empty() ? nullptr : batches.back().head;
-        const bool sameState =
-            head && batches.back().oneSided == oneSided &&
-            (!materials || head->mesh == d.mesh ||
-             (head->material == d.material && head->surfaceId == d.surfaceId && head->colored == d.colored));
-        if (!sameState) batches.push_back({commands.size(), 0, &d, oneSided});
-        commands.push_back({static_cast<GLuint>(d.indexCount), static_cast<GLuint>(std::max(instances, 1)),
-                            static_cast<GLuint>(d.firstIndex), d.baseVertex, d.instance});
-        ++batches.back().count;
     }
     count.runs = commands.size();
     count.calls = batches.size();
     if (commands.empty()) return count;
 
     // 2. This call's region of the command buffer, then one multi-draw per batch.
-    const std::size_t slotBytes = std::max<std::size_t>(mDraws.size(), 1) * sizeof(IndirectCommand);
-    const std::size_t base = (mCommandSlot++ % kCommandSlots) * slotBytes;
+    if (commands.size() > mCommandCapacity) reserveCommands(std::min(mMaxCommands, 2 * commands.size()));
+    const std::size_t slotBytes = mCommandCapacity * sizeof(IndirectCommand);
+    const std::size_t base = (mCommandSlot++ % mCommandSlots) * slotBytes;
     mCommands.upload(static_cast<GLintptr>(base),
                      static_cast<GLsizeiptr>(commands.size() * sizeof(IndirectCommand)), commands.data());
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCommands.id());

@@ -82,15 +82,21 @@ private:
         GLsizei indexCount = 0;
         GLint baseVertex = 0;
         int material = 0;
-        int mesh = 0;                               ///< index into Scene::meshes
-        int surfaceId = 0;                          ///< reflector id (setSurfaceIds)
-        GLuint instance = 0;                        ///< placement (mPlacements index; 0: identity)
-        bool colored = false;                       ///< the mesh has COLOR_0 (uHasVertexColor)
-        glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< world space, of this run's triangles
+        int mesh = 0;         ///< index into Scene::meshes
+        int surfaceId = 0;    ///< reflector id (setSurfaceIds)
+        bool colored = false; ///< the mesh has COLOR_0 (uHasVertexColor)
+        /// Placements [instance, instance + placements) of mPlacements (placement 0: the identity),
+        /// each with its world box at mRunBounds[firstBounds + k].
+        GLuint instance = 0, placements = 1;
+        std::size_t firstBounds = 0;
+    };
+    struct RunBounds {
+        glm::vec3 lo, hi; ///< world space, of one placement of a run's triangles
     };
     /// Draw commands, kCommandSlots regions of one command per run, used in turn by successive
     /// draw() calls (a region is rewritten only after the calls of the other regions were issued).
     static constexpr std::size_t kCommandSlots = 16;
+    static constexpr std::size_t kCommandBytes = std::size_t{32} << 20; ///< the ring's cap, bytes
     struct IndirectCommand {
         GLuint count, instanceCount, firstIndex;
         GLint baseVertex;
@@ -111,6 +117,11 @@ private:
     gl::Buffer mPlacements;
     mutable gl::Buffer mCommands;
     mutable std::size_t mCommandSlot = 0;
+    mutable std::size_t mCommandCapacity = 0; ///< commands per region
+    mutable std::size_t mCommandSlots = kCommandSlots;
+    std::size_t mMaxCommands = 0; ///< the most one draw() can send: every placement of every run
+    /// Regions of `commands` each (the buffer is replaced; GL keeps the old one while in use).
+    void reserveCommands(std::size_t commands) const;
     /// Consecutive commands of one state (draw()'s batches): one multi-draw each.
     struct Batch {
         std::size_t first = 0, count = 0;
@@ -121,6 +132,7 @@ private:
     mutable std::vector<Batch> mBatchScratch;
     gl::VertexArray mVao;
     std::vector<Draw> mDraws;
+    std::vector<RunBounds> mRunBounds;
     std::vector<Material> mMaterials;
     std::vector<gl::Texture> mTextures;
     std::size_t mTriangles = 0, mStoredTriangles = 0, mInstances = 0;

@@ -103,6 +103,8 @@ TEST(Corpus, LinkedDuplicatesStayInstancedAndRenderAsFlattened) {
         EXPECT_EQ(gis::test::badValues(a), 0u);
         EXPECT_GT(meanRadiance(a), 1e-3);
         EXPECT_EQ(gis::test::counter(a, "instances"), 12.0);
+        // The floor, and the twelve columns as one instanced command.
+        EXPECT_EQ(gis::test::counter(a, "draw_runs_gbuffer"), 2.0);
         const double error = gis::test::relativeRmseOf(a, b);
         std::printf("[corpus] colonnade %s instanced against flattened: relative RMSE %.5f\n", technique,
                     error);

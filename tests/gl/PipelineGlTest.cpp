@@ -271,11 +271,13 @@ TEST(Pipeline, InstancedMeshesDrawLikeTheirFlattenedCopies) {
         glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(0.55f, 0.3f, -0.6f)),
                                glm::radians(-40.0f), glm::vec3(0, 1, 0)),
                    glm::vec3(0.5f));
+    // A third copy far behind the camera, outside every view: culled on its own.
+    const glm::mat4 behind = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, 40.0f)) * original;
     transformMesh(*tall, glm::inverse(original));
-    tall->instances = {original, copy};
+    tall->instances = {original, copy, behind};
     instanced.updateBounds();
     const Scene flat = flattenInstances(instanced);
-    ASSERT_EQ(flat.meshes.size(), instanced.meshes.size() + 1);
+    ASSERT_EQ(flat.meshes.size(), instanced.meshes.size() + 2);
 
     for (const char* technique : {"none", "rsm_gather", "multires_gather"}) {
         SCOPED_TRACE(technique);
@@ -286,16 +288,21 @@ TEST(Pipeline, InstancedMeshesDrawLikeTheirFlattenedCopies) {
         const FrameOutput a = renderScene(instanced, technique, 96, 72, params);
         const FrameOutput b = renderScene(flat, technique, 96, 72, params);
         EXPECT_EQ(test::badValues(a), 0u);
-        EXPECT_EQ(test::counter(a, "instances"), 2.0);
+        EXPECT_EQ(test::counter(a, "instances"), 3.0);
         EXPECT_EQ(test::counter(a, "triangles"), test::counter(b, "triangles"));
         EXPECT_LT(test::counter(a, "triangles_stored"), test::counter(a, "triangles"));
+        // The far copy is culled as its flattened mesh is; the two in view go out as one instanced
+        // command where the flattened copies take a run each.
+        EXPECT_GT(test::counter(a, "triangles_gbuffer_culled"), 0.0);
+        EXPECT_EQ(test::counter(a, "triangles_gbuffer_culled"), test::counter(b, "triangles_gbuffer_culled"));
+        EXPECT_EQ(test::counter(a, "draw_runs_gbuffer"), test::counter(b, "draw_runs_gbuffer") - 1);
         // Float rounding of the placed positions only (the vertex stage against the CPU).
         EXPECT_LT(test::relativeRmseOf(a, b), 2e-3);
     }
     // The copy is really drawn: without it the image differs.
     Scene single = instanced;
     for (Mesh& m : single.meshes)
-        if (m.name == "tall_box") m.instances.pop_back();
+        if (m.name == "tall_box") m.instances.erase(m.instances.begin() + 1);
     EXPECT_GT(test::relativeRmseOf(renderScene(single, "none", 96, 72), renderScene(flat, "none", 96, 72)),
               0.02);
 }
