@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "scene/Geometry.h"
 
@@ -108,7 +109,12 @@ Camera framingCamera(const Bounds& bounds) {
     Camera cam;
     cam.name = "framing";
     cam.target = bounds.center();
-    cam.position = cam.target + glm::vec3(0.0f, 0.0f, distance);
+    // A three-quarter view from above (30 degrees round from +z, 25 up): a flat model (a terrain, a
+    // field, a floor plan) seen level would be an edge; any direction fits the bounding sphere.
+    const float azimuth = glm::radians(30.0f), elevation = glm::radians(25.0f);
+    const glm::vec3 towardEye(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
+                              std::cos(elevation) * std::cos(azimuth));
+    cam.position = cam.target + distance * towardEye;
     cam.up = kUp;
     cam.yfovRadians = kFramingFov;
     cam.znear = std::max(0.5f * (distance - radius), 1e-3f * distance);

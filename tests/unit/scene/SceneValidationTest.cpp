@@ -116,8 +116,11 @@ TEST(FinalizeScene, FramingCameraSeesTheWholeBoundingSphere) {
     const glm::vec3 center = s.bounds.center();
     EXPECT_EQ(c.target, center);
     EXPECT_NEAR(c.yfovRadians, glm::radians(40.0f), 1e-6f);
+    // A three-quarter view from above: in front (+z), to the right (+x) and above (+y), so a flat
+    // model is not seen edge-on.
     EXPECT_GT(c.position.z, center.z);
-    EXPECT_FLOAT_EQ(c.position.x, center.x);
+    EXPECT_GT(c.position.x, center.x);
+    EXPECT_NEAR(glm::normalize(c.position - center).y, std::sin(glm::radians(25.0f)), 1e-5f);
     // The sphere's angular radius from the camera equals half the field of view.
     const float d = glm::distance(c.position, center);
     EXPECT_NEAR(std::asin(s.bounds.radius() / d), 0.5f * c.yfovRadians, 1e-4f);
