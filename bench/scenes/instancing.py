@@ -81,8 +81,8 @@ def write_glb(path, count, segments, shared):
                       "rotation": [0.0, math.sin(0.1 * i), 0.0, math.cos(0.1 * i)]})
     doc = {"asset": {"version": "2.0", "generator": "bench/scenes/instancing.py"},
            "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
-           "materials": [{"name": "ball", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.5, 0.3, 1]}},
-                         {"name": "floor", "pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1]}}],
+           "materials": [{"name": "ball", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.5, 0.3, 1], "metallicFactor": 0}},
+                         {"name": "floor", "pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}}],
            "accessors": accessors, "bufferViews": views, "buffers": [{"byteLength": sum(len(b) for b in blobs)}]}
     body = json.dumps(doc).encode()
     body += b" " * (-len(body) % 4)

@@ -1,6 +1,7 @@
-// The placement of the mesh being drawn (render/SceneGpu.h, scene Mesh::instances): one object ->
-// world matrix per draw command. World-space meshes are drawn with the identity, which leaves every
-// position, normal and tangent bit for bit as it was.
+// The placement of the mesh being drawn (render/SceneGpu.h, scene Mesh::instances): per-instance
+// attributes, one object -> world matrix per placement (or per draw command, in passes that draw
+// instanced for their own reasons). World-space meshes are drawn with the identity, which leaves
+// every position, normal and tangent bit for bit as it was.
 layout(location = 5) in mat4 inToWorld;       // object -> world (locations 5-8)
 layout(location = 9) in mat3 inNormalToWorld; // its linear part's inverse transpose (locations 9-11)
 
