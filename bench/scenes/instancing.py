@@ -21,6 +21,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from benchlib import default_technique, run  # noqa: E402
+
 
 def sphere(segments):
     """A UV sphere of radius 0.4: positions, normals and indices (2 * segments^2 triangles, about)."""
@@ -93,14 +96,6 @@ def write_glb(path, count, segments, shared):
         f.write(struct.pack("<II", len(binary), 0x004E4942) + binary)
 
 
-def run(cmd):
-    """Runs cmd; returns its peak resident set in MiB (the child's own, by wait4)."""
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    err = proc.stderr.read().decode()
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit(f"failed: {' '.join(cmd)}\n{err}")
-    return usage.ru_maxrss / 1024.0
 
 
 def main():
@@ -115,10 +110,7 @@ def main():
                     help="the GI technique (default: the service's, presets/presets.json default_technique)")
     a = ap.parse_args()
     if a.technique is None:
-        try:
-            a.technique = json.load(open(os.environ.get("GI_PRESETS", "presets/presets.json")))["default_technique"]["name"]
-        except (OSError, KeyError, ValueError):
-            a.technique = "rsm_gather"
+        a.technique = default_technique()
     render = os.path.join(a.bin, "gi-render")
     work = tempfile.mkdtemp(prefix="gis_instancing_")
     files = {}

@@ -82,16 +82,8 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
             } else {
                 // The world box around the placed corners: culling stays conservative.
                 for (const glm::mat4& toWorld : mesh.instances) {
-                    RunBounds b{glm::vec3(std::numeric_limits<float>::max()),
-                                glm::vec3(-std::numeric_limits<float>::max())};
-                    for (int corner = 0; corner < 8; ++corner) {
-                        const glm::vec3 p(toWorld * glm::vec4(corner & 1 ? c.hi.x : c.lo.x,
-                                                              corner & 2 ? c.hi.y : c.lo.y,
-                                                              corner & 4 ? c.hi.z : c.lo.z, 1.0f));
-                        b.lo = glm::min(b.lo, p);
-                        b.hi = glm::max(b.hi, p);
-                    }
-                    mRunBounds.push_back(b);
+                    const Bounds placed = placedBounds({c.lo, c.hi}, toWorld);
+                    mRunBounds.push_back({placed.min, placed.max});
                 }
             }
             mMaxCommands += run.placements;

@@ -46,13 +46,25 @@ void Scene::updateBounds() {
             ownLo = glm::min(ownLo, p);
             ownHi = glm::max(ownHi, p);
         }
-        for (const glm::mat4& toWorld : m.instances)
-            for (int corner = 0; corner < 8; ++corner)
-                add(glm::vec3(toWorld * glm::vec4(corner & 1 ? ownHi.x : ownLo.x,
-                                                  corner & 2 ? ownHi.y : ownLo.y,
-                                                  corner & 4 ? ownHi.z : ownLo.z, 1.0f)));
+        for (const glm::mat4& toWorld : m.instances) {
+            const Bounds placed = placedBounds({ownLo, ownHi}, toWorld);
+            add(placed.min);
+            add(placed.max);
+        }
     }
     bounds = any ? Bounds{lo, hi} : Bounds{};
+}
+
+Bounds placedBounds(const Bounds& own, const glm::mat4& toWorld) {
+    Bounds out{glm::vec3(std::numeric_limits<float>::max()), glm::vec3(-std::numeric_limits<float>::max())};
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::vec3 p(toWorld * glm::vec4(corner & 1 ? own.max.x : own.min.x,
+                                              corner & 2 ? own.max.y : own.min.y,
+                                              corner & 4 ? own.max.z : own.min.z, 1.0f));
+        out.min = glm::min(out.min, p);
+        out.max = glm::max(out.max, p);
+    }
+    return out;
 }
 
 void transformMesh(Mesh& mesh, const glm::mat4& toWorld) {

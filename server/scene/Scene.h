@@ -129,6 +129,10 @@ struct Bounds {
     }
 };
 
+/// The world box around `own`'s eight corners placed by `toWorld` (object -> world): it holds the
+/// placed geometry, a little loosely under rotation.
+Bounds placedBounds(const Bounds& own, const glm::mat4& toWorld);
+
 /// Something the file asks for that the renderer does not show, said to the user rather than left out
 /// silently (stats.not_shown): a glTF extension or a core material feature, where, and what shows instead.
 struct NotShown {
