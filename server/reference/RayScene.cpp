@@ -192,8 +192,7 @@ struct RayScene::Impl {
     RTCScene scene = nullptr;
     // Copied, instances flattened to world space: the renderer must not depend on the caller's
     // lifetime, and the BVH holds every placement as triangles of its own.
-    Scene source;
-    std::vector<int> callerMesh;     // source.meshes index -> the caller's Scene::meshes index
+    Scene source;                    // its meshes have the caller's indices
     std::vector<int> meshOfGeometry; // Embree geometry id -> index into source.meshes
     std::vector<LinearTexture> textures;
     std::vector<std::unique_ptr<CutoutGeometry>> cutouts; // the filters' user data (stable addresses)
@@ -207,7 +206,7 @@ struct RayScene::Impl {
 
 RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
-    m.source = flattenInstances(scene, &m.callerMesh);
+    m.source = flattenInstances(scene);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw Error("reference: cannot create the Embree device");
     m.scene = rtcNewScene(m.device);
@@ -361,7 +360,7 @@ SurfaceHit RayScene::resolve(const RawHit& raw, const glm::vec3& origin, const g
         return h;
     }
     const Mesh& mesh = m.source.meshes[static_cast<size_t>(meshIndex)];
-    h.mesh = m.callerMesh[static_cast<size_t>(meshIndex)];
+    h.mesh = meshIndex;
     const size_t base = static_cast<size_t>(raw.primId) * 3;
     const std::uint32_t last = static_cast<std::uint32_t>(mesh.positions.size() - 1);
     const std::uint32_t i0 = std::min(mesh.indices[base], last), i1 = std::min(mesh.indices[base + 1], last),

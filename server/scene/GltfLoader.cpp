@@ -842,6 +842,13 @@ private:
         }
     }
 
+    /// What a mesh's attributes and indices hold in memory.
+    static std::uint64_t meshBytes(const Mesh& mesh) {
+        return mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
+               mesh.texcoords.size() * sizeof(glm::vec2) + mesh.colors.size() * sizeof(glm::vec4) +
+               mesh.tangents.size() * sizeof(glm::vec4) + mesh.indices.size() * sizeof(std::uint32_t);
+    }
+
     /// Whether a placement can be drawn through an instance matrix (Mesh::instances): finite, with a
     /// positive determinant and a finite inverse. Mirrored or collapsed placements are flattened.
     static bool instanceable(const glm::mat4& world) {
@@ -857,8 +864,7 @@ private:
 
     /// The meshes of the nodes walked, in walk order. A glTF mesh that two or more nodes place, each
     /// instanceably, is read once in its own space and keeps one matrix per node; any other
-    /// placement is flattened to world space (a small file can name one mesh a million times: an
-    /// instance costs 64 bytes, a flattened copy the whole mesh).
+    /// placement is flattened to world space.
     void addPlacedMeshes() {
         std::vector<int> uses(mModel.meshes.size(), 0);
         std::vector<bool> flatten(mModel.meshes.size(), false);
@@ -887,7 +893,14 @@ private:
             }
             for (int k = readAs[m].first; k < readAs[m].second; ++k) {
                 Mesh& mesh = mScene.meshes[static_cast<std::size_t>(k)];
-                if (!mContext.spend(sizeof(glm::mat4), "an instance of mesh '" + mesh.name + "'"))
+                // A placement beyond the first is charged as the flattened copy it would have been:
+                // the reference's BVH and the effect plan flatten it (flattenInstances), and a small
+                // file must not name a mesh a million times past the budget. The first was charged
+                // when the mesh was read.
+                const std::uint64_t bytes =
+                    sizeof(glm::mat4) + (mesh.instances.empty() ? 0 : meshBytes(mesh));
+                if (!mContext.spend(bytes, "placement " + std::to_string(mesh.instances.size() + 1) +
+                                               " of mesh '" + mesh.name + "'"))
                     fail(mContext.refusal);
                 mesh.instances.push_back(world);
             }
@@ -1008,11 +1021,7 @@ private:
         if (prim.material >= static_cast<int>(mModel.materials.size()))
             fail(context + ": material " + std::to_string(prim.material) + " does not exist");
         mesh.material = prim.material >= 0 ? prim.material : defaultMaterial();
-        const std::uint64_t bytes =
-            mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
-            mesh.texcoords.size() * sizeof(glm::vec2) + mesh.colors.size() * sizeof(glm::vec4) +
-            mesh.tangents.size() * sizeof(glm::vec4) + mesh.indices.size() * sizeof(std::uint32_t);
-        if (!mContext.spend(bytes, context)) fail(mContext.refusal);
+        if (!mContext.spend(meshBytes(mesh), context)) fail(mContext.refusal);
         mScene.meshes.push_back(std::move(mesh));
     }
 

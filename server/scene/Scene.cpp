@@ -85,7 +85,7 @@ void transformMesh(Mesh& mesh, const glm::mat4& toWorld) {
             std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
 }
 
-Scene flattenInstances(const Scene& scene, std::vector<int>* sourceMesh) {
+Scene flattenInstances(const Scene& scene) {
     Scene out;
     out.name = scene.name;
     out.materials = scene.materials;
@@ -94,22 +94,35 @@ Scene flattenInstances(const Scene& scene, std::vector<int>* sourceMesh) {
     out.cameras = scene.cameras;
     out.bounds = scene.bounds;
     out.notShown = scene.notShown;
-    if (sourceMesh) sourceMesh->clear();
-    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-        const Mesh& mesh = scene.meshes[i];
+    out.meshes.reserve(scene.meshes.size());
+    Mesh placed; // one placement at a time, its buffers reused
+    for (const Mesh& mesh : scene.meshes) {
         if (!mesh.instanced()) {
             out.meshes.push_back(mesh);
-            if (sourceMesh) sourceMesh->push_back(static_cast<int>(i));
             continue;
         }
-        for (std::size_t k = 0; k < mesh.instances.size(); ++k) {
-            Mesh placed = mesh;
-            placed.instances.clear();
-            placed.name.append(1, '@').append(std::to_string(k));
-            transformMesh(placed, mesh.instances[k]);
-            out.meshes.push_back(std::move(placed));
-            if (sourceMesh) sourceMesh->push_back(static_cast<int>(i));
+        // Every placement in one mesh: a field of 200,000 one-triangle blades is one mesh of
+        // 200,000 triangles here, not 200,000 meshes (each a BVH geometry of its own).
+        Mesh merged{.name = mesh.name, .material = mesh.material};
+        const auto append = [](auto& into, const auto& from) {
+            into.insert(into.end(), from.begin(), from.end());
+        };
+        for (const glm::mat4& toWorld : mesh.instances) {
+            placed.positions = mesh.positions;
+            placed.normals = mesh.normals;
+            placed.tangents = mesh.tangents;
+            placed.indices = mesh.indices;
+            transformMesh(placed, toWorld);
+            const auto base = static_cast<std::uint32_t>(merged.positions.size());
+            for (std::uint32_t& index : placed.indices) index += base;
+            append(merged.positions, placed.positions);
+            append(merged.normals, placed.normals);
+            append(merged.tangents, placed.tangents);
+            append(merged.texcoords, mesh.texcoords);
+            append(merged.colors, mesh.colors);
+            append(merged.indices, placed.indices);
         }
+        out.meshes.push_back(std::move(merged));
     }
     return out;
 }

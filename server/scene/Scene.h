@@ -161,10 +161,10 @@ struct Scene {
     void updateBounds();
 };
 
-/// `scene` with every instanced mesh replaced by one world-space copy per placement, for consumers
-/// that need world-space triangles (the reference's BVH). `sourceMesh`, when given, receives for each
-/// mesh of the result the index of the mesh of `scene` it came from.
-Scene flattenInstances(const Scene& scene, std::vector<int>* sourceMesh = nullptr);
+/// `scene` in world space, for consumers that need world-space triangles (the reference's BVH): each
+/// instanced mesh becomes one mesh holding a placed copy per placement, so the meshes keep their
+/// indices (a hit's mesh is the same mesh in `scene`).
+Scene flattenInstances(const Scene& scene);
 
 /// Moves `mesh`'s attributes by `toWorld` (object -> world): positions by it, normals by its
 /// inverse transpose (unit length; a zero or non-finite result stays zero for finalizeScene to

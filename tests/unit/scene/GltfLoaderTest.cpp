@@ -142,13 +142,13 @@ TEST(GltfLoader, MeshSharedByNodesIsStoredOnceWithOneMatrixPerNode) {
     expectNear(s.bounds.max, {11, 0, 0});
     expectNear(s.bounds.min, {-1, 0, -2});
 
-    // Flattened, each placement is a world-space mesh like a single-use node would give.
-    std::vector<int> source;
-    const Scene flat = flattenInstances(s, &source);
-    ASSERT_EQ(flat.meshes.size(), 3u);
-    EXPECT_EQ(source, (std::vector<int>{0, 0, 0}));
-    expectNear(flat.meshes[1].positions[2], {0, 0, -2});
-    EXPECT_TRUE(flat.meshes[1].instances.empty());
+    // Flattened, the placements are world-space copies in one mesh, as single-use nodes would give.
+    const Scene flat = flattenInstances(s);
+    ASSERT_EQ(flat.meshes.size(), 1u);
+    EXPECT_TRUE(flat.meshes[0].instances.empty());
+    ASSERT_EQ(flat.meshes[0].positions.size(), 9u);
+    expectNear(flat.meshes[0].positions[5], {0, 0, -2});
+    EXPECT_EQ(flat.meshes[0].indices, (std::vector<std::uint32_t>{0, 1, 2, 3, 4, 5, 6, 7, 8}));
     EXPECT_EQ(flat.triangleCount(), 3u);
 }
 
@@ -184,6 +184,34 @@ TEST(GltfLoader, GpuInstancingExtensionPlacesTheMeshPerElement) {
         EXPECT_NE(std::string(e.what()).find("node 0: EXT_mesh_gpu_instancing"), std::string::npos)
             << e.what();
     }
+}
+
+TEST(GltfLoader, PlacementsAreChargedAsTheFlattenedCopiesTheyStandFor) {
+    TempDir dir;
+    GltfBuilder b;
+    const int pos = b.addVec3s({{0, 0, 0}, {1, 0, 0}, {0, 0, -1}});
+    const int mesh = b.addMesh("blade", {{"attributes", {{"POSITION", pos}}}});
+    std::vector<glm::vec3> offsets;
+    for (int i = 0; i < 1000; ++i)
+        offsets.emplace_back(static_cast<float>(i % 40), 0.0f, static_cast<float>(i / 40));
+    const int translation = b.addVec3s(offsets);
+    b.setScene({b.addNode(
+        {{"mesh", mesh},
+         {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", translation}}}}}}}})});
+    b.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+    const std::string path = b.writeGlb(dir, "field.glb");
+    // 1,000 placements of a 48-byte triangle: the flattened copies the reference would build are
+    // about 110 KB, so a 64 KiB budget refuses the file, saying what to do, and 1 MiB takes it.
+    try {
+        loadGltf(path, SceneLoadOptions{.maxDecodedBytes = 64 << 10});
+        FAIL() << "placements past the budget were accepted";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("of mesh 'blade'"), std::string::npos) << what;
+        EXPECT_NE(what.find("fewer instances"), std::string::npos) << what;
+    }
+    const Scene s = loadGltf(path, SceneLoadOptions{.maxDecodedBytes = 1 << 20});
+    EXPECT_EQ(s.instanceCount(), 1000u);
 }
 
 TEST(GltfLoader, SharedMeshWithAMirroredPlacementIsFlattened) {
