@@ -590,6 +590,24 @@ check('a zipped .gltf with its .bin and texture folder uploads and renders; bad 
     assert.match(body.message, /damaged/);
 });
 
+check('an uploaded Blender file with linked duplicates stays instanced: the state and the frame say so', async () => {
+    const client = await open(servers.main);
+    const glb = readFileSync(path.join(REPO, 'tests/data/corpus/colonnade.glb'));
+    const res = await servers.main.http('/api/upload?name=colonnade.glb', {
+        method: 'POST', body: glb,
+        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
+    });
+    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
+    client.send({ type: 'scene', name: 'upload:colonnade.glb' });
+    const state = await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'upload:colonnade.glb',
+        'state after the upload loads', 15000);
+    assert.equal(state.state.load.instances, 12, 'twelve placements of the column');
+    assert.ok(state.state.load.triangles_stored * 5 < state.state.load.triangles, 'the column is held once');
+    const frame = await client.frame('a frame of the colonnade', (s) => s.scene === 'upload:colonnade.glb');
+    assert.equal(frame.stats.counts?.instances, 12);
+    assert.equal(frame.stats.counts?.triangles, state.state.load.triangles);
+});
+
 check('POST /api/upload of a body that is not a .glb is 400', async () => {
     const client = await open(servers.main);
     const res = await servers.main.http('/api/upload?name=tiny.glb', {
