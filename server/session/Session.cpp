@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <optional>
+#include <thread>
 
 #include "core/Error.h"
 #include "core/JsonSchema.h"
@@ -459,7 +461,122 @@ struct Session::Worker {
     /// Its stats and step: what a whole image sent again (Session::mWholeFrameWanted) carries.
     nlohmann::json lastStats;
     std::string lastQuality;
+    /// A scene loading on a thread of its own (file, decoding, finishing: no GL), so the view in
+    /// place keeps answering input; the worker swaps it in when the thread is done (finishLoad).
+    struct Load {
+        std::string request;                ///< the scene as the client named it
+        std::thread thread;                 ///< joined by finishLoad or ~Worker
+        std::shared_ptr<const Scene> scene; ///< the thread's result, or
+        std::exception_ptr error;           ///< why it failed
+        nlohmann::json info;                ///< state.load: ms, bytes, triangles, ...
+    };
+    std::unique_ptr<Load> load;
+    std::string queuedRequest; ///< asked for while `load` ran: started when it ends (the newer wins)
+    ~Worker() {
+        if (load && load->thread.joinable()) load->thread.join();
+    }
 };
+
+void Session::startLoad(Worker& w, std::string request) {
+    w.load = std::make_unique<Worker::Load>();
+    Worker::Load* load = w.load.get();
+    load->request = std::move(request);
+    // The thread touches only the load record, the scene cache and the clients' outboxes; the
+    // worker joins it before reading the record (finishLoad) or before the session ends (~Worker).
+    load->thread = std::thread([this, load] {
+        const std::string& name = load->request;
+        try {
+            const std::string path = mCatalog ? mCatalog->resolve(name, mUploadDir) : name;
+            std::error_code sizeError;
+            const auto bytes = std::filesystem::file_size(path, sizeError);
+            const std::string sizeText = sizeError ? std::string() : " (" + mebibytes(bytes) + ")";
+            // The client shows that a load is under way (a large file takes seconds) and what it
+            // cost; the scene cache answers at once for a scene another session holds.
+            broadcastProgress("loading", "scene", 0.0, 0.0, "loading " + validUtf8(name) + sizeText);
+            Stopwatch loadClock;
+            SceneLoadOptions loadOptions = mCatalog ? mCatalog->loadOptions(name) : SceneLoadOptions{};
+            // Where a long load is, at most every kLoadProgressMs: the bytes read, the images
+            // decoded and the meshes read, and the time left at the rate so far.
+            double lastReportMs = 0.0;
+            loadOptions.onProgress = [&](const SceneLoadProgress& p) {
+                const double nowMs = loadClock.elapsedMs();
+                if (nowMs - lastReportMs < kLoadProgressMs) return;
+                lastReportMs = nowMs;
+                const double etaMs = p.share > 0.02 ? nowMs * (1.0 - p.share) / p.share : 0.0;
+                broadcastProgress("loading", "scene", p.share, etaMs,
+                                  "loading " + validUtf8(name) + sizeText + ": " + p.describe());
+            };
+            try {
+                load->scene = mScenes->get(path, loadOptions);
+            } catch (...) {
+                broadcastProgress("load_failed", "scene", 0.0, 0.0, "could not load " + validUtf8(name));
+                throw;
+            }
+            const Scene& next = *load->scene;
+            const double loadMs = loadClock.elapsedMs();
+            logInfo("session " + mId + ": scene " + validUtf8(name) + " loaded (" +
+                    (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
+                    std::to_string(next.triangleCount()) + " triangles, " +
+                    std::to_string(static_cast<long>(loadMs)) + " ms)");
+            broadcastProgress("loaded", "scene", 1.0, 0.0,
+                              "loaded " + validUtf8(name) + sizeText + ": " +
+                                  std::to_string(next.triangleCount()) + " triangles in " +
+                                  std::to_string(std::lround(loadMs)) + " ms");
+            load->info = {{"ms", loadMs},
+                          {"bytes", sizeError ? nlohmann::json(nullptr) : nlohmann::json(bytes)},
+                          {"triangles", next.triangleCount()},
+                          {"triangles_stored", next.storedTriangleCount()},
+                          {"instances", next.instanceCount()}};
+        } catch (...) {
+            load->scene.reset();
+            load->error = std::current_exception();
+        }
+        {
+            std::lock_guard lock(mMutex);
+            mLoadDone = true;
+        }
+        mCv.notify_all();
+    });
+}
+
+void Session::finishLoad(Worker& w) {
+    const std::unique_ptr<Worker::Load> load = std::move(w.load);
+    load->thread.join();
+    if (!w.queuedRequest.empty()) { // asked for another scene meanwhile: this one is already old
+        startLoad(w, std::exchange(w.queuedRequest, {}));
+        return;
+    }
+    if (load->error) {
+        try {
+            std::rethrow_exception(load->error);
+        } catch (const std::exception& e) {
+            logWarn("session " + mId + ": scene " + validUtf8(load->request) +
+                    " refused: " + validUtf8(e.what()));
+            broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
+            if (mOnError) mOnError("scene_load_failed");
+        }
+        return;
+    }
+    const std::shared_ptr<const Scene>& next = load->scene;
+    w.renderer->setScene(next);
+    w.scene = next;
+    nlohmann::json stateMsg;
+    {
+        std::lock_guard lock(mMutex);
+        FrameState fresh = makeFrameState(*next, mDesired.technique);
+        mDesired.camera = fresh.camera;
+        mSceneCamera = fresh.camera;
+        mDesired.lights = fresh.lights;
+        mDesired.lightSource = fresh.lightSource;
+        mDesired.lightNote = fresh.lightNote;
+        mScene = next;
+        mSceneName = load->request;
+        mSceneLoad = load->info;
+        stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
+        markInput(); // the new scene's first frame is interactive, then it refines
+    }
+    broadcastText(stateMsg);
+}
 
 int Session::frameTargetMs(const StreamOptions& stream) const {
     return stream.frameTargetMs >= 0 ? stream.frameTargetMs : mConfig.limits.frameTargetMs;
@@ -467,7 +584,7 @@ int Session::frameTargetMs(const StreamOptions& stream) const {
 
 bool Session::inputPending() const {
     std::lock_guard lock(mMutex);
-    return mStop || mDirty || !mSnapshotFor.expired() || !mSceneRequest.empty();
+    return mStop || mDirty || !mSnapshotFor.expired() || !mSceneRequest.empty() || mLoadDone;
 }
 
 bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int width, int height,
@@ -813,6 +930,14 @@ void Session::workerMain() {
     EffectPlan plan;
 #endif
     while (!mStop) {
+        {
+            std::unique_lock lock(mMutex);
+            if (std::exchange(mLoadDone, false)) {
+                lock.unlock();
+                finishLoad(w);
+                continue;
+            }
+        }
         FrameState state;
         nlohmann::json explicitParams;
         std::string sceneRequest;
@@ -827,7 +952,7 @@ void Session::workerMain() {
             std::optional<Clock::time_point> windowWaitFrom;
             while (!mStop) {
                 const auto now = Clock::now();
-                if (readyLocked(now)) break;
+                if (mLoadDone || readyLocked(now)) break;
                 if (mDirty && mController && mController->windowFull() && !windowWaitFrom)
                     windowWaitFrom = now;
                 if (mStream.adaptive && mNextStep == Step::Balanced && !mDirty && mController)
@@ -836,6 +961,7 @@ void Session::workerMain() {
                     mCv.wait(lock);
             }
             if (mStop) break;
+            if (mLoadDone && !readyLocked(Clock::now())) continue; // the loop's top swaps the scene in
             // A viewer joined after patches and nothing else is to render: the last image again, whole.
             if (mWholeFrameWanted && mSnapshotFor.expired() && !stepReadyLocked(Clock::now())) {
                 const StreamOptions current = mStream;
@@ -880,76 +1006,10 @@ void Session::workerMain() {
             explicitParams = mExplicit;
         }
         if (!sceneRequest.empty()) {
-            try {
-                const std::string path =
-                    mCatalog ? mCatalog->resolve(sceneRequest, mUploadDir) : sceneRequest;
-                std::error_code sizeError;
-                const auto bytes = std::filesystem::file_size(path, sizeError);
-                const std::string sizeText = sizeError ? std::string() : " (" + mebibytes(bytes) + ")";
-                // The client shows that a load is under way (a large file takes seconds) and what
-                // it cost; the scene cache answers at once for a scene another session holds.
-                broadcastProgress("loading", "scene", 0.0, 0.0,
-                                  "loading " + validUtf8(sceneRequest) + sizeText);
-                Stopwatch loadClock;
-                SceneLoadOptions loadOptions =
-                    mCatalog ? mCatalog->loadOptions(sceneRequest) : SceneLoadOptions{};
-                // Where a long load is, at most every kLoadProgressMs: the bytes read, the images
-                // decoded and the meshes read, and the time left at the rate so far.
-                double lastReportMs = 0.0;
-                loadOptions.onProgress = [&](const SceneLoadProgress& p) {
-                    const double nowMs = loadClock.elapsedMs();
-                    if (nowMs - lastReportMs < kLoadProgressMs) return;
-                    lastReportMs = nowMs;
-                    const double etaMs = p.share > 0.02 ? nowMs * (1.0 - p.share) / p.share : 0.0;
-                    broadcastProgress("loading", "scene", p.share, etaMs,
-                                      "loading " + validUtf8(sceneRequest) + sizeText + ": " + p.describe());
-                };
-                std::shared_ptr<const Scene> next;
-                try {
-                    next = mScenes->get(path, loadOptions);
-                } catch (...) {
-                    broadcastProgress("load_failed", "scene", 0.0, 0.0,
-                                      "could not load " + validUtf8(sceneRequest));
-                    throw;
-                }
-                const double loadMs = loadClock.elapsedMs();
-                logInfo("session " + mId + ": scene " + validUtf8(sceneRequest) + " loaded (" +
-                        (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
-                        std::to_string(next->triangleCount()) + " triangles, " +
-                        std::to_string(static_cast<long>(loadMs)) + " ms)");
-                broadcastProgress("loaded", "scene", 1.0, 0.0,
-                                  "loaded " + validUtf8(sceneRequest) + sizeText + ": " +
-                                      std::to_string(next->triangleCount()) + " triangles in " +
-                                      std::to_string(std::lround(loadMs)) + " ms");
-                const nlohmann::json loadInfo = {
-                    {"ms", loadMs},
-                    {"bytes", sizeError ? nlohmann::json(nullptr) : nlohmann::json(bytes)},
-                    {"triangles", next->triangleCount()},
-                    {"triangles_stored", next->storedTriangleCount()},
-                    {"instances", next->instanceCount()}};
-                w.renderer->setScene(next);
-                w.scene = next;
-                nlohmann::json stateMsg;
-                {
-                    std::lock_guard lock(mMutex);
-                    FrameState fresh = makeFrameState(*next, mDesired.technique);
-                    mDesired.camera = fresh.camera;
-                    mSceneCamera = fresh.camera;
-                    mDesired.lights = fresh.lights;
-                    mDesired.lightSource = fresh.lightSource;
-                    mDesired.lightNote = fresh.lightNote;
-                    mScene = next;
-                    mSceneName = sceneRequest;
-                    mSceneLoad = loadInfo;
-                    stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
-                }
-                broadcastText(stateMsg);
-            } catch (const std::exception& e) {
-                logWarn("session " + mId + ": scene " + validUtf8(sceneRequest) +
-                        " refused: " + validUtf8(e.what()));
-                broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
-                if (mOnError) mOnError("scene_load_failed");
-            }
+            if (w.load)
+                w.queuedRequest = std::move(sceneRequest); // the newer request wins when this load ends
+            else
+                startLoad(w, std::move(sceneRequest));
         }
         const std::shared_ptr<const Scene>& scene = w.scene;
         {

@@ -142,6 +142,12 @@ private:
     RenderStatus renderAdmitted(Worker& w, const FrameState& state, Rendered& out);
     RefineResult refineInTiles(Worker& w, const FrameState& full, int step, const StreamOptions& stream,
                                const std::string& note);
+    /// Starts loading `request` on a thread of its own (Worker::load); the view in place keeps
+    /// rendering and answering input until finishLoad swaps the scene in.
+    void startLoad(Worker& w, std::string request);
+    /// Joins the finished load and swaps its scene in (state message, fresh camera and lights, an
+    /// interactive frame next), or reports why it failed; starts the request queued meanwhile instead.
+    void finishLoad(Worker& w);
     /// True when input (or a snapshot, or stop) waits: refinement yields to it.
     bool inputPending() const;
     int frameTargetMs(const StreamOptions& stream) const;
@@ -201,6 +207,7 @@ private:
     nlohmann::json mSceneLoad; ///< the last scene load's {ms, bytes, triangles} (state.load); null before one
     std::shared_ptr<const Scene> mScene;
     std::string mSceneRequest;
+    bool mLoadDone = false; ///< the worker's scene load has ended (Worker::load); guarded by mMutex
     StreamOptions mStream;
     bool mDirty = true;
     Step mNextStep = Step::Done;

@@ -232,6 +232,8 @@ export class Inbox {
         this.queue = [];
         this.waiters = [];
         this.closed = null;
+        /** When each text message arrived (performance.now()), for tests of message order. */
+        this.arrivedAt = new WeakMap();
         socket.on('message', (data, isBinary) => {
             const item = isBinary ? { binary: Buffer.from(data) } : JSON.parse(data.toString('utf8'));
             const violation = isBinary ? null : validateServerMessage(item);
@@ -244,6 +246,7 @@ export class Inbox {
                     w.reject(new Error(`${w.what}: the server sent ${text}`));
                 }
             }
+            if (!isBinary) this.arrivedAt.set(item, performance.now());
             this.queue.push(item);
             this.flush();
         });

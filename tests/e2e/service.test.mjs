@@ -11,6 +11,7 @@ import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
+import { deflateSync } from 'node:zlib';
 
 import { Client, isPng, REPO, SERVER, ServerProcess, sleep, testGroup } from './helpers.mjs';
 
@@ -606,6 +607,91 @@ check('an uploaded Blender file with linked duplicates stays instanced: the stat
     const frame = await client.frame('a frame of the colonnade', (s) => s.scene === 'upload:colonnade.glb');
     assert.equal(frame.stats.counts?.instances, 12);
     assert.equal(frame.stats.counts?.triangles, state.state.load.triangles);
+});
+
+/** A .glb of one textured quad whose side x side PNG (a gradient) takes a while to decode. */
+function slowToLoadGlb(side) {
+    const crcTable = Array.from({ length: 256 }, (_, n) => {
+        let c = n;
+        for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+        return c >>> 0;
+    });
+    const crc = (buf) => {
+        let c = 0xffffffff;
+        for (const b of buf) c = crcTable[(c ^ b) & 0xff] ^ (c >>> 8);
+        return (c ^ 0xffffffff) >>> 0;
+    };
+    const chunk = (type, data) => {
+        const head = Buffer.alloc(4);
+        head.writeUInt32BE(data.length);
+        const body = Buffer.concat([Buffer.from(type, 'ascii'), data]);
+        const tail = Buffer.alloc(4);
+        tail.writeUInt32BE(crc(body));
+        return Buffer.concat([head, body, tail]);
+    };
+    const rows = Buffer.alloc(side * (1 + side * 4));
+    for (let y = 0; y < side; y++) {
+        const row = y * (1 + side * 4);
+        for (let x = 0; x < side; x++) rows.set([(x * 255) / side, (y * 255) / side, 128, 255], row + 1 + x * 4);
+    }
+    const ihdr = Buffer.alloc(13);
+    ihdr.writeUInt32BE(side, 0);
+    ihdr.writeUInt32BE(side, 4);
+    ihdr.set([8, 6, 0, 0, 0], 8);
+    const png = Buffer.concat([Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]), chunk('IHDR', ihdr),
+        chunk('IDAT', deflateSync(rows)), chunk('IEND', Buffer.alloc(0))]);
+    const geometry = Buffer.from(new Float32Array([-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1, 0, 0, 1, 0, 1, 1, 0, 1]).buffer);
+    const indices = Buffer.from(new Uint32Array([0, 2, 1, 0, 3, 2]).buffer);
+    const pad = (b) => Buffer.concat([b, Buffer.alloc((4 - (b.length % 4)) % 4)]);
+    const bin = pad(Buffer.concat([geometry, indices, png]));
+    const doc = {
+        asset: { version: '2.0' }, scene: 0, scenes: [{ nodes: [0] }], nodes: [{ mesh: 0 }],
+        meshes: [{ primitives: [{ attributes: { POSITION: 0, TEXCOORD_0: 1 }, indices: 2, material: 0 }] }],
+        materials: [{ pbrMetallicRoughness: { baseColorTexture: { index: 0 }, metallicFactor: 0 } }],
+        textures: [{ source: 0 }], images: [{ bufferView: 3, mimeType: 'image/png' }],
+        accessors: [
+            { bufferView: 0, componentType: 5126, count: 4, type: 'VEC3', min: [-1, 0, -1], max: [1, 0, 1] },
+            { bufferView: 1, componentType: 5126, count: 4, type: 'VEC2' },
+            { bufferView: 2, componentType: 5125, count: 6, type: 'SCALAR' }],
+        bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: 48 }, { buffer: 0, byteOffset: 48, byteLength: 32 },
+            { buffer: 0, byteOffset: 80, byteLength: 24 }, { buffer: 0, byteOffset: 104, byteLength: png.length }],
+        buffers: [{ byteLength: bin.length }],
+    };
+    const json = Buffer.from(JSON.stringify(doc).padEnd(Math.ceil(JSON.stringify(doc).length / 4) * 4, ' '));
+    const header = Buffer.alloc(12);
+    header.writeUInt32LE(0x46546c67, 0);
+    header.writeUInt32LE(2, 4);
+    header.writeUInt32LE(12 + 8 + json.length + 8 + bin.length, 8);
+    const chunkHeader = (length, type) => {
+        const b = Buffer.alloc(8);
+        b.writeUInt32LE(length, 0);
+        b.writeUInt32LE(type, 4);
+        return b;
+    };
+    return Buffer.concat([header, chunkHeader(json.length, 0x4e4f534a), json, chunkHeader(bin.length, 0x004e4942), bin]);
+}
+
+check('input during a scene load is answered by the view in place; the new scene follows', async () => {
+    const client = await open(servers.main, { adaptive: true });
+    await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
+    // Decoding a 4096 x 4096 PNG takes a few hundred milliseconds: the load runs on its own thread.
+    const res = await servers.main.http('/api/upload?name=slow.glb', {
+        method: 'POST', body: slowToLoadGlb(4096),
+        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
+    });
+    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
+    client.send({ type: 'scene', name: 'upload:slow.glb' });
+    await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+    const sentAt = performance.now();
+    client.send({ type: 'camera', position: [0.5, 1.1, 3.7], target: [0, 1, 0] });
+    const answer = await client.frame('the view in place answers the camera', (s) => s.scene === 'builtin:cornell' &&
+        s.quality === 'interactive' && s.input !== undefined && client.inbox.arrivedAt.get(s) > sentAt, 15000);
+    const loaded = await client.inbox.next((m) => m.type === 'progress' && m.state === 'loaded', 'progress loaded', 30000);
+    const answeredAt = client.inbox.arrivedAt.get(answer.stats), loadedAt = client.inbox.arrivedAt.get(loaded);
+    assert.ok(answeredAt < loadedAt,
+        `the answer (input waited ${answer.stats.input.wait_ms} ms) came before the load ended (${loaded.reason})`);
+    await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'upload:slow.glb', 'state of the new scene', 15000);
+    await client.frame('a frame of the new scene', (s) => s.scene === 'upload:slow.glb', 15000);
 });
 
 check('POST /api/upload of a body that is not a .glb is 400', async () => {
