@@ -14,6 +14,28 @@ def run(cmd):
     return usage.ru_maxrss / 1024.0
 
 
+def render_arguments(doc, rounds):
+    """An argument parser with the options every gi-render benchmark takes: --bin, --size, --frames,
+    --rounds (default `rounds`) and --technique (default: the service's, filled in by parse())."""
+    import argparse
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default="build/ci/bin")
+    ap.add_argument("--size", default="512x512")
+    ap.add_argument("--frames", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=rounds)
+    ap.add_argument("--technique", default=None,
+                    help="the GI technique (default: the service's, presets/presets.json default_technique)")
+    return ap
+
+
+def parse(ap):
+    """ap's arguments, with --technique defaulted to the service's."""
+    a = ap.parse_args()
+    if a.technique is None:
+        a.technique = default_technique()
+    return a
+
+
 def default_technique(fallback="rsm_gather"):
     """The service's default technique (presets/presets.json, or $GI_PRESETS)."""
     import json

@@ -11,7 +11,6 @@ medians, the peak resident set, and the ratios shared / copies measured in this 
 usage: bench/scenes/instancing.py [--bin build/ci/bin] [--size 512x512] [--frames 3] [--rounds 2]
                                   [--count 100] [--segments 100] [--technique NAME]
 """
-import argparse
 import json
 import math
 import os
@@ -22,7 +21,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchlib import default_technique, run  # noqa: E402
+from benchlib import parse, render_arguments, run  # noqa: E402
 
 
 def sphere(segments):
@@ -99,18 +98,10 @@ def write_glb(path, count, segments, shared):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin", default="build/ci/bin")
-    ap.add_argument("--size", default="512x512")
-    ap.add_argument("--frames", type=int, default=3)
-    ap.add_argument("--rounds", type=int, default=2)
+    ap = render_arguments(__doc__, rounds=2)
     ap.add_argument("--count", type=int, default=100, help="placements of the sphere")
     ap.add_argument("--segments", type=int, default=100, help="the sphere's segments (2 x segments^2 / 2 triangles)")
-    ap.add_argument("--technique", default=None,
-                    help="the GI technique (default: the service's, presets/presets.json default_technique)")
-    a = ap.parse_args()
-    if a.technique is None:
-        a.technique = default_technique()
+    a = parse(ap)
     render = os.path.join(a.bin, "gi-render")
     work = tempfile.mkdtemp(prefix="gis_instancing_")
     files = {}

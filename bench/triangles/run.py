@@ -11,7 +11,6 @@ Also renders builtin:cornell-dense and builtin:atrium for the issue's ratio.
 usage: bench/triangles/run.py [--bin build/ci/bin] [--size 512x512] [--frames 3] [--rounds 1]
                               [--sizes 10,50,100,250,500,1000,2000] [--technique NAME]
 """
-import argparse
 import json
 import os
 import statistics
@@ -20,23 +19,15 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchlib import default_technique, run  # noqa: E402
+from benchlib import parse, render_arguments, run  # noqa: E402
 
 
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin", default="build/ci/bin")
-    ap.add_argument("--size", default="512x512")
-    ap.add_argument("--frames", type=int, default=3)
-    ap.add_argument("--rounds", type=int, default=1)
+    ap = render_arguments(__doc__, rounds=1)
     ap.add_argument("--sizes", default="10,50,100,250,500,1000,2000")
-    ap.add_argument("--technique", default=None,
-                    help="the GI technique (default: the service's, presets/presets.json default_technique)")
-    a = ap.parse_args()
-    if a.technique is None:
-        a.technique = default_technique()
+    a = parse(ap)
     render = os.path.join(a.bin, "gi-render")
     work = tempfile.mkdtemp(prefix="gis_triangles_")
     scenes = []

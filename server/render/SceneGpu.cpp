@@ -133,28 +133,22 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
         glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
         glVertexArrayAttribBinding(vao, a, 0);
     }
-    // The placement's matrices (shaders/render/instance.glsl), one per draw command: with a divisor
-    // no instance count reaches, every instance of a command reads element baseInstance, so the
-    // passes that draw instanced for their own reasons (cube faces per VPL) keep gl_InstanceID.
+    // The placements' matrices (shaders/render/instance.glsl), per instance; draw() sets the
+    // divisor each pass needs. Seven vec4 columns from attribute 5: the object -> world matrix's four,
+    // then the normal matrix's three (read as vec3).
+    static_assert(kNormalToWorldAttribute == kToWorldAttribute + 4 &&
+                  offsetof(InstanceTransform, toWorld) == 0 &&
+                  offsetof(InstanceTransform, normalToWorld) == 4 * sizeof(glm::vec4));
     mPlacements = gl::Buffer::create(static_cast<GLsizeiptr>(placements.size() * sizeof(InstanceTransform)),
                                      placements.data(), 0);
     glVertexArrayVertexBuffer(vao, 1, mPlacements.id(), 0, sizeof(InstanceTransform));
-    glVertexArrayBindingDivisor(vao, 1, kPlacementDivisor);
-    for (GLuint column = 0; column < 4; ++column) {
-        const GLuint toWorld = kToWorldAttribute + column;
-        glEnableVertexArrayAttrib(vao, toWorld);
-        glVertexArrayAttribFormat(
-            vao, toWorld, 4, GL_FLOAT, GL_FALSE,
-            static_cast<GLuint>(offsetof(InstanceTransform, toWorld) + column * sizeof(glm::vec4)));
-        glVertexArrayAttribBinding(vao, toWorld, 1);
-    }
-    for (GLuint column = 0; column < 3; ++column) {
-        const GLuint normal = kNormalToWorldAttribute + column;
-        glEnableVertexArrayAttrib(vao, normal);
-        glVertexArrayAttribFormat(
-            vao, normal, 3, GL_FLOAT, GL_FALSE,
-            static_cast<GLuint>(offsetof(InstanceTransform, normalToWorld) + column * sizeof(glm::vec4)));
-        glVertexArrayAttribBinding(vao, normal, 1);
+    glVertexArrayBindingDivisor(vao, 1, mDivisor);
+    for (GLuint column = 0; column < 7; ++column) {
+        const GLuint attribute = kToWorldAttribute + column;
+        glEnableVertexArrayAttrib(vao, attribute);
+        glVertexArrayAttribFormat(vao, attribute, column < 4 ? 4 : 3, GL_FLOAT, GL_FALSE,
+                                  static_cast<GLuint>(column * sizeof(glm::vec4)));
+        glVertexArrayAttribBinding(vao, attribute, 1);
     }
 
     for (const TextureImage& image : scene.textures) {
@@ -244,7 +238,10 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
     // placement, all of whose instances read it; any other pass draws each run of visible
     // consecutive placements as one instanced command, a placement per instance.
     const bool commandPerPlacement = instances > 1;
-    glVertexArrayBindingDivisor(mVao.id(), 1, commandPerPlacement ? kPlacementDivisor : 1u);
+    if (const GLuint divisor = commandPerPlacement ? kPlacementDivisor : 1u; divisor != mDivisor) {
+        glVertexArrayBindingDivisor(mVao.id(), 1, divisor);
+        mDivisor = divisor;
+    }
     for (const Draw& d : mDraws) {
         if (d.mesh == skipMesh) continue;
         const auto triangles = static_cast<std::size_t>(d.indexCount / 3);

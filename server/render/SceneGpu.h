@@ -112,6 +112,7 @@ private:
     static_assert(sizeof(InstanceTransform) == 112, "instance.glsl's attribute layout");
     /// Larger than any instance count a pass draws, so a command's instances all read its placement.
     static constexpr GLuint kPlacementDivisor = 1u << 30;
+    mutable GLuint mDivisor = 1; ///< the placement binding's divisor as last set (draw())
     gl::Buffer mVertices;
     gl::Buffer mIndices;
     gl::Buffer mPlacements;

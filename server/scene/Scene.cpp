@@ -86,21 +86,11 @@ void transformMesh(Mesh& mesh, const glm::mat4& toWorld) {
 }
 
 Scene flattenInstances(const Scene& scene) {
-    Scene out;
-    out.name = scene.name;
-    out.materials = scene.materials;
-    out.textures = scene.textures;
-    out.lights = scene.lights;
-    out.cameras = scene.cameras;
-    out.bounds = scene.bounds;
-    out.notShown = scene.notShown;
-    out.meshes.reserve(scene.meshes.size());
+    Scene out = scene;
     Mesh placed; // one placement at a time, its buffers reused
-    for (const Mesh& mesh : scene.meshes) {
-        if (!mesh.instanced()) {
-            out.meshes.push_back(mesh);
-            continue;
-        }
+    for (Mesh& flat : out.meshes) {
+        if (!flat.instanced()) continue;
+        const Mesh mesh = std::move(flat);
         // Every placement in one mesh: a field of 200,000 one-triangle blades is one mesh of
         // 200,000 triangles here, not 200,000 meshes (each a BVH geometry of its own).
         Mesh merged{.name = mesh.name, .material = mesh.material};
@@ -122,7 +112,7 @@ Scene flattenInstances(const Scene& scene) {
             append(merged.colors, mesh.colors);
             append(merged.indices, placed.indices);
         }
-        out.meshes.push_back(std::move(merged));
+        flat = std::move(merged);
     }
     return out;
 }
