@@ -17,6 +17,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
@@ -25,6 +26,7 @@
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Log.h"
+#include "core/Memory.h"
 #include "frame/FrameParams.h"
 #include "gi/Technique.h"
 #include "net/Metrics.h"
@@ -49,9 +51,11 @@ constexpr std::size_t kMaxDirectMessages = 64;
 
 /// Runs slow work away from the loop, in order, on one thread of its own: teardowns (joining render
 /// threads, deleting upload sandboxes) on one queue, unpacking zipped uploads on another.
+/// `whenDrained` runs on that thread each time the queue empties, before pending() falls to 0.
 class BackgroundQueue {
 public:
-    BackgroundQueue() : mThread([this] { loop(); }) {}
+    explicit BackgroundQueue(std::function<void()> whenDrained = {})
+        : mWhenDrained(std::move(whenDrained)), mThread([this] { loop(); }) {}
     ~BackgroundQueue() {
         {
             std::lock_guard lock(mMutex);
@@ -86,6 +90,11 @@ private:
                 work();
                 work = nullptr;
                 lock.lock();
+                if (mQueue.empty() && mWhenDrained) {
+                    lock.unlock();
+                    mWhenDrained();
+                    lock.lock();
+                }
                 --mPending;
             }
             if (mStop) return;
@@ -96,7 +105,8 @@ private:
     std::deque<std::function<void()>> mQueue;
     std::size_t mPending = 0;
     bool mStop = false;
-    std::thread mThread;
+    std::function<void()> mWhenDrained;
+    std::thread mThread; // last: started once every other member is ready
 };
 
 inline std::string header(lws* wsi, lws_token_indexes token) {
@@ -266,7 +276,10 @@ struct WsServer::Impl {
     std::map<lws*, std::unique_ptr<Connection>> connections;
     std::map<lws*, std::unique_ptr<HttpExchange>> exchanges; ///< PerSession::http points into it
     std::unique_ptr<Directory> sessions;                     // made with the config's limits
-    std::unique_ptr<BackgroundQueue> reaper = std::make_unique<BackgroundQueue>();
+    /// Session teardowns. A session frees tens of MiB (GL context, frame resources, its scene's
+    /// share) across the allocator arenas of its threads; trimming once the queue is empty gives
+    /// them back, so the resident size after sessions end is what is still live (core/Memory.h).
+    std::unique_ptr<BackgroundQueue> reaper = std::make_unique<BackgroundQueue>(releaseFreedMemory);
     lws_protocols protocols[3];
     Housekeeping housekeeping{};
 

@@ -61,6 +61,9 @@ void WsServer::Impl::updateGauges() {
         .set(static_cast<double>(workers->queued()));
     metrics.gauge("gis_teardowns_pending", "ended sessions whose render thread is still being joined")
         .set(static_cast<double>(reaper->pending()));
+    if (const auto resident = residentBytes())
+        metrics.gauge("process_resident_memory_bytes", "the server's resident set size")
+            .set(static_cast<double>(*resident));
     metrics.gauge("gis_uptime_seconds", "seconds since the server started")
         .set(std::chrono::duration<double>(Clock::now() - started).count());
     metrics.gauge("gis_draining", "1 while the server drains after SIGTERM (no new sessions)")
