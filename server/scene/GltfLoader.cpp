@@ -68,6 +68,8 @@ struct LoadContext {
     std::uint64_t spent = 0;
     std::string refusal; ///< the first refusal, for the error message
     std::function<void(const SceneLoadProgress&)> onProgress;
+    std::function<bool()> cancelled;
+    bool cancelSeen = false;
     SceneLoadProgress progress;
     std::size_t imagesTotal = 0, imagesDecoded = 0; ///< images in the document, decoded so far
 
@@ -95,6 +97,16 @@ struct LoadContext {
         progress.total = total;
         progress.share = std::max(progress.share, from + (to - from) * within);
         onProgress(progress);
+    }
+
+    /// True once the load is no longer wanted (and from then on). tinygltf's callbacks answer false
+    /// on it; the loader's own loops call throwIfCancelled.
+    bool cancelRequested() {
+        if (!cancelSeen && cancelled && cancelled()) cancelSeen = true;
+        return cancelSeen;
+    }
+    void throwIfCancelled() {
+        if (cancelRequested()) throw LoadCancelled(name);
     }
 
     /// Counts `bytes` against the budget; false (with the refusal recorded) when it would overflow.
@@ -170,7 +182,7 @@ bool externalAllowed(LoadContext& c, const std::string& absPath) {
 
 bool sandboxFileExists(const std::string& absPath, void* user) {
     auto& c = *static_cast<LoadContext*>(user);
-    if (!externalAllowed(c, absPath)) return false;
+    if (c.cancelRequested() || !externalAllowed(c, absPath)) return false;
     std::error_code ec;
     return std::filesystem::is_regular_file(absPath, ec);
 }
@@ -182,7 +194,7 @@ std::string sandboxExpandPath(const std::string& path, void*) {
 bool sandboxReadFile(std::vector<unsigned char>* out, std::string* err, const std::string& absPath,
                      void* user) {
     auto& c = *static_cast<LoadContext*>(user);
-    if (!externalAllowed(c, absPath)) return false;
+    if (c.cancelRequested() || !externalAllowed(c, absPath)) return false;
     std::error_code ec;
     const auto size = std::filesystem::file_size(absPath, ec);
     const std::string uri = uriInBaseDir(c, absPath).value_or("?");
@@ -211,6 +223,7 @@ bool sandboxWriteFile(std::string* err, const std::string&, const std::vector<un
 bool budgetedImageLoader(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
                          int reqWidth, int reqHeight, const unsigned char* bytes, int size, void* user) {
     auto& c = *static_cast<LoadContext*>(user);
+    if (c.cancelRequested()) return false; // the load throws LoadCancelled once tinygltf returns
     int w = 0, h = 0, comp = 0;
     if (size <= 0 || !stbi_info_from_memory(bytes, size, &w, &h, &comp) || w <= 0 || h <= 0) {
         if (err)
@@ -365,6 +378,7 @@ public:
         mScene.name = mPath;
         mScene.updateBounds();
         closeInfiniteFarPlanes();
+        mContext.throwIfCancelled();
         mContext.report(SceneLoadProgress::Stage::Finishing, 0, 0);
         finalizeScene(mScene, mPath);
         return std::move(mScene);
@@ -910,6 +924,7 @@ private:
     void addMesh(int meshIndex, const glm::mat4& world) {
         const tinygltf::Mesh& mesh = mModel.meshes[static_cast<std::size_t>(meshIndex)];
         for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
+            mContext.throwIfCancelled();
             addPrimitive(mesh, meshIndex, static_cast<int>(p), world);
             mContext.report(SceneLoadProgress::Stage::Meshes, ++mPrimitivesRead, mPrimitivesTotal);
         }
@@ -1173,6 +1188,7 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
             context.progress.bytesRead = at;
             context.report(SceneLoadProgress::Stage::Reading, static_cast<std::size_t>(at),
                            static_cast<std::size_t>(size));
+            context.throwIfCancelled();
         }
     }
     // tinygltf walks extras and extensions recursively: a deep document must never reach it.
@@ -1184,6 +1200,7 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
     // Draco and meshopt data decoded into plain accessors, which is all tinygltf reads.
     std::string_view checkedJson = json;
     auto spend = [&](std::uint64_t n, const std::string& what) {
+        context.throwIfCancelled(); // called per decoded primitive and buffer
         if (!context.spend(n, what)) throw InputError(name, context.refusal);
         return true;
     };
@@ -1234,7 +1251,8 @@ tinygltf::Model parseFile(const std::string& path, LoadContext& context) {
         for (std::size_t at; (at = text.find(prefix)) != std::string::npos;) text.erase(at, prefix.size());
         return validUtf8(oneLine(text));
     };
-    if (!warnings.empty()) logWarn("scene: " + name + ": " + relative(warnings));
+    if (!warnings.empty() && !context.cancelSeen) logWarn("scene: " + name + ": " + relative(warnings));
+    context.throwIfCancelled();
     if (!context.refusal.empty()) throw InputError(name, context.refusal);
     if (!ok) {
         // nlohmann's messages ("[json.exception.parse_error.101] ...") do not say what was parsed.
@@ -1253,6 +1271,7 @@ Scene loadGltf(const std::string& path, const SceneLoadOptions& options) {
     context.allowExternal = options.allowExternalFiles;
     context.budget = options.maxDecodedBytes;
     context.onProgress = options.onProgress;
+    context.cancelled = options.cancelled;
     try {
         std::error_code ec;
         const std::filesystem::path absolute = std::filesystem::absolute(path, ec);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/Error.h"
 #include "scene/Scene.h"
 
 namespace gis {
@@ -39,6 +40,16 @@ struct SceneLoadOptions {
     /// primitive: the callee throttles); null for none. It must not throw. Built-in scenes, which
     /// generate in milliseconds, report nothing.
     std::function<void(const SceneLoadProgress&)> onProgress;
+    /// Asked on the loading thread between file chunks, images and mesh primitives; once it answers
+    /// true the load stops there and throws LoadCancelled (a newer scene was asked for, or the
+    /// session ended). Null: never cancelled. It must not throw.
+    std::function<bool()> cancelled;
+};
+
+/// A load stopped because SceneLoadOptions::cancelled asked it to: no fault of the file.
+class LoadCancelled : public InputError {
+public:
+    explicit LoadCancelled(std::string where) : InputError(std::move(where), "the load was cancelled") {}
 };
 
 /// Deepest JSON nesting a glTF file may have: far beyond what exporters write (extras included),

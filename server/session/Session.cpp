@@ -465,6 +465,7 @@ struct Session::Worker {
     /// place keeps answering input; the worker swaps it in when the thread is done (finishLoad).
     struct Load {
         std::string request;                ///< the scene as the client named it
+        std::atomic<bool> cancelled{false}; ///< a newer scene was asked for: stop at the next check
         std::thread thread;                 ///< joined by finishLoad or ~Worker
         std::shared_ptr<const Scene> scene; ///< the thread's result, or
         std::exception_ptr error;           ///< why it failed
@@ -473,7 +474,10 @@ struct Session::Worker {
     std::unique_ptr<Load> load;
     std::string queuedRequest; ///< asked for while `load` ran: started when it ends (the newer wins)
     ~Worker() {
-        if (load && load->thread.joinable()) load->thread.join();
+        if (load && load->thread.joinable()) {
+            load->cancelled = true; // the session ends: a long load must not hold its teardown
+            load->thread.join();
+        }
     }
 };
 
@@ -506,8 +510,14 @@ void Session::startLoad(Worker& w, std::string request) {
                 broadcastProgress("loading", "scene", p.share, etaMs,
                                   "loading " + validUtf8(name) + sizeText + ": " + p.describe());
             };
+            loadOptions.cancelled = [this, load] { return load->cancelled.load() || mStop.load(); };
             try {
                 load->scene = mScenes->get(path, loadOptions);
+            } catch (const LoadCancelled&) {
+                // Said by the load that replaces it ('loading'), or by nobody when the session ends.
+                logInfo("session " + mId + ": scene " + validUtf8(name) + " load cancelled after " +
+                        std::to_string(std::lround(loadClock.elapsedMs())) + " ms");
+                throw;
             } catch (...) {
                 broadcastProgress("load_failed", "scene", 0.0, 0.0, "could not load " + validUtf8(name));
                 throw;
@@ -549,6 +559,8 @@ void Session::finishLoad(Worker& w) {
     if (load->error) {
         try {
             std::rethrow_exception(load->error);
+        } catch (const LoadCancelled&) {
+            // Only a newer request (started above) or the session's end cancels a load.
         } catch (const std::exception& e) {
             logWarn("session " + mId + ": scene " + validUtf8(load->request) +
                     " refused: " + validUtf8(e.what()));
@@ -1006,9 +1018,12 @@ void Session::workerMain() {
             explicitParams = mExplicit;
         }
         if (!sceneRequest.empty()) {
-            if (w.load)
-                w.queuedRequest = std::move(sceneRequest); // the newer request wins when this load ends
-            else
+            if (w.load) {
+                // The newer request wins: the load under way stops at its next check (between file
+                // chunks, images or meshes) and this one starts when it has.
+                w.load->cancelled = true;
+                w.queuedRequest = std::move(sceneRequest);
+            } else
                 startLoad(w, std::move(sceneRequest));
         }
         const std::shared_ptr<const Scene>& scene = w.scene;

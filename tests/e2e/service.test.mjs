@@ -610,7 +610,8 @@ check('an uploaded Blender file with linked duplicates stays instanced: the stat
 });
 
 /** A .glb of one textured quad whose side x side PNG (a gradient) takes a while to decode. */
-function slowToLoadGlb(side) {
+// `images` copies of one side x side PNG: each is decoded on its own (about 250 ms at 4096).
+function slowToLoadGlb(side, images = 1) {
     const crcTable = Array.from({ length: 256 }, (_, n) => {
         let c = n;
         for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
@@ -648,7 +649,7 @@ function slowToLoadGlb(side) {
         asset: { version: '2.0' }, scene: 0, scenes: [{ nodes: [0] }], nodes: [{ mesh: 0 }],
         meshes: [{ primitives: [{ attributes: { POSITION: 0, TEXCOORD_0: 1 }, indices: 2, material: 0 }] }],
         materials: [{ pbrMetallicRoughness: { baseColorTexture: { index: 0 }, metallicFactor: 0 } }],
-        textures: [{ source: 0 }], images: [{ bufferView: 3, mimeType: 'image/png' }],
+        textures: [{ source: 0 }], images: Array.from({ length: images }, () => ({ bufferView: 3, mimeType: 'image/png' })),
         accessors: [
             { bufferView: 0, componentType: 5126, count: 4, type: 'VEC3', min: [-1, 0, -1], max: [1, 0, 1] },
             { bufferView: 1, componentType: 5126, count: 4, type: 'VEC2' },
@@ -692,6 +693,55 @@ check('input during a scene load is answered by the view in place; the new scene
         `the answer (input waited ${answer.stats.input.wait_ms} ms) came before the load ended (${loaded.reason})`);
     await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'upload:slow.glb', 'state of the new scene', 15000);
     await client.frame('a frame of the new scene', (s) => s.scene === 'upload:slow.glb', 15000);
+});
+
+check('a scene asked for during a load cancels that load: the newer scene does not wait for it', async () => {
+    const client = await open(servers.main, { adaptive: true });
+    await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
+    // Three 4096 x 4096 images: about 750 ms of decoding, checked for a cancel between images.
+    const res = await servers.main.http('/api/upload?name=slower.glb', {
+        method: 'POST', body: slowToLoadGlb(4096, 3),
+        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
+    });
+    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
+    const loadAskedAt = performance.now();
+    client.send({ type: 'scene', name: 'upload:slower.glb' });
+    await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+    const askedAt = performance.now();
+    client.send({ type: 'scene', name: 'builtin:cornell-empty' });
+    await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'builtin:cornell-empty',
+        'state of the newer scene', 15000);
+    const stateAt = performance.now();
+    console.log(`# the newer scene's state ${Math.round(stateAt - askedAt)} ms after it was asked for ` +
+        `(${Math.round(askedAt - loadAskedAt)} ms into the cancelled load)`);
+    const oldLoad = client.inbox.queue.filter((m) => m.type === 'progress' && m.state === 'loaded' &&
+        m.reason.includes('slower.glb'));
+    assert.deepEqual(oldLoad, [], 'the cancelled load never finished');
+    assert.ok(!client.inbox.queue.some((m) => m.type === 'error'), 'a cancel is no error');
+    await client.frame('a frame of the newer scene', (s) => s.scene === 'builtin:cornell-empty', 15000);
+});
+
+check('a session that ends during a load cancels it: its teardown does not wait for the file', async () => {
+    const client = await open(servers.main, { adaptive: true });
+    await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
+    const res = await servers.main.http('/api/upload?name=abandoned.glb', {
+        method: 'POST', body: slowToLoadGlb(4096, 3),
+        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
+    });
+    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
+    client.send({ type: 'scene', name: 'upload:abandoned.glb' });
+    await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+    const closedAt = performance.now();
+    await client.close();
+    const deadline = Date.now() + 15000;
+    let health = await servers.main.health();
+    while (health.teardowns_pending > 0 || servers.main.log.match(/upload:abandoned\.glb load cancelled/) === null) {
+        assert.ok(Date.now() < deadline, `the teardown did not finish: ${JSON.stringify(health)}`);
+        await sleep(10);
+        health = await servers.main.health();
+    }
+    console.log(`# the session's teardown finished ${Math.round(performance.now() - closedAt)} ms after the close`);
+    assert.doesNotMatch(servers.main.log, /upload:abandoned\.glb loaded/, 'the load never finished');
 });
 
 check('POST /api/upload of a body that is not a .glb is 400', async () => {

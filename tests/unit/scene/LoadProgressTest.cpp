@@ -131,5 +131,51 @@ TEST(LoadProgress, DescribesTheBytesRead) {
     EXPECT_EQ(p.describe(), "reading the file: 3.0 MiB of 12.0 MiB");
 }
 
+/// Loads `path`, asking for a cancel once a report of `stage` arrived; the reports seen.
+std::vector<SceneLoadProgress> loadCancellingAt(const std::string& path, Stage stage) {
+    std::vector<SceneLoadProgress> reports;
+    bool wanted = true;
+    SceneLoadOptions options;
+    options.onProgress = [&](const SceneLoadProgress& p) {
+        reports.push_back(p);
+        if (p.stage == stage) wanted = false;
+    };
+    options.cancelled = [&] { return !wanted; };
+    EXPECT_THROW(loadScene(path, options), LoadCancelled) << "cancelled at stage " << static_cast<int>(stage);
+    return reports;
+}
+
+TEST(LoadProgress, ACancelledLoadStopsWithinTheStageItWasCancelledIn) {
+    TempDir dir;
+    test::GltfBuilder b;
+    b.setScene({b.addTriangleNode("a"), b.addTriangleNode("b"), b.addTriangleNode("c")});
+    const std::string plain = b.writeGltf(dir, "three.gltf");
+    struct Case {
+        std::string path;
+        Stage stage;
+    };
+    for (const Case& c :
+         {Case{corpus("textured_box.glb"), Stage::Reading}, Case{corpus("textured_box.glb"), Stage::Images},
+          Case{corpus("textured_box_draco.glb"), Stage::Decompressing}, Case{plain, Stage::Meshes}}) {
+        const auto reports = loadCancellingAt(c.path, c.stage);
+        ASSERT_FALSE(reports.empty()) << c.path;
+        EXPECT_EQ(reports.back().stage, c.stage) << c.path << ": nothing after the stage it was cancelled in";
+        if (c.stage == Stage::Meshes) {
+            EXPECT_LE(reports.back().done, 1u) << "at most the primitive under way";
+        }
+        if (c.stage == Stage::Images) {
+            EXPECT_EQ(reports.back().done, 0u) << "no image decoded after the cancel";
+        }
+    }
+    // A cancel function that never answers true changes nothing.
+    SceneLoadOptions options;
+    options.cancelled = [] { return false; };
+    EXPECT_NO_THROW(loadScene(corpus("textured_box.glb"), options));
+    // A cancelled load is an InputError like every other failed load: callers that catch only that
+    // still catch it.
+    options.cancelled = [] { return true; };
+    EXPECT_THROW(loadScene(corpus("textured_box.glb"), options), InputError);
+}
+
 } // namespace
 } // namespace gis
