@@ -39,6 +39,9 @@ try {
             + `  eta ${Math.round(m.eta_ms)} ms  ${m.reason}`);
         if (m.state !== 'loading') break;
     }
+    const state = await client.inbox.next((x) => x.type === 'state' && x.state?.load, 'state', 120000);
+    const stateAt = performance.now() - t0;
+    console.log(`${stateAt.toFixed(0).padStart(6)} ms  state  load ${JSON.stringify(state.state.load)}`);
     await client.close();
 } finally {
     await server.stop();

@@ -179,9 +179,10 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
 
 FrameRenderer::~FrameRenderer() = default;
 
-void FrameRenderer::setScene(std::shared_ptr<const Scene> scene) {
+void FrameRenderer::setScene(std::shared_ptr<const Scene> scene,
+                             std::shared_ptr<const SceneGpu::Prepared> prepared) {
     GIS_ASSERT(scene != nullptr);
-    mSceneGpu = std::make_unique<SceneGpu>(*scene);
+    mSceneGpu = std::make_unique<SceneGpu>(*scene, std::move(prepared));
     mSceneCutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
                                 [](const Material& m) { return m.cutsOut(); });
     mSceneHasOcclusionMaps = std::any_of(scene->materials.begin(), scene->materials.end(),

@@ -57,7 +57,10 @@ class FrameRenderer {
 public:
     explicit FrameRenderer(bool useTimerQueries = true);
     ~FrameRenderer();
-    void setScene(std::shared_ptr<const Scene> scene);
+    /// Uploads `scene`; `prepared` (SceneGpu::prepare of the same scene, built off this thread) spares
+    /// the render thread the CPU half of the upload.
+    void setScene(std::shared_ptr<const Scene> scene,
+                  std::shared_ptr<const SceneGpu::Prepared> prepared = nullptr);
     const Scene* scene() const { return mScene.get(); }
     /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics),
     /// `wantDirect` the direct pass's (indirect-only metrics).

@@ -11,16 +11,6 @@
 #include "scene/Frustum.h"
 
 namespace gis {
-namespace {
-struct Vertex {
-    float position[3];
-    float normal[3];
-    float texcoord[2];
-    float tangent[4]; ///< Mesh::tangents; zero where the mesh has none (no normal map)
-    float color[4];   ///< Mesh::colors; white where the mesh has none
-};
-static_assert(sizeof(Vertex) == 64);
-} // namespace
 
 SceneGpu::InstanceTransform SceneGpu::InstanceTransform::of(const glm::mat4& toWorld) {
     InstanceTransform t;
@@ -30,11 +20,20 @@ SceneGpu::InstanceTransform SceneGpu::InstanceTransform::of(const glm::mat4& toW
     return t;
 }
 
-SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
-    std::vector<Vertex> vertices;
-    std::vector<std::uint32_t> indices;
+std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene) {
+    auto prepared = std::make_shared<Prepared>();
+    std::vector<Vertex>& vertices = prepared->vertices;
+    std::vector<std::uint32_t>& indices = prepared->indices;
     // Placement 0 is the identity that every world-space mesh is drawn with.
-    std::vector<InstanceTransform> placements{InstanceTransform::of(glm::mat4(1.0f))};
+    std::vector<InstanceTransform>& placements = prepared->placements;
+    placements.push_back(InstanceTransform::of(glm::mat4(1.0f)));
+    std::size_t vertexCount = 0, indexCount = 0;
+    for (const Mesh& mesh : scene.meshes) {
+        vertexCount += mesh.positions.size();
+        indexCount += mesh.indices.size();
+    }
+    vertices.reserve(vertexCount);
+    indices.reserve(indexCount);
     for (const Mesh& mesh : scene.meshes) {
         Draw d;
         d.baseVertex = static_cast<GLint>(vertices.size());
@@ -76,18 +75,18 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
             run.indexCount = c.indexCount;
             run.instance = firstPlacement;
             run.placements = static_cast<GLuint>(mesh.placements());
-            run.firstBounds = mRunBounds.size();
+            run.firstBounds = prepared->runBounds.size();
             if (!mesh.instanced()) {
-                mRunBounds.push_back({c.lo, c.hi});
+                prepared->runBounds.push_back({c.lo, c.hi});
             } else {
                 // The world box around the placed corners: culling stays conservative.
                 for (const glm::mat4& toWorld : mesh.instances) {
                     const Bounds placed = placedBounds({c.lo, c.hi}, toWorld);
-                    mRunBounds.push_back({placed.min, placed.max});
+                    prepared->runBounds.push_back({placed.min, placed.max});
                 }
             }
-            mMaxCommands += run.placements;
-            mDraws.push_back(run);
+            prepared->maxCommands += run.placements;
+            prepared->draws.push_back(run);
         }
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
@@ -109,9 +108,28 @@ SceneGpu::SceneGpu(const Scene& scene) : mMaterials(scene.materials) {
             vertices.push_back(v);
         }
         indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
-        mTriangles += mesh.indices.size() / 3 * mesh.placements();
-        mStoredTriangles += mesh.indices.size() / 3;
+        prepared->triangles += mesh.indices.size() / 3 * mesh.placements();
+        prepared->storedTriangles += mesh.indices.size() / 3;
     }
+    return prepared;
+}
+
+SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared)
+    : mMaterials(scene.materials) {
+    if (!prepared) prepared = prepare(scene);
+    GIS_ASSERT(prepared->vertices.size() == [&] {
+        std::size_t n = 0;
+        for (const Mesh& mesh : scene.meshes) n += mesh.positions.size();
+        return n;
+    }());
+    const std::vector<Vertex>& vertices = prepared->vertices;
+    const std::vector<std::uint32_t>& indices = prepared->indices;
+    const std::vector<InstanceTransform>& placements = prepared->placements;
+    mDraws = prepared->draws;
+    mRunBounds = prepared->runBounds;
+    mMaxCommands = prepared->maxCommands;
+    mTriangles = prepared->triangles;
+    mStoredTriangles = prepared->storedTriangles;
     mInstances = placements.size() - 1;
     if (vertices.empty() || indices.empty())
         throw Error("render: scene '" + scene.name + "' has no triangles");

@@ -2,6 +2,7 @@
 // (shadow map, RSM, G-buffer) shares.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "gl/Objects.h"
@@ -45,8 +46,15 @@ public:
     /// bounds, so culling can leave out part of it.
     static constexpr std::size_t kChunkTriangles = 16384;
 
-    /// Uploads everything; throws gis::Error on GL failure (a load boundary).
-    explicit SceneGpu(const Scene& scene);
+    /// What the upload sends, built without GL on any thread: the interleaved vertices, the indices,
+    /// the placements and the runs with their bounds. A scene load builds it beside the scene, so
+    /// the render thread only uploads (on a 2M-triangle scene this was 115 of its 241 ms).
+    struct Prepared;
+    static std::shared_ptr<const Prepared> prepare(const Scene& scene);
+
+    /// Uploads everything; throws gis::Error on GL failure (a load boundary). `prepared` must come
+    /// from prepare(scene) of this scene; null: prepared here.
+    explicit SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared = nullptr);
     /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
     /// through `materials` (null: none, as for depth-only passes). `skipMesh` (an index into
     /// Scene::meshes) is left out: a local environment probe does not see the object it belongs to.
@@ -77,6 +85,14 @@ public:
     void setSurfaceIds(const std::vector<int>& idOfMesh);
 
 private:
+    struct Vertex {
+        float position[3];
+        float normal[3];
+        float texcoord[2];
+        float tangent[4]; ///< Mesh::tangents; zero where the mesh has none (no normal map)
+        float color[4];   ///< Mesh::colors; white where the mesh has none
+    };
+    static_assert(sizeof(Vertex) == 64);
     struct Draw {
         GLint firstIndex = 0;
         GLsizei indexCount = 0;
@@ -110,6 +126,18 @@ private:
         static InstanceTransform of(const glm::mat4& toWorld);
     };
     static_assert(sizeof(InstanceTransform) == 112, "instance.glsl's attribute layout");
+
+public:
+    struct Prepared {
+        std::vector<Vertex> vertices;
+        std::vector<std::uint32_t> indices;
+        std::vector<InstanceTransform> placements; ///< [0]: the identity of world-space meshes
+        std::vector<Draw> draws;
+        std::vector<RunBounds> runBounds;
+        std::size_t maxCommands = 0, triangles = 0, storedTriangles = 0;
+    };
+
+private:
     /// Larger than any instance count a pass draws, so a command's instances all read its placement.
     static constexpr GLuint kPlacementDivisor = 1u << 30;
     mutable GLuint mDivisor = 1; ///< the placement binding's divisor as last set (draw())

@@ -214,6 +214,7 @@ check('every client message type has its effect', async (t) => {
         const state = await client.inbox.nextOfType('state', 'state after scene', 15000);
         assert.equal(state.state?.scene, 'builtin:cornell-empty', 'state.scene');
         assert.ok(state.state.load?.triangles > 0 && state.state.load.ms >= 0, 'state.load: what the load cost');
+        assert.ok(state.state.load.upload_ms >= 0, 'state.load.upload_ms: what the GL upload held the render thread');
         assert.ok(Array.isArray(state.state?.camera?.position), 'state carries the reset camera');
         last = await client.frame('frame of the new scene', (s) => s.scene === 'builtin:cornell-empty');
         await client.expectError({ type: 'scene', name: 'builtin:no-such-scene' }, 'unknown_scene');
