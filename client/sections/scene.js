@@ -85,6 +85,12 @@ export function createSceneSection({ ui, state, store, actions }) {
             const key = `${state.params.effects}:${JSON.stringify(p ?? null)}:${JSON.stringify(nondiffuse ?? null)}`;
             if (key === lastPlanKey) return;
             lastPlanKey = key;
+            if (typeof p?.pending === 'string') {
+                // The server is still measuring the scene (its ray structure for the planner).
+                planSummary.textContent = `Effects: ${p.pending}.`;
+                planList.replaceChildren();
+                return;
+            }
             if (!p || p.mode === 'manual' || !Array.isArray(p.decisions)) {
                 planSummary.textContent = 'Manual: the technique\'s parameters decide which effects run. '
                     + 'Turn on "plan effects" to let the server measure what this view needs.';

@@ -220,10 +220,20 @@ bool EffectPlan::enabled(std::string_view effect) const {
 
 EffectPlan planEffects(const Scene& scene, const FrameState& state, const EffectPlanOptions& options) {
     const auto start = std::chrono::steady_clock::now();
+    const RayScene rays(scene);
+    EffectPlan plan = planEffects(scene, rays, state, options);
+    // The structure's build is part of what this call cost.
+    plan.analysisMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return plan;
+}
+
+EffectPlan planEffects(const Scene& scene, const reference::RayScene& rays, const FrameState& state,
+                       const EffectPlanOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
     EffectPlan plan;
     plan.mode = state.frameParams.has("effects") ? state.frameParams.getEnum("effects") : "manual";
 
-    const RayScene rays(scene);
     const float eps = rays.epsilon();
     // The lights exactly as the renderer shows them (frame/LightModel.h): the enabled ones that reach
     // the scene, at most max_lights.

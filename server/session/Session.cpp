@@ -25,6 +25,7 @@
 #include "session/VplPartPlanner.h"
 #if GIS_HAVE_EFFECTS
 #include "effects/EffectPlan.h"
+#include "reference/RayScene.h"
 #endif
 
 namespace gis {
@@ -72,6 +73,8 @@ std::string effectPlanKey(const Scene& scene, const FrameState& s) {
     };
     return nlohmann::json{
         {"scene", scene.name},
+        // The same name can be a new scene (an upload replaced under its name).
+        {"scene_object", reinterpret_cast<std::uintptr_t>(&scene)},
         {"technique", s.technique},
         {"params", s.techniqueParams.toJson()},
         {"frame", s.frameParams.toJson()},
@@ -234,6 +237,7 @@ std::vector<std::shared_ptr<ClientLink>> Session::clients() const {
 }
 
 void Session::markInput() {
+    mPlanRaysWaited = false; // the step that waited is replaced; the next one asks again
     if (!mDirty) mPendingSince = Clock::now();
     mDirty = true;
     mNextStep = Step::Interactive;
@@ -444,6 +448,7 @@ bool Session::readyLocked(Clock::time_point now) const {
 
 bool Session::stepReadyLocked(Clock::time_point now) const {
     if (mDirty) return true;
+    if (mPlanRaysWaited) return false;
     if (!mStream.adaptive || mNextStep == Step::Done || mNextStep == Step::Interactive) return false;
     return mNextStep != Step::Balanced ||
            now >= mLastInput + std::chrono::milliseconds(mConfig.limits.settleMs);
@@ -474,11 +479,28 @@ struct Session::Worker {
     };
     std::unique_ptr<Load> load;
     std::string queuedRequest; ///< asked for while `load` ran: started when it ends (the newer wins)
+    /// The effect planner's ray structure of the scene shown, built on a thread of its own the first
+    /// time a frame asks for a plan and kept while that scene is shown: a plan then costs its rays
+    /// (milliseconds) rather than the structure's build (1.5 s at 2M triangles). planRaysFor.
+    struct PlanRays {
+        std::shared_ptr<const Scene> scene;
+        std::thread thread;
+        bool done = false; ///< guarded by Session::mMutex; set last by the thread
+        std::shared_ptr<const reference::RayScene> rays; ///< the thread's result, or
+        std::string error;                               ///< why there is none
+        double buildMs = 0.0;
+    };
+    std::unique_ptr<PlanRays> planRays;
+    /// Builds for a scene no longer shown: joined once done (or when the session ends).
+    std::vector<std::unique_ptr<PlanRays>> retiredPlanRays;
     ~Worker() {
         if (load && load->thread.joinable()) {
             load->cancelled = true; // the session ends: a long load must not hold its teardown
             load->thread.join();
         }
+        if (planRays && planRays->thread.joinable()) planRays->thread.join();
+        for (auto& r : retiredPlanRays)
+            if (r->thread.joinable()) r->thread.join();
     }
 };
 
@@ -573,6 +595,7 @@ void Session::finishLoad(Worker& w) {
         return;
     }
     const std::shared_ptr<const Scene>& next = load->scene;
+    if (w.planRays && !w.planRays->thread.joinable()) w.planRays.reset(); // the old scene's structure
     // The GL upload (buffers, textures, their mipmaps) is the part of a load that holds the render
     // thread: state.load says what it cost.
     const Stopwatch uploadClock;
@@ -598,6 +621,84 @@ void Session::finishLoad(Worker& w) {
     }
     broadcastText(stateMsg);
 }
+
+#if GIS_HAVE_EFFECTS
+const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr<const Scene>& scene,
+                                                bool& failed) {
+    failed = false;
+    // Builds for scenes no longer shown: joined once their thread is done, never waited for.
+    std::erase_if(w.retiredPlanRays, [&](std::unique_ptr<Worker::PlanRays>& r) {
+        {
+            std::lock_guard lock(mMutex);
+            if (!r->done) return false;
+        }
+        r->thread.join();
+        return true;
+    });
+    if (w.planRays && w.planRays->scene != scene) {
+        if (w.planRays->thread.joinable()) {
+            bool done = false;
+            {
+                std::lock_guard lock(mMutex);
+                done = w.planRays->done;
+            }
+            if (done)
+                w.planRays->thread.join();
+            else
+                w.retiredPlanRays.push_back(std::move(w.planRays));
+        }
+        w.planRays.reset();
+    }
+    if (!w.planRays) {
+        w.planRays = std::make_unique<Worker::PlanRays>();
+        Worker::PlanRays* build = w.planRays.get();
+        build->scene = scene;
+        build->thread = std::thread([this, build] {
+            Stopwatch clock;
+            std::shared_ptr<const reference::RayScene> rays;
+            std::string error;
+            try {
+                rays = std::make_shared<const reference::RayScene>(*build->scene);
+            } catch (const std::exception& e) {
+                error = e.what();
+            } catch (...) {
+                error = "unknown error";
+            }
+            {
+                std::lock_guard lock(mMutex);
+                build->rays = std::move(rays);
+                build->error = std::move(error);
+                build->buildMs = clock.elapsedMs();
+                build->done = true;
+                mPlanRaysWaited = false; // a step that waited for it may render now
+                if (mPlanPendingShown && !mStream.adaptive) {
+                    // Fixed quality renders on input only: the view shown was not planned.
+                    if (!mDirty) mPendingSince = Clock::now();
+                    mDirty = true;
+                }
+            }
+            mCv.notify_all();
+        });
+        logInfo("session " + mId + ": building the effect planner's ray structure for " +
+                validUtf8(scene->name) + " (" + std::to_string(scene->triangleCount()) + " triangles)");
+    }
+    {
+        std::lock_guard lock(mMutex);
+        if (!w.planRays->done) return nullptr;
+    }
+    if (w.planRays->thread.joinable()) {
+        w.planRays->thread.join();
+        if (w.planRays->rays)
+            logInfo("session " + mId + ": effect planner's ray structure built in " +
+                    std::to_string(std::lround(w.planRays->buildMs)) + " ms");
+        else
+            logWarn("session " + mId + ": the effect planner's ray structure could not be built (" +
+                    validUtf8(w.planRays->error) + "): effects render as the technique's parameters say");
+    }
+    failed = w.planRays->rays == nullptr;
+    return w.planRays->rays.get();
+}
+#endif
 
 int Session::frameTargetMs(const StreamOptions& stream) const {
     return stream.frameTargetMs >= 0 ? stream.frameTargetMs : mConfig.limits.frameTargetMs;
@@ -976,7 +1077,8 @@ void Session::workerMain() {
                 if (mLoadDone || readyLocked(now)) break;
                 if (mDirty && mController && mController->windowFull() && !windowWaitFrom)
                     windowWaitFrom = now;
-                if (mStream.adaptive && mNextStep == Step::Balanced && !mDirty && mController)
+                if (mStream.adaptive && mNextStep == Step::Balanced && !mDirty && mController &&
+                    !mPlanRaysWaited)
                     mCv.wait_until(lock, mLastInput + std::chrono::milliseconds(mConfig.limits.settleMs));
                 else
                     mCv.wait(lock);
@@ -1061,12 +1163,47 @@ void Session::workerMain() {
         // The effect plan: measured again only when the scene, the parameters, or the camera or light
         // change materially, never every frame.
         if (effectPlanRequested(state)) {
-            const std::string key = effectPlanKey(*scene, state);
-            if (key != planKey) {
-                plan = planEffects(*scene, state);
-                planKey = key;
+            bool raysFailed = false;
+            const reference::RayScene* rays = planRaysFor(w, scene, raysFailed);
+            if (rays) {
+                const std::string key = effectPlanKey(*scene, state);
+                if (key != planKey) {
+                    plan = planEffects(*scene, *rays, state);
+                    planKey = key;
+                }
+                applyEffectPlan(state, plan);
+                std::lock_guard lock(mMutex);
+                mPlanPendingShown = false;
+            } else if (!raysFailed && !snapshotFor &&
+                       (step == static_cast<int>(Step::Balanced) || step == static_cast<int>(Step::Final))) {
+                // A refinement step waits for the structure (input does not: it still renders at
+                // once), and is taken up again when the build ends.
+                bool wait = false;
+                {
+                    std::lock_guard lock(mMutex);
+                    if (!mDirty) {
+                        mNextStep = static_cast<Step>(step);
+                        mPlanRaysWaited = wait = !w.planRays->done;
+                    }
+                }
+                if (wait)
+                    broadcastProgress("refining", qualityStepName(static_cast<QualityStep>(step)), 0.0, 0.0,
+                                      "measuring the scene for the effect plan (its ray structure: " +
+                                          std::to_string(scene->triangleCount()) + " triangles)");
+                continue;
+            } else {
+                // Interactive frames and snapshots do not wait: the technique's parameters decide.
+                // A fixed-quality view is rendered again when the plan is ready (the build's end).
+                if (!raysFailed && !snapshotFor) {
+                    std::lock_guard lock(mMutex);
+                    mPlanPendingShown = true;
+                }
+                state.plan = {{"mode", "auto"},
+                              {"pending", raysFailed ? "the scene's ray structure could not be built: the "
+                                                       "technique's parameters decide"
+                                                     : "measuring the scene: the technique's parameters "
+                                                       "decide until the plan is ready"}};
             }
-            applyEffectPlan(state, plan);
         }
 #endif
         const bool refinement = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||

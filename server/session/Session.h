@@ -38,6 +38,9 @@
 namespace gis {
 
 struct TileRect;
+namespace reference {
+class RayScene;
+}
 
 class RenderGate;
 
@@ -148,6 +151,11 @@ private:
     /// Joins the finished load and swaps its scene in (state message, fresh camera and lights, an
     /// interactive frame next), or reports why it failed; starts the request queued meanwhile instead.
     void finishLoad(Worker& w);
+    /// The effect planner's ray structure of `scene` (Worker::planRays), or null while a thread of
+    /// its own builds it (started here when none runs) or when it could not be built (`failed`).
+    /// Defined where the effects library is built in (GIS_HAVE_EFFECTS).
+    const reference::RayScene* planRaysFor(Worker& w, const std::shared_ptr<const Scene>& scene,
+                                           bool& failed);
     /// True when input (or a snapshot, or stop) waits: refinement yields to it.
     bool inputPending() const;
     int frameTargetMs(const StreamOptions& stream) const;
@@ -208,6 +216,11 @@ private:
     std::shared_ptr<const Scene> mScene;
     std::string mSceneRequest;
     bool mLoadDone = false; ///< the worker's scene load has ended (Worker::load); guarded by mMutex
+    /// A refinement step waits for the planner's ray structure (planRaysFor): not ready to render
+    /// until its build ends or input comes. Guarded by mMutex.
+    bool mPlanRaysWaited = false;
+    /// The frame last shown was rendered without its effect plan (the structure was being built).
+    bool mPlanPendingShown = false;
     StreamOptions mStream;
     bool mDirty = true;
     Step mNextStep = Step::Done;

@@ -745,6 +745,50 @@ check('a session that ends during a load cancels it: its teardown does not wait 
     assert.doesNotMatch(servers.main.log, /upload:abandoned\.glb loaded/, 'the load never finished');
 });
 
+check('the final step waits for the effect planner\'s ray structure without holding input, and keeps it', async () => {
+    const client = await open(servers.main, { adaptive: true });
+    await client.frame('a first frame', (s) => s.scene === 'builtin:cornell');
+    client.send({ type: 'scene', name: 'builtin:atrium' });
+    // The final step plans effects (adaptive quality); the atrium's 560k triangles take a while to
+    // build into the planner's ray structure, on a thread of the session's own.
+    await client.inbox.next((m) => m.type === 'progress' && m.step === 'final' && /effect plan/.test(m.reason),
+        'the final step says it waits for the effect plan', 60000);
+    const sentAt = performance.now();
+    client.send({ type: 'camera', position: [4, 3, 9], target: [0, 2, 0] });
+    const answer = await client.frame('the camera is answered meanwhile', (s) => s.scene === 'builtin:atrium' &&
+        s.quality === 'interactive' && client.inbox.arrivedAt.get(s) > sentAt, 15000);
+    assert.ok(answer.stats.plan === undefined || answer.stats.plan.mode !== 'auto' || answer.stats.plan.pending !== undefined,
+        'an interactive frame does not wait for a plan');
+    const planned = await client.frame('a final frame with its plan', (s) => s.quality === 'final' &&
+        Array.isArray(s.plan?.decisions), 60000);
+    assert.ok(planned.stats.plan.decisions.length > 0);
+    // A camera move far enough to plan again: the structure is kept, so this plan is rays only.
+    client.send({ type: 'camera', position: [-6, 4, 8], target: [0, 2, 0] });
+    await client.frame('the move is answered', (s) => s.quality === 'interactive', 15000);
+    const replanned = await client.frame('the next final frame with its plan', (s) => s.quality === 'final' &&
+        Array.isArray(s.plan?.decisions), 60000);
+    const builds = servers.main.log.split('\n').filter((l) => l.includes(`session ${client.welcome.session}: building the effect planner`));
+    assert.equal(builds.length, 1, `one build for the session's scene: ${builds.join(' | ')}`);
+    console.log(`# plans: ${planned.stats.plan.analysis_ms.toFixed(1)} ms, then ${replanned.stats.plan.analysis_ms.toFixed(1)} ms; ` +
+        `${servers.main.log.match(/ray structure built in \d+ ms/g)?.at(-1) ?? ''}`);
+});
+
+check('a fixed-quality view with effects=auto is planned when the ray structure is ready, without input', async () => {
+    const client = await open(servers.main);
+    await client.frame('a first frame', (s) => s.scene === 'builtin:cornell');
+    client.send({ type: 'params', values: { effects: 'auto' } });
+    client.send({ type: 'scene', name: 'builtin:atrium' });
+    const first = await client.frame('the first frame of the new scene', (s) => s.scene === 'builtin:atrium', 60000);
+    if (Array.isArray(first.stats.plan?.decisions)) {
+        console.log('# the structure was ready before the first frame: nothing to wait for');
+        return;
+    }
+    assert.match(first.stats.plan?.pending ?? '', /measuring the scene/, 'the frame says it is not planned yet');
+    const planned = await client.frame('the view again once the plan is ready', (s) => Array.isArray(s.plan?.decisions), 60000);
+    assert.equal(planned.stats.scene, 'builtin:atrium');
+    console.log(`# unplanned first frame ("${first.stats.plan.pending}"), planned frame ${planned.stats.frame} without input`);
+});
+
 check('POST /api/upload of a body that is not a .glb is 400', async () => {
     const client = await open(servers.main);
     const res = await servers.main.http('/api/upload?name=tiny.glb', {
