@@ -220,7 +220,7 @@ bool EffectPlan::enabled(std::string_view effect) const {
 
 EffectPlan planEffects(const Scene& scene, const FrameState& state, const EffectPlanOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    const RayScene rays(scene);
+    const RayScene rays(scene, {.fastBuild = true}); // a few thousand rays: the build is what costs
     EffectPlan plan = planEffects(scene, rays, state, options);
     // The structure's build is part of what this call cost.
     plan.analysisMs =

@@ -83,8 +83,8 @@ struct EffectPlan {
 /// off with a reason).
 EffectPlan planEffects(const Scene& scene, const FrameState& state, const EffectPlanOptions& options = {});
 /// The same with the scene's ray structure built once and kept (RayScene(scene), flattened instances
-/// and all; its build is most of a plan on a big scene: 1.5 s of 1.5 s at 2M triangles, against a
-/// few milliseconds of rays). `rays` must be built from `scene`; queries are thread-safe.
+/// and all; its build is most of a plan on a big scene: 0.5-0.8 s at 2M triangles, against a few
+/// milliseconds of rays). `rays` must be built from `scene`; queries are thread-safe.
 EffectPlan planEffects(const Scene& scene, const reference::RayScene& rays, const FrameState& state,
                        const EffectPlanOptions& options = {});
 

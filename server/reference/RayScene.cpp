@@ -204,14 +204,27 @@ struct RayScene::Impl {
     }
 };
 
-RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
+RayScene::RayScene(const Scene& scene, const RaySceneOptions& options) : mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
+    const auto throwIfCancelled = [&] {
+        if (options.cancelled && options.cancelled()) throw BuildCancelled();
+    };
     m.source = flattenInstances(scene);
+    throwIfCancelled();
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw Error("reference: cannot create the Embree device");
     m.scene = rtcNewScene(m.device);
     rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
-    rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(m.scene, options.fastBuild ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
+    if (options.cancelled) {
+        // Embree asks from its build threads; answering false cancels the commit.
+        rtcSetSceneProgressMonitorFunction(
+            m.scene,
+            [](void* cancelled, double) {
+                return !(*static_cast<const std::function<bool()>*>(cancelled))();
+            },
+            const_cast<std::function<bool()>*>(&options.cancelled));
+    }
 
     // One sRGB decode table: textures are decoded to linear once, then filtered in linear space.
     std::array<float, 256> decode{};
@@ -238,6 +251,7 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
     }
 
     for (size_t mi = 0; mi < m.source.meshes.size(); ++mi) {
+        throwIfCancelled();
         const Mesh& mesh = m.source.meshes[mi];
         const size_t triangles = mesh.indices.size() / 3;
         if (triangles == 0 || mesh.positions.empty()) continue;
@@ -283,8 +297,10 @@ RayScene::RayScene(const Scene& scene) : mImpl(std::make_unique<Impl>()) {
             m.oneSided[id] = &mesh;
     }
     rtcCommitScene(m.scene);
-    if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
-        throw Error("reference: Embree failed to build the scene");
+    const RTCError built = rtcGetDeviceError(m.device);
+    if (built == RTC_ERROR_CANCELLED || (built != RTC_ERROR_NONE && options.cancelled && options.cancelled()))
+        throw BuildCancelled();
+    if (built != RTC_ERROR_NONE) throw Error("reference: Embree failed to build the scene");
 
     // Far enough to clear float rounding of positions anywhere in the scene (coordinates up to
     // |centre| + radius carry a relative error of ~1e-7), small enough not to skip real geometry in

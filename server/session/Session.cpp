@@ -481,9 +481,10 @@ struct Session::Worker {
     std::string queuedRequest; ///< asked for while `load` ran: started when it ends (the newer wins)
     /// The effect planner's ray structure of the scene shown, built on a thread of its own the first
     /// time a frame asks for a plan and kept while that scene is shown: a plan then costs its rays
-    /// (milliseconds) rather than the structure's build (1.5 s at 2M triangles). planRaysFor.
+    /// (milliseconds) rather than the structure's build (0.5-0.8 s at 2M triangles). planRaysFor.
     struct PlanRays {
         std::shared_ptr<const Scene> scene;
+        std::atomic<bool> cancel{false}; ///< its scene is no longer shown, or the session ends
         std::thread thread;
         bool done = false; ///< guarded by Session::mMutex; set last by the thread
         std::shared_ptr<const reference::RayScene> rays; ///< the thread's result, or
@@ -498,6 +499,9 @@ struct Session::Worker {
             load->cancelled = true; // the session ends: a long load must not hold its teardown
             load->thread.join();
         }
+        // Builds stop at Embree's next progress check: the teardown does not wait for them.
+        if (planRays) planRays->cancel = true;
+        for (auto& r : retiredPlanRays) r->cancel = true;
         if (planRays && planRays->thread.joinable()) planRays->thread.join();
         for (auto& r : retiredPlanRays)
             if (r->thread.joinable()) r->thread.join();
@@ -642,10 +646,12 @@ const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr
                 std::lock_guard lock(mMutex);
                 done = w.planRays->done;
             }
-            if (done)
+            if (done) {
                 w.planRays->thread.join();
-            else
+            } else {
+                w.planRays->cancel = true; // not wanted any more: stop it rather than finish it
                 w.retiredPlanRays.push_back(std::move(w.planRays));
+            }
         }
         w.planRays.reset();
     }
@@ -658,7 +664,13 @@ const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr
             std::shared_ptr<const reference::RayScene> rays;
             std::string error;
             try {
-                rays = std::make_shared<const reference::RayScene>(*build->scene);
+                // The planner traces a few thousand rays: the faster build (RaySceneOptions).
+                reference::RaySceneOptions options;
+                options.fastBuild = true;
+                options.cancelled = [this, build] { return build->cancel.load() || mStop.load(); };
+                rays = std::make_shared<const reference::RayScene>(*build->scene, options);
+            } catch (const reference::BuildCancelled&) {
+                error = "cancelled";
             } catch (const std::exception& e) {
                 error = e.what();
             } catch (...) {
