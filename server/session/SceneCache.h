@@ -1,4 +1,6 @@
-// Scenes shared read-only by every session: loaded once per name, kept while anyone holds them.
+// Scenes shared read-only by every session: loaded once per name, kept while anyone holds them; and
+// the effect planner's ray structure of each, kept while a session holds it, so a second session on
+// the same scene plans without building it again.
 #pragma once
 
 #include <map>
@@ -10,6 +12,9 @@
 #include "scene/SceneLoader.h"
 
 namespace gis {
+namespace reference {
+class RayScene;
+}
 
 class SceneCache {
 public:
@@ -17,9 +22,21 @@ public:
     /// by `name` (a builtin: name or an absolute path); `options` apply when it is loaded.
     std::shared_ptr<const Scene> get(const std::string& name, const SceneLoadOptions& options = {});
 
+    /// The planner's ray structure of `scene` that a session built and still holds, or null.
+    std::shared_ptr<const reference::RayScene> planRays(const std::shared_ptr<const Scene>& scene);
+    /// Offers `rays` (built from `scene`) to the sessions that plan on the same scene later.
+    void keepPlanRays(const std::shared_ptr<const Scene>& scene,
+                      const std::shared_ptr<const reference::RayScene>& rays);
+
 private:
     std::mutex mMutex;
     std::map<std::string, std::weak_ptr<const Scene>> mScenes;
+    /// By the scene's address, with the scene itself to tell a new scene at a reused address.
+    struct KeptRays {
+        std::weak_ptr<const Scene> scene;
+        std::weak_ptr<const reference::RayScene> rays;
+    };
+    std::map<const Scene*, KeptRays> mPlanRays;
 };
 
 } // namespace gis

@@ -659,6 +659,15 @@ const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr
         w.planRays = std::make_unique<Worker::PlanRays>();
         Worker::PlanRays* build = w.planRays.get();
         build->scene = scene;
+        // Another session on this scene built it already.
+        if (auto shared = mScenes->planRays(scene)) {
+            std::lock_guard lock(mMutex);
+            build->rays = std::move(shared);
+            build->done = true;
+            logInfo("session " + mId + ": the effect planner's ray structure for " + validUtf8(scene->name) +
+                    " is shared with another session");
+            return build->rays.get();
+        }
         build->thread = std::thread([this, build] {
             Stopwatch clock;
             std::shared_ptr<const reference::RayScene> rays;
@@ -700,10 +709,11 @@ const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr
     }
     if (w.planRays->thread.joinable()) {
         w.planRays->thread.join();
-        if (w.planRays->rays)
+        if (w.planRays->rays) {
             logInfo("session " + mId + ": effect planner's ray structure built in " +
                     std::to_string(std::lround(w.planRays->buildMs)) + " ms");
-        else
+            mScenes->keepPlanRays(scene, w.planRays->rays);
+        } else
             logWarn("session " + mId + ": the effect planner's ray structure could not be built (" +
                     validUtf8(w.planRays->error) + "): effects render as the technique's parameters say");
     }

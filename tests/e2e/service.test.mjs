@@ -773,6 +773,24 @@ check('the final step waits for the effect planner\'s ray structure without hold
         `${servers.main.log.match(/ray structure built in \d+ ms/g)?.at(-1) ?? ''}`);
 });
 
+check('a second session on the same scene plans with the first one\'s ray structure', async () => {
+    const planned = async (client) => {
+        await client.frame('a first frame', () => true);
+        client.send({ type: 'scene', name: 'builtin:atrium' });
+        return client.frame('a final frame with its plan', (s) => s.scene === 'builtin:atrium' && s.quality === 'final' &&
+            Array.isArray(s.plan?.decisions), 60000);
+    };
+    const first = await open(servers.main, { adaptive: true });
+    await planned(first);
+    const second = await open(servers.main, { adaptive: true });
+    await planned(second);
+    const lines = (session) => servers.main.log.split('\n').filter((l) => l.includes(`session ${session}: `));
+    assert.ok(!lines(second.welcome.session).some((l) => l.includes('building the effect planner')),
+        'the second session builds nothing');
+    assert.ok(lines(second.welcome.session).some((l) => l.includes('is shared with another session')),
+        'it says it shares the structure');
+});
+
 check('a fixed-quality view with effects=auto is planned when the ray structure is ready, without input', async () => {
     const client = await open(servers.main);
     await client.frame('a first frame', (s) => s.scene === 'builtin:cornell');
