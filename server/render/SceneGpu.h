@@ -48,7 +48,8 @@ public:
 
     /// What the upload sends, built without GL on any thread: the interleaved vertices, the indices,
     /// the placements and the runs with their bounds. A scene load builds it beside the scene, so
-    /// the render thread only uploads (on a 2M-triangle scene this was 115 of its 241 ms).
+    /// the render thread only uploads (2M triangles held it about 170 ms instead of 344 ms:
+    /// `state.load.upload_ms` in bench/scenes/load_progress.mjs).
     struct Prepared;
     static std::shared_ptr<const Prepared> prepare(const Scene& scene);
 

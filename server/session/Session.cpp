@@ -484,9 +484,10 @@ struct Session::Worker {
     /// (milliseconds) rather than the structure's build (0.5-0.8 s at 2M triangles). planRaysFor.
     struct PlanRays {
         std::shared_ptr<const Scene> scene;
-        std::atomic<bool> cancel{false}; ///< its scene is no longer shown, or the session ends
+        std::atomic<bool> cancelled{false}; ///< its scene is no longer shown, or the session ends
         std::thread thread;
-        bool done = false; ///< guarded by Session::mMutex; set last by the thread
+        /// Set last by the thread (under Session::mMutex, with the wake-up of a step that waits).
+        std::atomic<bool> done{false};
         std::shared_ptr<const reference::RayScene> rays; ///< the thread's result, or
         std::string error;                               ///< why there is none
         double buildMs = 0.0;
@@ -494,14 +495,33 @@ struct Session::Worker {
     std::unique_ptr<PlanRays> planRays;
     /// Builds for a scene no longer shown: joined once done (or when the session ends).
     std::vector<std::unique_ptr<PlanRays>> retiredPlanRays;
+    /// Lets go of `planRays` (another scene is shown): a build still running is cancelled and
+    /// joined later (joinRetiredPlanRays), never waited for.
+    void dropPlanRays() {
+        if (!planRays) return;
+        if (planRays->thread.joinable() && !planRays->done) {
+            planRays->cancelled = true;
+            retiredPlanRays.push_back(std::move(planRays));
+            return;
+        }
+        if (planRays->thread.joinable()) planRays->thread.join();
+        planRays.reset();
+    }
+    void joinRetiredPlanRays() {
+        std::erase_if(retiredPlanRays, [](std::unique_ptr<PlanRays>& r) {
+            if (!r->done) return false;
+            r->thread.join();
+            return true;
+        });
+    }
     ~Worker() {
         if (load && load->thread.joinable()) {
             load->cancelled = true; // the session ends: a long load must not hold its teardown
             load->thread.join();
         }
         // Builds stop at Embree's next progress check: the teardown does not wait for them.
-        if (planRays) planRays->cancel = true;
-        for (auto& r : retiredPlanRays) r->cancel = true;
+        if (planRays) planRays->cancelled = true;
+        for (auto& r : retiredPlanRays) r->cancelled = true;
         if (planRays && planRays->thread.joinable()) planRays->thread.join();
         for (auto& r : retiredPlanRays)
             if (r->thread.joinable()) r->thread.join();
@@ -599,7 +619,7 @@ void Session::finishLoad(Worker& w) {
         return;
     }
     const std::shared_ptr<const Scene>& next = load->scene;
-    if (w.planRays && !w.planRays->thread.joinable()) w.planRays.reset(); // the old scene's structure
+    if (w.planRays && w.planRays->scene != next) w.dropPlanRays(); // the old scene's structure
     // The GL upload (buffers, textures, their mipmaps) is the part of a load that holds the render
     // thread: state.load says what it cost.
     const Stopwatch uploadClock;
@@ -630,38 +650,14 @@ void Session::finishLoad(Worker& w) {
 const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr<const Scene>& scene,
                                                 bool& failed) {
     failed = false;
-    // Builds for scenes no longer shown: joined once their thread is done, never waited for.
-    std::erase_if(w.retiredPlanRays, [&](std::unique_ptr<Worker::PlanRays>& r) {
-        {
-            std::lock_guard lock(mMutex);
-            if (!r->done) return false;
-        }
-        r->thread.join();
-        return true;
-    });
-    if (w.planRays && w.planRays->scene != scene) {
-        if (w.planRays->thread.joinable()) {
-            bool done = false;
-            {
-                std::lock_guard lock(mMutex);
-                done = w.planRays->done;
-            }
-            if (done) {
-                w.planRays->thread.join();
-            } else {
-                w.planRays->cancel = true; // not wanted any more: stop it rather than finish it
-                w.retiredPlanRays.push_back(std::move(w.planRays));
-            }
-        }
-        w.planRays.reset();
-    }
+    w.joinRetiredPlanRays();
+    if (w.planRays && w.planRays->scene != scene) w.dropPlanRays();
     if (!w.planRays) {
         w.planRays = std::make_unique<Worker::PlanRays>();
         Worker::PlanRays* build = w.planRays.get();
         build->scene = scene;
         // Another session on this scene built it already.
         if (auto shared = mScenes->planRays(scene)) {
-            std::lock_guard lock(mMutex);
             build->rays = std::move(shared);
             build->done = true;
             logInfo("session " + mId + ": the effect planner's ray structure for " + validUtf8(scene->name) +
@@ -676,7 +672,7 @@ const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr
                 // The planner traces a few thousand rays: the faster build (RaySceneOptions).
                 reference::RaySceneOptions options;
                 options.fastBuild = true;
-                options.cancelled = [this, build] { return build->cancel.load() || mStop.load(); };
+                options.cancelled = [this, build] { return build->cancelled.load() || mStop.load(); };
                 rays = std::make_shared<const reference::RayScene>(*build->scene, options);
             } catch (const reference::BuildCancelled&) {
                 error = "cancelled";
@@ -703,10 +699,7 @@ const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr
         logInfo("session " + mId + ": building the effect planner's ray structure for " +
                 validUtf8(scene->name) + " (" + std::to_string(scene->triangleCount()) + " triangles)");
     }
-    {
-        std::lock_guard lock(mMutex);
-        if (!w.planRays->done) return nullptr;
-    }
+    if (!w.planRays->done) return nullptr;
     if (w.planRays->thread.joinable()) {
         w.planRays->thread.join();
         if (w.planRays->rays) {

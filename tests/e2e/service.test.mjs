@@ -673,17 +673,28 @@ function slowToLoadGlb(side, images = 1) {
     return Buffer.concat([header, chunkHeader(json.length, 0x4e4f534a), json, chunkHeader(bin.length, 0x004e4942), bin]);
 }
 
-check('input during a scene load is answered by the view in place; the new scene follows', async () => {
+/**
+ * An adaptive session past its first frame of the built-in scene that has asked for `name`, an
+ * upload of `images` 4096 x 4096 PNGs (about 250 ms of decoding each), and seen its `loading`.
+ * `askedAt`: when the scene was asked for.
+ */
+async function loadingSlowUpload(name, images) {
     const client = await open(servers.main, { adaptive: true });
     await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
-    // Decoding a 4096 x 4096 PNG takes a few hundred milliseconds: the load runs on its own thread.
-    const res = await servers.main.http('/api/upload?name=slow.glb', {
-        method: 'POST', body: slowToLoadGlb(4096),
+    const res = await servers.main.http(`/api/upload?name=${name}`, {
+        method: 'POST', body: slowToLoadGlb(4096, images),
         headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
     });
     assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
-    client.send({ type: 'scene', name: 'upload:slow.glb' });
+    const askedAt = performance.now();
+    client.send({ type: 'scene', name: `upload:${name}` });
     await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+    return { client, askedAt };
+}
+
+check('input during a scene load is answered by the view in place; the new scene follows', async () => {
+    // The load runs on its own thread.
+    const { client } = await loadingSlowUpload('slow.glb', 1);
     const sentAt = performance.now();
     client.send({ type: 'camera', position: [0.5, 1.1, 3.7], target: [0, 1, 0] });
     const answer = await client.frame('the view in place answers the camera', (s) => s.scene === 'builtin:cornell' &&
@@ -697,17 +708,8 @@ check('input during a scene load is answered by the view in place; the new scene
 });
 
 check('a scene asked for during a load cancels that load: the newer scene does not wait for it', async () => {
-    const client = await open(servers.main, { adaptive: true });
-    await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
-    // Three 4096 x 4096 images: about 750 ms of decoding, checked for a cancel between images.
-    const res = await servers.main.http('/api/upload?name=slower.glb', {
-        method: 'POST', body: slowToLoadGlb(4096, 3),
-        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
-    });
-    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
-    const loadAskedAt = performance.now();
-    client.send({ type: 'scene', name: 'upload:slower.glb' });
-    await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+    // Three images: about 750 ms of decoding, checked for a cancel between images.
+    const { client, askedAt: loadAskedAt } = await loadingSlowUpload('slower.glb', 3);
     const askedAt = performance.now();
     client.send({ type: 'scene', name: 'builtin:cornell-empty' });
     await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'builtin:cornell-empty',
@@ -723,15 +725,7 @@ check('a scene asked for during a load cancels that load: the newer scene does n
 });
 
 check('a session that ends during a load cancels it: its teardown does not wait for the file', async () => {
-    const client = await open(servers.main, { adaptive: true });
-    await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
-    const res = await servers.main.http('/api/upload?name=abandoned.glb', {
-        method: 'POST', body: slowToLoadGlb(4096, 3),
-        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
-    });
-    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
-    client.send({ type: 'scene', name: 'upload:abandoned.glb' });
-    await client.inbox.next((m) => m.type === 'progress' && m.state === 'loading', 'progress loading', 15000);
+    const { client } = await loadingSlowUpload('abandoned.glb', 3);
     const closedAt = performance.now();
     await client.close();
     const deadline = Date.now() + 15000;
