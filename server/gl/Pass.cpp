@@ -292,4 +292,10 @@ bool Pass::drawFullscreenAnySamples(const VertexArray& emptyVao, const Query& an
     return any != 0;
 }
 
+void Pass::drawFullscreenCounted(const VertexArray& emptyVao, const Query& samplesPassed) {
+    glBeginQuery(GL_SAMPLES_PASSED, samplesPassed.id());
+    drawFullscreen(emptyVao);
+    glEndQuery(GL_SAMPLES_PASSED);
+}
+
 } // namespace gis::gl

@@ -94,6 +94,9 @@ public:
     /// drawFullscreen() counted by `anySamples` (a GL_ANY_SAMPLES_PASSED query): waits for the result
     /// and returns whether any sample passed the tests.
     bool drawFullscreenAnySamples(const VertexArray& emptyVao, const Query& anySamples);
+    /// drawFullscreen() counted by `samplesPassed` (a GL_SAMPLES_PASSED query); does not wait: read
+    /// the result when it is needed.
+    void drawFullscreenCounted(const VertexArray& emptyVao, const Query& samplesPassed);
     /// Dispatches groupsX x groupsY x groupsZ work groups of the compute program in use.
     Pass& dispatch(int groupsX, int groupsY = 1, int groupsZ = 1);
     /// Dispatches the work-group counts stored at `offset` in `commands`.

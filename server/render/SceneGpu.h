@@ -165,6 +165,7 @@ private:
     std::vector<RunBounds> mRunBounds;
     std::vector<Material> mMaterials;
     std::vector<gl::Texture> mTextures;
+    gl::Texture mFallbackTexture; ///< one white texel, nearest: on the units of maps a material lacks
     std::size_t mTriangles = 0, mStoredTriangles = 0, mInstances = 0;
 };
 

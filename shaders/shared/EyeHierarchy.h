@@ -20,6 +20,7 @@
 #define GIS_EYE_FLAG_REFINE 1u  // this patch must be subdivided
 #define GIS_EYE_FLAG_COVERED 2u // at least one pixel of the patch sees geometry
 #define GIS_EYE_FLAG_DISCONTINUOUS 4u // the patch itself holds a discontinuity (before the diagonal rule)
+#define GIS_EYE_FLAG_SUBDIVIDED 8u // this patch and every ancestor refine: its children are visited
 
 struct EyeHierarchyUniforms {
     ivec4 level[GIS_MAX_EYE_LEVELS]; // xy: atlas offset (texels); zw: level size (texels)

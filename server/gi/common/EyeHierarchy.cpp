@@ -55,17 +55,21 @@ EyeHierarchy::EyeHierarchy() {
         return gl::Program::build(
             {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, fragment}}, defines);
     };
-    mReduceFromPixels =
-        std::make_unique<ReduceProgram>(build("gi/common/eye_mip_reduce.frag", {{"GIS_FROM_GBUFFER", "1"}}));
+    for (int metrics = 0; metrics < 2; ++metrics)
+        mReduceFromPixels[static_cast<size_t>(metrics)] = std::make_unique<ReduceProgram>(
+            build("gi/common/eye_mip_reduce.frag",
+                  {{"GIS_FROM_GBUFFER", "1"}, {"GIS_EYE_PIXEL_METRICS", metrics ? "1" : "0"}}));
     mReduce = std::make_unique<ReduceProgram>(build("gi/common/eye_mip_reduce.frag"));
 
     mFlagsProgram.program = build("gi/common/eye_flags.frag");
+    mFlagsProgram.level = mFlagsProgram.program.location("uLevel");
     mFlagsProgram.discFlags = mFlagsProgram.program.textureUnit("uDiscFlags");
+    mFlagsProgram.flags = mFlagsProgram.program.textureUnit("uFlags");
 
     ReceiversProgram& r = mReceivers;
     r.program = build("gi/common/eye_receivers.frag");
+    r.level = r.program.location("uLevel");
     r.flags = r.program.textureUnit("uFlags");
-    r.counts = r.program.storageBlock("ReceiverCounts");
     r.inputs = EyeInputHandles(r.program);
 
     UpsampleProgram& u = mUpsample;
@@ -92,7 +96,7 @@ EyeHierarchy::EyeHierarchy() {
 
     mEmptyVao = gl::VertexArray::create();
     mUbo = gl::Buffer::create(sizeof(shader::EyeHierarchyUniforms));
-    mCounts = gl::Buffer::create(sizeof(mLastCounts), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    for (gl::Query& query : mReceiverQueries) query = gl::Query::create(GL_SAMPLES_PASSED);
 }
 
 void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
@@ -137,6 +141,7 @@ void EyeHierarchy::uploadUniforms(const ParamSet& params) {
     if (params.getBool("diagonal_refine")) options |= GIS_EYE_DIAGONAL;
     if (params.getEnum("depth_metric") == "derivative") options |= GIS_EYE_DEPTH_DERIVATIVE;
     if (params.getEnum("normal_metric") == "curvature") options |= GIS_EYE_CURVATURE;
+    mPixelMetrics = (options & (GIS_EYE_DEPTH_DERIVATIVE | GIS_EYE_CURVATURE)) != 0;
     u.info = glm::ivec4(static_cast<int>(mLevels.size()), mWidth, mHeight, options);
     u.thresholds =
         glm::vec4(params.getFloat("depth_threshold"), params.getFloat("depth_derivative_threshold"),
@@ -174,9 +179,10 @@ void EyeHierarchy::buildGeometryLevels(const FrameInputs& in, gl::PassTimer& tim
         const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
                                      &mDepthInfo,   &mNormalMin, &mNormalMax};
         for (int i = 0; i < 6; ++i) pass.texture(mReduce->geo[static_cast<size_t>(i)], *geo[i]);
-        bindInputs(pass, mReduceFromPixels->inputs, in);
+        const ReduceProgram& fromPixels = *mReduceFromPixels[mPixelMetrics ? 1 : 0];
+        bindInputs(pass, fromPixels.inputs, in);
         for (size_t l = 1; l < mLevels.size(); ++l) {
-            const ReduceProgram& program = l == 1 ? *mReduceFromPixels : *mReduce;
+            const ReduceProgram& program = l == 1 ? fromPixels : *mReduce;
             pass.use(program.program).textureBarrier(); // level l - 1 is complete before level l reads it
             pass.set(program.level, static_cast<int>(l))
                 .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
@@ -191,8 +197,14 @@ void EyeHierarchy::buildGeometryLevels(const FrameInputs& in, gl::PassTimer& tim
             pass.target(mFlagsFbo, mAtlasWidth, mAtlasHeight)
                 .use(mFlagsProgram.program)
                 .texture(mFlagsProgram.discFlags, mDiscFlags)
-                .viewport(mWidth, 0, mAtlasWidth - mWidth, mAtlasHeight) // the level column only
-                .drawFullscreen(mEmptyVao);
+                .texture(mFlagsProgram.flags, mFlags);
+            // Coarsest first: each level reads its parents' finished flags. Padding keeps the cleared 0.
+            for (size_t l = mLevels.size() - 1; l >= 1; --l) {
+                pass.textureBarrier()
+                    .set(mFlagsProgram.level, static_cast<int>(l))
+                    .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
+                    .drawFullscreen(mEmptyVao);
+            }
         }
     }
 }
@@ -213,18 +225,23 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
 
     gl::Pass pass(timer, "stencil_setup");
     pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight).clearColor(1).clearDepthStencil(1.0f, 0);
-    const GLuint zeroCounts[GIS_MAX_EYE_LEVELS] = {};
-    mCounts.upload(0, sizeof zeroCounts, zeroCounts);
-    pass.use(mReceivers.program).buffer(mReceivers.counts, mCounts).texture(mReceivers.flags, mFlags);
+    pass.use(mReceivers.program).texture(mReceivers.flags, mFlags);
     bindInputs(pass, mReceivers.inputs, in);
-    pass.noColorWrites().stencilTest(true).stencilFunc(GL_ALWAYS, 1).drawFullscreen(mEmptyVao);
+    pass.noColorWrites().stencilTest(true).stencilFunc(GL_ALWAYS, 1);
+    // One draw per level, each counted: the padding between levels is never shaded.
+    for (size_t l = 0; l < mLevels.size(); ++l) {
+        pass.set(mReceivers.level, static_cast<int>(l))
+            .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
+            .drawFullscreenCounted(mEmptyVao, mReceiverQueries[l]);
+    }
 }
 
 void EyeHierarchy::countReceivers(Counters& counters, int coveredPixels) {
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(mCounts.id(), 0, sizeof mLastCounts, mLastCounts.data());
     double total = 0;
     for (size_t l = 0; l < mLevels.size(); ++l) {
+        GLuint passed = 0;
+        glGetQueryObjectuiv(mReceiverQueries[l].id(), GL_QUERY_RESULT, &passed);
+        mLastCounts[l] = passed;
         counters["receivers_l" + std::to_string(l)] = mLastCounts[l];
         total += mLastCounts[l];
     }

@@ -107,12 +107,13 @@ private:
     };
     struct FlagsProgram {
         gl::Program program;
-        gl::TextureUnit discFlags;
+        gl::UniformLocation level;
+        gl::TextureUnit discFlags, flags;
     };
     struct ReceiversProgram {
         gl::Program program;
+        gl::UniformLocation level;
         gl::TextureUnit flags;
-        gl::BlockBinding counts;
         EyeInputHandles inputs;
     };
     struct UpsampleProgram {
@@ -125,13 +126,18 @@ private:
         gl::UniformLocation irradiance, interpolate, detailAlpha;
         gl::TextureUnit position, normal, albedo, reconstructed, rendered, atlasPosition, atlasNormal;
     };
-    std::unique_ptr<ReduceProgram> mReduceFromPixels, mReduce;
+    /// Level 1 from the G-buffer, without and with the per-pixel neighbour metrics (derivative,
+    /// curvature: a program variant, see eye_mip_reduce.frag); the coarser levels.
+    std::array<std::unique_ptr<ReduceProgram>, 2> mReduceFromPixels;
+    std::unique_ptr<ReduceProgram> mReduce;
+    bool mPixelMetrics = false; ///< the depth or normal metric reads the pixels' neighbours
     FlagsProgram mFlagsProgram;
     ReceiversProgram mReceivers;
     UpsampleProgram mUpsample;
     ResolveProgram mResolve;
     gl::VertexArray mEmptyVao;
-    gl::Buffer mUbo, mCounts;
+    gl::Buffer mUbo;
+    std::array<gl::Query, GIS_MAX_EYE_LEVELS> mReceiverQueries; ///< samples passed per level's stencil draw
     std::vector<EyeLevel> mLevels;
     int mWidth = 0, mHeight = 0, mCoarsest = 0, mAtlasWidth = 0, mAtlasHeight = 0;
     bool mBuilt = false; ///< the mipmaps and flags were built for the current layout

@@ -8,8 +8,9 @@
 //   1. (renderer) RSM and G-buffer
 //   2. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid into the compact VPL buffer (the cache)
 //   3. eye_mipmap: level 0 statistics from the G-buffer, min-max / derivative / curvature mips up
-//      to the coarsest level, and the refinement flag of every texel (EyeHierarchy)
-//   4. stencil_setup: one full-screen pass over the flattened buffer sets stencil 1 at receivers
+//      to the coarsest level; refine_flags: the refinement flag of every texel (EyeHierarchy)
+//   4. stencil_setup: one full-screen draw per level of the flattened buffer sets stencil 1 at
+//      receivers, counted by occlusion queries
 //   5. vpl_gather: one full-screen pass per VPL batch with the stencil test; receivers sum the kernel
 //   6. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel
 //

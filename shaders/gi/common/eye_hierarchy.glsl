@@ -47,24 +47,22 @@ bool eyePatchDiscontinuous(int level, ivec2 t, float covered, vec4 depthInfo, ve
 }
 
 // The receiver predicate (digest S.3 R2 == R3). A patch receives light when it has geometry, needs
-// no subdivision, and every ancestor was subdivided. 001's pseudo-code tests only the parent, which
-// equals the iterative refinement only when the refine test is monotone (a child never refines
-// without its parent); the diagonal rule breaks that, so the whole ancestor chain is tested
-// (<= C lookups). Boundary cases (001 leaves them open): the coarsest level has no ancestor, and
-// the finest level never refines, so its covered pixels receive whenever all ancestors refined.
-// Level 0 lives in the G-buffer: `pixelCovered` is its coverage at t when level == 0.
+// no subdivision, and every ancestor was subdivided. 001's pseudo-code tests only the parent's
+// refine flag, which equals the iterative refinement only when the refine test is monotone (a
+// child never refines without its parent); the diagonal rule breaks that, so the whole ancestor
+// chain counts: the flags pass marks a patch GIS_EYE_FLAG_SUBDIVIDED when it and every ancestor
+// refine, and the test reads that mark on the parent. Boundary cases (001 leaves them open): the
+// coarsest level has no ancestor, and the finest level never refines, so its covered pixels
+// receive whenever all ancestors refined. Level 0 lives in the G-buffer: `pixelCovered` is its
+// coverage at t when level == 0. Written without early returns (llvmpipe runs both sides of a
+// divergent branch anyway): the fetches a level does not need are clamped to valid texels.
 bool eyeIsReceiver(usampler2D flags, int level, ivec2 t, bool pixelCovered) {
-    if (level == 0) {
-        if (!pixelCovered) return false;
-    } else {
-        uint f = texelFetch(flags, eyeAtlas(level, t), 0).r;
-        if ((f & GIS_EYE_FLAG_COVERED) == 0u || (f & GIS_EYE_FLAG_REFINE) != 0u) return false;
-    }
-    for (int l = level + 1; l < gEye.info.x; ++l) {
-        t >>= 1;
-        if ((texelFetch(flags, eyeAtlas(l, t), 0).r & GIS_EYE_FLAG_REFINE) == 0u) return false;
-    }
-    return true;
+    uint own = texelFetch(flags, eyeAtlas(max(level, 1), level == 0 ? ivec2(0) : t), 0).r;
+    bool receives = level == 0 ? pixelCovered
+                               : (own & GIS_EYE_FLAG_COVERED) != 0u && (own & GIS_EYE_FLAG_REFINE) == 0u;
+    bool coarsest = level + 1 >= gEye.info.x;
+    uint parent = texelFetch(flags, eyeAtlas(min(level + 1, gEye.info.x - 1), coarsest ? ivec2(0) : t >> 1), 0).r;
+    return receives && (coarsest || (parent & GIS_EYE_FLAG_SUBDIVIDED) != 0u);
 }
 
 // Receiver geometry the reconstruction compares (digest S.4 case 10): the texel's mean position
@@ -85,14 +83,14 @@ float eyePixelFootprint(vec3 p) {
 }
 
 // How far a coarse neighbour's surface agrees with the fine texel's (1 same surface, 0 another):
-// its plane distance (either tangent plane) against the coarse texel's footprint, 1 up to 1/4 of it
-// and 0 from 1/2 (a continuous surface's neighbours lie in its tangent plane up to its curvature),
-// times the normals' agreement, 1 up to 26 degrees and 0 from 60 degrees apart.
-float eyeGeometricWeight(EyeGeometry fine, vec3 coarsePos, vec3 coarseNormal, int coarse) {
+// its plane distance (either tangent plane) against the coarse texel's footprint (m, from
+// eyePixelFootprint scaled to the coarse level), 1 up to 1/4 of it and 0 from 1/2 (a continuous
+// surface's neighbours lie in its tangent plane up to its curvature), times the normals' agreement,
+// 1 up to 26 degrees and 0 from 60 degrees apart.
+float eyeGeometricWeight(EyeGeometry fine, vec3 coarsePos, vec3 coarseNormal, float coarseFootprint) {
     vec3 v = coarsePos - fine.position.xyz;
     float plane = max(abs(dot(fine.normal, v)), abs(dot(coarseNormal, v)));
-    float footprint = float(1 << coarse) * eyePixelFootprint(fine.position.xyz);
-    float wd = clamp(2.0 - 4.0 * plane / max(footprint, 1e-30), 0.0, 1.0);
+    float wd = clamp(2.0 - 4.0 * plane / max(coarseFootprint, 1e-30), 0.0, 1.0);
     float wn = clamp((dot(fine.normal, coarseNormal) - 0.5) * 2.5, 0.0, 1.0);
     return isBad(wd * wn) ? 0.0 : wd * wn;
 }
@@ -108,33 +106,38 @@ float eyeGeometricWeight(EyeGeometry fine, vec3 coarsePos, vec3 coarseNormal, in
 // nearest sample, is replicated. On a continuous surface every geometric weight is exactly 1 and the
 // result is the plain bilinear one.
 // `interpolate` false replicates the parent instead (per-VPL lists, see eyeCombine).
+// Written without branches (each neighbour fetched, clamped into the level, and weighted in or
+// out): llvmpipe shades 4x4 fragment blocks together and would run every branch anyway.
 vec4 eyeInterpolateCoarse(sampler2D reconstructed, sampler2D atlasPosition, sampler2D atlasNormal, int coarse,
                           ivec2 t, bool interpolate, EyeGeometry fine) {
-    if (coarse >= gEye.info.x) return vec4(0.0);
-    vec4 parent = texelFetch(reconstructed, eyeAtlas(coarse, t >> 1), 0);
-    if (parent.a <= 0.0 || !interpolate) return parent.a > 0.0 ? parent : vec4(0.0);
+    if (coarse >= gEye.info.x) return vec4(0.0); // the same for every fragment of a draw
+    ivec2 size = eyeLevelSize(coarse);
     vec2 c = (vec2(t) + 0.5) * 0.5 - 0.5; // centre of t in the coarse level's texel coordinates
     ivec2 base = ivec2(floor(c));
     vec2 f = c - vec2(base);
+    // The parent t >> 1 is one of the four: base + 1 on an axis where t is even, base where odd.
+    ivec2 parentCorner = ivec2(1) - (t & 1);
+    float coarseFootprint = float(1 << coarse) * eyePixelFootprint(fine.position.xyz);
+    bool hasGeometry = fine.position.w > 0.0;
+    vec4 parent = vec4(0.0);
     vec3 sum = vec3(0.0);
     float weight = 0.0;
     for (int j = 0; j < 2; ++j)
         for (int i = 0; i < 2; ++i) {
             ivec2 q = base + ivec2(i, j);
-            if (!eyeInLevel(coarse, q)) continue;
-            vec4 v = texelFetch(reconstructed, eyeAtlas(coarse, q), 0);
-            if (v.a <= 0.0) continue;
-            float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
-            if (fine.position.w > 0.0) {
-                ivec2 a = eyeAtlas(coarse, q);
-                w *= eyeGeometricWeight(fine, texelFetch(atlasPosition, a, 0).xyz, texelFetch(atlasNormal, a, 0).xyz,
-                                        coarse);
-            }
-            sum += w * v.rgb;
-            weight += w;
+            ivec2 a = eyeAtlas(coarse, clamp(q, ivec2(0), size - 1));
+            vec4 v = texelFetch(reconstructed, a, 0);
+            parent = ivec2(i, j) == parentCorner ? v : parent;
+            float g = eyeGeometricWeight(fine, texelFetch(atlasPosition, a, 0).xyz, texelFetch(atlasNormal, a, 0).xyz,
+                                         coarseFootprint);
+            float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y) * (hasGeometry ? g : 1.0);
+            bool used = eyeInLevel(coarse, q) && v.a > 0.0 && w > 0.0;
+            sum += used ? w * v.rgb : vec3(0.0);
+            weight += used ? w : 0.0;
         }
     // Every neighbour on another surface: the parent (it holds data, and covers the texel).
-    return weight > 1e-6 ? vec4(sum / weight, 1.0) : vec4(parent.rgb, 1.0);
+    vec4 interpolated = weight > 1e-6 ? vec4(sum / weight, 1.0) : vec4(parent.rgb, 1.0);
+    return parent.a > 0.0 ? (interpolate ? interpolated : parent) : vec4(0.0);
 }
 
 // One texel of the reconstruction: what was splatted or gathered on its own level plus the

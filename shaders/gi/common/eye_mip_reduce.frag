@@ -5,9 +5,17 @@
 // directly (GIS_FROM_GBUFFER); coarser levels read the level below from the atlas textures they
 // render into (the viewport covers only this level; glTextureBarrier between levels makes that
 // defined, GL 4.5 §9.3). Odd sizes: a texel reduces only the children that exist.
+// Written without branches: llvmpipe shades a 4x4 block of fragments together and runs both sides
+// of a branch whose condition it cannot prove uniform, so every child is fetched (clamped into its
+// level) and selected in or out. The neighbour metrics of level 1's pixels (derivative, curvature)
+// are a program variant, GIS_EYE_PIXEL_METRICS, not a test of the options uniform.
 #include "common.glsl"
 #include "gi/common/eye_hierarchy.glsl"
 #include "gi/common/eye_pixel.glsl"
+
+#ifndef GIS_EYE_PIXEL_METRICS
+#define GIS_EYE_PIXEL_METRICS 0
+#endif
 
 layout(binding = 0) uniform sampler2D uGeoPosition; // xyz mean position (m); w covered pixels
 layout(binding = 1) uniform sampler2D uGeoNormal;   // xyz mean unit normal
@@ -27,33 +35,37 @@ layout(location = 6) out uint outDiscFlags; // covered | discontinuous (the flag
 uniform int uLevel; // the level written (>= 1)
 
 struct PatchStats {
-    float count;
+    float count; // covered pixels; 0 for an empty child, whose other fields are not used
     vec3 pos, normal, albedo, nmin, nmax;
-    vec4 depth;
+    vec4 depth; // min, max, derivative, curvature; an empty child's is neutral for min/max
 };
 
+// Child c of the level below, c inside it.
 PatchStats childStats(ivec2 c) {
     PatchStats s;
 #if GIS_FROM_GBUFFER
-    s.count = eyePixelCovered(c) ? 1.0 : 0.0;
-    if (s.count == 0.0) {
-        s.depth = vec4(3.0e38, -3.0e38, 0.0, 0.0);
-        return s;
-    }
-    s.pos = texelFetch(gPosition, c, 0).xyz;
+    vec4 p = texelFetch(gPosition, c, 0);
     s.normal = texelFetch(gNormal, c, 0).xyz;
     s.albedo = texelFetch(gAlbedo, c, 0).rgb;
+    bool covered = p.w > 0.5 && !any(isnan(p.xyz)) && !any(isinf(p.xyz)) && !any(isnan(s.normal)) &&
+                   !any(isinf(s.normal));
+    s.count = covered ? 1.0 : 0.0;
+    s.pos = p.xyz;
     s.nmin = s.normal;
     s.nmax = s.normal;
-    float d = length(s.pos - gFrame.cameraPos.xyz);
-    s.depth = vec4(d, d, eyePixelDerivativeCurvature(c, d, s.normal));
+    float d = length(p.xyz - gFrame.cameraPos.xyz);
+#if GIS_EYE_PIXEL_METRICS
+    vec2 metrics = eyePixelDerivativeCurvature(c, d, s.normal);
+#else
+    vec2 metrics = vec2(0.0);
+#endif
+    s.depth = covered ? vec4(d, d, metrics) : vec4(3.0e38, -3.0e38, 0.0, 0.0);
 #else
     ivec2 a = eyeAtlas(uLevel - 1, c);
     vec4 gp = texelFetch(uGeoPosition, a, 0);
     s.count = gp.w;
-    s.depth = texelFetch(uDepthInfo, a, 0);
-    if (s.count <= 0.0) return s;
     s.pos = gp.xyz;
+    s.depth = texelFetch(uDepthInfo, a, 0);
     s.normal = texelFetch(uGeoNormal, a, 0).xyz;
     s.albedo = texelFetch(uGeoAlbedo, a, 0).rgb;
     s.nmin = texelFetch(uNormalMin, a, 0).xyz;
@@ -70,21 +82,21 @@ void main() {
     vec4 depth = vec4(3.0e38, -3.0e38, 0.0, 0.0);
     vec3 nmin = vec3(2.0), nmax = vec3(-2.0);
     vec3 firstNormal = vec3(0.0);
-    for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-            ivec2 c = 2 * t + ivec2(i, j);
-            if (any(greaterThanEqual(c, childSize))) continue;
-            PatchStats s = childStats(c);
-            depth = vec4(min(depth.x, s.depth.x), max(depth.y, s.depth.y), max(depth.zw, s.depth.zw));
-            if (s.count <= 0.0) continue;
-            if (count == 0.0) firstNormal = s.normal;
-            count += s.count;
-            pos += s.pos * s.count;
-            nrm += s.normal * s.count;
-            alb += s.albedo * s.count;
-            nmin = min(nmin, s.nmin);
-            nmax = max(nmax, s.nmax);
-        }
+    for (int k = 0; k < 4; ++k) {
+        ivec2 c = 2 * t + ivec2(k & 1, k >> 1);
+        bool exists = all(lessThan(c, childSize));
+        PatchStats s = childStats(min(c, childSize - 1));
+        bool used = exists && s.count > 0.0;
+        vec4 merged = vec4(min(depth.x, s.depth.x), max(depth.y, s.depth.y), max(depth.zw, s.depth.zw));
+        depth = exists ? merged : depth;
+        firstNormal = used && count == 0.0 ? s.normal : firstNormal;
+        count += used ? s.count : 0.0;
+        pos += used ? s.pos * s.count : vec3(0.0);
+        nrm += used ? s.normal * s.count : vec3(0.0);
+        alb += used ? s.albedo * s.count : vec3(0.0);
+        nmin = used ? min(nmin, s.nmin) : nmin;
+        nmax = used ? max(nmax, s.nmax) : nmax;
+    }
     float inv = count > 0.0 ? 1.0 / count : 0.0;
     // Opposing normals can cancel: keep a child's normal rather than normalising ~0.
     float len = length(nrm);

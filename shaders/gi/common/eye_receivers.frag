@@ -1,21 +1,20 @@
 #version 450 core
 // One-pass stencil refinement (001 §3.2.1): one full-screen pass over the flattened multiresolution
-// buffer keeps (stencil = 1) exactly the fragments that receive light, and counts them per level.
-// Everything else (padding, background, refined patches, patches under a coarser receiver) is
-// discarded and keeps stencil 0, so the gather's early stencil test skips it.
+// buffer keeps (stencil = 1) exactly the fragments that receive light. Everything else (padding,
+// background, refined patches, patches under a coarser receiver) is discarded and keeps stencil 0,
+// so the gather's early stencil test skips it. Drawn once per level (the viewport covers level
+// uLevel only, so no fragment searches for its level); the host counts each level's receivers with
+// an occlusion query (discarded fragments do not count), which costs llvmpipe nothing per fragment
+// where a per-fragment atomic counter did.
 #include "common.glsl"
 #include "gi/common/eye_hierarchy.glsl"
 #include "gi/common/eye_pixel.glsl"
 
 layout(binding = 6) uniform usampler2D uFlags;
 
-layout(std430, binding = 1) buffer ReceiverCounts {
-    uint gReceiverCount[GIS_MAX_EYE_LEVELS];
-};
+uniform int uLevel;
 
 void main() {
-    ivec2 t;
-    int level = eyeLevelOf(ivec2(gl_FragCoord.xy), t);
-    if (level < 0 || !eyeIsReceiver(uFlags, level, t, level == 0 && eyePixelCovered(t))) discard;
-    atomicAdd(gReceiverCount[level], 1u);
+    ivec2 t = ivec2(gl_FragCoord.xy) - gEye.level[uLevel].xy;
+    if (!eyeIsReceiver(uFlags, uLevel, t, uLevel == 0 && eyePixelCovered(t))) discard;
 }

@@ -24,21 +24,20 @@ uniform float uDetailAlpha; // [0, 1]; 0 = off
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec4 pos = texelFetch(gPosition, p, 0);
-    vec3 c = vec3(0.0);
-    if (pos.w > 0.5) {
-        EyeGeometry fine;
-        fine.position = pos;
-        fine.normal = texelFetch(gNormal, p, 0).xyz;
-        // Level 0 at the atlas origin.
-        c = eyeCombine(texelFetch(uRendered, p, 0), uReconstructed, uAtlasPosition, uAtlasNormal, 0, p,
-                       uInterpolate != 0, fine).rgb;
-        if (uIrradiance != 0) c *= texelFetch(gAlbedo, p, 0).rgb * kInvPi;
-        if (uDetailAlpha > 0.0) {
-            vec3 toEye = gFrame.cameraPos.xyz - pos.xyz;
-            float len2 = dot(toEye, toEye);
-            float cosV = len2 > 1e-20 ? max(dot(texelFetch(gNormal, p, 0).xyz, toEye * inversesqrt(len2)), 0.0) : 1.0;
-            c *= uDetailAlpha * cosV + (1.0 - uDetailAlpha);
-        }
+    vec3 normal = texelFetch(gNormal, p, 0).xyz;
+    // Computed for background pixels too and selected away: llvmpipe would run a divergent branch anyway.
+    EyeGeometry fine;
+    fine.position = pos;
+    fine.normal = normal;
+    // Level 0 at the atlas origin.
+    vec3 c = eyeCombine(texelFetch(uRendered, p, 0), uReconstructed, uAtlasPosition, uAtlasNormal, 0, p,
+                        uInterpolate != 0, fine).rgb;
+    if (uIrradiance != 0) c *= texelFetch(gAlbedo, p, 0).rgb * kInvPi;
+    if (uDetailAlpha > 0.0) {
+        vec3 toEye = gFrame.cameraPos.xyz - pos.xyz;
+        float len2 = dot(toEye, toEye);
+        float cosV = len2 > 1e-20 ? max(dot(normal, toEye * inversesqrt(len2)), 0.0) : 1.0;
+        c *= uDetailAlpha * cosV + (1.0 - uDetailAlpha);
     }
-    outIndirect = vec4(max(sanitize(c), vec3(0.0)), 1.0);
+    outIndirect = vec4(pos.w > 0.5 ? max(sanitize(c), vec3(0.0)) : vec3(0.0), 1.0);
 }
