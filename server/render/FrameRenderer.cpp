@@ -182,7 +182,13 @@ FrameRenderer::~FrameRenderer() = default;
 void FrameRenderer::setScene(std::shared_ptr<const Scene> scene,
                              std::shared_ptr<const SceneGpu::Prepared> prepared) {
     GIS_ASSERT(scene != nullptr);
-    mSceneGpu = std::make_unique<SceneGpu>(*scene, std::move(prepared));
+    auto gpu = std::make_unique<SceneGpu>(*scene, std::move(prepared));
+    setScene(std::move(scene), std::move(gpu));
+}
+
+void FrameRenderer::setScene(std::shared_ptr<const Scene> scene, std::unique_ptr<SceneGpu> uploaded) {
+    GIS_ASSERT(scene != nullptr && uploaded != nullptr && uploaded->complete());
+    mSceneGpu = std::move(uploaded);
     mSceneCutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
                                 [](const Material& m) { return m.cutsOut(); });
     mSceneHasOcclusionMaps = std::any_of(scene->materials.begin(), scene->materials.end(),

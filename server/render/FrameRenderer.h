@@ -61,6 +61,8 @@ public:
     /// the render thread the CPU half of the upload.
     void setScene(std::shared_ptr<const Scene> scene,
                   std::shared_ptr<const SceneGpu::Prepared> prepared = nullptr);
+    /// Shows `scene` with its upload already done (a staged SceneGpu whose complete() is true).
+    void setScene(std::shared_ptr<const Scene> scene, std::unique_ptr<SceneGpu> uploaded);
     const Scene* scene() const { return mScene.get(); }
     /// Renders one frame. `wantLinear` also reads back the linear radiance (EXR output, metrics),
     /// `wantDirect` the direct pass's (indirect-only metrics).

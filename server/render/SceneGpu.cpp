@@ -1,6 +1,7 @@
 #include "render/SceneGpu.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -20,7 +21,8 @@ SceneGpu::InstanceTransform SceneGpu::InstanceTransform::of(const glm::mat4& toW
     return t;
 }
 
-std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene) {
+std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene,
+                                                            const std::function<bool()>& cancelled) {
     auto prepared = std::make_shared<Prepared>();
     std::vector<Vertex>& vertices = prepared->vertices;
     std::vector<std::uint32_t>& indices = prepared->indices;
@@ -111,11 +113,21 @@ std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene) 
         prepared->triangles += mesh.indices.size() / 3 * mesh.placements();
         prepared->storedTriangles += mesh.indices.size() / 3;
     }
+    prepared->textureMips.reserve(scene.textures.size());
+    for (const TextureImage& image : scene.textures) {
+        if (cancelled && cancelled()) return nullptr;
+        prepared->textureMips.push_back(mipChain(image));
+    }
     return prepared;
 }
 
 SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared)
-    : mMaterials(scene.materials) {
+    : SceneGpu(scene, std::move(prepared), Staged{}) {
+    uploadSome(std::numeric_limits<double>::infinity());
+}
+
+SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared, Staged)
+    : mMaterials(scene.materials), mSceneName(scene.name) {
     if (!prepared) prepared = prepare(scene);
     GIS_ASSERT(prepared->vertices.size() == [&] {
         std::size_t n = 0;
@@ -134,10 +146,75 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared)
     if (vertices.empty() || indices.empty())
         throw Error("render: scene '" + scene.name + "' has no triangles");
 
-    mVertices =
-        gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0);
-    mIndices = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)),
-                                  indices.data(), 0);
+    // Everything in pieces (uploadSome), each buffer's storage a piece of its own (llvmpipe clears
+    // it): the pieces read `prepared` and the scene's images.
+    const auto bufferInPieces = [&](gl::Buffer& buffer, const void* data, std::size_t bytes) {
+        mChunks.push_back([&buffer, bytes] {
+            buffer = gl::Buffer::create(static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        });
+        const auto* bytesIn = static_cast<const std::uint8_t*>(data);
+        for (std::size_t offset = 0; offset < bytes; offset += kUploadChunkBytes) {
+            const std::size_t size = std::min(kUploadChunkBytes, bytes - offset);
+            mChunks.push_back([&buffer, offset, size, bytesIn] {
+                glNamedBufferSubData(buffer.id(), static_cast<GLintptr>(offset),
+                                     static_cast<GLsizeiptr>(size), bytesIn + offset);
+            });
+        }
+    };
+    bufferInPieces(mVertices, vertices.data(), vertices.size() * sizeof(Vertex));
+    bufferInPieces(mIndices, indices.data(), indices.size() * sizeof(std::uint32_t));
+    bufferInPieces(mPlacements, placements.data(), placements.size() * sizeof(InstanceTransform));
+    mChunks.push_back([this] { setUpVertexArray(); });
+
+    GIS_ASSERT(prepared->textureMips.size() == scene.textures.size());
+    // Creating a texture's storage is a piece of its own: llvmpipe clears it (12 ms for a 2048^2
+    // texture with its mipmaps on this machine).
+    mTextures.resize(scene.textures.size());
+    for (std::size_t i = 0; i < scene.textures.size(); ++i) {
+        const TextureImage& image = scene.textures[i];
+        const std::vector<MipLevel>& mips = prepared->textureMips[i];
+        // Colour is sRGB-encoded (the sampler decodes it); metallic-roughness data is linear. The
+        // mipmaps come from prepare(), built on the CPU off the render thread.
+        const GLenum format = image.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8;
+        const int width = image.width, height = image.height, levels = static_cast<int>(mips.size()) + 1;
+        mChunks.push_back([this, i, format, width, height, levels] {
+            gl::Texture t = gl::Texture::create2D(format, width, height, levels);
+            t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
+            t.setWrap(GL_REPEAT);
+            mTextures[i] = std::move(t);
+        });
+        const auto levelInBands = [&](GLint level, int levelWidth, int levelHeight,
+                                      const std::uint8_t* rgba) {
+            const std::size_t rowBytes = static_cast<std::size_t>(levelWidth) * 4;
+            const int rowsPerBand = static_cast<int>(std::max<std::size_t>(1, kUploadChunkBytes / rowBytes));
+            for (int y = 0; y < levelHeight; y += rowsPerBand) {
+                const int rows = std::min(rowsPerBand, levelHeight - y);
+                const std::uint8_t* first = rgba + static_cast<std::size_t>(y) * rowBytes;
+                mChunks.push_back([this, i, level, y, levelWidth, rows, first] {
+                    glTextureSubImage2D(mTextures[i].id(), level, 0, y, levelWidth, rows, GL_RGBA,
+                                        GL_UNSIGNED_BYTE, first);
+                });
+            }
+        };
+        levelInBands(0, image.width, image.height, image.rgba.data());
+        for (std::size_t l = 0; l < mips.size(); ++l)
+            levelInBands(static_cast<GLint>(l + 1), mips[l].width, mips[l].height, mips[l].rgba.data());
+    }
+    mUploading = std::move(prepared);
+    // Bound wherever a material lacks a map: the shader ignores it (uHas*Tex 0) but still samples
+    // what the unit holds (llvmpipe runs both sides of the branch), and a one-texel nearest texture
+    // is the cheapest thing to sample. Left to whatever a previous pass bound there, the
+    // G-buffer pass of the untextured Cornell box took 17 ms at 512^2 instead of 7.
+    mFallbackTexture = gl::Texture::create2D(GL_RGBA8, 1, 1);
+    const unsigned char white[4] = {255, 255, 255, 255};
+    glTextureSubImage2D(mFallbackTexture.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
+    mFallbackTexture.setFilter(GL_NEAREST, GL_NEAREST);
+    reserveCommands(std::max<std::size_t>(mDraws.size(), 1));
+    mCommandScratch.reserve(mDraws.size());
+    gl::checkErrors("scene upload");
+}
+
+void SceneGpu::setUpVertexArray() {
     mVao = gl::VertexArray::create();
     const GLuint vao = mVao.id();
     glVertexArrayVertexBuffer(vao, 0, mVertices.id(), 0, sizeof(Vertex));
@@ -157,8 +234,6 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared)
     static_assert(kNormalToWorldAttribute == kToWorldAttribute + 4 &&
                   offsetof(InstanceTransform, toWorld) == 0 &&
                   offsetof(InstanceTransform, normalToWorld) == 4 * sizeof(glm::vec4));
-    mPlacements = gl::Buffer::create(static_cast<GLsizeiptr>(placements.size() * sizeof(InstanceTransform)),
-                                     placements.data(), 0);
     glVertexArrayVertexBuffer(vao, 1, mPlacements.id(), 0, sizeof(InstanceTransform));
     glVertexArrayBindingDivisor(vao, 1, mDivisor);
     for (GLuint column = 0; column < 7; ++column) {
@@ -168,31 +243,25 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared)
                                   static_cast<GLuint>(column * sizeof(glm::vec4)));
         glVertexArrayAttribBinding(vao, attribute, 1);
     }
+}
 
-    for (const TextureImage& image : scene.textures) {
-        int levels =
-            1 + static_cast<int>(std::floor(std::log2(std::max(std::max(image.width, image.height), 1))));
-        // Colour is sRGB-encoded (the sampler decodes it); metallic-roughness data is linear.
-        gl::Texture t =
-            gl::Texture::create2D(image.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, image.width, image.height, levels);
-        glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
-                            image.rgba.data());
-        glGenerateTextureMipmap(t.id());
-        t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
-        t.setWrap(GL_REPEAT);
-        mTextures.push_back(std::move(t));
+bool SceneGpu::uploadSome(double budgetMs) {
+    const auto start = std::chrono::steady_clock::now();
+    while (mNextChunk < mChunks.size()) {
+        mChunks[mNextChunk++]();
+        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() >=
+            budgetMs)
+            break;
     }
-    // Bound wherever a material lacks a map: the shader ignores it (uHas*Tex 0) but still samples
-    // what the unit holds (llvmpipe runs both sides of the branch), and a one-texel nearest texture
-    // is the cheapest thing to sample. Left to whatever a previous pass bound there, the
-    // G-buffer pass of the untextured Cornell box took 17 ms at 512^2 instead of 7.
-    mFallbackTexture = gl::Texture::create2D(GL_RGBA8, 1, 1);
-    const unsigned char white[4] = {255, 255, 255, 255};
-    glTextureSubImage2D(mFallbackTexture.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
-    mFallbackTexture.setFilter(GL_NEAREST, GL_NEAREST);
-    reserveCommands(std::max<std::size_t>(mDraws.size(), 1));
-    mCommandScratch.reserve(mDraws.size());
-    gl::checkErrors("scene upload");
+    if (mNextChunk < mChunks.size()) return false;
+    if (mUploading) {
+        mChunks.clear();
+        mChunks.shrink_to_fit();
+        mNextChunk = 0;
+        mUploading.reset(); // the prepared copy is no longer needed
+        gl::checkErrors(("scene upload of '" + mSceneName + "'").c_str());
+    }
+    return true;
 }
 
 void SceneGpu::reserveCommands(std::size_t commands) const {
@@ -248,6 +317,7 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
 DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int instances, int skipMesh,
                          const glm::mat4* cullViewProj, bool cullBackFaces) const {
     // The caller has bound the program; `materials` were resolved from it.
+    GIS_ASSERT(complete());
     glBindVertexArray(mVao.id());
     const std::optional<Frustum> frustum =
         cullViewProj ? std::optional<Frustum>(Frustum(*cullViewProj)) : std::nullopt;

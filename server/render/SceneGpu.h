@@ -2,12 +2,15 @@
 // (shadow map, RSM, G-buffer) shares.
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "gl/Objects.h"
 #include "gl/Shader.h"
 #include "scene/Scene.h"
+#include "scene/TextureMips.h"
 
 namespace gis {
 
@@ -47,15 +50,32 @@ public:
     static constexpr std::size_t kChunkTriangles = 16384;
 
     /// What the upload sends, built without GL on any thread: the interleaved vertices, the indices,
-    /// the placements and the runs with their bounds. A scene load builds it beside the scene, so
-    /// the render thread only uploads (2M triangles held it about 170 ms instead of 344 ms:
-    /// `state.load.upload_ms` in bench/scenes/load_progress.mjs).
+    /// the placements, the runs with their bounds and every texture's mipmap chain. A scene load
+    /// builds it beside the scene, so the render thread only uploads (2M triangles held it about
+    /// 170 ms instead of 344 ms; eight 2048^2 textures about ... ms instead of 326 ms:
+    /// `state.load.upload_ms` in bench/scenes/load_progress.mjs). `cancelled` (may be empty) is
+    /// asked between textures; when it answers true, prepare returns null.
     struct Prepared;
-    static std::shared_ptr<const Prepared> prepare(const Scene& scene);
+    static std::shared_ptr<const Prepared> prepare(const Scene& scene,
+                                                   const std::function<bool()>& cancelled = {});
 
     /// Uploads everything; throws gis::Error on GL failure (a load boundary). `prepared` must come
     /// from prepare(scene) of this scene; null: prepared here.
     explicit SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared = nullptr);
+    /// Staged: creates the GL objects now and sends their contents in pieces of at most
+    /// kUploadChunkBytes through uploadSome(), so that a big scene's upload can be spread between
+    /// frames instead of holding the render thread. Draw only once complete(). `scene` must outlive
+    /// the upload; `prepared` as above.
+    struct Staged {};
+    SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared, Staged);
+    // The staged pieces refer to this object: it stays where it was made.
+    SceneGpu(const SceneGpu&) = delete;
+    SceneGpu& operator=(const SceneGpu&) = delete;
+    /// Sends pieces until `budgetMs` is spent (at least one piece); true when everything is sent.
+    /// Throws gis::Error on GL failure once the last piece is sent.
+    bool uploadSome(double budgetMs);
+    bool complete() const { return mNextChunk >= mChunks.size(); }
+    static constexpr std::size_t kUploadChunkBytes = std::size_t{4} << 20;
     /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
     /// through `materials` (null: none, as for depth-only passes). `skipMesh` (an index into
     /// Scene::meshes) is left out: a local environment probe does not see the object it belongs to.
@@ -136,6 +156,7 @@ public:
         std::vector<Draw> draws;
         std::vector<RunBounds> runBounds;
         std::size_t maxCommands = 0, triangles = 0, storedTriangles = 0;
+        std::vector<std::vector<MipLevel>> textureMips; ///< levels 1.. of each Scene::textures entry
     };
 
 private:
@@ -165,6 +186,13 @@ private:
     std::vector<RunBounds> mRunBounds;
     std::vector<Material> mMaterials;
     std::vector<gl::Texture> mTextures;
+    /// The staged upload: each piece sends one buffer range or one band of rows of one texture level,
+    /// from the prepared data and the scene's images (kept until the last piece).
+    std::vector<std::function<void()>> mChunks;
+    void setUpVertexArray(); ///< the last piece: attributes over the filled buffers
+    std::size_t mNextChunk = 0;
+    std::shared_ptr<const Prepared> mUploading;
+    std::string mSceneName;
     gl::Texture mFallbackTexture; ///< one white texel, nearest: on the units of maps a material lacks
     std::size_t mTriangles = 0, mStoredTriangles = 0, mInstances = 0;
 };

@@ -479,6 +479,18 @@ struct Session::Worker {
     };
     std::unique_ptr<Load> load;
     std::string queuedRequest; ///< asked for while `load` ran: started when it ends (the newer wins)
+    /// A loaded scene whose GL upload is under way: sent in slices of about limits.sliceMs between
+    /// frames (continueUpload), so that input is answered meanwhile; swapped in when complete.
+    struct Upload {
+        std::string request;
+        std::shared_ptr<const Scene> scene; ///< what the pieces read: kept until the swap
+        std::unique_ptr<SceneGpu> gpu;
+        nlohmann::json info;       ///< state.load, completed by the upload's figures
+        double renderThreadMs = 0; ///< every slice together
+        double longestSliceMs = 0;
+        int slices = 0;
+    };
+    std::unique_ptr<Upload> upload;
     /// The effect planner's ray structure of the scene shown, built on a thread of its own the first
     /// time a frame asks for a plan and kept while that scene is shown: a plan then costs its rays
     /// (milliseconds) rather than the structure's build (0.5-0.8 s at 2M triangles). planRaysFor.
@@ -570,8 +582,9 @@ void Session::startLoad(Worker& w, std::string request) {
                 throw;
             }
             const Scene& next = *load->scene;
-            // The CPU half of the GL upload, here rather than on the render thread.
-            if (!load->cancelled) load->gpu = SceneGpu::prepare(next);
+            // The CPU half of the GL upload (vertex layout, runs, texture mipmaps), here rather
+            // than on the render thread.
+            load->gpu = SceneGpu::prepare(next, loadOptions.cancelled);
             const double loadMs = loadClock.elapsedMs();
             logInfo("session " + mId + ": scene " + validUtf8(name) + " loaded (" +
                     (sizeError ? std::string() : std::to_string(bytes) + " bytes, ") +
@@ -618,15 +631,62 @@ void Session::finishLoad(Worker& w) {
         }
         return;
     }
-    const std::shared_ptr<const Scene>& next = load->scene;
+    // The GL upload (buffers, textures with their mipmaps) is the part of a load that needs the
+    // render thread: it goes in slices between frames (continueUpload), the first one now.
+    w.upload.reset(); // an older scene's upload still under way: this one is newer
+    auto upload = std::make_unique<Worker::Upload>();
+    upload->request = load->request;
+    upload->scene = load->scene;
+    upload->info = std::move(load->info);
+    const Stopwatch stageClock;
+    try {
+        upload->gpu = std::make_unique<SceneGpu>(*upload->scene, std::move(load->gpu), SceneGpu::Staged{});
+    } catch (const std::exception& e) {
+        logWarn("session " + mId + ": scene " + validUtf8(load->request) +
+                " could not be uploaded: " + validUtf8(e.what()));
+        broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
+        if (mOnError) mOnError("scene_load_failed");
+        return;
+    }
+    upload->renderThreadMs = upload->longestSliceMs = stageClock.elapsedMs();
+    w.upload = std::move(upload);
+    continueUpload(w);
+}
+
+void Session::continueUpload(Worker& w) {
+    Worker::Upload& upload = *w.upload;
+    const Stopwatch sliceClock;
+    bool done = false;
+    try {
+        done = upload.gpu->uploadSome(static_cast<double>(mConfig.limits.sliceMs));
+    } catch (const std::exception& e) {
+        logWarn("session " + mId + ": scene " + validUtf8(upload.request) +
+                " could not be uploaded: " + validUtf8(e.what()));
+        broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
+        if (mOnError) mOnError("scene_load_failed");
+        w.upload.reset();
+        return;
+    }
+    const double sliceMs = sliceClock.elapsedMs();
+    upload.renderThreadMs += sliceMs;
+    upload.longestSliceMs = std::max(upload.longestSliceMs, sliceMs);
+    ++upload.slices;
+    if (!done) return;
+
+    const std::unique_ptr<Worker::Upload> finished = std::move(w.upload);
+    const std::shared_ptr<const Scene>& next = finished->scene;
     if (w.planRays && w.planRays->scene != next) w.dropPlanRays(); // the old scene's structure
-    // The GL upload (buffers, textures, their mipmaps) is the part of a load that holds the render
-    // thread: state.load says what it cost.
-    const Stopwatch uploadClock;
-    w.renderer->setScene(next, std::move(load->gpu));
-    load->info["upload_ms"] = uploadClock.elapsedMs();
-    logInfo("session " + mId + ": scene " + validUtf8(load->request) + " uploaded to GL in " +
-            std::to_string(std::lround(uploadClock.elapsedMs())) + " ms");
+    const Stopwatch swapClock;
+    w.renderer->setScene(next, std::move(finished->gpu));
+    finished->renderThreadMs += swapClock.elapsedMs();
+    finished->info["upload_ms"] = finished->renderThreadMs;
+    finished->info["upload_slice_max_ms"] = std::max(finished->longestSliceMs, swapClock.elapsedMs());
+    finished->info["upload_slices"] = finished->slices;
+    logInfo("session " + mId + ": scene " + validUtf8(finished->request) + " uploaded to GL in " +
+            std::to_string(std::lround(finished->renderThreadMs)) + " ms of the render thread (" +
+            std::to_string(finished->slices) + " slices, the longest " +
+            std::to_string(std::lround(finished->longestSliceMs)) + " ms)");
+    Worker::Upload* load = finished.get(); // the state message below reads its request and info
     w.scene = next;
     nlohmann::json stateMsg;
     {
@@ -1075,6 +1135,13 @@ void Session::workerMain() {
                 continue;
             }
         }
+        // A loaded scene's upload under way: a slice of it each turn, and a frame of the scene in
+        // place only to answer input or a snapshot (its refinement waits for the new scene).
+        if (w.upload) {
+            continueUpload(w);
+            std::lock_guard lock(mMutex);
+            if (w.upload && !mStop && !mDirty && mSnapshotFor.expired()) continue;
+        }
         FrameState state;
         nlohmann::json explicitParams;
         std::string sceneRequest;
@@ -1089,7 +1156,7 @@ void Session::workerMain() {
             std::optional<Clock::time_point> windowWaitFrom;
             while (!mStop) {
                 const auto now = Clock::now();
-                if (mLoadDone || readyLocked(now)) break;
+                if (mLoadDone || w.upload || readyLocked(now)) break;
                 if (mDirty && mController && mController->windowFull() && !windowWaitFrom)
                     windowWaitFrom = now;
                 if (mStream.adaptive && mNextStep == Step::Balanced && !mDirty && mController &&
@@ -1099,7 +1166,8 @@ void Session::workerMain() {
                     mCv.wait(lock);
             }
             if (mStop) break;
-            if (mLoadDone && !readyLocked(Clock::now())) continue; // the loop's top swaps the scene in
+            // The loop's top swaps a loaded scene in, or sends the next slice of its upload.
+            if ((mLoadDone || w.upload) && !readyLocked(Clock::now())) continue;
             // A viewer joined after patches and nothing else is to render: the last image again, whole.
             if (mWholeFrameWanted && mSnapshotFor.expired() && !stepReadyLocked(Clock::now())) {
                 const StreamOptions current = mStream;
@@ -1144,6 +1212,7 @@ void Session::workerMain() {
             explicitParams = mExplicit;
         }
         if (!sceneRequest.empty()) {
+            w.upload.reset(); // a scene still uploading is older than this request
             if (w.load) {
                 // The newer request wins: the load under way stops at its next check (between file
                 // chunks, images or meshes) and this one starts when it has.
@@ -1270,7 +1339,8 @@ void Session::workerMain() {
             w.quality->budget().record(budgetKey, cost);
         }
     }
-    w.renderer.reset(); // GL objects die while the context is still current
+    w.upload.reset(); // GL objects die while the context is still current
+    w.renderer.reset();
     context.reset();
 }
 

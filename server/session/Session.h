@@ -151,6 +151,8 @@ private:
     /// Joins the finished load and swaps its scene in (state message, fresh camera and lights, an
     /// interactive frame next), or reports why it failed; starts the request queued meanwhile instead.
     void finishLoad(Worker& w);
+    /// Sends the next slice of a loaded scene's GL upload; swaps the scene in when it is complete.
+    void continueUpload(Worker& w);
     /// The effect planner's ray structure of `scene` (Worker::planRays), or null while a thread of
     /// its own builds it (started here when none runs) or when it could not be built (`failed`).
     /// Defined where the effects library is built in (GIS_HAVE_EFFECTS).

@@ -724,6 +724,60 @@ check('a scene asked for during a load cancels that load: the newer scene does n
     await client.frame('a frame of the newer scene', (s) => s.scene === 'builtin:cornell-empty', 15000);
 });
 
+check('a textured scene reaches GL in slices between frames, not in one hold of the render thread', async () => {
+    // Four quads, each with a texture of its own (one 2048 x 2048 PNG, decoded four times): creating
+    // and filling a texture with its mipmaps is several pieces, sent about --slice-ms at a time.
+    const png = slowToLoadGlb(2048, 1);
+    const glb = texturedQuadsGlb(png, 4);
+    const client = await open(servers.main, { adaptive: true });
+    await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
+    const res = await servers.main.http('/api/upload?name=quads.glb', {
+        method: 'POST', body: glb,
+        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
+    });
+    assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
+    client.send({ type: 'scene', name: 'upload:quads.glb' });
+    const state = await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'upload:quads.glb',
+        'state of the textured scene', 30000);
+    const load = state.state.load;
+    console.log(`# upload: ${Math.round(load.upload_ms)} ms of the render thread in ${load.upload_slices} slices, ` +
+        `the longest ${Math.round(load.upload_slice_max_ms)} ms`);
+    assert.ok(load.upload_slices >= 2, `several slices (${load.upload_slices})`);
+    assert.ok(load.upload_slice_max_ms < load.upload_ms, 'no slice holds the whole upload');
+    assert.match(servers.main.log, /upload:quads\.glb uploaded to GL in \d+ ms of the render thread \(\d+ slices/);
+    const frame = await client.frame('a frame of the textured scene', (s) => s.scene === 'upload:quads.glb', 15000);
+    assert.equal(frame.stats.counts?.triangles, 8);
+    await client.close();
+});
+
+/** `count` quads side by side, each with its own material and texture, all from the PNG in `glb`'s images[0]. */
+function texturedQuadsGlb(glb, count) {
+    const jsonLength = glb.readUInt32LE(12);
+    const doc = JSON.parse(glb.subarray(20, 20 + jsonLength).toString());
+    const bin = glb.subarray(20 + jsonLength + 8);
+    const pngView = doc.images[0].bufferView;
+    Object.assign(doc, {
+        scenes: [{ nodes: Array.from({ length: count }, (_, i) => i) }],
+        nodes: Array.from({ length: count }, (_, i) => ({ mesh: i, translation: [i * 2.2, 0, 0] })),
+        meshes: Array.from({ length: count }, (_, i) => ({ primitives: [{ ...doc.meshes[0].primitives[0], material: i }] })),
+        materials: Array.from({ length: count }, (_, i) => ({ pbrMetallicRoughness: { baseColorTexture: { index: i }, metallicFactor: 0 } })),
+        textures: Array.from({ length: count }, (_, i) => ({ source: i })),
+        images: Array.from({ length: count }, () => ({ bufferView: pngView, mimeType: 'image/png' })),
+    });
+    const json = Buffer.from(JSON.stringify(doc).padEnd(Math.ceil(JSON.stringify(doc).length / 4) * 4, ' '));
+    const header = Buffer.alloc(12);
+    header.writeUInt32LE(0x46546c67, 0);
+    header.writeUInt32LE(2, 4);
+    header.writeUInt32LE(12 + 8 + json.length + 8 + bin.length, 8);
+    const chunkHeader = (length, type) => {
+        const b = Buffer.alloc(8);
+        b.writeUInt32LE(length, 0);
+        b.writeUInt32LE(type, 4);
+        return b;
+    };
+    return Buffer.concat([header, chunkHeader(json.length, 0x4e4f534a), json, chunkHeader(bin.length, 0x004e4942), bin]);
+}
+
 check('a session that ends during a load cancels it: its teardown does not wait for the file', async () => {
     const { client } = await loadingSlowUpload('abandoned.glb', 3);
     const closedAt = performance.now();
