@@ -51,9 +51,9 @@ public:
 
     /// What the upload sends, built without GL on any thread: the interleaved vertices, the indices,
     /// the placements, the runs with their bounds and every texture's mipmap chain. A scene load
-    /// builds it beside the scene, so the render thread only uploads (2M triangles held it about
-    /// 170 ms instead of 344 ms; eight 2048^2 textures about ... ms instead of 326 ms:
-    /// `state.load.upload_ms` in bench/scenes/load_progress.mjs). `cancelled` (may be empty) is
+    /// builds it beside the scene, so the render thread only uploads, in slices (docs/scenes.md,
+    /// "Loading": eight 2048^2 textures 108-145 ms in 5 slices, the longest 27-37 ms, against one
+    /// hold of 326 ms; `state.load` in bench/scenes/load_progress.mjs). `cancelled` (may be empty) is
     /// asked between textures; when it answers true, prepare returns null.
     struct Prepared;
     static std::shared_ptr<const Prepared> prepare(const Scene& scene,
