@@ -149,22 +149,25 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
     // Everything in pieces (uploadSome), each buffer's storage a piece of its own (llvmpipe clears
     // it): the pieces read `prepared` and the scene's images.
     const auto bufferInPieces = [&](gl::Buffer& buffer, const void* data, std::size_t bytes) {
-        mChunks.push_back([&buffer, bytes] {
-            buffer = gl::Buffer::create(static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
-        });
+        mChunks.push_back({[&buffer, bytes] {
+                               buffer = gl::Buffer::create(static_cast<GLsizeiptr>(bytes), nullptr,
+                                                           GL_DYNAMIC_STORAGE_BIT);
+                           },
+                           bytes, true});
         const auto* bytesIn = static_cast<const std::uint8_t*>(data);
         for (std::size_t offset = 0; offset < bytes; offset += kUploadChunkBytes) {
             const std::size_t size = std::min(kUploadChunkBytes, bytes - offset);
-            mChunks.push_back([&buffer, offset, size, bytesIn] {
-                glNamedBufferSubData(buffer.id(), static_cast<GLintptr>(offset),
-                                     static_cast<GLsizeiptr>(size), bytesIn + offset);
-            });
+            mChunks.push_back({[&buffer, offset, size, bytesIn] {
+                                   glNamedBufferSubData(buffer.id(), static_cast<GLintptr>(offset),
+                                                        static_cast<GLsizeiptr>(size), bytesIn + offset);
+                               },
+                               size, false});
         }
     };
     bufferInPieces(mVertices, vertices.data(), vertices.size() * sizeof(Vertex));
     bufferInPieces(mIndices, indices.data(), indices.size() * sizeof(std::uint32_t));
     bufferInPieces(mPlacements, placements.data(), placements.size() * sizeof(InstanceTransform));
-    mChunks.push_back([this] { setUpVertexArray(); });
+    mChunks.push_back({[this] { setUpVertexArray(); }, 0, false});
 
     GIS_ASSERT(prepared->textureMips.size() == scene.textures.size());
     // Creating a texture's storage is a piece of its own: llvmpipe clears it (12 ms for a 2048^2
@@ -177,12 +180,15 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
         // mipmaps come from prepare(), built on the CPU off the render thread.
         const GLenum format = image.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8;
         const int width = image.width, height = image.height, levels = static_cast<int>(mips.size()) + 1;
-        mChunks.push_back([this, i, format, width, height, levels] {
-            gl::Texture t = gl::Texture::create2D(format, width, height, levels);
-            t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
-            t.setWrap(GL_REPEAT);
-            mTextures[i] = std::move(t);
-        });
+        std::size_t textureBytes = image.rgba.size();
+        for (const MipLevel& m : mips) textureBytes += m.rgba.size();
+        mChunks.push_back({[this, i, format, width, height, levels] {
+                               gl::Texture t = gl::Texture::create2D(format, width, height, levels);
+                               t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
+                               t.setWrap(GL_REPEAT);
+                               mTextures[i] = std::move(t);
+                           },
+                           textureBytes, true});
         const auto levelInBands = [&](GLint level, int levelWidth, int levelHeight,
                                       const std::uint8_t* rgba) {
             const std::size_t rowBytes = static_cast<std::size_t>(levelWidth) * 4;
@@ -190,10 +196,11 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
             for (int y = 0; y < levelHeight; y += rowsPerBand) {
                 const int rows = std::min(rowsPerBand, levelHeight - y);
                 const std::uint8_t* first = rgba + static_cast<std::size_t>(y) * rowBytes;
-                mChunks.push_back([this, i, level, y, levelWidth, rows, first] {
-                    glTextureSubImage2D(mTextures[i].id(), level, 0, y, levelWidth, rows, GL_RGBA,
-                                        GL_UNSIGNED_BYTE, first);
-                });
+                mChunks.push_back({[this, i, level, y, levelWidth, rows, first] {
+                                       glTextureSubImage2D(mTextures[i].id(), level, 0, y, levelWidth, rows,
+                                                           GL_RGBA, GL_UNSIGNED_BYTE, first);
+                                   },
+                                   static_cast<std::size_t>(rows) * rowBytes, false});
             }
         };
         levelInBands(0, image.width, image.height, image.rgba.data());
@@ -246,12 +253,21 @@ void SceneGpu::setUpVertexArray() {
 }
 
 bool SceneGpu::uploadSome(double budgetMs) {
-    const auto start = std::chrono::steady_clock::now();
-    while (mNextChunk < mChunks.size()) {
-        mChunks[mNextChunk++]();
-        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() >=
-            budgetMs)
-            break;
+    using Clock = std::chrono::steady_clock;
+    const auto msSince = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    const auto start = Clock::now();
+    for (bool first = true; mNextChunk < mChunks.size(); first = false) {
+        const Piece& piece = mChunks[mNextChunk];
+        const double mib = static_cast<double>(piece.bytes) / (1024.0 * 1024.0);
+        double& msPerMiB = piece.creates ? mCreateMsPerMiB : mFillMsPerMiB;
+        if (!first && msSince(start) + mib * msPerMiB > budgetMs) break;
+        const auto pieceStart = Clock::now();
+        piece.send();
+        ++mNextChunk;
+        // Pieces under 1 MiB say little about the rate (their fixed cost dominates).
+        if (mib >= 1.0) msPerMiB = 0.5 * msPerMiB + 0.5 * msSince(pieceStart) / mib;
     }
     if (mNextChunk < mChunks.size()) return false;
     if (mUploading) {

@@ -52,8 +52,8 @@ public:
     /// What the upload sends, built without GL on any thread: the interleaved vertices, the indices,
     /// the placements, the runs with their bounds and every texture's mipmap chain. A scene load
     /// builds it beside the scene, so the render thread only uploads, in slices (docs/scenes.md,
-    /// "Loading": eight 2048^2 textures 108-145 ms in 5 slices, the longest 27-37 ms, against one
-    /// hold of 326 ms; `state.load` in bench/scenes/load_progress.mjs). `cancelled` (may be empty) is
+    /// "Loading": eight 2048^2 textures 138-143 ms in 8-9 slices of at most 20 ms, against one hold
+    /// of 326 ms; `state.load` in bench/scenes/load_progress.mjs). `cancelled` (may be empty) is
     /// asked between textures; when it answers true, prepare returns null.
     struct Prepared;
     static std::shared_ptr<const Prepared> prepare(const Scene& scene,
@@ -71,7 +71,8 @@ public:
     // The staged pieces refer to this object: it stays where it was made.
     SceneGpu(const SceneGpu&) = delete;
     SceneGpu& operator=(const SceneGpu&) = delete;
-    /// Sends pieces until `budgetMs` is spent (at least one piece); true when everything is sent.
+    /// Sends pieces while they are predicted to fit `budgetMs` (at least one piece; each kind's
+    /// cost per byte measured as it goes); true when everything is sent.
     /// Throws gis::Error on GL failure once the last piece is sent.
     bool uploadSome(double budgetMs);
     bool complete() const { return mNextChunk >= mChunks.size(); }
@@ -188,7 +189,15 @@ private:
     std::vector<gl::Texture> mTextures;
     /// The staged upload: each piece sends one buffer range or one band of rows of one texture level,
     /// from the prepared data and the scene's images (kept until the last piece).
-    std::vector<std::function<void()>> mChunks;
+    struct Piece {
+        std::function<void()> send;
+        std::size_t bytes = 0;
+        bool creates = false; ///< makes a storage (llvmpipe clears it) rather than filling one
+    };
+    std::vector<Piece> mChunks;
+    /// Measured cost of a piece, ms per MiB, of creating and of filling storage: uploadSome stops
+    /// before a piece predicted to overrun its budget (starting values measured on llvmpipe).
+    double mCreateMsPerMiB = 0.6, mFillMsPerMiB = 0.3;
     void setUpVertexArray(); ///< the last piece: attributes over the filled buffers
     std::size_t mNextChunk = 0;
     std::shared_ptr<const Prepared> mUploading;
