@@ -610,6 +610,22 @@ check('an uploaded Blender file with linked duplicates stays instanced: the stat
     assert.equal(frame.stats.counts?.triangles, state.state.load.triangles);
 });
 
+/** A .glb of the glTF document `doc` and its binary chunk `bin` (4-byte aligned). */
+function glbOf(doc, bin) {
+    const json = Buffer.from(JSON.stringify(doc).padEnd(Math.ceil(JSON.stringify(doc).length / 4) * 4, ' '));
+    const header = Buffer.alloc(12);
+    header.writeUInt32LE(0x46546c67, 0);
+    header.writeUInt32LE(2, 4);
+    header.writeUInt32LE(12 + 8 + json.length + 8 + bin.length, 8);
+    const chunkHeader = (length, type) => {
+        const b = Buffer.alloc(8);
+        b.writeUInt32LE(length, 0);
+        b.writeUInt32LE(type, 4);
+        return b;
+    };
+    return Buffer.concat([header, chunkHeader(json.length, 0x4e4f534a), json, chunkHeader(bin.length, 0x004e4942), bin]);
+}
+
 /** A .glb of one textured quad whose side x side PNG (a gradient) takes a while to decode. */
 // `images` copies of one side x side PNG: each is decoded on its own (about 250 ms at 4096).
 function slowToLoadGlb(side, images = 1) {
@@ -659,18 +675,7 @@ function slowToLoadGlb(side, images = 1) {
             { buffer: 0, byteOffset: 80, byteLength: 24 }, { buffer: 0, byteOffset: 104, byteLength: png.length }],
         buffers: [{ byteLength: bin.length }],
     };
-    const json = Buffer.from(JSON.stringify(doc).padEnd(Math.ceil(JSON.stringify(doc).length / 4) * 4, ' '));
-    const header = Buffer.alloc(12);
-    header.writeUInt32LE(0x46546c67, 0);
-    header.writeUInt32LE(2, 4);
-    header.writeUInt32LE(12 + 8 + json.length + 8 + bin.length, 8);
-    const chunkHeader = (length, type) => {
-        const b = Buffer.alloc(8);
-        b.writeUInt32LE(length, 0);
-        b.writeUInt32LE(type, 4);
-        return b;
-    };
-    return Buffer.concat([header, chunkHeader(json.length, 0x4e4f534a), json, chunkHeader(bin.length, 0x004e4942), bin]);
+    return glbOf(doc, bin);
 }
 
 /**
@@ -764,18 +769,7 @@ function texturedQuadsGlb(glb, count) {
         textures: Array.from({ length: count }, (_, i) => ({ source: i })),
         images: Array.from({ length: count }, () => ({ bufferView: pngView, mimeType: 'image/png' })),
     });
-    const json = Buffer.from(JSON.stringify(doc).padEnd(Math.ceil(JSON.stringify(doc).length / 4) * 4, ' '));
-    const header = Buffer.alloc(12);
-    header.writeUInt32LE(0x46546c67, 0);
-    header.writeUInt32LE(2, 4);
-    header.writeUInt32LE(12 + 8 + json.length + 8 + bin.length, 8);
-    const chunkHeader = (length, type) => {
-        const b = Buffer.alloc(8);
-        b.writeUInt32LE(length, 0);
-        b.writeUInt32LE(type, 4);
-        return b;
-    };
-    return Buffer.concat([header, chunkHeader(json.length, 0x4e4f534a), json, chunkHeader(bin.length, 0x004e4942), bin]);
+    return glbOf(doc, bin);
 }
 
 check('a session that ends during a load cancels it: its teardown does not wait for the file', async () => {
