@@ -1,6 +1,7 @@
 #include "render/SceneGpu.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -170,8 +171,8 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
     mChunks.push_back({[this] { setUpVertexArray(); }, 0, false});
 
     GIS_ASSERT(prepared->textureMips.size() == scene.textures.size());
-    // Creating a texture's storage is a piece of its own: llvmpipe clears it (12 ms for a 2048^2
-    // texture with its mipmaps on this machine).
+    // Creating a texture's storage is a piece of its own: llvmpipe clears it, which is most of a
+    // big texture's upload.
     mTextures.resize(scene.textures.size());
     for (std::size_t i = 0; i < scene.textures.size(); ++i) {
         const TextureImage& image = scene.textures[i];
@@ -211,7 +212,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
     // Bound wherever a material lacks a map: the shader ignores it (uHas*Tex 0) but still samples
     // what the unit holds (llvmpipe runs both sides of the branch), and a one-texel nearest texture
     // is the cheapest thing to sample. Left to whatever a previous pass bound there, the
-    // G-buffer pass of the untextured Cornell box took 17 ms at 512^2 instead of 7.
+    // G-buffer pass of the untextured Cornell box took about twice as long (docs/multires.md).
     mFallbackTexture = gl::Texture::create2D(GL_RGBA8, 1, 1);
     const unsigned char white[4] = {255, 255, 255, 255};
     glTextureSubImage2D(mFallbackTexture.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
@@ -400,6 +401,7 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
                      static_cast<GLsizeiptr>(commands.size() * sizeof(IndirectCommand)), commands.data());
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCommands.id());
     bool culling = false; // GL_CULL_FACE is off in every pass (FrameRenderer::render) until set here
+    std::array<GLuint, 5> unitHolds{}; // what this call bound on each material unit (0: not yet)
     for (const Batch& b : batches) {
         if (cullBackFaces && b.oneSided != culling) {
             if (b.oneSided) {
@@ -421,19 +423,23 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
             glUniform1f(s.alphaCutoff.location, m.cutsOut() ? m.cutoff() : -1.0f);
             glUniform3f(s.emissive.location, m.emissive.r, m.emissive.g, m.emissive.b);
             // Each texture the material has, on its unit, the fallback texel on the others; a unit the
-            // program does not sample is skipped.
-            auto bind = [&](int texture, gl::UniformLocation has, const gl::TextureUnit& unit) {
+            // program does not sample is skipped, and one that already holds the texture (an earlier
+            // batch of this call bound it) is left as it is.
+            auto bind = [&](std::size_t slot, int texture, gl::UniformLocation has,
+                            const gl::TextureUnit& unit) {
                 const bool present = texture >= 0 && texture < static_cast<int>(mTextures.size());
                 glUniform1i(has.location, present ? 1 : 0);
-                if (unit.unit != gl::kNoUnit)
-                    glBindTextureUnit(unit.unit, present ? mTextures[static_cast<size_t>(texture)].id()
-                                                         : mFallbackTexture.id());
+                const GLuint id =
+                    present ? mTextures[static_cast<size_t>(texture)].id() : mFallbackTexture.id();
+                if (unit.unit == gl::kNoUnit || unitHolds[slot] == id) return;
+                glBindTextureUnit(unit.unit, id);
+                unitHolds[slot] = id;
             };
-            bind(m.baseColorTexture, s.hasTexture, s.baseColorTexture);
-            bind(m.metallicRoughnessTexture, s.hasMetalRoughTexture, s.metalRoughTexture);
-            bind(m.emissiveTexture, s.hasEmissiveTexture, s.emissiveTexture);
-            bind(m.normalTexture, s.hasNormalTexture, s.normalTexture);
-            bind(m.occlusionTexture, s.hasOcclusionTexture, s.occlusionTexture);
+            bind(0, m.baseColorTexture, s.hasTexture, s.baseColorTexture);
+            bind(1, m.metallicRoughnessTexture, s.hasMetalRoughTexture, s.metalRoughTexture);
+            bind(2, m.emissiveTexture, s.hasEmissiveTexture, s.emissiveTexture);
+            bind(3, m.normalTexture, s.hasNormalTexture, s.normalTexture);
+            bind(4, m.occlusionTexture, s.hasOcclusionTexture, s.occlusionTexture);
             glUniform1f(s.occlusionStrength.location,
                         std::isfinite(m.occlusionStrength) ? m.occlusionStrength : 1.0f);
             glUniform1f(s.normalScale.location, std::isfinite(m.normalScale) ? m.normalScale : 1.0f);

@@ -611,6 +611,12 @@ void Session::startLoad(Worker& w, std::string request) {
     });
 }
 
+void Session::refuseScene(const std::string& request, const char* what, const std::string& why) {
+    logWarn("session " + mId + ": scene " + validUtf8(request) + " " + what + ": " + validUtf8(why));
+    broadcastText(errorMessage({"scene_load_failed", why, "/name", "scene"}));
+    if (mOnError) mOnError("scene_load_failed");
+}
+
 void Session::finishLoad(Worker& w) {
     const std::unique_ptr<Worker::Load> load = std::move(w.load);
     load->thread.join();
@@ -624,10 +630,7 @@ void Session::finishLoad(Worker& w) {
         } catch (const LoadCancelled&) {
             // Only a newer request (started above) or the session's end cancels a load.
         } catch (const std::exception& e) {
-            logWarn("session " + mId + ": scene " + validUtf8(load->request) +
-                    " refused: " + validUtf8(e.what()));
-            broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
-            if (mOnError) mOnError("scene_load_failed");
+            refuseScene(load->request, "refused", e.what());
         }
         return;
     }
@@ -642,10 +645,7 @@ void Session::finishLoad(Worker& w) {
     try {
         upload->gpu = std::make_unique<SceneGpu>(*upload->scene, std::move(load->gpu), SceneGpu::Staged{});
     } catch (const std::exception& e) {
-        logWarn("session " + mId + ": scene " + validUtf8(load->request) +
-                " could not be uploaded: " + validUtf8(e.what()));
-        broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
-        if (mOnError) mOnError("scene_load_failed");
+        refuseScene(load->request, "could not be uploaded", e.what());
         return;
     }
     upload->renderThreadMs = upload->longestSliceMs = stageClock.elapsedMs();
@@ -660,10 +660,7 @@ void Session::continueUpload(Worker& w) {
     try {
         done = upload.gpu->uploadSome(static_cast<double>(mConfig.limits.sliceMs));
     } catch (const std::exception& e) {
-        logWarn("session " + mId + ": scene " + validUtf8(upload.request) +
-                " could not be uploaded: " + validUtf8(e.what()));
-        broadcastText(errorMessage({"scene_load_failed", e.what(), "/name", "scene"}));
-        if (mOnError) mOnError("scene_load_failed");
+        refuseScene(upload.request, "could not be uploaded", e.what());
         w.upload.reset();
         return;
     }
