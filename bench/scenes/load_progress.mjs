@@ -1,9 +1,12 @@
 // What a client sees while a big scene loads: exports a generated courtyard as .glb (gi-render
 // --export), offers its folder with --scene-dir, asks a session for it and prints every `progress`
 // message of the load with its time since the request (docs/scenes.md, "Loading").
-// usage: node bench/scenes/load_progress.mjs [--scene builtin:atrium-2000k | FILE.glb] [--bin build/ci/bin]
+// --textures N instead loads N quads, each with a texture of its own (--side x --side pixels), to see
+// how the GL upload of many textures is sliced (state.load.upload_slices, upload_slice_max_ms).
+// usage: node bench/scenes/load_progress.mjs [--scene builtin:atrium-2000k | FILE.glb | --textures N
+//        [--side 2048]] [--bin build/ci/bin]
 import { execFileSync } from 'node:child_process';
-import { copyFileSync, mkdtempSync, rmSync } from 'node:fs';
+import { copyFileSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 
@@ -13,14 +16,19 @@ const option = (name, fallback) => {
     return i >= 0 && i + 1 < args.length ? args[i + 1] : fallback;
 };
 if (args.includes('--help')) {
-    console.log('usage: node bench/scenes/load_progress.mjs [--scene builtin:NAME | FILE.glb] [--bin DIR]');
+    console.log('usage: node bench/scenes/load_progress.mjs [--scene builtin:NAME | FILE.glb | --textures N [--side S]]'
+        + ' [--bin DIR]');
     process.exit(0);
 }
 const scene = option('--scene', 'builtin:atrium-2000k');
 const bin = path.resolve(option('--bin', 'build/ci/bin'));
 const dir = mkdtempSync(path.join(os.tmpdir(), 'gi-load-progress-'));
 const file = path.join(dir, 'scene.glb');
-if (scene.startsWith('builtin:')) {
+const textures = Number(option('--textures', '0'));
+if (textures > 0) {
+    const { slowToLoadGlb, texturedQuadsGlb } = await import('../../tests/e2e/glb.mjs');
+    writeFileSync(file, texturedQuadsGlb(slowToLoadGlb(Number(option('--side', '2048'))), textures));
+} else if (scene.startsWith('builtin:')) {
     execFileSync(path.join(bin, 'gi-render'), ['--scene', scene, '--export', file, '--quiet']);
 } else {
     copyFileSync(scene, file);

@@ -52,8 +52,8 @@ public:
     /// What the upload sends, built without GL on any thread: the interleaved vertices, the indices,
     /// the placements, the runs with their bounds and every texture's mipmap chain. A scene load
     /// builds it beside the scene, so the render thread only uploads, in slices (docs/scenes.md,
-    /// "Loading": eight 2048^2 textures 138-143 ms in 8-9 slices of at most 20 ms, against one hold
-    /// of 326 ms; `state.load` in bench/scenes/load_progress.mjs). `cancelled` (may be empty) is
+    /// "Loading": eight 2048^2 textures 108-122 ms in 8 slices of at most 14-19 ms, against one hold
+    /// of 291-306 ms; `node bench/scenes/load_progress.mjs --textures 8`). `cancelled` (may be empty) is
     /// asked between textures; when it answers true, prepare returns null.
     struct Prepared;
     static std::shared_ptr<const Prepared> prepare(const Scene& scene,

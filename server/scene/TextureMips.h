@@ -1,6 +1,5 @@
 // The mipmap chain of a texture, built on the CPU so that a scene's load thread, not the render
-// thread, pays for it (glGenerateTextureMipmap on llvmpipe took 10-18 ms per 2048^2 texture on the
-// render thread, and 94 ms for the first one of a session).
+// thread, pays for it (glGenerateTextureMipmap runs on the render thread: docs/scenes.md, "Loading").
 #pragma once
 
 #include <cstdint>
