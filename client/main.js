@@ -157,7 +157,8 @@ const store = new Store({
     serverScene: null, // the scene of the last full state from the server
     lighting: null, // state.lighting {source, note}, until a frame's stats.lighting says more
     statsByFrame: new Map(), // frame -> {stats, arrivedAt}
-    lastDrawn: null, // {frame, width, height, stats}
+    lastDrawn: null, // {frame, width, height, stats, arrivedAt, drawnAt, decodeMs} (times: performance.now())
+    lastSteerAt: null, // performance.now() when the last steering message (camera, light, params) left
     framesDrawn: 0,
     decoding: false,
     pending: [], // frames that arrived while another was decoding (frames.js: the newest whole frame, then patches)
@@ -194,6 +195,13 @@ const hook = {
     get framesDrawn() { return state.framesDrawn; },
     get lastStats() { return state.lastDrawn?.stats ?? null; },
     get lastFrame() { return state.lastDrawn?.frame ?? null; },
+    // When the last frame's bytes arrived and when it was drawn on the canvas, and when the last steering
+    // message left (epoch ms, as Date.now() counts): where an answer to input spent its time.
+    get lastDrawTiming() {
+        const epoch = (t) => (t === null || t === undefined ? null : performance.timeOrigin + t);
+        return { arrivedAt: epoch(state.lastDrawn?.arrivedAt), drawnAt: epoch(state.lastDrawn?.drawnAt),
+            decodeMs: state.lastDrawn?.decodeMs ?? null, steerAt: epoch(state.lastSteerAt) };
+    },
     get connection() { return state.connState; },
     get role() { return state.viewer ? 'viewer' : 'controller'; },
     get session() { return state.welcome?.session ?? null; },
@@ -506,7 +514,8 @@ function recordDraw(frame, decodeMs, frameBytes) {
     const now = performance.now();
     const stats = frame.entry?.stats ?? null;
     state.framesDrawn += 1;
-    state.lastDrawn = { frame: frame.header.frame, width: frame.header.width, height: frame.header.height, stats };
+    state.lastDrawn = { frame: frame.header.frame, width: frame.header.width, height: frame.header.height, stats,
+        arrivedAt: frame.arrivedAt, drawnAt: now, decodeMs };
     ui.canvas.dataset.frame = String(frame.header.frame);
     rate.tick(now);
     if (stats && !stats.snapshot) {

@@ -43,6 +43,7 @@ export function createOutbox({ ui, state, settings, store, camera, connection, l
             const now = performance.now();
             latency.input(now);
             watch.input(now);
+            state.lastSteerAt = now;
         }
         return sent;
     }

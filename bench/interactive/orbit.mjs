@@ -5,6 +5,9 @@
 //     interactive frame drawn, p50 and p95, against that frame's own render + encode time,
 //   - input during refinement: the same, pressed while a slow configuration (rsm_gather with 65,536
 //     VPLs, hier_isr with tau 0) refines in tiles.
+// Each press is timed twice: from this script's key dispatch to the page's next animation frame after
+// the draw (`still_input_to_frame_ms`, `input_to_frame_ms`), and in the page, from the key event to the
+// frame drawn on the canvas (`still_in_page`, `in_page`, with where the time went).
 // Figures are measured side by side in one run on whatever machine runs it; docs/interactive.md has
 // the ones recorded. usage:
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
@@ -56,13 +59,23 @@ await page.evaluate(() => {
         if (n !== seen) {
             seen = n;
             const s = window.giClient.lastStats ?? {};
+            const timing = window.giClient.lastDrawTiming;
             window.benchDraws.push({ t: performance.timeOrigin + performance.now(), quality: s.quality,
                 ms: (s.frame_ms ?? 0) + (s.encode_ms ?? 0), refine: s.refine ?? null, size: s.size,
-                input: s.input ?? null, encode: s.encode_ms ?? 0 });
+                input: s.input ?? null, encode: s.encode_ms ?? 0, drawnAt: timing.drawnAt,
+                arrivedAt: timing.arrivedAt, decodeMs: timing.decodeMs });
         }
         requestAnimationFrame(poll);
     };
     requestAnimationFrame(poll);
+    // Each key press as the page received it (the event's own time), and when the client's camera
+    // message for it left: this listener runs after the view's, whose message goes out in a microtask
+    // of the same event.
+    window.benchKeys = [];
+    window.addEventListener('keydown', (e) => {
+        if (!e.repeat) window.benchKeys.push({ at: performance.timeOrigin + e.timeStamp,
+            steerAt: window.giClient.lastDrawTiming.steerAt });
+    });
 });
 const view = await page.$('canvas') ?? await page.$('#view');
 const box = await view.boundingBox();
@@ -87,8 +100,40 @@ async function pressLatency(key) {
     const d = (await draws(t0)).find((x) => x.quality === 'interactive');
     const sent = wire.cameraSent.find((t) => t >= t0);
     const arrived = wire.interactiveStats.find((t) => t >= t0);
+    const keyEvent = await page.evaluate((t) => window.benchKeys.find((k) => k.at >= t - 5) ?? null, t0);
+    // Measured in the page from the key event (as the browser's own input-latency metrics count it):
+    // the harness's dispatch of the key through the DevTools protocol is left out, and the frame counts
+    // as shown when drawn on the canvas rather than at the page's next animation frame.
+    const inPage = keyEvent && d.drawnAt ? {
+        fromKey: d.drawnAt - keyEvent.at,
+        client: keyEvent.steerAt !== null && keyEvent.steerAt >= keyEvent.at - 1 ? keyEvent.steerAt - keyEvent.at : null,
+        server: keyEvent.steerAt !== null && d.arrivedAt ? d.arrivedAt - keyEvent.steerAt : null,
+        decodeDraw: d.arrivedAt ? d.drawnAt - d.arrivedAt : null,
+        dispatch: keyEvent.at - t0, toAnimationFrame: d.t - d.drawnAt,
+        // The camera message's way to the server and the frame's way back (both sockets, the server's
+        // network thread and the page's message handling): the server part less the server's own time
+        // from the input's arrival to the encoded frame.
+        sockets: keyEvent.steerAt !== null && d.arrivedAt && d.input?.rendered_ms !== undefined
+            ? d.arrivedAt - keyEvent.steerAt - d.input.rendered_ms - d.encode : null,
+    } : null;
     return { latency: d.t - t0, frameMs: d.ms, inputWait: d.input?.wait_ms ?? null, windowWait: d.input?.window_wait_ms ?? null, toSend: sent ? sent - t0 : null,
-        toStats: arrived && sent ? arrived - sent : null, toDraw: arrived ? d.t - arrived : null };
+        toStats: arrived && sent ? arrived - sent : null, toDraw: arrived ? d.t - arrived : null, inPage };
+}
+
+// The in-page figures of a set of presses: from the key event to the frame drawn, that less the frame's
+// own render + encode, and where the time went (p50 and p95 of each part).
+function inPageSummary(results) {
+    const pressed = results.filter((r) => r.inPage);
+    if (!pressed.length) return null;
+    const pcts = (v) => ({ p50: percentile(v, 0.5), p95: percentile(v, 0.95) });
+    const parts = {};
+    for (const k of ['dispatch', 'client', 'server', 'sockets', 'decodeDraw', 'toAnimationFrame']) {
+        const v = pressed.map((r) => r.inPage[k]).filter((x) => x !== null && x !== undefined);
+        if (v.length) parts[k] = pcts(v);
+    }
+    return { from_key_to_drawn_ms: pcts(pressed.map((r) => r.inPage.fromKey)),
+        beyond_frame_ms: pcts(pressed.map((r) => r.inPage.fromKey - r.frameMs)), parts_ms: parts,
+        presses: pressed.length };
 }
 
 async function measureScene(scene, technique, params) {
@@ -110,9 +155,11 @@ async function measureScene(scene, technique, params) {
     const frameMs = orbit.map((d) => d.ms);
     // Input from a still view.
     const stillLat = [], stillFrame = [], parts = { toSend: [], inputWait: [], toStats: [], toDraw: [] };
+    const results = [];
     for (let i = 0; i < opts.presses; i++) {
         await still();
         const r = await pressLatency(i % 2 ? 'ArrowLeft' : 'ArrowRight');
+        results.push(r);
         if (opts.verbose) console.error('still press', JSON.stringify(r));
         stillLat.push(r.latency);
         stillFrame.push(r.frameMs);
@@ -128,7 +175,7 @@ async function measureScene(scene, technique, params) {
         still_frame_ms_p50: percentile(stillFrame, 0.5),
         still_over_frame_ms: { p50: percentile(over, 0.5), p95: percentile(over, 0.95) },
         still_input_wait_ms: { p50: percentile(parts.inputWait, 0.5), p95: percentile(parts.inputWait, 0.95) },
-        still_breakdown_ms_p50: breakdown, presses: stillLat.length,
+        still_breakdown_ms_p50: breakdown, still_in_page: inPageSummary(results), presses: stillLat.length,
         last_size: orbit.at(-1)?.size };
 }
 
@@ -138,7 +185,7 @@ async function duringRefinement(scene, technique, params) {
         window.giClient.send?.({ type: 'technique', name: technique });
         window.giClient.send?.({ type: 'params', values: params });
     }, { scene, technique, params });
-    const lat = [], frame = [], waits = [];
+    const lat = [], frame = [], waits = [], results = [];
     let refining = 0;
     for (let i = 0; i < opts.presses; i++) {
         const t = Date.now();
@@ -149,6 +196,7 @@ async function duringRefinement(scene, technique, params) {
         if (tile) refining++;
         await sleep(50 + 37 * (i % 3)); // somewhere inside a tile
         const r = await pressLatency(i % 2 ? 'ArrowLeft' : 'ArrowRight');
+        results.push(r);
         if (opts.verbose) console.error('refining press', JSON.stringify(r));
         lat.push(r.latency);
         frame.push(r.frameMs);
@@ -158,7 +206,8 @@ async function duringRefinement(scene, technique, params) {
     return { scene, technique, params, input_to_frame_ms: { p50: percentile(lat, 0.5), p95: percentile(lat, 0.95) },
         over_frame_ms: { p50: percentile(over, 0.5), p95: percentile(over, 0.95) },
         input_wait_ms: { p50: percentile(waits, 0.5), p95: percentile(waits, 0.95) },
-        frame_ms_p50: percentile(frame, 0.5), presses: lat.length, presses_during_refinement: refining };
+        in_page: inPageSummary(results), frame_ms_p50: percentile(frame, 0.5), presses: lat.length,
+        presses_during_refinement: refining };
 }
 
 const report = { viewport, machine: process.env.GI_BENCH_MACHINE ?? null, scenes: [], refinement: [] };

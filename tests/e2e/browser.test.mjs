@@ -338,6 +338,14 @@ test('the stats overlay shows fps, latency, times, bytes and per-pass timings', 
         const frame = await page.evaluate(() => window.giClient.lastFrame);
         await until('a frame after the drag', (f) => window.giClient.lastFrame > f, frame);
     }
+    // The timing points the interactive benchmark reads: the drag's camera message left before the frame
+    // that followed it arrived, and the frame arrived before it was drawn (epoch ms, as Date.now()).
+    const timing = await page.evaluate(() => window.giClient.lastDrawTiming);
+    const now = Date.now();
+    assert.ok(timing.steerAt > now - 60000 && timing.steerAt <= now, `steerAt ${timing.steerAt} near ${now}`);
+    assert.ok(timing.arrivedAt > timing.steerAt, `the frame arrived after the camera left: ${JSON.stringify(timing)}`);
+    assert.ok(timing.drawnAt >= timing.arrivedAt && timing.drawnAt <= now, JSON.stringify(timing));
+    assert.ok(timing.decodeMs >= 0 && timing.decodeMs <= timing.drawnAt - timing.arrivedAt + 1, JSON.stringify(timing));
     await until('pass legend with vpl_gather', () => {
         const ms = document.querySelector('#ov-legend li[data-pass="vpl_gather"] .pass-ms')?.textContent;
         return ms && /^\d+\.\d$/.test(ms);
