@@ -136,13 +136,24 @@ function inPageSummary(results) {
         presses: pressed.length };
 }
 
-async function measureScene(scene, technique, params) {
+// A built-in scene may be named without its prefix on the command line; the server knows it with it.
+const sceneName = (name) => (name.includes(':') || /\.(glb|gltf|zip)$/i.test(name) ? name : `builtin:${name}`);
+
+// Frames of `scene` are being drawn (a name the server refuses would otherwise leave the previous scene
+// measured under the new name).
+async function untilSceneShown(scene) {
+    await until(`frames of ${scene} (is the name right?)`, (name) => window.giClient.lastStats?.scene === name, scene, 60000);
+}
+
+async function measureScene(requested, technique, params) {
+    const scene = sceneName(requested);
     await page.evaluate(({ scene, technique, params }) => {
         window.giClient.send?.({ type: 'scene', name: scene });
         // No technique: the server's default (presets/presets.json's measured default_technique).
         if (technique) window.giClient.send?.({ type: 'technique', name: technique });
         if (params) window.giClient.send?.({ type: 'params', values: params });
     }, { scene, technique, params });
+    await untilSceneShown(scene);
     await sleep(1500);
     technique ??= await page.evaluate(() => window.giClient.lastStats?.technique ?? null);
     // Orbit: hold the left arrow.
@@ -185,6 +196,7 @@ async function duringRefinement(scene, technique, params) {
         window.giClient.send?.({ type: 'technique', name: technique });
         window.giClient.send?.({ type: 'params', values: params });
     }, { scene, technique, params });
+    await untilSceneShown(scene);
     const lat = [], frame = [], waits = [], results = [];
     let refining = 0;
     for (let i = 0; i < opts.presses; i++) {

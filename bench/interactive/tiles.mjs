@@ -19,6 +19,9 @@ const opts = parseOptions({ server: DEFAULT_SERVER, technique: '', params: '', s
 'usage: node bench/interactive/tiles.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--seconds S] [--server-args "FLAGS"] [--whole 1] [--verbose 1] [--nudge S]');
 const { server, port } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 
+// A built-in scene may be named without its prefix; the server knows it with it.
+const sceneName = opts.scene && !opts.scene.includes(':') && !/\.(glb|gltf|zip)$/i.test(opts.scene)
+    ? `builtin:${opts.scene}` : opts.scene;
 const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
 let stats = null;
 let camera = null;
@@ -30,7 +33,7 @@ ws.on('open', () => {
     ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2, codecs: ['webp', 'jpeg'],
         // As the web client: patches (the regions pasted since the last send) unless --whole 1.
         patches: !opts.whole }));
-    if (opts.scene) ws.send(JSON.stringify({ type: 'scene', name: opts.scene }));
+    if (opts.scene) ws.send(JSON.stringify({ type: 'scene', name: sceneName }));
     if (opts.technique) ws.send(JSON.stringify({ type: 'technique', name: opts.technique }));
     if (opts.params) ws.send(JSON.stringify({ type: 'params', values: JSON.parse(opts.params) }));
 });
@@ -44,6 +47,8 @@ ws.on('message', (data, isBinary) => {
         return;
     }
     ws.send(JSON.stringify({ type: 'ack', frame: data.readUInt32LE(4) }));
+    // Tiles of the scene asked for only: a refused name would leave the default scene measured.
+    if (sceneName && stats?.scene !== sceneName) return;
     if (stats?.refine) {
         if (stats.refine.complete) stepsDone.push({ step: stats.quality, ms: Math.round(stats.refine.elapsed_ms) });
         if (opts.verbose) console.log(JSON.stringify({ step: stats.quality, share: +stats.refine.share.toFixed(3),
@@ -62,6 +67,10 @@ if (opts.nudge > 0) {
     }, opts.nudge * 1000);
 }
 setTimeout(() => {
+    if (sceneName && !tiles.length) {
+        console.error(`no refinement tiles of ${sceneName}: is the name right? (the server's log says)`);
+        process.exit(1);
+    }
     const rounds = [];
     for (let r = 0; r <= round; r++) {
         const t = tiles.filter((x) => x.round === r);
