@@ -47,6 +47,9 @@ export async function startServer(serverPath, args = []) {
     server.stderr.on('data', (d) => { log += d; });
     for (let i = 0; i < 100 && !log.includes('listening'); i++) await sleep(100);
     if (!log.includes('listening')) throw new Error(`gi-server did not start:\n${log}`);
+    // A benchmark that stops on an error must not leave its server running (and loading the machine
+    // the next measurement runs on).
+    process.on('exit', () => server.kill('SIGKILL'));
     return { server, port, log: () => log };
 }
 

@@ -31,7 +31,7 @@ const browser = await chromium.launch({ executablePath: opts.chromium,
 const page = await (await browser.newContext({ viewport: { width: 960 + 320, height: 800 } })).newPage();
 // The socket's traffic as this process sees it (through the browser's debugging protocol, so a few ms
 // late): when camera messages left and when interactive frames' stats arrived, for the breakdown.
-const wire = { cameraSent: [], interactiveStats: [] };
+const wire = { cameraSent: [], interactiveStats: [], errors: [] };
 page.on('websocket', (ws) => {
     ws.on('framesent', ({ payload }) => {
         if (typeof payload === 'string' && payload.includes('"camera"')) wire.cameraSent.push(Date.now());
@@ -39,6 +39,12 @@ page.on('websocket', (ws) => {
     ws.on('framereceived', ({ payload }) => {
         if (typeof payload === 'string' && payload.includes('"stats"') && payload.includes('"interactive"'))
             wire.interactiveStats.push(Date.now());
+        if (typeof payload === 'string' && payload.includes('"error"')) {
+            try {
+                const m = JSON.parse(payload);
+                if (m.type === 'error') wire.errors.push({ t: Date.now(), message: m.message ?? payload, request: m.request });
+            } catch { /* not JSON: not an error message */ }
+        }
     });
 });
 await page.goto(`http://127.0.0.1:${port}/`);
@@ -141,19 +147,27 @@ const sceneName = (name) => (name.includes(':') || /\.(glb|gltf|zip)$/i.test(nam
 
 // Frames of `scene` are being drawn (a name the server refuses would otherwise leave the previous scene
 // measured under the new name).
-async function untilSceneShown(scene) {
-    await until(`frames of ${scene} (is the name right?)`, (name) => window.giClient.lastStats?.scene === name, scene, 60000);
+async function untilSceneShown(scene, since) {
+    const refusal = () => wire.errors.find((x) => x.t >= since && x.request === 'scene');
+    for (const end = Date.now() + 60000; Date.now() < end;) {
+        if (await page.evaluate((name) => window.giClient.lastStats?.scene === name, scene)) return;
+        // The server's refusal (an unknown name, a file that failed to load) ends the wait.
+        if (refusal()) throw new Error(`${scene}: the server said "${refusal().message}"`);
+        await sleep(100);
+    }
+    throw new Error(`timed out waiting for frames of ${scene} (is the name right?)`);
 }
 
 async function measureScene(requested, technique, params) {
     const scene = sceneName(requested);
+    const asked = Date.now();
     await page.evaluate(({ scene, technique, params }) => {
         window.giClient.send?.({ type: 'scene', name: scene });
         // No technique: the server's default (presets/presets.json's measured default_technique).
         if (technique) window.giClient.send?.({ type: 'technique', name: technique });
         if (params) window.giClient.send?.({ type: 'params', values: params });
     }, { scene, technique, params });
-    await untilSceneShown(scene);
+    await untilSceneShown(scene, asked);
     await sleep(1500);
     technique ??= await page.evaluate(() => window.giClient.lastStats?.technique ?? null);
     // Orbit: hold the left arrow.
@@ -191,12 +205,13 @@ async function measureScene(requested, technique, params) {
 }
 
 async function duringRefinement(scene, technique, params) {
+    const asked = Date.now();
     await page.evaluate(({ scene, technique, params }) => {
         window.giClient.send?.({ type: 'scene', name: scene });
         window.giClient.send?.({ type: 'technique', name: technique });
         window.giClient.send?.({ type: 'params', values: params });
     }, { scene, technique, params });
-    await untilSceneShown(scene);
+    await untilSceneShown(scene, asked);
     const lat = [], frame = [], waits = [], results = [];
     let refining = 0;
     for (let i = 0; i < opts.presses; i++) {
