@@ -150,7 +150,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
     // Everything in pieces (uploadSome), each buffer's storage a piece of its own (llvmpipe clears
     // it): the pieces read `prepared` and the scene's images.
     const auto bufferInPieces = [&](gl::Buffer& buffer, const void* data, std::size_t bytes) {
-        mChunks.push_back({[&buffer, bytes] {
+        mPieces.push_back({[&buffer, bytes] {
                                buffer = gl::Buffer::create(static_cast<GLsizeiptr>(bytes), nullptr,
                                                            GL_DYNAMIC_STORAGE_BIT);
                            },
@@ -158,7 +158,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
         const auto* bytesIn = static_cast<const std::uint8_t*>(data);
         for (std::size_t offset = 0; offset < bytes; offset += kUploadChunkBytes) {
             const std::size_t size = std::min(kUploadChunkBytes, bytes - offset);
-            mChunks.push_back({[&buffer, offset, size, bytesIn] {
+            mPieces.push_back({[&buffer, offset, size, bytesIn] {
                                    glNamedBufferSubData(buffer.id(), static_cast<GLintptr>(offset),
                                                         static_cast<GLsizeiptr>(size), bytesIn + offset);
                                },
@@ -168,7 +168,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
     bufferInPieces(mVertices, vertices.data(), vertices.size() * sizeof(Vertex));
     bufferInPieces(mIndices, indices.data(), indices.size() * sizeof(std::uint32_t));
     bufferInPieces(mPlacements, placements.data(), placements.size() * sizeof(InstanceTransform));
-    mChunks.push_back({[this] { setUpVertexArray(); }, 0, false});
+    mPieces.push_back({[this] { setUpVertexArray(); }, 0, false});
 
     GIS_ASSERT(prepared->textureMips.size() == scene.textures.size());
     // Creating a texture's storage is a piece of its own: llvmpipe clears it, which is most of a
@@ -183,7 +183,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
         const int width = image.width, height = image.height, levels = static_cast<int>(mips.size()) + 1;
         std::size_t textureBytes = image.rgba.size();
         for (const MipLevel& m : mips) textureBytes += m.rgba.size();
-        mChunks.push_back({[this, i, format, width, height, levels] {
+        mPieces.push_back({[this, i, format, width, height, levels] {
                                gl::Texture t = gl::Texture::create2D(format, width, height, levels);
                                t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
                                t.setWrap(GL_REPEAT);
@@ -197,7 +197,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
             for (int y = 0; y < levelHeight; y += rowsPerBand) {
                 const int rows = std::min(rowsPerBand, levelHeight - y);
                 const std::uint8_t* first = rgba + static_cast<std::size_t>(y) * rowBytes;
-                mChunks.push_back({[this, i, level, y, levelWidth, rows, first] {
+                mPieces.push_back({[this, i, level, y, levelWidth, rows, first] {
                                        glTextureSubImage2D(mTextures[i].id(), level, 0, y, levelWidth, rows,
                                                            GL_RGBA, GL_UNSIGNED_BYTE, first);
                                    },
@@ -259,22 +259,22 @@ bool SceneGpu::uploadSome(double budgetMs) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
     };
     const auto start = Clock::now();
-    for (bool first = true; mNextChunk < mChunks.size(); first = false) {
-        const Piece& piece = mChunks[mNextChunk];
+    for (bool first = true; mNextPiece < mPieces.size(); first = false) {
+        const Piece& piece = mPieces[mNextPiece];
         const double mib = static_cast<double>(piece.bytes) / (1024.0 * 1024.0);
         double& msPerMiB = piece.creates ? mCreateMsPerMiB : mFillMsPerMiB;
         if (!first && msSince(start) + mib * msPerMiB > budgetMs) break;
         const auto pieceStart = Clock::now();
         piece.send();
-        ++mNextChunk;
+        ++mNextPiece;
         // Pieces under 1 MiB say little about the rate (their fixed cost dominates).
         if (mib >= 1.0) msPerMiB = 0.5 * msPerMiB + 0.5 * msSince(pieceStart) / mib;
     }
-    if (mNextChunk < mChunks.size()) return false;
+    if (mNextPiece < mPieces.size()) return false;
     if (mUploading) {
-        mChunks.clear();
-        mChunks.shrink_to_fit();
-        mNextChunk = 0;
+        mPieces.clear();
+        mPieces.shrink_to_fit();
+        mNextPiece = 0;
         mUploading.reset(); // the prepared copy is no longer needed
         gl::checkErrors(("scene upload of '" + mSceneName + "'").c_str());
     }

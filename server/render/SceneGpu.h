@@ -62,9 +62,10 @@ public:
     /// Uploads everything; throws gis::Error on GL failure (a load boundary). `prepared` must come
     /// from prepare(scene) of this scene; null: prepared here.
     explicit SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared = nullptr);
-    /// Staged: creates the GL objects now and sends their contents in pieces of at most
-    /// kUploadChunkBytes through uploadSome(), so that a big scene's upload can be spread between
-    /// frames instead of holding the render thread. Draw only once complete(). `scene` must outlive
+    /// Staged: plans the upload as pieces (each buffer's or texture's storage, then ranges and row
+    /// bands of at most kUploadChunkBytes, the vertex array last) and sends them through
+    /// uploadSome(), so that a big scene's upload can be spread between frames instead of holding
+    /// the render thread. Draw only once complete(). `scene` must outlive
     /// the upload; `prepared` as above.
     struct Staged {};
     SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared, Staged);
@@ -75,7 +76,7 @@ public:
     /// cost per byte measured as it goes); true when everything is sent.
     /// Throws gis::Error on GL failure once the last piece is sent.
     bool uploadSome(double budgetMs);
-    bool complete() const { return mNextChunk >= mChunks.size(); }
+    bool complete() const { return mNextPiece >= mPieces.size(); }
     static constexpr std::size_t kUploadChunkBytes = std::size_t{4} << 20;
     /// Draws every mesh with `program` bound (`instances` times each); sets the material uniforms
     /// through `materials` (null: none, as for depth-only passes). `skipMesh` (an index into
@@ -194,12 +195,13 @@ private:
         std::size_t bytes = 0;
         bool creates = false; ///< makes a storage (llvmpipe clears it) rather than filling one
     };
-    std::vector<Piece> mChunks;
-    /// Measured cost of a piece, ms per MiB, of creating and of filling storage: uploadSome stops
-    /// before a piece predicted to overrun its budget (starting values measured on llvmpipe).
+    std::vector<Piece> mPieces;
+    /// Cost of a piece, ms per MiB, of creating and of filling storage: uploadSome stops before a
+    /// piece predicted to overrun its budget. The first values are guesses; each piece of 1 MiB or
+    /// more replaces half of its kind's value by what it measured.
     double mCreateMsPerMiB = 0.6, mFillMsPerMiB = 0.3;
     void setUpVertexArray(); ///< the last piece: attributes over the filled buffers
-    std::size_t mNextChunk = 0;
+    std::size_t mNextPiece = 0;
     std::shared_ptr<const Prepared> mUploading;
     std::string mSceneName;
     gl::Texture mFallbackTexture; ///< one white texel, nearest: on the units of maps a material lacks

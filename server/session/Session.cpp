@@ -683,7 +683,6 @@ void Session::continueUpload(Worker& w) {
             std::to_string(std::lround(finished->renderThreadMs)) + " ms of the render thread (" +
             std::to_string(finished->slices) + " slices, the longest " +
             std::to_string(std::lround(finished->longestSliceMs)) + " ms)");
-    Worker::Upload* load = finished.get(); // the state message below reads its request and info
     w.scene = next;
     nlohmann::json stateMsg;
     {
@@ -695,8 +694,8 @@ void Session::continueUpload(Worker& w) {
         mDesired.lightSource = fresh.lightSource;
         mDesired.lightNote = fresh.lightNote;
         mScene = next;
-        mSceneName = load->request;
-        mSceneLoad = load->info;
+        mSceneName = finished->request;
+        mSceneLoad = std::move(finished->info);
         stateMsg = {{"type", "state"}, {"state", stateJsonLocked()}};
         markInput(); // the new scene's first frame is interactive, then it refines
     }

@@ -148,11 +148,12 @@ private:
     /// Starts loading `request` on a thread of its own (Worker::load); the view in place keeps
     /// rendering and answering input until finishLoad swaps the scene in.
     void startLoad(Worker& w, std::string request);
-    /// Joins the finished load and swaps its scene in (state message, fresh camera and lights, an
-    /// interactive frame next), or reports why it failed; starts the request queued meanwhile instead.
     /// A loaded scene that will not be shown: logged (`what` happened, `why`), and the clients get
     /// the error scene_load_failed.
     void refuseScene(const std::string& request, const char* what, const std::string& why);
+    /// Joins the finished load and starts its staged GL upload (continueUpload swaps the scene in:
+    /// state message, fresh camera and lights, an interactive frame next), or reports why it failed;
+    /// starts the request queued meanwhile instead.
     void finishLoad(Worker& w);
     /// Sends the next slice of a loaded scene's GL upload; swaps the scene in when it is complete.
     void continueUpload(Worker& w);

@@ -57,6 +57,13 @@ async function open(server, hello = {}, options) {
     return client;
 }
 
+/** POST /api/upload of `body` as `name` into `client`'s session; the HTTP answer. */
+function upload(client, name, body, type = 'model/gltf-binary') {
+    return servers.main.http(`/api/upload?name=${name}`, {
+        method: 'POST', body, headers: { 'Content-Type': type, 'X-GI-Session': client.welcome.resume_token },
+    });
+}
+
 async function connect(server, options) {
     const client = await Client.connect(server, options);
     clients.add(client);
@@ -568,12 +575,10 @@ check('GET /metrics is Prometheus text with the session and frame counters', asy
 
 check('a zipped .gltf with its .bin and texture folder uploads and renders; bad archives are 400', async () => {
     const client = await open(servers.main);
-    const upload = (name, body) => servers.main.http(`/api/upload?name=${name}`, {
-        method: 'POST', body, headers: { 'Content-Type': 'application/zip', 'X-GI-Session': client.welcome.resume_token },
-    });
+    const uploadZip = (name, body) => upload(client, name, body, 'application/zip');
     // glTF Transform's .gltf + .bin + PNG of the corpus box, zipped (tests/data/corpus/compress.sh).
     const zip = readFileSync(path.join(REPO, 'tests/data/corpus/textured_box_gltf.zip'));
-    const res = await upload('box.zip', zip);
+    const res = await uploadZip('box.zip', zip);
     assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
     const stored = JSON.parse(res.body.toString());
     assert.equal(stored.scene, 'upload:box.zip');
@@ -582,10 +587,10 @@ check('a zipped .gltf with its .bin and texture folder uploads and renders; bad 
     const frame = await client.frame('a frame of the zipped scene', (s) => s.scene === 'upload:box.zip');
     assert.equal(frame.stats.counts?.triangles, 108, 'the box, with its .bin read from the folder');
 
-    const notZip = await upload('bad.zip', Buffer.from('glTF not a zip'));
+    const notZip = await uploadZip('bad.zip', Buffer.from('glTF not a zip'));
     assert.equal(notZip.status, 400);
     assert.equal(JSON.parse(notZip.body.toString()).error, 'not_zip');
-    const damaged = await upload('bad.zip', zip.subarray(0, zip.length / 2));
+    const damaged = await uploadZip('bad.zip', zip.subarray(0, zip.length / 2));
     assert.equal(damaged.status, 400);
     const body = JSON.parse(damaged.body.toString());
     assert.equal(body.error, 'bad_archive');
@@ -595,10 +600,7 @@ check('a zipped .gltf with its .bin and texture folder uploads and renders; bad 
 check('an uploaded Blender file with linked duplicates stays instanced: the state and the frame say so', async () => {
     const client = await open(servers.main);
     const glb = readFileSync(path.join(REPO, 'tests/data/corpus/colonnade.glb'));
-    const res = await servers.main.http('/api/upload?name=colonnade.glb', {
-        method: 'POST', body: glb,
-        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
-    });
+    const res = await upload(client, 'colonnade.glb', glb);
     assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
     client.send({ type: 'scene', name: 'upload:colonnade.glb' });
     const state = await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'upload:colonnade.glb',
@@ -618,10 +620,7 @@ check('an uploaded Blender file with linked duplicates stays instanced: the stat
 async function loadingSlowUpload(name, images) {
     const client = await open(servers.main, { adaptive: true });
     await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
-    const res = await servers.main.http(`/api/upload?name=${name}`, {
-        method: 'POST', body: slowToLoadGlb(4096, images),
-        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
-    });
+    const res = await upload(client, name, slowToLoadGlb(4096, images));
     assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
     const askedAt = performance.now();
     client.send({ type: 'scene', name: `upload:${name}` });
@@ -668,10 +667,7 @@ check('a textured scene reaches GL in slices between frames, not in one hold of 
     const glb = texturedQuadsGlb(png, 4);
     const client = await open(servers.main, { adaptive: true });
     await client.frame('a first frame of the built-in scene', (s) => s.scene === 'builtin:cornell');
-    const res = await servers.main.http('/api/upload?name=quads.glb', {
-        method: 'POST', body: glb,
-        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
-    });
+    const res = await upload(client, 'quads.glb', glb);
     assert.equal(res.status, 201, `status (${res.body.toString().slice(0, 300)})`);
     client.send({ type: 'scene', name: 'upload:quads.glb' });
     const state = await client.inbox.next((m) => m.type === 'state' && m.state?.scene === 'upload:quads.glb',
@@ -767,10 +763,7 @@ check('a fixed-quality view with effects=auto is planned when the ray structure 
 
 check('POST /api/upload of a body that is not a .glb is 400', async () => {
     const client = await open(servers.main);
-    const res = await servers.main.http('/api/upload?name=tiny.glb', {
-        method: 'POST', body: Buffer.from('not a glb'),
-        headers: { 'Content-Type': 'model/gltf-binary', 'X-GI-Session': client.welcome.resume_token },
-    });
+    const res = await upload(client, 'tiny.glb', Buffer.from('not a glb'));
     assert.equal(res.status, 400, `status (${res.body.toString().slice(0, 200)})`);
     assert.equal(typeof JSON.parse(res.body.toString()).error, 'string', 'a JSON error');
 });
