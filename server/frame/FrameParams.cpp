@@ -45,6 +45,16 @@ const ParamTable& frameParamTable() {
          .unit = "texels",
          .help = "soft-shadow filter radius: (2r+1)^2 shadow-map taps",
          .source = "eng"},
+        {.name = "lod_pixels",
+         .type = ParamType::Float,
+         .defaultValue = 0.0,
+         .min = 0.0,
+         .max = 8.0,
+         .unit = "px",
+         .help = "level of detail: the camera draws each big mesh's coarsest simplified version whose "
+                 "error, seen from its nearest point, spans at most this many pixels; 0 draws every "
+                 "triangle. The live view sets it for its interactive frames",
+         .source = "eng"},
         {.name = "rsm_size",
          .type = ParamType::Int,
          .defaultValue = 256,

@@ -149,6 +149,11 @@ std::vector<ServerOption> buildOptions() {
                              "largest size factor of interactive frames while input arrives (the frame "
                              "budget picks one up to it; with --frame-target-ms 0, the factor)",
                              0.1, 1.0, GIS_FIELD(session.limits.interactiveScale)));
+    t.push_back(numberOption("--interactive-lod-px", "GI_INTERACTIVE_LOD_PX", "PX",
+                             "level-of-detail tolerance of interactive frames (their lod_pixels unless the "
+                             "client set it): big meshes are drawn simplified where the error spans at most "
+                             "this many of the frame's pixels; 0 = every triangle",
+                             0.0, 8.0, GIS_FIELD(session.limits.interactiveLodPixels)));
     t.push_back(
         integerOption("--frame-target-ms", "GI_FRAME_TARGET_MS", "MS",
                       "render + encode time an interactive frame should take: each session sizes its "

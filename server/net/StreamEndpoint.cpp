@@ -72,6 +72,7 @@ nlohmann::json WsServer::Impl::welcomeFor(const SessionEntry& entry, ClientRole 
           {"resume_grace_s", config.resumeGraceS},
           {"idle_timeout_s", config.idleTimeoutS},
           {"interactive_scale", l.interactiveScale},
+          {"interactive_lod_px", l.interactiveLodPixels},
           {"frame_target_ms", l.frameTargetMs},
           {"slice_ms", l.sliceMs},
           {"settle_ms", l.settleMs},

@@ -330,12 +330,13 @@ std::vector<double> FrameRenderer::readViewFlux(int views) const {
     return out;
 }
 
-DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& viewProj) {
+DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& viewProj, const LodView& lod) {
     gl::Pass pass(mTimer, "gbuffer");
     pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
     const MeshPass& gbuffer = gbufferPass();
     pass.use(gbuffer.program).set(gbuffer.view, -1);
-    const DrawCount count = mSceneGpu->draw(gbuffer.program, &gbuffer.materials, 1, -1, &viewProj, true);
+    const DrawCount count =
+        mSceneGpu->draw(gbuffer.program, &gbuffer.materials, 1, -1, &viewProj, true, &lod);
     publishGBuffer();
     return count;
 }
@@ -428,6 +429,15 @@ const gl::Texture& FrameRenderer::averageVplPart(const FrameState& state, const 
     return a.mean;
 }
 
+void FrameRenderer::setSceneLevels(std::shared_ptr<const SceneGpu::LodSet> levels) {
+    GIS_ASSERT(mSceneGpu != nullptr);
+    mSceneGpu->setLevels(std::move(levels));
+}
+
+bool FrameRenderer::sceneHasLevels() const {
+    return mSceneGpu && mSceneGpu->hasLevels();
+}
+
 FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool wantDirect) {
     GIS_ASSERT(mSceneGpu != nullptr);
     GIS_ASSERT(state.width > 0 && state.height > 0);
@@ -449,6 +459,15 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     for (const LightViewModel& v : lightSet.views)
         if (!v.orthographic) widestTan = std::max(widestTan, v.tanHalfFov);
     u.viewProj = frameViewProj(state);
+    // Levels of detail in the camera's view only (lod_pixels, a tolerance in pixels of the whole
+    // image, tiles included). The light views draw every triangle: a simplified surface is shadowed
+    // by the full mesh, within the shadow lookup's normal offset (offsetting it by the level's error as
+    // well was measured worse: docs/interactive.md, "Level of detail").
+    if (mLevelsOnDemand && fp.getFloat("lod_pixels") > 0.0 && !mSceneGpu->hasLevels())
+        mSceneGpu->setLevels(SceneGpu::prepareLevels(*mScene));
+    const LodView lod{state.camera.position,
+                      lodErrorPerMetre(fp.getFloat("lod_pixels"), state.camera.yfovRadians,
+                                       state.window.active() ? state.window.fullHeight : state.height)};
     u.cameraPos = glm::vec4(state.camera.position, 0.0f);
     const bool lightOn = lightSet.any();
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
@@ -517,7 +536,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         publishGBuffer();
         mResources.publish("direct", "direct", mDirect);
     } else {
-        eyeDraws = renderGBuffer(state.width, state.height, u.viewProj);
+        eyeDraws = renderGBuffer(state.width, state.height, u.viewProj, lod);
         renderDirect();
     }
 
@@ -528,6 +547,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     // every view; 0 when last frame's are reused) drew and left out.
     counters["triangles_gbuffer"] = static_cast<double>(eyeDraws.drawn);
     counters["triangles_gbuffer_culled"] = static_cast<double>(eyeDraws.culled);
+    if (lod.errorPerMetre > 0.0f)
+        counters["triangles_gbuffer_simplified"] = static_cast<double>(eyeDraws.simplified);
     counters["triangles_light_views"] = static_cast<double>(lightDraws.drawn);
     counters["triangles_light_views_culled"] = static_cast<double>(lightDraws.culled);
     counters["draw_runs_gbuffer"] = static_cast<double>(eyeDraws.runs);
@@ -634,6 +655,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         countJson["triangles_stored"] = mSceneGpu->storedTriangleCount();
         countJson["instances"] = mSceneGpu->instanceCount();
     }
+    if (mSceneGpu->lodTriangleCount() > 0) countJson["triangles_lod_stored"] = mSceneGpu->lodTriangleCount();
     countJson["pixels"] = state.width * state.height;
     if (reuseLights) countJson["light_views_reused"] = views;
     for (const auto& [k, v] : counters) countJson[k] = v;

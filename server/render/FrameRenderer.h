@@ -71,6 +71,14 @@ public:
     /// the same (the stats' counts then have `light_views_reused`). Off by default, so that benchmarks
     /// and tests time every pass of every frame; the service turns it on.
     void setReuseLightPasses(bool reuse) { mReuseLightPasses = reuse; }
+    /// Levels of detail (lod_pixels): on demand (the default) the first frame that asks for them builds
+    /// them on this thread (CLI renders, benchmarks, tests); a session turns that off, builds them on a
+    /// thread of its own and hands them in with setSceneLevels (until then its frames draw every
+    /// triangle).
+    void setLevelsOnDemand(bool onDemand) { mLevelsOnDemand = onDemand; }
+    /// `levels` (SceneGpu::prepareLevels of the current scene) for the scene's draws.
+    void setSceneLevels(std::shared_ptr<const SceneGpu::LodSet> levels);
+    bool sceneHasLevels() const;
 
     /// The technique of the last frame (tests inspect its intermediate buffers); may be null.
     Technique* technique() { return mTechnique.get(); }
@@ -89,7 +97,7 @@ private:
     void measureViewFlux(int views);
     /// Those sums, read back (waits for the pass); empty without views.
     std::vector<double> readViewFlux(int views) const;
-    DrawCount renderGBuffer(int width, int height, const glm::mat4& viewProj);
+    DrawCount renderGBuffer(int width, int height, const glm::mat4& viewProj, const LodView& lod);
     void renderDirect();
     /// `applyOcclusion`: multiply the indirect light by the G-buffer's occlusion (glTF occlusion maps).
     void composite(int width, int height, const gl::Texture* indirect, const gl::Texture* reflection,
@@ -103,6 +111,7 @@ private:
     bool followsLastPart(const FrameState& state, const glm::mat4& viewProj) const;
 
     std::shared_ptr<const Scene> mScene;
+    bool mLevelsOnDemand = true;
     nlohmann::json mNotShown; ///< stats.not_shown of mScene (an empty array: nothing to say)
     std::unique_ptr<SceneGpu> mSceneGpu;
     gl::PassTimer mTimer;

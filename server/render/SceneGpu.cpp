@@ -11,6 +11,7 @@
 
 #include "core/Error.h"
 #include "scene/Frustum.h"
+#include "scene/MeshLod.h"
 
 namespace gis {
 
@@ -38,59 +39,27 @@ std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene,
     vertices.reserve(vertexCount);
     indices.reserve(indexCount);
     for (const Mesh& mesh : scene.meshes) {
+        if (cancelled && cancelled()) return nullptr;
         Draw d;
         d.baseVertex = static_cast<GLint>(vertices.size());
         d.material = mesh.material;
         d.mesh = static_cast<int>(&mesh - scene.meshes.data());
         d.colored = !mesh.colors.empty();
-        // Runs of consecutive triangles with their bounds in the mesh's space. Indices were
-        // validated at load; a bad one is skipped here rather than read out of range.
-        struct Chunk {
-            GLint firstIndex;
-            GLsizei indexCount;
-            glm::vec3 lo, hi;
-        };
-        std::vector<Chunk> chunks;
-        const std::size_t meshFirst = indices.size();
-        for (std::size_t t0 = 0; t0 + 3 <= mesh.indices.size(); t0 += 3 * kChunkTriangles) {
-            const std::size_t t1 = std::min(mesh.indices.size() / 3 * 3, t0 + 3 * kChunkTriangles);
-            glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-            for (std::size_t i = t0; i < t1; ++i) {
-                const std::uint32_t v = mesh.indices[i];
-                if (v >= mesh.positions.size()) continue;
-                lo = glm::min(lo, mesh.positions[v]);
-                hi = glm::max(hi, mesh.positions[v]);
-            }
-            if (t1 > t0)
-                chunks.push_back({static_cast<GLint>(meshFirst + t0), static_cast<GLsizei>(t1 - t0), lo, hi});
-        }
-        // One run per chunk, covering all the mesh's placements, each with its world box: draw()
-        // sends a run's visible placements as instanced commands.
         GLuint firstPlacement = 0;
         if (mesh.instanced()) {
             firstPlacement = static_cast<GLuint>(placements.size());
             for (const glm::mat4& toWorld : mesh.instances)
                 placements.push_back(InstanceTransform::of(toWorld));
         }
-        for (const Chunk& c : chunks) {
-            Draw run = d;
-            run.firstIndex = c.firstIndex;
-            run.indexCount = c.indexCount;
-            run.instance = firstPlacement;
-            run.placements = static_cast<GLuint>(mesh.placements());
-            run.firstBounds = prepared->runBounds.size();
-            if (!mesh.instanced()) {
-                prepared->runBounds.push_back({c.lo, c.hi});
-            } else {
-                // The world box around the placed corners: culling stays conservative.
-                for (const glm::mat4& toWorld : mesh.instances) {
-                    const Bounds placed = placedBounds({c.lo, c.hi}, toWorld);
-                    prepared->runBounds.push_back({placed.min, placed.max});
-                }
-            }
-            prepared->maxCommands += run.placements;
-            prepared->draws.push_back(run);
-        }
+        d.instance = firstPlacement;
+        d.placements = static_cast<GLuint>(mesh.placements());
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        const std::size_t firstDraw = prepared->draws.size();
+        const std::size_t runs =
+            appendRuns(mesh, d, mesh.indices, indices.size(), prepared->draws, prepared->runBounds, lo, hi);
+        indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+        prepared->meshes.push_back({firstDraw, runs});
+        prepared->maxCommands += runs * mesh.placements();
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             Vertex v{};
             v.position[0] = mesh.positions[i].x;
@@ -110,7 +79,6 @@ std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene,
             for (int c = 0; c < 4; ++c) v.color[c] = i < mesh.colors.size() ? mesh.colors[i][c] : 1.0f;
             vertices.push_back(v);
         }
-        indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
         prepared->triangles += mesh.indices.size() / 3 * mesh.placements();
         prepared->storedTriangles += mesh.indices.size() / 3;
     }
@@ -120,6 +88,122 @@ std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene,
         prepared->textureMips.push_back(mipChain(image));
     }
     return prepared;
+}
+
+std::size_t SceneGpu::appendRuns(const Mesh& mesh, const Draw& proto,
+                                 const std::vector<std::uint32_t>& levelIndices, std::size_t firstIndex,
+                                 std::vector<Draw>& draws, std::vector<RunBounds>& bounds, glm::vec3& meshLo,
+                                 glm::vec3& meshHi) {
+    // Runs of consecutive triangles with their bounds in the mesh's space. Indices were validated at
+    // load; a bad one is skipped here rather than read out of range.
+    std::size_t runs = 0;
+    for (std::size_t t0 = 0; t0 + 3 <= levelIndices.size(); t0 += 3 * kChunkTriangles) {
+        const std::size_t t1 = std::min(levelIndices.size() / 3 * 3, t0 + 3 * kChunkTriangles);
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        for (std::size_t i = t0; i < t1; ++i) {
+            const std::uint32_t v = levelIndices[i];
+            if (v >= mesh.positions.size()) continue;
+            lo = glm::min(lo, mesh.positions[v]);
+            hi = glm::max(hi, mesh.positions[v]);
+        }
+        if (t1 <= t0) continue;
+        meshLo = glm::min(meshLo, lo);
+        meshHi = glm::max(meshHi, hi);
+        // One run per chunk, covering all the mesh's placements, each with its world box: draw()
+        // sends a run's visible placements as instanced commands.
+        Draw run = proto;
+        run.firstIndex = static_cast<GLint>(firstIndex + t0);
+        run.indexCount = static_cast<GLsizei>(t1 - t0);
+        run.firstBounds = bounds.size();
+        if (!mesh.instanced()) {
+            bounds.push_back({lo, hi});
+        } else {
+            // The world box around the placed corners: culling stays conservative.
+            for (const glm::mat4& toWorld : mesh.instances) {
+                const Bounds placed = placedBounds({lo, hi}, toWorld);
+                bounds.push_back({placed.min, placed.max});
+            }
+        }
+        draws.push_back(run);
+        ++runs;
+    }
+    return runs;
+}
+
+std::shared_ptr<const SceneGpu::LodSet> SceneGpu::prepareLevels(const Scene& scene,
+                                                                const std::function<bool()>& cancelled) {
+    auto set = std::make_shared<LodSet>();
+    // The vertices and placements as prepare() lays them out: each mesh's after the ones before it,
+    // placement 0 the identity.
+    GLint baseVertex = 0;
+    GLuint nextPlacement = 1;
+    for (const Mesh& mesh : scene.meshes) {
+        if (cancelled && cancelled()) return nullptr;
+        Draw d;
+        d.baseVertex = baseVertex;
+        d.material = mesh.material;
+        d.mesh = static_cast<int>(&mesh - scene.meshes.data());
+        d.colored = !mesh.colors.empty();
+        d.instance = mesh.instanced() ? nextPlacement : 0;
+        d.placements = static_cast<GLuint>(mesh.placements());
+        baseVertex += static_cast<GLint>(mesh.positions.size());
+        if (mesh.instanced()) nextPlacement += static_cast<GLuint>(mesh.instances.size());
+
+        MeshLevels levels;
+        levels.firstLevel = set->levels.size();
+        levels.firstExtent = set->extents.size();
+        levels.placements = mesh.placements();
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        for (const LodLevel& level : buildLodLevels(mesh)) {
+            const std::size_t firstDraw = set->draws.size();
+            const std::size_t runs =
+                appendRuns(mesh, d, level.indices, set->indices.size(), set->draws, set->runBounds, lo, hi);
+            set->indices.insert(set->indices.end(), level.indices.begin(), level.indices.end());
+            set->levels.push_back({firstDraw, runs, level.error});
+            set->triangles += level.indices.size() / 3;
+            ++levels.levelCount;
+        }
+        // The mesh's own box (a level's vertices are some of the mesh's): where the eye's distance is
+        // measured from.
+        lo = glm::vec3(std::numeric_limits<float>::max());
+        hi = glm::vec3(-std::numeric_limits<float>::max());
+        for (const glm::vec3& p : mesh.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
+        if (!mesh.instanced()) {
+            set->extents.push_back({lo, hi, 1.0f});
+        } else {
+            for (const glm::mat4& toWorld : mesh.instances) {
+                const Bounds placed = placedBounds({lo, hi}, toWorld);
+                const float scale =
+                    std::max({glm::length(glm::vec3(toWorld[0])), glm::length(glm::vec3(toWorld[1])),
+                              glm::length(glm::vec3(toWorld[2]))});
+                set->extents.push_back({placed.min, placed.max, std::isfinite(scale) ? scale : 1.0f});
+            }
+        }
+        set->meshes.push_back(levels);
+    }
+    return set;
+}
+
+void SceneGpu::setLevels(std::shared_ptr<const LodSet> levels) {
+    GIS_ASSERT(complete());
+    if (!levels || levels->meshes.size() != mMeshes.size()) return;
+    gl::Buffer buffer;
+    if (!levels->indices.empty())
+        buffer = gl::Buffer::create(static_cast<GLsizeiptr>(levels->indices.size() * sizeof(std::uint32_t)),
+                                    levels->indices.data());
+    gl::checkErrors(("levels of detail of '" + mSceneName + "'").c_str());
+    mLodIndices = std::move(buffer);
+    mLodDraws = levels->draws;
+    mLod = std::move(levels);
+    setSurfaceIds(mSurfaceIdOfMesh);
+}
+
+std::size_t SceneGpu::lodTriangleCount() const {
+    return mLod ? mLod->triangles : 0;
 }
 
 SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared)
@@ -140,6 +224,7 @@ SceneGpu::SceneGpu(const Scene& scene, std::shared_ptr<const Prepared> prepared,
     const std::vector<InstanceTransform>& placements = prepared->placements;
     mDraws = prepared->draws;
     mRunBounds = prepared->runBounds;
+    mMeshes = prepared->meshes;
     mMaxCommands = prepared->maxCommands;
     mTriangles = prepared->triangles;
     mStoredTriangles = prepared->storedTriangles;
@@ -293,10 +378,12 @@ void SceneGpu::reserveCommands(std::size_t commands) const {
 }
 
 void SceneGpu::setSurfaceIds(const std::vector<int>& idOfMesh) {
-    for (Draw& d : mDraws) {
-        const auto m = static_cast<size_t>(d.mesh);
-        d.surfaceId = m < idOfMesh.size() ? idOfMesh[m] : 0;
-    }
+    mSurfaceIdOfMesh = idOfMesh;
+    for (std::vector<Draw>* draws : {&mDraws, &mLodDraws})
+        for (Draw& d : *draws) {
+            const auto m = static_cast<size_t>(d.mesh);
+            d.surfaceId = m < idOfMesh.size() ? idOfMesh[m] : 0;
+        }
 }
 
 MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
@@ -331,8 +418,14 @@ MaterialSlots MaterialSlots::of(const gl::Program& program, bool complete) {
     return m;
 }
 
+float lodErrorPerMetre(float pixels, float yfovRadians, int imageHeight) {
+    if (!(pixels > 0.0f) || imageHeight <= 0 || !(yfovRadians > 0.0f) || !(yfovRadians < 3.1f)) return 0.0f;
+    const float perMetre = pixels * 2.0f * std::tan(0.5f * yfovRadians) / static_cast<float>(imageHeight);
+    return std::isfinite(perMetre) ? perMetre : 0.0f;
+}
+
 DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int instances, int skipMesh,
-                         const glm::mat4* cullViewProj, bool cullBackFaces) const {
+                         const glm::mat4* cullViewProj, bool cullBackFaces, const LodView* lod) const {
     // The caller has bound the program; `materials` were resolved from it.
     GIS_ASSERT(complete());
     glBindVertexArray(mVao.id());
@@ -355,38 +448,82 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
         glVertexArrayBindingDivisor(mVao.id(), 1, divisor);
         mDivisor = divisor;
     }
-    for (const Draw& d : mDraws) {
-        if (d.mesh == skipMesh) continue;
-        const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
-        bool open = false; // the last command takes the next placement as one more instance
-        for (GLuint k = 0; k < d.placements; ++k) {
-            const RunBounds& b = mRunBounds[d.firstBounds + k];
-            if (frustum && frustum->outside(b.lo, b.hi)) {
-                count.culled += triangles;
-                open = false;
-                continue;
+    for (std::size_t meshIndex = 0; meshIndex < mMeshes.size(); ++meshIndex) {
+        if (static_cast<int>(meshIndex) == skipMesh) continue;
+        const MeshRuns& own = mMeshes[meshIndex];
+        const MeshLevels* levels = mLod ? &mLod->meshes[meshIndex] : nullptr;
+        // Each placement's level (0: the mesh itself): the coarsest whose error, at the placement's
+        // nearest point, the view tolerates (none inside the box: distance 0 tolerates no error).
+        std::vector<std::uint8_t>& chosen = mLevelScratch;
+        std::size_t lastLevel = 0;
+        const bool choose = lod && lod->errorPerMetre > 0.0f && levels && levels->levelCount > 0;
+        if (choose) {
+            chosen.assign(levels->placements, 0);
+            for (std::size_t k = 0; k < levels->placements; ++k) {
+                const PlacementExtent& e = mLod->extents[levels->firstExtent + k];
+                const float distance =
+                    glm::length(glm::max(glm::max(e.lo - lod->eye, lod->eye - e.hi), glm::vec3(0.0f)));
+                const float tolerated = lod->errorPerMetre * distance;
+                for (std::size_t l = levels->levelCount; l > 0; --l)
+                    if (mLod->levels[levels->firstLevel + l - 1].error * e.scale <= tolerated) {
+                        chosen[k] = static_cast<std::uint8_t>(l);
+                        lastLevel = std::max(lastLevel, l);
+                        break;
+                    }
             }
-            count.drawn += triangles;
-            if (open) {
-                ++commands.back().instanceCount;
-                continue;
+        }
+        for (std::size_t l = 0; l <= lastLevel; ++l) {
+            const bool coarse = l > 0;
+            const Draw* runs = coarse ? mLodDraws.data() : mDraws.data();
+            const std::vector<RunBounds>& runBounds = coarse ? mLod->runBounds : mRunBounds;
+            std::size_t firstRun = own.firstDraw, runCount = own.drawCount;
+            if (coarse) {
+                const Level& level = mLod->levels[levels->firstLevel + l - 1];
+                firstRun = level.firstDraw;
+                runCount = level.drawCount;
             }
-            if (k == 0 || batches.empty() || batches.back().head != &d) {
-                const bool oneSided = cullBackFaces && d.material >= 0 &&
-                                      static_cast<std::size_t>(d.material) < mMaterials.size() &&
-                                      !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
-                const Draw* head = batches.empty() ? nullptr : batches.back().head;
-                const bool sameState = head && batches.back().oneSided == oneSided &&
-                                       (!materials || head->mesh == d.mesh ||
-                                        (head->material == d.material && head->surfaceId == d.surfaceId &&
-                                         head->colored == d.colored));
-                if (!sameState) batches.push_back({commands.size(), 0, &d, oneSided});
+            for (std::size_t r = firstRun; r < firstRun + runCount; ++r) {
+                const Draw& d = runs[r];
+                const auto triangles = static_cast<std::size_t>(d.indexCount / 3);
+                bool open = false; // the last command takes the next placement as one more instance
+                bool first = true; // no command of this run yet
+                for (GLuint k = 0; k < d.placements; ++k) {
+                    if (choose && chosen[k] != l) {
+                        open = false;
+                        continue;
+                    }
+                    const RunBounds& b = runBounds[d.firstBounds + k];
+                    if (frustum && frustum->outside(b.lo, b.hi)) {
+                        count.culled += triangles;
+                        open = false;
+                        continue;
+                    }
+                    count.drawn += triangles;
+                    if (coarse) count.simplified += triangles;
+                    if (open) {
+                        ++commands.back().instanceCount;
+                        continue;
+                    }
+                    if (first || batches.empty() || batches.back().head != &d) {
+                        const bool oneSided = cullBackFaces && d.material >= 0 &&
+                                              static_cast<std::size_t>(d.material) < mMaterials.size() &&
+                                              !mMaterials[static_cast<std::size_t>(d.material)].doubleSided;
+                        const Draw* head = batches.empty() ? nullptr : batches.back().head;
+                        const bool sameState =
+                            head && batches.back().oneSided == oneSided && batches.back().coarse == coarse &&
+                            (!materials || head->mesh == d.mesh ||
+                             (head->material == d.material && head->surfaceId == d.surfaceId &&
+                              head->colored == d.colored));
+                        if (!sameState) batches.push_back({commands.size(), 0, &d, oneSided, coarse});
+                    }
+                    first = false;
+                    commands.push_back({static_cast<GLuint>(d.indexCount),
+                                        static_cast<GLuint>(commandPerPlacement ? instances : 1),
+                                        static_cast<GLuint>(d.firstIndex), d.baseVertex, d.instance + k});
+                    ++batches.back().count;
+                    open = !commandPerPlacement;
+                }
             }
-            commands.push_back({static_cast<GLuint>(d.indexCount),
-                                static_cast<GLuint>(commandPerPlacement ? instances : 1),
-                                static_cast<GLuint>(d.firstIndex), d.baseVertex, d.instance + k});
-            ++batches.back().count;
-            open = !commandPerPlacement;
         }
     }
     count.runs = commands.size();
@@ -402,7 +539,12 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, mCommands.id());
     bool culling = false; // GL_CULL_FACE is off in every pass (FrameRenderer::render) until set here
     std::array<GLuint, 5> unitHolds{}; // what this call bound on each material unit (0: not yet)
+    bool coarseBound = false;          // the vertex array's element buffer is mIndices until a coarse batch
     for (const Batch& b : batches) {
+        if (b.coarse != coarseBound) {
+            glVertexArrayElementBuffer(mVao.id(), b.coarse ? mLodIndices.id() : mIndices.id());
+            coarseBound = b.coarse;
+        }
         if (cullBackFaces && b.oneSided != culling) {
             if (b.oneSided) {
                 glCullFace(GL_BACK);
@@ -451,6 +593,7 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     if (culling) glDisable(GL_CULL_FACE);
+    if (coarseBound) glVertexArrayElementBuffer(mVao.id(), mIndices.id());
     return count;
 }
 

@@ -34,14 +34,28 @@ struct MaterialSlots {
 struct DrawCount {
     std::size_t drawn = 0, culled = 0;
     std::size_t runs = 0, calls = 0; ///< runs drawn; glMultiDrawElementsIndirect calls they took
+    std::size_t simplified = 0;      ///< of `drawn`, triangles of coarser levels of detail (LodView)
     DrawCount& operator+=(const DrawCount& o) {
         drawn += o.drawn;
         culled += o.culled;
+        simplified += o.simplified;
         runs += o.runs;
         calls += o.calls;
         return *this;
     }
 };
+
+/// What a view tolerates of the meshes' levels of detail (scene/MeshLod.h): each placement of a mesh is
+/// drawn at its coarsest level whose error, seen from `eye` at the placement's nearest point, stays
+/// within `errorPerMetre` per metre of that distance. For a camera, a tolerance of p pixels is
+/// p * 2 tan(fov / 2) / image height (lodErrorPerMetre()).
+struct LodView {
+    glm::vec3 eye{0.0f};
+    float errorPerMetre = 0.0f; ///< 0: every mesh at full detail
+};
+/// The world distance per metre from the eye that `pixels` of an image `imageHeight` px tall under a
+/// vertical field of view `yfovRadians` span; 0 for no tolerance or a degenerate view.
+float lodErrorPerMetre(float pixels, float yfovRadians, int imageHeight);
 
 class SceneGpu {
 public:
@@ -53,11 +67,24 @@ public:
     /// the placements, the runs with their bounds and every texture's mipmap chain. A scene load
     /// builds it beside the scene, so the render thread only uploads, in slices (docs/scenes.md,
     /// "Loading": eight 2048^2 textures 108-122 ms in 8 slices of at most 14-19 ms, against one hold
-    /// of 291-306 ms; `node bench/scenes/load_progress.mjs --textures 8`). `cancelled` (may be empty) is
-    /// asked between textures; when it answers true, prepare returns null.
+    /// of 291-306 ms; `node bench/scenes/load_progress.mjs --textures 8`). `cancelled` (may be
+    /// empty) is asked between meshes and between textures; when it answers true, prepare returns null.
     struct Prepared;
     static std::shared_ptr<const Prepared> prepare(const Scene& scene,
                                                    const std::function<bool()>& cancelled = {});
+
+    /// The coarser levels of detail of the scene's meshes of at least LodOptions::minTriangles
+    /// (scene/MeshLod.h), their runs and bounds, built without GL on any thread. Kept apart from the
+    /// scene's upload because they cost several times its load (0.25-0.35 s for the atrium's 560k
+    /// triangles): a session shows the scene first and adds them when they are ready. `cancelled`
+    /// is asked between meshes (null when it answers true).
+    struct LodSet;
+    static std::shared_ptr<const LodSet> prepareLevels(const Scene& scene,
+                                                       const std::function<bool()>& cancelled = {});
+    /// Uploads `levels` (from prepareLevels of this scene) into an index buffer of their own; draw()
+    /// uses them from then on. Throws gis::Error on GL failure.
+    void setLevels(std::shared_ptr<const LodSet> levels);
+    bool hasLevels() const { return mLod != nullptr; }
 
     /// Uploads everything; throws gis::Error on GL failure (a load boundary). `prepared` must come
     /// from prepare(scene) of this scene; null: prepared here.
@@ -89,12 +116,17 @@ public:
     /// culled (front faces as the pass's glFrontFace says: CCW, as glTF, unless mirrored).
     /// Consecutive runs that need the same state (material uniforms and textures, face culling) go
     /// out as one glMultiDrawElementsIndirect, in scene order, so images do not change.
+    /// With `lod` and levels (setLevels), a mesh with coarser levels draws each placement at the
+    /// coarsest level the view tolerates; without them, or with a zero tolerance, every mesh is
+    /// drawn whole.
     DrawCount draw(const gl::Program& program, const MaterialSlots* materials, int instances = 1,
-                   int skipMesh = -1, const glm::mat4* cullViewProj = nullptr,
-                   bool cullBackFaces = false) const;
+                   int skipMesh = -1, const glm::mat4* cullViewProj = nullptr, bool cullBackFaces = false,
+                   const LodView* lod = nullptr) const;
     /// Triangles drawn (an instanced mesh's once per placement) and stored.
     std::size_t triangleCount() const { return mTriangles; }
     std::size_t storedTriangleCount() const { return mStoredTriangles; }
+    /// Triangles stored in the coarser levels of detail besides the meshes' own (0 without levels).
+    std::size_t lodTriangleCount() const;
     /// Placements of instanced meshes (Mesh::instances).
     std::size_t instanceCount() const { return mInstances; }
     std::size_t drawCount() const { return mDraws.size(); }
@@ -132,6 +164,34 @@ private:
     struct RunBounds {
         glm::vec3 lo, hi; ///< world space, of one placement of a run's triangles
     };
+    /// Scene::meshes[i]'s own runs: mDraws[firstDraw, firstDraw + drawCount).
+    struct MeshRuns {
+        std::size_t firstDraw = 0, drawCount = 0;
+    };
+    /// One coarser level of detail of a mesh: its runs LodSet::draws[firstDraw, + drawCount).
+    struct Level {
+        std::size_t firstDraw = 0, drawCount = 0;
+        float error = 0.0f; ///< in the mesh's own units (LodLevel::error)
+    };
+    /// A placement of a mesh as the level choice sees it: its world box and how much its matrix
+    /// enlarges (the largest column length: an error in the mesh's units times this is metres).
+    struct PlacementExtent {
+        glm::vec3 lo, hi;
+        float scale = 1.0f;
+    };
+    /// Scene::meshes[i]'s coarser levels, LodSet::levels[firstLevel, + levelCount) finest first, and
+    /// its placements' extents LodSet::extents[firstExtent, + placements).
+    struct MeshLevels {
+        std::size_t firstLevel = 0, levelCount = 0;
+        std::size_t firstExtent = 0, placements = 1;
+    };
+    /// Appends the runs of `levelIndices` (a triangle list of `mesh`, stored from `firstIndex` on)
+    /// to `draws` and their per-placement bounds to `bounds`, each run a copy of `proto`; widens
+    /// [lo, hi] by the triangles' bounds in the mesh's space. Returns how many runs.
+    static std::size_t appendRuns(const Mesh& mesh, const Draw& proto,
+                                  const std::vector<std::uint32_t>& levelIndices, std::size_t firstIndex,
+                                  std::vector<Draw>& draws, std::vector<RunBounds>& bounds, glm::vec3& lo,
+                                  glm::vec3& hi);
     /// Draw commands, kCommandSlots regions of one command per run, used in turn by successive
     /// draw() calls (a region is rewritten only after the calls of the other regions were issued).
     static constexpr std::size_t kCommandSlots = 16;
@@ -157,8 +217,18 @@ public:
         std::vector<InstanceTransform> placements; ///< [0]: the identity of world-space meshes
         std::vector<Draw> draws;
         std::vector<RunBounds> runBounds;
+        std::vector<MeshRuns> meshes; ///< one per Scene::meshes entry
         std::size_t maxCommands = 0, triangles = 0, storedTriangles = 0;
         std::vector<std::vector<MipLevel>> textureMips; ///< levels 1.. of each Scene::textures entry
+    };
+    struct LodSet {
+        std::vector<std::uint32_t> indices; ///< every level's, in an index buffer of their own
+        std::vector<Draw> draws;            ///< firstIndex into `indices`
+        std::vector<RunBounds> runBounds;
+        std::vector<Level> levels;
+        std::vector<PlacementExtent> extents;
+        std::vector<MeshLevels> meshes; ///< one per Scene::meshes entry
+        std::size_t triangles = 0;      ///< stored in all levels
     };
 
 private:
@@ -180,12 +250,19 @@ private:
         std::size_t first = 0, count = 0;
         const Draw* head = nullptr; ///< the first run: its material, ids and face culling
         bool oneSided = false;
+        bool coarse = false; ///< its runs index mLodIndices, not mIndices
     };
     mutable std::vector<IndirectCommand> mCommandScratch; ///< reused by draw(): no per-call allocation
     mutable std::vector<Batch> mBatchScratch;
     gl::VertexArray mVao;
     std::vector<Draw> mDraws;
     std::vector<RunBounds> mRunBounds;
+    std::vector<MeshRuns> mMeshes;
+    std::shared_ptr<const LodSet> mLod; ///< null until setLevels
+    std::vector<Draw> mLodDraws;        ///< mLod's runs, with the surface ids (setSurfaceIds)
+    std::vector<int> mSurfaceIdOfMesh;  ///< as last set, for levels set later
+    gl::Buffer mLodIndices;
+    mutable std::vector<std::uint8_t> mLevelScratch; ///< draw(): each placement's chosen level
     std::vector<Material> mMaterials;
     std::vector<gl::Texture> mTextures;
     /// The staged upload: each piece sends one buffer range or one band of rows of one texture level,

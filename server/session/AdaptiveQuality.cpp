@@ -140,6 +140,12 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
     if (p.step == QualityStep::Interactive && !snapshot) {
         planInteractive(frameTargetMs, p);
         if (budgetProbes) p.budget["env_budget_ms"] = envBudgetMs;
+        // Interactive frames only: the steps that refine the view draw every triangle.
+        if (mLimits.interactiveLodPixels > 0.0 && p.state.frameParams.has("lod_pixels") &&
+            !explicitParams.contains("lod_pixels")) {
+            p.state.frameParams.set("lod_pixels", mLimits.interactiveLodPixels);
+            p.budget["lod_pixels"] = mLimits.interactiveLodPixels;
+        }
     }
     return p;
 }

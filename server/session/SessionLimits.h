@@ -9,6 +9,10 @@ struct SessionLimits {
     long maxVpls = 65536;                  ///< upper bound on VPLs a parameter set may ask for
     /// (0, 1]: the largest size factor of interactive frames (with frameTargetMs 0: the factor).
     double interactiveScale = 1.0;
+    /// px: interactive frames draw big meshes at the coarsest level of detail whose error spans at most
+    /// this many of their pixels (frame parameter lod_pixels, unless the client set it); the
+    /// refinement steps draw every triangle. 0: every triangle always.
+    double interactiveLodPixels = 1.0;
     /// ms of render and encode an interactive frame should take: the frame budget picks its size and
     /// VPL cap from measured costs (session/FrameBudget.h); a client may ask for its own in `hello` or
     /// `quality`. 0 = no budget: interactive frames at interactiveScale with their preset.

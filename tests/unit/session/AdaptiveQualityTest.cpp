@@ -196,5 +196,37 @@ TEST(AdaptiveQuality, RefinementStepsBudgetTheEnvironmentProbes) {
     EXPECT_DOUBLE_EQ(own.state.frameParams.getFloat("env_budget_ms"), 500.0) << "the client's value wins";
 }
 
+TEST(AdaptiveQuality, InteractiveFramesDrawAtTheServersLevelOfDetailUnlessTheClientSetOne) {
+    SessionLimits limits;
+    limits.interactiveLodPixels = 1.5;
+    AdaptiveQuality q(limits, nullptr);
+    const nlohmann::json none = nlohmann::json::object();
+    const AdaptiveQuality::Plan interactive =
+        q.plan("cornell", requested(), none, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(interactive.state.frameParams.getFloat("lod_pixels"), 1.5);
+    EXPECT_DOUBLE_EQ(interactive.budget.at("lod_pixels").get<double>(), 1.5) << "shown in stats.budget";
+    for (QualityStep step : {QualityStep::Balanced, QualityStep::Final, QualityStep::Fixed})
+        EXPECT_DOUBLE_EQ(
+            q.plan("cornell", requested(), none, step, false, 80).state.frameParams.getFloat("lod_pixels"),
+            0.0)
+            << qualityStepName(step) << " draws every triangle";
+    EXPECT_DOUBLE_EQ(q.plan("cornell", requested(), none, QualityStep::Interactive, true, 80)
+                         .state.frameParams.getFloat("lod_pixels"),
+                     0.0)
+        << "a snapshot draws every triangle";
+
+    FrameState asked = requested();
+    asked.frameParams.set("lod_pixels", 0.0);
+    const AdaptiveQuality::Plan own =
+        q.plan("cornell", asked, {{"lod_pixels", 0.0}}, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(own.state.frameParams.getFloat("lod_pixels"), 0.0) << "the client's value wins";
+
+    limits.interactiveLodPixels = 0.0;
+    AdaptiveQuality off(limits, nullptr);
+    EXPECT_DOUBLE_EQ(off.plan("cornell", requested(), none, QualityStep::Interactive, false, 80)
+                         .state.frameParams.getFloat("lod_pixels"),
+                     0.0);
+}
+
 } // namespace
 } // namespace gis
