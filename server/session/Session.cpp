@@ -574,6 +574,17 @@ void Session::provideLevels(Worker& w, const FrameState& state) {
         if (!(state.frameParams.getFloat("lod_pixels") > 0.0)) return; // not asked for yet
         auto build = std::make_unique<Worker::Levels>();
         build->scene = shown;
+        // Another session on this scene built them already.
+        if (auto shared = mScenes->levels(shown)) {
+            build->set = std::move(shared);
+            build->done = true;
+            build->handed = true;
+            w.renderer->setSceneLevels(build->set);
+            w.levels = std::move(build);
+            logInfo("session " + mId + ": the levels of detail for " + validUtf8(shown->name) +
+                    " are shared with another session");
+            return;
+        }
         Worker::Levels* raw = build.get();
         build->thread = std::thread([this, raw] {
             const Stopwatch clock;
@@ -595,6 +606,7 @@ void Session::provideLevels(Worker& w, const FrameState& state) {
     w.levels->handed = true;
     if (!w.levels->set) return;
     w.renderer->setSceneLevels(w.levels->set);
+    mScenes->keepLevels(shown, w.levels->set);
     logInfo("session " + mId + ": levels of detail for " + validUtf8(shown->name) + " built in " +
             std::to_string(std::lround(w.levels->buildMs)) + " ms (" +
             std::to_string(w.levels->set->triangles) + " triangles)");

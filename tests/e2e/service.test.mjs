@@ -748,7 +748,7 @@ check('a second session on the same scene plans with the first one\'s ray struct
         'it says it shares the atrium\'s structure');
 });
 
-check('interactive frames of a big scene draw its levels of detail once built; refinement draws every triangle', async () => {
+check('interactive frames of a big scene draw its levels of detail once built, shared with the next session; refinement draws every triangle', async () => {
     const client = await open(servers.main, { adaptive: true });
     await client.frame('a first frame', (s) => s.scene === 'builtin:cornell');
     client.send({ type: 'scene', name: 'builtin:atrium' });
@@ -772,6 +772,21 @@ check('interactive frames of a big scene draw its levels of detail once built; r
     const refined = await client.frame('a refinement frame', (s) => s.quality === 'balanced' || s.quality === 'final', 60000);
     assert.equal(refined.stats.params?.lod_pixels, 0, 'refinement draws every triangle');
     assert.equal(refined.stats.counts?.triangles_gbuffer_simplified, undefined);
+
+    // A second session on the same scene uses the first one's levels: its first moved frame draws them.
+    const second = await open(servers.main, { adaptive: true });
+    await second.frame('a first frame', () => true);
+    second.send({ type: 'scene', name: 'builtin:atrium' });
+    await second.frame('an atrium frame', (s) => s.scene === 'builtin:atrium', 60000);
+    second.send({ type: 'camera', position: [5, 2.6, 1.2], target: [-6, 2.2, -0.8] });
+    const moved = await second.frame('a moved frame', (s) => s.scene === 'builtin:atrium' && s.quality === 'interactive' &&
+        s.counts?.triangles_gbuffer_simplified > 0, 15000);
+    assert.ok(moved.stats.counts.triangles_gbuffer_simplified > 0);
+    const lines = servers.main.log.split('\n').filter((l) => l.includes(`session ${second.welcome.session}: `));
+    assert.ok(lines.some((l) => l.includes('levels of detail for builtin:atrium are shared with another session')),
+        'the second session says it shares the levels');
+    assert.ok(!lines.some((l) => l.includes('levels of detail for builtin:atrium built in')), 'and builds none');
+    await second.close();
     await client.close();
 });
 
