@@ -83,7 +83,7 @@ const ms0 = (v) => (Number.isFinite(v) ? `${Math.round(v)} ms` : '–');
 
 /**
  * A frame's `stats.budget` as one overlay line and its reason, or null without one:
- * "budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31".
+ * "budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31 · detail within 1 px".
  */
 export function budgetLine(budget) {
     if (!budget || typeof budget !== 'object') return null;
@@ -93,6 +93,8 @@ export function budgetLine(budget) {
             ? `VPLs ${budget.vpl_cap} of ${budget.vpls}` : `VPLs ${budget.vpls}`);
     }
     if (Number.isFinite(budget.scale)) parts.push(`scale ${Number(budget.scale.toPrecision(3))}`);
+    // The server draws big meshes simplified within this many of the frame's pixels.
+    if (Number.isFinite(budget.lod_pixels) && budget.lod_pixels > 0) parts.push(`detail within ${budget.lod_pixels} px`);
     return {
         text: `budget ${ms0(budget.target_ms)}: ${parts.join(' · ')}`,
         reason: typeof budget.reason === 'string' ? budget.reason : '',

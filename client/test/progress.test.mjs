@@ -196,6 +196,10 @@ test('a frame\'s budget reads as one line with its reason', () => {
     assert.equal(budgetLine({ target_ms: 80, vpls: 64, vpl_cap: null, predicted_ms: 12 }).text,
         'budget 80 ms: predicted 12 ms · VPLs 64');
     assert.equal(budgetLine({ target_ms: 80, vpls: 64, vpl_cap: null }).capped, false);
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, lod_pixels: 1 }).text,
+        'budget 80 ms: predicted 12 ms · VPLs 64 · detail within 1 px', 'the level of detail the server set');
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, lod_pixels: 0 }).text,
+        'budget 80 ms: predicted 12 ms · VPLs 64');
     assert.equal(budgetLine(undefined), null);
     assert.equal(budgetLine('x'), null);
 });

@@ -280,7 +280,8 @@ test('the frame-time target is offered, sent with quality and kept; interactive 
             });
             assert.ok(Number.isFinite(budget.predicted_ms) && Number.isFinite(budget.vpls), JSON.stringify(budget));
             assert.equal(typeof budget.reason, 'string');
-            assert.match(await page.locator('#ov-budget').textContent(), /^budget 50 ms: predicted \d+ ms · VPLs \d+/);
+            assert.equal(budget.lod_pixels, 1, 'interactive frames at the server\'s level of detail');
+            assert.match(await page.locator('#ov-budget').textContent(), /^budget 50 ms: predicted \d+ ms · VPLs \d+.* · detail within 1 px$/);
             assert.ok(await page.locator('#ov-budget').isVisible());
         } finally {
             await control('frame-target', 'select').selectOption({ index: 0 });
