@@ -463,10 +463,11 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     // image, tiles included). The light views draw every triangle: a simplified surface is shadowed
     // by the full mesh, within the shadow lookup's normal offset (offsetting it by the level's error as
     // well was measured worse: docs/interactive.md, "Level of detail").
-    if (mLevelsOnDemand && fp.getFloat("lod_pixels") > 0.0 && !mSceneGpu->hasLevels())
+    const auto lodPixels = static_cast<float>(fp.getFloat("lod_pixels"));
+    if (mLevelsOnDemand && lodPixels > 0.0f && !mSceneGpu->hasLevels())
         mSceneGpu->setLevels(SceneGpu::prepareLevels(*mScene));
     const LodView lod{state.camera.position,
-                      lodErrorPerMetre(fp.getFloat("lod_pixels"), state.camera.yfovRadians,
+                      lodErrorPerMetre(lodPixels, state.camera.yfovRadians,
                                        state.window.active() ? state.window.fullHeight : state.height)};
     u.cameraPos = glm::vec4(state.camera.position, 0.0f);
     const bool lightOn = lightSet.any();

@@ -40,23 +40,12 @@ std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene,
     indices.reserve(indexCount);
     for (const Mesh& mesh : scene.meshes) {
         if (cancelled && cancelled()) return nullptr;
-        Draw d;
-        d.baseVertex = static_cast<GLint>(vertices.size());
-        d.material = mesh.material;
-        d.mesh = static_cast<int>(&mesh - scene.meshes.data());
-        d.colored = !mesh.colors.empty();
-        GLuint firstPlacement = 0;
-        if (mesh.instanced()) {
-            firstPlacement = static_cast<GLuint>(placements.size());
-            for (const glm::mat4& toWorld : mesh.instances)
-                placements.push_back(InstanceTransform::of(toWorld));
-        }
-        d.instance = firstPlacement;
-        d.placements = static_cast<GLuint>(mesh.placements());
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        const Draw d = meshDraw(scene, mesh, static_cast<GLint>(vertices.size()),
+                                static_cast<GLuint>(placements.size()));
+        for (const glm::mat4& toWorld : mesh.instances) placements.push_back(InstanceTransform::of(toWorld));
         const std::size_t firstDraw = prepared->draws.size();
         const std::size_t runs =
-            appendRuns(mesh, d, mesh.indices, indices.size(), prepared->draws, prepared->runBounds, lo, hi);
+            appendRuns(mesh, d, mesh.indices, indices.size(), prepared->draws, prepared->runBounds);
         indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
         prepared->meshes.push_back({firstDraw, runs});
         prepared->maxCommands += runs * mesh.placements();
@@ -90,10 +79,21 @@ std::shared_ptr<const SceneGpu::Prepared> SceneGpu::prepare(const Scene& scene,
     return prepared;
 }
 
+SceneGpu::Draw SceneGpu::meshDraw(const Scene& scene, const Mesh& mesh, GLint baseVertex,
+                                  GLuint nextPlacement) {
+    Draw d;
+    d.baseVertex = baseVertex;
+    d.material = mesh.material;
+    d.mesh = static_cast<int>(&mesh - scene.meshes.data());
+    d.colored = !mesh.colors.empty();
+    d.instance = mesh.instanced() ? nextPlacement : 0; // world-space meshes: the identity
+    d.placements = static_cast<GLuint>(mesh.placements());
+    return d;
+}
+
 std::size_t SceneGpu::appendRuns(const Mesh& mesh, const Draw& proto,
                                  const std::vector<std::uint32_t>& levelIndices, std::size_t firstIndex,
-                                 std::vector<Draw>& draws, std::vector<RunBounds>& bounds, glm::vec3& meshLo,
-                                 glm::vec3& meshHi) {
+                                 std::vector<Draw>& draws, std::vector<RunBounds>& bounds) {
     // Runs of consecutive triangles with their bounds in the mesh's space. Indices were validated at
     // load; a bad one is skipped here rather than read out of range.
     std::size_t runs = 0;
@@ -107,8 +107,6 @@ std::size_t SceneGpu::appendRuns(const Mesh& mesh, const Draw& proto,
             hi = glm::max(hi, mesh.positions[v]);
         }
         if (t1 <= t0) continue;
-        meshLo = glm::min(meshLo, lo);
-        meshHi = glm::max(meshHi, hi);
         // One run per chunk, covering all the mesh's placements, each with its world box: draw()
         // sends a run's visible placements as instanced commands.
         Draw run = proto;
@@ -139,13 +137,7 @@ std::shared_ptr<const SceneGpu::LodSet> SceneGpu::prepareLevels(const Scene& sce
     GLuint nextPlacement = 1;
     for (const Mesh& mesh : scene.meshes) {
         if (cancelled && cancelled()) return nullptr;
-        Draw d;
-        d.baseVertex = baseVertex;
-        d.material = mesh.material;
-        d.mesh = static_cast<int>(&mesh - scene.meshes.data());
-        d.colored = !mesh.colors.empty();
-        d.instance = mesh.instanced() ? nextPlacement : 0;
-        d.placements = static_cast<GLuint>(mesh.placements());
+        const Draw d = meshDraw(scene, mesh, baseVertex, nextPlacement);
         baseVertex += static_cast<GLint>(mesh.positions.size());
         if (mesh.instanced()) nextPlacement += static_cast<GLuint>(mesh.instances.size());
 
@@ -153,11 +145,10 @@ std::shared_ptr<const SceneGpu::LodSet> SceneGpu::prepareLevels(const Scene& sce
         levels.firstLevel = set->levels.size();
         levels.firstExtent = set->extents.size();
         levels.placements = mesh.placements();
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
         for (const LodLevel& level : buildLodLevels(mesh)) {
             const std::size_t firstDraw = set->draws.size();
             const std::size_t runs =
-                appendRuns(mesh, d, level.indices, set->indices.size(), set->draws, set->runBounds, lo, hi);
+                appendRuns(mesh, d, level.indices, set->indices.size(), set->draws, set->runBounds);
             set->indices.insert(set->indices.end(), level.indices.begin(), level.indices.end());
             set->levels.push_back({firstDraw, runs, level.error});
             set->triangles += level.indices.size() / 3;
@@ -165,8 +156,7 @@ std::shared_ptr<const SceneGpu::LodSet> SceneGpu::prepareLevels(const Scene& sce
         }
         // The mesh's own box (a level's vertices are some of the mesh's): where the eye's distance is
         // measured from.
-        lo = glm::vec3(std::numeric_limits<float>::max());
-        hi = glm::vec3(-std::numeric_limits<float>::max());
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
         for (const glm::vec3& p : mesh.positions) {
             lo = glm::min(lo, p);
             hi = glm::max(hi, p);

@@ -185,13 +185,15 @@ private:
         std::size_t firstLevel = 0, levelCount = 0;
         std::size_t firstExtent = 0, placements = 1;
     };
+    /// The draw every run of `mesh` copies: its vertices from `baseVertex`, its placements (when
+    /// instanced) from `nextPlacement`.
+    static Draw meshDraw(const Scene& scene, const Mesh& mesh, GLint baseVertex, GLuint nextPlacement);
     /// Appends the runs of `levelIndices` (a triangle list of `mesh`, stored from `firstIndex` on)
-    /// to `draws` and their per-placement bounds to `bounds`, each run a copy of `proto`; widens
-    /// [lo, hi] by the triangles' bounds in the mesh's space. Returns how many runs.
+    /// to `draws` and their per-placement bounds to `bounds`, each run a copy of `proto`. Returns
+    /// how many runs.
     static std::size_t appendRuns(const Mesh& mesh, const Draw& proto,
                                   const std::vector<std::uint32_t>& levelIndices, std::size_t firstIndex,
-                                  std::vector<Draw>& draws, std::vector<RunBounds>& bounds, glm::vec3& lo,
-                                  glm::vec3& hi);
+                                  std::vector<Draw>& draws, std::vector<RunBounds>& bounds);
     /// Draw commands, kCommandSlots regions of one command per run, used in turn by successive
     /// draw() calls (a region is rewritten only after the calls of the other regions were issued).
     static constexpr std::size_t kCommandSlots = 16;

@@ -505,6 +505,8 @@ struct Session::Worker {
         double buildMs = 0.0;
     };
     std::unique_ptr<PlanRays> planRays;
+    /// Builds for a scene no longer shown: joined once done (or when the session ends).
+    std::vector<std::unique_ptr<PlanRays>> retiredPlanRays;
     /// The levels of detail of the scene shown (SceneGpu::prepareLevels: 0.25-0.35 s for the atrium's
     /// 560k triangles, several times its load), built on a thread of their own so that a new scene
     /// shows at once and input is answered meanwhile; provideLevels.
@@ -518,57 +520,51 @@ struct Session::Worker {
         bool handed = false; ///< given to the renderer
     };
     std::unique_ptr<Levels> levels;
-    std::vector<std::unique_ptr<Levels>> retiredLevels; ///< cancelled builds, joined once done
-    /// Builds for a scene no longer shown: joined once done (or when the session ends).
-    std::vector<std::unique_ptr<PlanRays>> retiredPlanRays;
-    /// Lets go of `planRays` (another scene is shown): a build still running is cancelled and
-    /// joined later (joinRetiredPlanRays), never waited for.
-    void dropPlanRays() {
-        if (!planRays) return;
-        if (planRays->thread.joinable() && !planRays->done) {
-            planRays->cancelled = true;
-            retiredPlanRays.push_back(std::move(planRays));
+    std::vector<std::unique_ptr<Levels>> retiredLevels;
+    /// Lets go of a build (PlanRays, Levels) for a scene no longer shown: one still running is
+    /// cancelled and joined later (joinFinished), never waited for.
+    template <typename Build>
+    static void drop(std::unique_ptr<Build>& build, std::vector<std::unique_ptr<Build>>& retired) {
+        if (!build) return;
+        if (build->thread.joinable() && !build->done) {
+            build->cancelled = true;
+            retired.push_back(std::move(build));
             return;
         }
-        if (planRays->thread.joinable()) planRays->thread.join();
-        planRays.reset();
+        if (build->thread.joinable()) build->thread.join();
+        build.reset();
     }
-    void joinRetiredPlanRays() {
-        std::erase_if(retiredPlanRays, [](std::unique_ptr<PlanRays>& r) {
-            if (!r->done) return false;
-            r->thread.join();
+    template <typename Build> static void joinFinished(std::vector<std::unique_ptr<Build>>& retired) {
+        std::erase_if(retired, [](std::unique_ptr<Build>& b) {
+            if (!b->done) return false;
+            if (b->thread.joinable()) b->thread.join();
             return true;
         });
+    }
+    /// The session ends: builds stop at their next check, and the teardown joins them.
+    template <typename Build>
+    static void cancelAndJoin(std::unique_ptr<Build>& build, std::vector<std::unique_ptr<Build>>& retired) {
+        if (build) retired.push_back(std::move(build));
+        for (auto& b : retired) b->cancelled = true;
+        for (auto& b : retired)
+            if (b->thread.joinable()) b->thread.join();
     }
     ~Worker() {
         if (load && load->thread.joinable()) {
             load->cancelled = true; // the session ends: a long load must not hold its teardown
             load->thread.join();
         }
-        // Builds stop at Embree's next progress check: the teardown does not wait for them.
-        if (planRays) planRays->cancelled = true;
-        for (auto& r : retiredPlanRays) r->cancelled = true;
-        if (planRays && planRays->thread.joinable()) planRays->thread.join();
-        for (auto& r : retiredPlanRays)
-            if (r->thread.joinable()) r->thread.join();
-        if (levels) retiredLevels.push_back(std::move(levels));
-        for (auto& l : retiredLevels) l->cancelled = true;
-        for (auto& l : retiredLevels)
-            if (l->thread.joinable()) l->thread.join();
+        // Builds stop at their next check (Embree's progress, the next mesh): the teardown does not
+        // wait for them to finish.
+        cancelAndJoin(planRays, retiredPlanRays);
+        cancelAndJoin(levels, retiredLevels);
     }
 };
 
 void Session::provideLevels(Worker& w, const FrameState& state) {
-    std::erase_if(w.retiredLevels, [](std::unique_ptr<Worker::Levels>& l) {
-        if (!l->done) return false;
-        if (l->thread.joinable()) l->thread.join(); // a handed set's thread was joined already
-        return true;
-    });
+    Worker::joinFinished(w.retiredLevels);
     const std::shared_ptr<const Scene> shown = w.scene;
-    if (w.levels && w.levels->scene != shown) {
-        w.levels->cancelled = true;
-        w.retiredLevels.push_back(std::move(w.levels));
-    }
+    if (w.levels && w.levels->scene != shown) Worker::drop(w.levels, w.retiredLevels);
     if (!shown) return;
     if (!w.levels) {
         if (!(state.frameParams.getFloat("lod_pixels") > 0.0)) return; // not asked for yet
@@ -744,7 +740,8 @@ void Session::continueUpload(Worker& w) {
 
     const std::unique_ptr<Worker::Upload> finished = std::move(w.upload);
     const std::shared_ptr<const Scene>& next = finished->scene;
-    if (w.planRays && w.planRays->scene != next) w.dropPlanRays(); // the old scene's structure
+    if (w.planRays && w.planRays->scene != next)
+        Worker::drop(w.planRays, w.retiredPlanRays); // the old scene's structure
     const Stopwatch swapClock;
     w.renderer->setScene(next, std::move(finished->gpu));
     finished->renderThreadMs += swapClock.elapsedMs();
@@ -778,8 +775,8 @@ void Session::continueUpload(Worker& w) {
 const reference::RayScene* Session::planRaysFor(Worker& w, const std::shared_ptr<const Scene>& scene,
                                                 bool& failed) {
     failed = false;
-    w.joinRetiredPlanRays();
-    if (w.planRays && w.planRays->scene != scene) w.dropPlanRays();
+    Worker::joinFinished(w.retiredPlanRays);
+    if (w.planRays && w.planRays->scene != scene) Worker::drop(w.planRays, w.retiredPlanRays);
     if (!w.planRays) {
         w.planRays = std::make_unique<Worker::PlanRays>();
         Worker::PlanRays* build = w.planRays.get();
