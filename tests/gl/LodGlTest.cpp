@@ -119,6 +119,22 @@ TEST_F(LodGl, ASessionsRendererWaitsForTheLevelsItIsHanded) {
     EXPECT_LT(counter(after, "triangles_gbuffer"), 0.5 * counter(before, "triangles_gbuffer"));
 }
 
+TEST(LodGlCorpus, ABlenderExportInMillimetresDrawsItsLevels) {
+    // Blender's monkey subdivided twice (15,746 triangles), 2,700 units across, no lights, Draco
+    // (tests/data/corpus/generate.py, compress.sh): the tolerance is in pixels, whatever the units.
+    const std::string path = std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/dense_monkey_draco.glb";
+    const FrameOutput full = renderScene(path, "multires_gather", 160, 120, {{"lod_pixels", 0.0}});
+    const FrameOutput lod = renderScene(path, "multires_gather", 160, 120, {{"lod_pixels", 1.0}});
+    const double error = relativeRmseOf(lod, full);
+    std::printf("[lod] dense_monkey_draco 160x120: %.0f -> %.0f triangles, relative RMSE %.4f, mean |diff| "
+                "%.2f / 255\n",
+                counter(full, "triangles_gbuffer"), counter(lod, "triangles_gbuffer"), error,
+                meanDifference(lod.rgba8, full.rgba8));
+    EXPECT_LT(counter(lod, "triangles_gbuffer"), 0.5 * counter(full, "triangles_gbuffer"));
+    EXPECT_LT(error, 0.05);
+    EXPECT_EQ(badValues(lod), 0u);
+}
+
 TEST_F(LodGl, TilesChooseTheLevelsOfTheWholeImage) {
     // rsm_gather is per pixel: tiled and whole frames agree to rounding when they draw the same levels.
     const FrameState whole = atriumState(*scene, "rsm_gather", 160, 128, 2.0);

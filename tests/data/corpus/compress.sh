@@ -3,6 +3,7 @@
 # tests; the outputs are committed): Draco with glTF Transform's CLI (npm @gltf-transform/cli, in a
 # scratch folder outside the repository) and meshopt with Debian's gltfpack (apt-get install gltfpack).
 #   suzanne_draco.glb, textured_box_draco.glb     gltf-transform draco (14-bit positions by default)
+#   dense_monkey_draco.glb                        the same, and the 412 KB original is removed
 #   suzanne_meshopt.glb                           gltfpack -c (meshopt, quantized: KHR_mesh_quantization)
 #   textured_box_meshopt.glb                      gltfpack -cc -noq (meshopt with filters, float data)
 #   textured_box_quantized.glb                    gltfpack (quantized; UVs dequantized by KHR_texture_transform)
@@ -19,6 +20,11 @@ fi
 for name in suzanne textured_box; do
     "$scratch/node_modules/.bin/gltf-transform" draco "$here/$name.glb" "$here/${name}_draco.glb"
 done
+# dense_monkey.glb (412 KB from Blender) is kept only as its Draco copy (56 KB).
+if [[ -f "$here/dense_monkey.glb" ]]; then
+    "$scratch/node_modules/.bin/gltf-transform" draco "$here/dense_monkey.glb" "$here/dense_monkey_draco.glb"
+    rm "$here/dense_monkey.glb"
+fi
 gltfpack -i "$here/suzanne.glb" -o "$here/suzanne_meshopt.glb" -c
 gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_meshopt.glb" -cc -noq
 gltfpack -i "$here/textured_box.glb" -o "$here/textured_box_quantized.glb"

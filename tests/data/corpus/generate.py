@@ -9,6 +9,9 @@
 #   textured_box.glb   a bevelled box with a generated 64x64 checker texture, no lights
 #   millimetres.glb    a bracket modelled in millimetres (about 400 units across), no lights
 #   point_lamps.glb    a table with two point lamps and a sun (KHR_lights_punctual), no camera
+#   dense_monkey.glb   Blender's monkey subdivided twice (about 15,700 triangles) in millimetres (about
+#                      2,700 units across), on a floor, no lights: a mesh big enough for the levels
+#                      of detail, at another scale; committed as compress.sh's dense_monkey_draco.glb
 #   colonnade.glb      twelve linked duplicates of one fluted column (one mesh, twelve nodes), a
 #                      floor and a sun: the loader keeps the column as one mesh with twelve instances
 #
@@ -59,6 +62,23 @@ def suzanne():
     bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, -1.2))
     bpy.context.active_object.data.materials.append(material("floor", (0.7, 0.7, 0.7, 1.0)))
     export("suzanne.glb")
+
+
+def dense_monkey():
+    reset()
+    bpy.ops.mesh.primitive_monkey_add(size=2000.0)
+    obj = bpy.context.active_object
+    subdivision = obj.modifiers.new("subdivision", "SUBSURF")
+    subdivision.levels = 2
+    subdivision.render_levels = 2
+    bpy.ops.object.shade_smooth()
+    obj.data.materials.append(material("clay", (0.8, 0.45, 0.3, 1.0), roughness=0.6))
+    bpy.ops.mesh.primitive_plane_add(size=8000.0, location=(0.0, 0.0, -1200.0))
+    bpy.context.active_object.data.materials.append(material("floor", (0.7, 0.7, 0.7, 1.0)))
+    path = os.path.join(out_dir, "dense_monkey.glb")
+    bpy.ops.export_scene.gltf(filepath=path, export_format="GLB", export_lights=True, export_cameras=True,
+                              export_apply=True)
+    print("wrote", path, os.path.getsize(path), "bytes")
 
 
 def textured_box():
@@ -161,6 +181,6 @@ def colonnade():
     print("wrote", path, os.path.getsize(path), "bytes")
 
 
-for make in (suzanne, textured_box, millimetres, point_lamps, colonnade):
+for make in (suzanne, textured_box, millimetres, point_lamps, colonnade, dense_monkey):
     if not wanted or make.__name__ in wanted:
         make()
