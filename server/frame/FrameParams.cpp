@@ -55,6 +55,17 @@ const ParamTable& frameParamTable() {
                  "error, seen from its nearest point, spans at most this many pixels; 0 draws every "
                  "triangle. The live view sets it for its interactive frames",
          .source = "eng"},
+        {.name = "light_lod_texels",
+         .type = ParamType::Float,
+         .defaultValue = 0.0,
+         .min = 0.0,
+         .max = 1.0,
+         .unit = "texels",
+         .help = "level of detail in the light views (shadow maps, RSMs): each big mesh's coarsest "
+                 "simplified version whose error spans at most this many texels of the map; 0 draws every "
+                 "triangle. One at most: the shadow lookup's normal offset (1 to 2.5 texels) covers it. The "
+                 "live view sets it to 1",
+         .source = "eng"},
         {.name = "rsm_size",
          .type = ParamType::Int,
          .defaultValue = 256,

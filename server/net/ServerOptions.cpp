@@ -152,7 +152,8 @@ std::vector<ServerOption> buildOptions() {
     t.push_back(numberOption("--interactive-lod-px", "GI_INTERACTIVE_LOD_PX", "PX",
                              "level-of-detail tolerance of interactive frames (their lod_pixels unless the "
                              "client set it): big meshes are drawn simplified where the error spans at most "
-                             "this many of the frame's pixels; 0 = every triangle",
+                             "this many of the frame's pixels; above 0 every live frame's light views are "
+                             "drawn within one texel as well (light_lod_texels); 0 = every triangle",
                              0.0, 8.0, GIS_FIELD(session.limits.interactiveLodPixels)));
     t.push_back(
         integerOption("--frame-target-ms", "GI_FRAME_TARGET_MS", "MS",

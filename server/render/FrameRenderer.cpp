@@ -54,6 +54,31 @@ std::vector<float> readRgba32f(const gl::Framebuffer& fbo, int attachment, int w
     return pixels;
 }
 
+// The light views' tolerance for levels of detail, in texels of their maps (light_lod_texels' maximum):
+// the shadow lookup offsets its point along the normal by one to two and a half shadow texels
+// (shaders/render/lighting.glsl), so a surface simplified by up to one texel is still not shadowed by
+// its own full mesh or by itself.
+constexpr float kLightLodMaxTexels = 1.0f;
+
+// What each light view tolerates of the levels of detail: `texels` of its side x side map. A
+// perspective view's texel grows with distance from its eye; an orthographic view's is one size.
+std::vector<LodView> lightViewLods(const LightSetModel& set, float texels, int side) {
+    std::vector<LodView> lods;
+    if (!(texels > 0.0f) || side <= 0) return lods;
+    lods.reserve(set.views.size());
+    for (const LightViewModel& v : set.views) {
+        LodView lod;
+        lod.eye = v.eye;
+        const float perTexel = texels * 2.0f / static_cast<float>(side);
+        if (v.orthographic)
+            lod.errorAtEye = std::isfinite(v.halfWidth) ? perTexel * std::max(v.halfWidth, 0.0f) : 0.0f;
+        else
+            lod.errorPerMetre = std::isfinite(v.tanHalfFov) ? perTexel * std::max(v.tanHalfFov, 0.0f) : 0.0f;
+        lods.push_back(lod);
+    }
+    return lods;
+}
+
 } // namespace
 
 nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set,
@@ -269,7 +294,7 @@ void FrameRenderer::ensureTechnique(const std::string& name, int width, int heig
     }
 }
 
-DrawCount FrameRenderer::renderShadowMaps(int views) {
+DrawCount FrameRenderer::renderShadowMaps(int views, std::span<const LodView> lods) {
     // Depth only, with a slope-scaled offset against acne; layers without a view are cleared (lit).
     gl::Pass pass(mTimer, "shadow_map");
     DrawCount count;
@@ -282,14 +307,16 @@ DrawCount FrameRenderer::renderShadowMaps(int views) {
         layer.polygonOffset(2.0f, 4.0f);
         const MeshPass& shadow = shadowPass();
         layer.use(shadow.program).set(shadow.view, v);
-        count += mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr, 1, -1,
-                                 &mLightBlock->views[v].viewProj);
+        count +=
+            mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr, 1, -1,
+                            &mLightBlock->views[v].viewProj, false,
+                            static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)] : nullptr);
     }
     mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
     return count;
 }
 
-DrawCount FrameRenderer::renderRsms(int views) {
+DrawCount FrameRenderer::renderRsms(int views, std::span<const LodView> lods) {
     gl::Pass pass(mTimer, "rsm");
     DrawCount count;
     for (int v = 0; v < mRsmLayers; ++v) {
@@ -301,7 +328,9 @@ DrawCount FrameRenderer::renderRsms(int views) {
         if (v >= views) continue;
         const MeshPass& rsm = rsmPass();
         layer.use(rsm.program).set(rsm.view, v);
-        count += mSceneGpu->draw(rsm.program, &rsm.materials, 1, -1, &mLightBlock->views[v].viewProj);
+        count +=
+            mSceneGpu->draw(rsm.program, &rsm.materials, 1, -1, &mLightBlock->views[v].viewProj, false,
+                            static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)] : nullptr);
     }
     mResources.publish("lights.rsm.position", "rsm", mRsmPosition);
     mResources.publish("lights.rsm.normal", "rsm", mRsmNormal);
@@ -459,12 +488,14 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     for (const LightViewModel& v : lightSet.views)
         if (!v.orthographic) widestTan = std::max(widestTan, v.tanHalfFov);
     u.viewProj = frameViewProj(state);
-    // Levels of detail in the camera's view only (lod_pixels, a tolerance in pixels of the whole
-    // image, tiles included). The light views draw every triangle: a simplified surface is shadowed
-    // by the full mesh, within the shadow lookup's normal offset (offsetting it by the level's error as
-    // well was measured worse: docs/interactive.md, "Level of detail").
+    // Levels of detail: in the camera's view a tolerance in pixels of the whole image, tiles included
+    // (lod_pixels); in the light views one in texels of their maps (light_lod_texels, at most one,
+    // which the shadow lookup's normal offset covers; offsetting it by the level's error as well was
+    // measured worse: docs/interactive.md, "Level of detail").
     const auto lodPixels = static_cast<float>(fp.getFloat("lod_pixels"));
-    if (mLevelsOnDemand && lodPixels > 0.0f && !mSceneGpu->hasLevels())
+    const auto lightLodWanted =
+        std::clamp(static_cast<float>(fp.getFloat("light_lod_texels")), 0.0f, kLightLodMaxTexels);
+    if (mLevelsOnDemand && (lodPixels > 0.0f || lightLodWanted > 0.0f) && !mSceneGpu->hasLevels())
         mSceneGpu->setLevels(SceneGpu::prepareLevels(*mScene));
     const LodView lod{state.camera.position,
                       lodErrorPerMetre(lodPixels, state.camera.yfovRadians,
@@ -495,7 +526,11 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     // tiles of one refinement step render them once).
     const glm::vec4 lightKey(static_cast<float>(lightSet.rsmSide), static_cast<float>(lightSet.shadowSide),
                              u.toneInfo.w, readsRsm ? 1.0f : 0.0f);
+    // Maps drawn at a finer level of detail than this frame tolerates serve it as well; coarser ones
+    // never serve a frame that asks for more detail (an API render after a live view's light drag).
+    const float lightLodTexels = mSceneGpu->hasLevels() ? lightLodWanted : 0.0f;
     const bool reuseLights = mReuseLightPasses && mLightPassesValid && lightKey == mLightPassKey &&
+                             mLightPassLodTexels <= lightLodTexels &&
                              std::memcmp(mLightPassBlock.get(), &lights, sizeof lights) == 0;
     if (reuseLights) {
         viewFlux = mLightPassFlux;
@@ -507,11 +542,11 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
                                          {"lights.rsm.specular", &mRsmSpecular}})
                 mResources.publish(name, "rsm", *texture);
     } else {
-        lightDraws += renderShadowMaps(views);
+        lightDraws += renderShadowMaps(views, lightViewLods(lightSet, lightLodTexels, lightSet.shadowSide));
     }
     // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
     if (readsRsm && !reuseLights) {
-        lightDraws += renderRsms(views);
+        lightDraws += renderRsms(views, lightViewLods(lightSet, lightLodTexels, lightSet.rsmSide));
         measureViewFlux(views);
         // Several views: the VPL split needs the sums before the technique's extraction is dispatched,
         // so they are read now (a small synchronous read; the previous frame's would make a single
@@ -548,8 +583,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     // every view; 0 when last frame's are reused) drew and left out.
     counters["triangles_gbuffer"] = static_cast<double>(eyeDraws.drawn);
     counters["triangles_gbuffer_culled"] = static_cast<double>(eyeDraws.culled);
-    if (lod.errorPerMetre > 0.0f)
-        counters["triangles_gbuffer_simplified"] = static_cast<double>(eyeDraws.simplified);
+    if (lod.tolerates()) counters["triangles_gbuffer_simplified"] = static_cast<double>(eyeDraws.simplified);
+    if (lightLodTexels > 0.0f && !reuseLights)
+        counters["triangles_light_views_simplified"] = static_cast<double>(lightDraws.simplified);
     counters["triangles_light_views"] = static_cast<double>(lightDraws.drawn);
     counters["triangles_light_views_culled"] = static_cast<double>(lightDraws.culled);
     counters["draw_runs_gbuffer"] = static_cast<double>(eyeDraws.runs);
@@ -636,6 +672,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         if (!mLightPassBlock) mLightPassBlock = std::make_unique<shader::LightUniforms>();
         *mLightPassBlock = lights;
         mLightPassKey = lightKey;
+        mLightPassLodTexels = lightLodTexels;
         mLightPassFlux = viewFlux;
         mLightPassesValid = true;
     }

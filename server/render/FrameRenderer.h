@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -91,8 +92,9 @@ private:
     void ensureTargets(int width, int height, int rsmSide, int shadowSide, int views);
     void ensureTechnique(const std::string& name, int width, int height);
     // The frame's stages, in order; each publishes what it writes in mResources.
-    DrawCount renderShadowMaps(int views);
-    DrawCount renderRsms(int views);
+    /// `lods`: each view's tolerance for levels of detail (empty: every triangle).
+    DrawCount renderShadowMaps(int views, std::span<const LodView> lods);
+    DrawCount renderRsms(int views, std::span<const LodView> lods);
     /// Sums the reflected flux luminance of every view's RSM on the GPU (pass "rsm_flux").
     void measureViewFlux(int views);
     /// Those sums, read back (waits for the pass); empty without views.
@@ -197,6 +199,7 @@ private:
     bool mLightPassesValid = false; ///< the maps hold mLightPassBlock's views
     std::unique_ptr<shader::LightUniforms> mLightPassBlock;
     glm::vec4 mLightPassKey{0.0f};
+    float mLightPassLodTexels = 0.0f; ///< the texels of level-of-detail error the maps were drawn with
     std::vector<double> mLightPassFlux;
 
     std::string mTechniqueName;

@@ -446,14 +446,14 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
         // nearest point, the view tolerates (none inside the box: distance 0 tolerates no error).
         std::vector<std::uint8_t>& chosen = mLevelScratch;
         std::size_t lastLevel = 0;
-        const bool choose = lod && lod->errorPerMetre > 0.0f && levels && levels->levelCount > 0;
+        const bool choose = lod && lod->tolerates() && levels && levels->levelCount > 0;
         if (choose) {
             chosen.assign(levels->placements, 0);
             for (std::size_t k = 0; k < levels->placements; ++k) {
                 const PlacementExtent& e = mLod->extents[levels->firstExtent + k];
                 const float distance =
                     glm::length(glm::max(glm::max(e.lo - lod->eye, lod->eye - e.hi), glm::vec3(0.0f)));
-                const float tolerated = lod->errorPerMetre * distance;
+                const float tolerated = lod->errorAtEye + lod->errorPerMetre * distance;
                 for (std::size_t l = levels->levelCount; l > 0; --l)
                     if (mLod->levels[levels->firstLevel + l - 1].error * e.scale <= tolerated) {
                         chosen[k] = static_cast<std::uint8_t>(l);

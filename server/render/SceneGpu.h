@@ -47,11 +47,16 @@ struct DrawCount {
 
 /// What a view tolerates of the meshes' levels of detail (scene/MeshLod.h): each placement of a mesh is
 /// drawn at its coarsest level whose error, seen from `eye` at the placement's nearest point, stays
-/// within `errorPerMetre` per metre of that distance. For a camera, a tolerance of p pixels is
-/// p * 2 tan(fov / 2) / image height (lodErrorPerMetre()).
+/// within `errorAtEye` plus `errorPerMetre` per metre of that distance. For a camera (or a perspective
+/// light view), a tolerance of p pixels is p * 2 tan(fov / 2) / image height per metre
+/// (lodErrorPerMetre()); an orthographic view's pixel has one size at any distance, p * its width /
+/// its pixels, which is `errorAtEye`.
 struct LodView {
     glm::vec3 eye{0.0f};
-    float errorPerMetre = 0.0f; ///< 0: every mesh at full detail
+    float errorPerMetre = 0.0f; ///< world units per unit of distance
+    float errorAtEye = 0.0f;    ///< world units, whatever the distance
+    /// Both 0: every mesh at full detail.
+    bool tolerates() const { return errorPerMetre > 0.0f || errorAtEye > 0.0f; }
 };
 /// The world distance per metre from the eye that `pixels` of an image `imageHeight` px tall under a
 /// vertical field of view `yfovRadians` span; 0 for no tolerance or a degenerate view.

@@ -135,6 +135,15 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
     const bool budgetProbes = !snapshot && envBudgetMs > 0.0 && p.state.frameParams.has("env_budget_ms") &&
                               !explicitParams.contains("env_budget_ms");
     if (budgetProbes) p.state.frameParams.set("env_budget_ms", envBudgetMs);
+    // The light views within a texel at every step, not only the interactive one: drawn once while the
+    // lights stay, a light drag's maps then serve the refinement after it, whose first tile would
+    // otherwise hold input back while it draws every light view at full detail (176 ms on the
+    // atrium), for no measured gain (docs/interactive.md, "Level of detail").
+    // A snapshot (the best image the client asked for) draws every triangle.
+    const bool lightLevels = !snapshot && mLimits.interactiveLodPixels > 0.0 &&
+                             p.state.frameParams.has("light_lod_texels") &&
+                             !explicitParams.contains("light_lod_texels");
+    if (lightLevels) p.state.frameParams.set("light_lod_texels", kLiveLightLodTexels);
     if (p.step != QualityStep::Interactive && !snapshot && mLimits.refineBudgetMs > 0)
         planRefinement(sceneName, requested, explicitParams, p);
     if (p.step == QualityStep::Interactive && !snapshot) {
@@ -146,6 +155,7 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
             p.state.frameParams.set("lod_pixels", mLimits.interactiveLodPixels);
             p.budget["lod_pixels"] = mLimits.interactiveLodPixels;
         }
+        if (lightLevels) p.budget["light_lod_texels"] = kLiveLightLodTexels;
     }
     return p;
 }

@@ -41,6 +41,9 @@ inline double envProbeBudgetMs(int frameTargetMs, QualityStep step) {
 constexpr int kMinRefineTileSide = 16;
 /// A snapshot renders in one piece while the controller's input waits behind it: at most this long.
 constexpr double kSnapshotBudgetMs = 5000.0;
+/// light_lod_texels of every adaptive step while the server's levels of detail are on
+/// (--interactive-lod-px above 0) and the client did not set it: the frame parameter's maximum.
+constexpr double kLiveLightLodTexels = 1.0;
 
 class AdaptiveQuality {
 public:

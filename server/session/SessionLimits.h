@@ -11,7 +11,8 @@ struct SessionLimits {
     double interactiveScale = 1.0;
     /// px: interactive frames draw big meshes at the coarsest level of detail whose error spans at most
     /// this many of their pixels (frame parameter lod_pixels, unless the client set it); the
-    /// refinement steps draw every triangle. 0: every triangle always.
+    /// refinement steps draw every triangle. Above 0, every adaptive step (snapshots aside) also draws
+    /// the light views within kLiveLightLodTexels (light_lod_texels). 0: every triangle always.
     double interactiveLodPixels = 1.0;
     /// ms of render and encode an interactive frame should take: the frame budget picks its size and
     /// VPL cap from measured costs (session/FrameBudget.h); a client may ask for its own in `hello` or

@@ -761,6 +761,8 @@ check('interactive frames of a big scene draw its levels of detail once built, s
         const f = await client.frame('an interactive atrium frame', (s) => s.scene === 'builtin:atrium' && s.quality === 'interactive', 15000);
         assert.equal(f.stats.budget?.lod_pixels, 1, 'stats.budget.lod_pixels: the server default');
         assert.equal(f.stats.params?.lod_pixels, 1, 'the frame rendered with it');
+        assert.equal(f.stats.params?.light_lod_texels, 1, 'its light views within a texel');
+        assert.equal(f.stats.budget?.light_lod_texels, 1, 'stats.budget.light_lod_texels');
         if (f.stats.counts?.triangles_gbuffer_simplified > 0) simplified = f;
         else await sleep(100);
     }
@@ -772,6 +774,7 @@ check('interactive frames of a big scene draw its levels of detail once built, s
     const refined = await client.frame('a refinement frame', (s) => s.quality === 'balanced' || s.quality === 'final', 60000);
     assert.equal(refined.stats.params?.lod_pixels, 0, 'refinement draws every triangle');
     assert.equal(refined.stats.counts?.triangles_gbuffer_simplified, undefined);
+    assert.equal(refined.stats.params?.light_lod_texels, 1, 'and keeps the light views within a texel');
 
     // A second session on the same scene uses the first one's levels: its first moved frame draws them.
     const second = await open(servers.main, { adaptive: true });

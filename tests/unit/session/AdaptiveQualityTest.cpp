@@ -228,5 +228,37 @@ TEST(AdaptiveQuality, InteractiveFramesDrawAtTheServersLevelOfDetailUnlessTheCli
                      0.0);
 }
 
+TEST(AdaptiveQuality, EveryLiveStepDrawsTheLightViewsWithinATexelUnlessTheClientSetIt) {
+    // The light views are kept while the lights stay: simplified in an interactive frame, they serve the
+    // refinement steps after it, which must not draw them again at full detail.
+    SessionLimits limits;
+    AdaptiveQuality q(limits, nullptr);
+    const nlohmann::json none = nlohmann::json::object();
+    const auto texels = [](const AdaptiveQuality::Plan& p) {
+        return p.state.frameParams.getFloat("light_lod_texels");
+    };
+    for (QualityStep step : {QualityStep::Interactive, QualityStep::Balanced, QualityStep::Final})
+        EXPECT_DOUBLE_EQ(texels(q.plan("cornell", requested(), none, step, false, 80)), kLiveLightLodTexels)
+            << qualityStepName(step);
+    EXPECT_DOUBLE_EQ(q.plan("cornell", requested(), none, QualityStep::Interactive, false, 80)
+                         .budget.at("light_lod_texels")
+                         .get<double>(),
+                     kLiveLightLodTexels)
+        << "shown in stats.budget";
+    EXPECT_DOUBLE_EQ(texels(q.plan("cornell", requested(), none, QualityStep::Fixed, false, 80)), 0.0)
+        << "a fixed-quality view renders what was asked";
+    EXPECT_DOUBLE_EQ(texels(q.plan("cornell", requested(), none, QualityStep::Final, true, 80)), 0.0)
+        << "a snapshot draws every triangle";
+    FrameState asked = requested();
+    asked.frameParams.set("light_lod_texels", 0.0);
+    EXPECT_DOUBLE_EQ(
+        texels(q.plan("cornell", asked, {{"light_lod_texels", 0.0}}, QualityStep::Balanced, false, 80)), 0.0)
+        << "the client's value wins";
+    limits.interactiveLodPixels = 0.0;
+    AdaptiveQuality off(limits, nullptr);
+    EXPECT_DOUBLE_EQ(texels(off.plan("cornell", requested(), none, QualityStep::Interactive, false, 80)), 0.0)
+        << "--interactive-lod-px 0 turns the levels off everywhere";
+}
+
 } // namespace
 } // namespace gis

@@ -1,0 +1,153 @@
+// Light-drag benchmark (not a test): what a user dragging a light sees, with the server's levels of
+// detail on and off side by side in one run. A WebSocket client (no browser: the frames are not
+// decoded) opens a live-view session on a big scene, then repeatedly
+//   - drags the scene's first light for --drag-s seconds: every interactive frame it receives is
+//     acknowledged and answered with the light turned a little further, as the client's gizmo does,
+//     so each frame draws the light views again;
+//   - lets go, waits for the refinement to start (its first tile draws the light views at full
+//     detail) and --press-ms later moves the camera, timing how long that input waited for the work
+//     in progress (`stats.input.wait_ms`) and how long its answer took to arrive.
+// Reported per server setting: the drag's frames per second, their render time p50 / p95, size and
+// light-view triangles, and the press's wait and answer time p50 / max; then the ratios.
+//
+//   node bench/interactive/light_drag.mjs [--server build/ci/bin/gi-server] [--scene builtin:atrium]
+//       [--rounds 3] [--drag-s 4] [--press-ms 60] [--settings "--interactive-lod-px 1|--interactive-lod-px 0"]
+import WebSocket from 'ws';
+import { DEFAULT_SERVER, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
+
+const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:atrium', rounds: 3, 'drag-s': 4, 'press-ms': 60,
+    settings: '--interactive-lod-px 1|--interactive-lod-px 0', size: '960x800' },
+'usage: node bench/interactive/light_drag.mjs [--server PATH] [--scene NAME] [--rounds N] [--drag-s S] [--press-ms MS] [--size WxH] [--settings "FLAGS|FLAGS"]');
+const [width, height] = opts.size.split('x').map(Number);
+
+// One connection's messages, with waits on what arrives.
+function connect(port) {
+    const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
+    const link = { ws, stats: null, frames: [], progress: [], state: null, waiters: [] };
+    const wake = () => { for (const w of link.waiters.splice(0)) w(); };
+    ws.on('message', (data, isBinary) => {
+        if (isBinary) {
+            const id = data.readUInt32LE(4);
+            ws.send(JSON.stringify({ type: 'ack', frame: id }));
+            if (link.stats) link.frames.push({ at: performance.now(), stats: link.stats });
+            link.onFrame?.(link.stats);
+        } else {
+            const m = JSON.parse(data.toString());
+            if (m.type === 'stats') link.stats = m;
+            else if (m.type === 'progress') link.progress.push({ at: performance.now(), ...m });
+            else if (m.type === 'welcome' || m.type === 'state') link.state = m.state;
+            else if (m.type === 'error') console.error(`server error: ${m.message}`);
+        }
+        wake();
+    });
+    link.until = async (what, test, timeoutMs = 60000) => {
+        const end = performance.now() + timeoutMs;
+        while (!test()) {
+            if (performance.now() > end) throw new Error(`timed out waiting for ${what}`);
+            await new Promise((resolve) => { link.waiters.push(resolve); setTimeout(resolve, 100); });
+        }
+    };
+    link.send = (m) => ws.send(JSON.stringify(m));
+    return new Promise((resolve, reject) => {
+        ws.on('open', () => {
+            link.send({ type: 'hello', protocol: 2, client: 'light_drag', codecs: ['jpeg'], adaptive: true,
+                size: [width, height], dpr: 1, max_in_flight: 2 });
+            resolve(link);
+        });
+        ws.on('error', reject);
+    });
+}
+
+// Turns a light a step further about the vertical: a directional light's direction, another light's
+// position about the scene's centre.
+function turned(light, bounds, angle) {
+    const rotate = ([x, y, z], c) => [c[0] + (x - c[0]) * Math.cos(angle) - (z - c[2]) * Math.sin(angle), y,
+        c[2] + (x - c[0]) * Math.sin(angle) + (z - c[2]) * Math.cos(angle)];
+    const centre = bounds ? bounds.min.map((v, i) => (v + bounds.max[i]) / 2) : [0, 0, 0];
+    return light.type === 'directional' ? { direction: rotate(light.direction, [0, 0, 0]) }
+        : { position: rotate(light.position, centre) };
+}
+
+async function measure(flags) {
+    const { server, port } = await startServer(opts.server, flags.split(' ').filter(Boolean));
+    try {
+        const link = await connect(port);
+        await link.until('the welcome', () => link.state);
+        link.send({ type: 'scene', name: opts.scene });
+        await link.until(`frames of ${opts.scene}`, () => link.stats?.scene === opts.scene, 120000);
+        await link.until('a refined frame', () => link.stats?.refine?.complete || link.stats?.quality === 'final', 60000)
+            .catch(() => {});
+        const light = link.state.lights[0];
+        const camera = link.state.camera;
+        const drag = [], presses = [];
+        let angle = 0;
+        for (let round = 0; round < opts.rounds; round++) {
+            // The drag: each interactive frame answered by the next step.
+            const from = link.frames.length;
+            const start = performance.now();
+            link.onFrame = (s) => {
+                if (s?.quality !== 'interactive' || performance.now() - start > opts['drag-s'] * 1000) return;
+                angle += 0.01;
+                link.send({ type: 'light', id: light.id, light: turned(light, link.state.bounds, angle) });
+            };
+            angle += 0.01;
+            link.send({ type: 'light', id: light.id, light: turned(light, link.state.bounds, angle) });
+            await sleep(opts['drag-s'] * 1000);
+            link.onFrame = null;
+            // Frames after the first second (the budget settles), interactive only.
+            const frames = link.frames.slice(from).filter((f) => f.at - start > 1000 && f.stats.quality === 'interactive');
+            if (frames.length > 1) {
+                drag.push({ fps: (frames.length - 1) / ((frames.at(-1).at - frames[0].at) / 1000),
+                    ms: frames.map((f) => f.stats.frame_ms), sizes: frames.map((f) => f.stats.size[0]),
+                    lightTriangles: frames.map((f) => f.stats.counts?.triangles_light_views ?? 0),
+                    lightSimplified: frames.map((f) => f.stats.counts?.triangles_light_views_simplified ?? 0) });
+            }
+            // Let go; the refinement's first tile draws the light views at full detail.
+            const released = performance.now();
+            await link.until('the refinement to start', () => link.progress.some((p) => p.at > released && p.state === 'refining'), 20000);
+            await sleep(opts['press-ms']);
+            const pressed = performance.now();
+            const nudge = 0.02 * (round % 2 ? 1 : -1);
+            link.send({ type: 'camera', position: camera.position.map((v, i) => v + (i === 0 ? nudge : 0)), target: camera.target });
+            const before = link.frames.length;
+            await link.until('the answer to the press', () => link.frames.slice(before).some((f) => f.stats.quality === 'interactive'), 30000);
+            const answer = link.frames.slice(before).find((f) => f.stats.quality === 'interactive');
+            presses.push({ waitMs: answer.stats.input?.wait_ms ?? null, answerMs: answer.at - pressed, frameMs: answer.stats.frame_ms });
+            await sleep(500);
+        }
+        link.ws.close();
+        const all = (k) => drag.flatMap((d) => d[k]);
+        const r = (v) => (v === null || v === undefined ? null : +v.toFixed(1));
+        return {
+            settings: flags, scene: opts.scene, rounds: opts.rounds,
+            drag_fps: r(percentile(drag.map((d) => d.fps), 0.5)),
+            drag_frame_ms: { p50: r(percentile(all('ms'), 0.5)), p95: r(percentile(all('ms'), 0.95)) },
+            drag_width_p50: percentile(all('sizes'), 0.5),
+            drag_light_view_triangles_p50: percentile(all('lightTriangles'), 0.5),
+            drag_light_view_simplified_p50: percentile(all('lightSimplified'), 0.5),
+            press_wait_ms: { p50: r(percentile(presses.map((p) => p.waitMs), 0.5)), max: r(Math.max(...presses.map((p) => p.waitMs))) },
+            press_answer_ms: { p50: r(percentile(presses.map((p) => p.answerMs), 0.5)), max: r(Math.max(...presses.map((p) => p.answerMs))) },
+            press_frame_ms_p50: r(percentile(presses.map((p) => p.frameMs), 0.5)),
+        };
+    } finally {
+        server.kill('SIGINT');
+        await sleep(500);
+    }
+}
+
+const settings = opts.settings.split('|');
+const results = [];
+for (const flags of settings) {
+    const result = await measure(flags);
+    results.push(result);
+    console.log(JSON.stringify(result));
+}
+if (results.length > 1) {
+    const [a, b] = results;
+    console.log(JSON.stringify({ ratios: `${a.settings} against ${b.settings}`,
+        drag_fps: +(a.drag_fps / b.drag_fps).toFixed(2),
+        drag_frame_ms_p50: +(a.drag_frame_ms.p50 / b.drag_frame_ms.p50).toFixed(2),
+        drag_width: +(a.drag_width_p50 / b.drag_width_p50).toFixed(2),
+        press_wait_p50: +(a.press_wait_ms.p50 / Math.max(b.press_wait_ms.p50, 0.1)).toFixed(2) }));
+}
+process.exit(0);
