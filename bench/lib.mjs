@@ -38,11 +38,15 @@ export const freePort = () => new Promise((resolve) => {
 /**
  * Starts `serverPath` with the repository's client on a free port and `args`; resolves once it
  * listens (10 s at most) with {server (the child process), port, log () => its stderr so far}.
+ * `nice` (0..19) lowers the server's CPU priority below the benchmark's browser: on one machine the
+ * browser then decodes and draws as if it had a machine of its own, as a remote viewer's has.
  */
-export async function startServer(serverPath, args = []) {
+export async function startServer(serverPath, args = [], { nice = 0 } = {}) {
     const port = await freePort();
-    const server = spawn(serverPath, ['--port', String(port), '--client-dir', path.join(ROOT, 'client'), ...args],
-        { stdio: ['ignore', 'ignore', 'pipe'] });
+    const serverArgs = ['--port', String(port), '--client-dir', path.join(ROOT, 'client'), ...args];
+    const server = nice > 0
+        ? spawn('nice', ['-n', String(nice), serverPath, ...serverArgs], { stdio: ['ignore', 'ignore', 'pipe'] })
+        : spawn(serverPath, serverArgs, { stdio: ['ignore', 'ignore', 'pipe'] });
     let log = '';
     server.stderr.on('data', (d) => { log += d; });
     for (let i = 0; i < 100 && !log.includes('listening'); i++) await sleep(100);

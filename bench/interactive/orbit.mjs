@@ -12,17 +12,18 @@
 // the ones recorded. usage:
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
 //        [--orbit-s 6] [--still-s 3] [--chromium /usr/bin/chromium] [--out report.json]
-//        [--server-args "--slice-ms 20"]
+//        [--server-args "--slice-ms 20"] [--server-nice 10]
 import { writeFileSync } from 'node:fs';
 
 import { DEFAULT_SERVER, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
-    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0 },
-'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"]');
+    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0, 'server-nice': 0 },
+'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"] [--server-nice 0..19]');
 
 const serverArgs = opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : [];
-const { server, port, log: serverLog } = await startServer(opts.server, serverArgs);
+// --server-nice N: the server below the browser's CPU priority (bench/lib.mjs, startServer).
+const { server, port, log: serverLog } = await startServer(opts.server, serverArgs, { nice: opts['server-nice'] });
 
 const { chromium } = await import('playwright-core');
 const browser = await chromium.launch({ executablePath: opts.chromium,
@@ -237,7 +238,7 @@ async function duringRefinement(scene, technique, params) {
         presses_during_refinement: refining };
 }
 
-const report = { viewport, machine: process.env.GI_BENCH_MACHINE ?? null, scenes: [], refinement: [] };
+const report = { viewport, machine: process.env.GI_BENCH_MACHINE ?? null, server_nice: opts['server-nice'], scenes: [], refinement: [] };
 for (const scene of scenes) {
     const r = await measureScene(scene, null);
     report.scenes.push(r);
