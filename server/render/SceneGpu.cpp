@@ -443,7 +443,8 @@ DrawCount SceneGpu::draw(const gl::Program&, const MaterialSlots* materials, int
         const MeshRuns& own = mMeshes[meshIndex];
         const MeshLevels* levels = mLod ? &mLod->meshes[meshIndex] : nullptr;
         // Each placement's level (0: the mesh itself): the coarsest whose error, at the placement's
-        // nearest point, the view tolerates (none inside the box: distance 0 tolerates no error).
+        // nearest point, the view tolerates (inside the box, distance 0: only an orthographic view's
+        // errorAtEye).
         std::vector<std::uint8_t>& chosen = mLevelScratch;
         std::size_t lastLevel = 0;
         const bool choose = lod && lod->tolerates() && levels && levels->levelCount > 0;

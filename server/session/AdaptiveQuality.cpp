@@ -138,8 +138,8 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
     // The light views within a texel at every step, not only the interactive one: drawn once while the
     // lights stay, a light drag's maps then serve the refinement after it, whose first tile would
     // otherwise hold input back while it draws every light view at full detail (176 ms on the
-    // atrium), for no measured gain (docs/interactive.md, "Level of detail").
-    // A snapshot (the best image the client asked for) draws every triangle.
+    // atrium), for no measured gain (docs/interactive.md, "Level of detail"). A snapshot (the best
+    // image the client asked for) draws every triangle.
     const bool lightLevels = !snapshot && mLimits.interactiveLodPixels > 0.0 &&
                              p.state.frameParams.has("light_lod_texels") &&
                              !explicitParams.contains("light_lod_texels");
