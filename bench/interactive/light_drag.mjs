@@ -58,14 +58,17 @@ function connect(port) {
     });
 }
 
-// Turns a light a step further about the vertical: a directional light's direction, another light's
-// position about the scene's centre.
+// The light `angle` into the drag: a directional light's direction turned about the vertical, another
+// light moved sideways by up to a twentieth of the scene's extent (a light on the vertical axis
+// would not move if turned about it).
 function turned(light, bounds, angle) {
-    const rotate = ([x, y, z], c) => [c[0] + (x - c[0]) * Math.cos(angle) - (z - c[2]) * Math.sin(angle), y,
-        c[2] + (x - c[0]) * Math.sin(angle) + (z - c[2]) * Math.cos(angle)];
-    const centre = bounds ? bounds.min.map((v, i) => (v + bounds.max[i]) / 2) : [0, 0, 0];
-    return light.type === 'directional' ? { direction: rotate(light.direction, [0, 0, 0]) }
-        : { position: rotate(light.position, centre) };
+    if (light.type === 'directional') {
+        const [x, y, z] = light.direction;
+        return { direction: [x * Math.cos(angle) - z * Math.sin(angle), y, x * Math.sin(angle) + z * Math.cos(angle)] };
+    }
+    const extent = bounds ? Math.hypot(...bounds.max.map((v, i) => v - bounds.min[i])) : 1;
+    const [x, y, z] = light.position;
+    return { position: [x + 0.05 * extent * Math.sin(4 * angle), y, z] };
 }
 
 async function measure(flags) {
