@@ -83,7 +83,7 @@ const ms0 = (v) => (Number.isFinite(v) ? `${Math.round(v)} ms` : '–');
 
 /**
  * A frame's `stats.budget` as one overlay line and its reason, or null without one:
- * "budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31 · detail within 1 px".
+ * "budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31 · detail within 1 px, light views 1 texel".
  */
 export function budgetLine(budget) {
     if (!budget || typeof budget !== 'object') return null;
@@ -93,8 +93,14 @@ export function budgetLine(budget) {
             ? `VPLs ${budget.vpl_cap} of ${budget.vpls}` : `VPLs ${budget.vpls}`);
     }
     if (Number.isFinite(budget.scale)) parts.push(`scale ${Number(budget.scale.toPrecision(3))}`);
-    // The server draws big meshes simplified within this many of the frame's pixels.
-    if (Number.isFinite(budget.lod_pixels) && budget.lod_pixels > 0) parts.push(`detail within ${budget.lod_pixels} px`);
+    // The server draws big meshes simplified within this many of the frame's pixels, and in the light
+    // views within this many texels of their maps.
+    const eye = Number.isFinite(budget.lod_pixels) && budget.lod_pixels > 0 ? `${budget.lod_pixels} px` : null;
+    const lights = Number.isFinite(budget.light_lod_texels) && budget.light_lod_texels > 0
+        ? `${budget.light_lod_texels} texel${budget.light_lod_texels === 1 ? '' : 's'}` : null;
+    if (eye && lights) parts.push(`detail within ${eye}, light views ${lights}`);
+    else if (eye) parts.push(`detail within ${eye}`);
+    else if (lights) parts.push(`light views within ${lights}`);
     return {
         text: `budget ${ms0(budget.target_ms)}: ${parts.join(' · ')}`,
         reason: typeof budget.reason === 'string' ? budget.reason : '',

@@ -200,6 +200,10 @@ test('a frame\'s budget reads as one line with its reason', () => {
         'budget 80 ms: predicted 12 ms · VPLs 64 · detail within 1 px', 'the level of detail the server set');
     assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, lod_pixels: 0 }).text,
         'budget 80 ms: predicted 12 ms · VPLs 64');
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, lod_pixels: 1, light_lod_texels: 1 }).text,
+        'budget 80 ms: predicted 12 ms · VPLs 64 · detail within 1 px, light views 1 texel', 'and in the light views');
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, light_lod_texels: 0.5 }).text,
+        'budget 80 ms: predicted 12 ms · VPLs 64 · light views within 0.5 texels');
     assert.equal(budgetLine(undefined), null);
     assert.equal(budgetLine('x'), null);
 });

@@ -281,7 +281,8 @@ test('the frame-time target is offered, sent with quality and kept; interactive 
             assert.ok(Number.isFinite(budget.predicted_ms) && Number.isFinite(budget.vpls), JSON.stringify(budget));
             assert.equal(typeof budget.reason, 'string');
             assert.equal(budget.lod_pixels, 1, 'interactive frames at the server\'s level of detail');
-            assert.match(await page.locator('#ov-budget').textContent(), /^budget 50 ms: predicted \d+ ms · VPLs \d+.* · detail within 1 px$/);
+            assert.equal(budget.light_lod_texels, 1, 'and their light views');
+            assert.match(await page.locator('#ov-budget').textContent(), /^budget 50 ms: predicted \d+ ms · VPLs \d+.* · detail within 1 px, light views 1 texel$/);
             assert.ok(await page.locator('#ov-budget').isVisible());
         } finally {
             await control('frame-target', 'select').selectOption({ index: 0 });
