@@ -467,6 +467,11 @@ bool FrameRenderer::sceneHasLevels() const {
     return mSceneGpu && mSceneGpu->hasLevels();
 }
 
+bool FrameRenderer::wantsLevels(const FrameState& state) {
+    return state.frameParams.getFloat("lod_pixels") > 0.0 ||
+           state.frameParams.getFloat("light_lod_texels") > 0.0;
+}
+
 FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool wantDirect) {
     GIS_ASSERT(mSceneGpu != nullptr);
     GIS_ASSERT(state.width > 0 && state.height > 0);
@@ -495,7 +500,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     const auto lodPixels = static_cast<float>(fp.getFloat("lod_pixels"));
     const auto lightLodWanted =
         std::clamp(static_cast<float>(fp.getFloat("light_lod_texels")), 0.0f, kLightLodMaxTexels);
-    if (mLevelsOnDemand && (lodPixels > 0.0f || lightLodWanted > 0.0f) && !mSceneGpu->hasLevels())
+    if (mLevelsOnDemand && wantsLevels(state) && !mSceneGpu->hasLevels())
         mSceneGpu->setLevels(SceneGpu::prepareLevels(*mScene));
     const LodView lod{state.camera.position,
                       lodErrorPerMetre(lodPixels, state.camera.yfovRadians,

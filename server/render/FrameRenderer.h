@@ -80,6 +80,9 @@ public:
     /// `levels` (SceneGpu::prepareLevels of the current scene) for the scene's draws.
     void setSceneLevels(std::shared_ptr<const SceneGpu::LodSet> levels);
     bool sceneHasLevels() const;
+    /// Whether `state` draws anything at a level of detail (lod_pixels or light_lod_texels above 0):
+    /// what makes levels worth building.
+    static bool wantsLevels(const FrameState& state);
 
     /// The technique of the last frame (tests inspect its intermediate buffers); may be null.
     Technique* technique() { return mTechnique.get(); }

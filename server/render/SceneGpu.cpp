@@ -156,17 +156,12 @@ std::shared_ptr<const SceneGpu::LodSet> SceneGpu::prepareLevels(const Scene& sce
         }
         // The mesh's own box (a level's vertices are some of the mesh's): where the eye's distance is
         // measured from.
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-        for (const glm::vec3& p : mesh.positions) {
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-        if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
+        const Bounds own = ownBounds(mesh);
         if (!mesh.instanced()) {
-            set->extents.push_back({lo, hi, 1.0f});
+            set->extents.push_back({own.min, own.max, 1.0f});
         } else {
             for (const glm::mat4& toWorld : mesh.instances) {
-                const Bounds placed = placedBounds({lo, hi}, toWorld);
+                const Bounds placed = placedBounds(own, toWorld);
                 const float scale =
                     std::max({glm::length(glm::vec3(toWorld[0])), glm::length(glm::vec3(toWorld[1])),
                               glm::length(glm::vec3(toWorld[2]))});

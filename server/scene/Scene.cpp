@@ -41,18 +41,24 @@ void Scene::updateBounds() {
             continue;
         }
         if (m.positions.empty()) continue;
-        glm::vec3 ownLo = m.positions[0], ownHi = m.positions[0];
-        for (const auto& p : m.positions) {
-            ownLo = glm::min(ownLo, p);
-            ownHi = glm::max(ownHi, p);
-        }
+        const Bounds own = ownBounds(m);
         for (const glm::mat4& toWorld : m.instances) {
-            const Bounds placed = placedBounds({ownLo, ownHi}, toWorld);
+            const Bounds placed = placedBounds(own, toWorld);
             add(placed.min);
             add(placed.max);
         }
     }
     bounds = any ? Bounds{lo, hi} : Bounds{};
+}
+
+Bounds ownBounds(const Mesh& mesh) {
+    if (mesh.positions.empty()) return {};
+    Bounds out{mesh.positions[0], mesh.positions[0]};
+    for (const glm::vec3& p : mesh.positions) {
+        out.min = glm::min(out.min, p);
+        out.max = glm::max(out.max, p);
+    }
+    return out;
 }
 
 Bounds placedBounds(const Bounds& own, const glm::mat4& toWorld) {

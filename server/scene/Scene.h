@@ -132,6 +132,8 @@ struct Bounds {
 /// The world box around `own`'s eight corners placed by `toWorld` (object -> world): it holds the
 /// placed geometry, a little loosely under rotation.
 Bounds placedBounds(const Bounds& own, const glm::mat4& toWorld);
+/// The box around `mesh`'s own positions (its space, before any placement); a zero box without any.
+Bounds ownBounds(const Mesh& mesh);
 
 /// Something the file asks for that the renderer does not show, said to the user rather than left out
 /// silently (stats.not_shown): a glTF extension or a core material feature, where, and what shows instead.

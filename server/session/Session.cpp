@@ -567,7 +567,7 @@ void Session::provideLevels(Worker& w, const FrameState& state) {
     if (w.levels && w.levels->scene != shown) Worker::drop(w.levels, w.retiredLevels);
     if (!shown) return;
     if (!w.levels) {
-        if (!(state.frameParams.getFloat("lod_pixels") > 0.0)) return; // not asked for yet
+        if (!FrameRenderer::wantsLevels(state)) return; // not asked for yet
         auto build = std::make_unique<Worker::Levels>();
         build->scene = shown;
         // Another session on this scene built them already.

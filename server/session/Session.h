@@ -163,8 +163,8 @@ private:
     const reference::RayScene* planRaysFor(Worker& w, const std::shared_ptr<const Scene>& scene,
                                            bool& failed);
     /// Levels of detail for the scene shown (Worker::levels): built on a thread of their own the
-    /// first time a frame asks for lod_pixels, handed to the renderer when ready (frames until then
-    /// draw every triangle), dropped for the next scene.
+    /// first time a frame asks for them (FrameRenderer::wantsLevels), handed to the renderer when ready
+    /// (frames until then draw every triangle), dropped for the next scene.
     void provideLevels(Worker& w, const FrameState& state);
     /// True when input (or a snapshot, or stop) waits: refinement yields to it.
     bool inputPending() const;

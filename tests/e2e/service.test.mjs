@@ -789,6 +789,18 @@ check('interactive frames of a big scene draw its levels of detail once built, s
     assert.ok(lines.some((l) => l.includes('levels of detail for builtin:atrium are shared with another session')),
         'the second session says it shares the levels');
     assert.ok(!lines.some((l) => l.includes('levels of detail for builtin:atrium built in')), 'and builds none');
+
+    // A client that wants every triangle in its own view still gets the light views within a texel,
+    // which need the levels as well.
+    const third = await open(servers.main, { adaptive: true });
+    await third.frame('a first frame', () => true);
+    third.send({ type: 'params', values: { lod_pixels: 0 } });
+    third.send({ type: 'scene', name: 'builtin:atrium' });
+    const lit = await third.frame('an atrium frame with simplified light views', (s) => s.scene === 'builtin:atrium' &&
+        s.counts?.triangles_light_views_simplified > 0, 30000);
+    assert.equal(lit.stats.params?.lod_pixels, 0, 'the client\'s lod_pixels holds');
+    assert.equal(lit.stats.counts?.triangles_gbuffer_simplified, undefined);
+    await third.close();
     await second.close();
     await client.close();
 });

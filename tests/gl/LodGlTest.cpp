@@ -188,6 +188,25 @@ TEST(LodGlCorpus, ABlenderExportInMillimetresDrawsItsLevels) {
     EXPECT_LT(counter(lod, "triangles_gbuffer"), 0.5 * counter(full, "triangles_gbuffer"));
     EXPECT_LT(error, 0.05);
     EXPECT_EQ(badValues(lod), 0u);
+
+    // Its light views (the default rig a file without lights gets: a key spot and a directional fill)
+    // within a texel as well.
+    const FrameOutput lit =
+        renderScene(path, "multires_gather", 160, 120, {{"lod_pixels", 1.0}, {"light_lod_texels", 1.0}});
+    const double litError = relativeRmseOf(lit, full);
+    std::printf(
+        "[lod] dense_monkey_draco 160x120, light views too: %.0f -> %.0f light-view triangles, relative "
+        "RMSE %.4f, mean |diff| %.2f / 255\n",
+        counter(full, "triangles_light_views"), counter(lit, "triangles_light_views"), litError,
+        meanDifference(lit.rgba8, full.rgba8));
+    if (const char* dir = std::getenv("GIS_LOD_IMAGES")) {
+        writePng(std::string(dir) + "/monkey_full.png", full.width, full.height, full.rgba8);
+        writePng(std::string(dir) + "/monkey_lit.png", lit.width, lit.height, lit.rgba8);
+    }
+    EXPECT_GT(counter(lit, "triangles_light_views_simplified"), 0.0);
+    EXPECT_LT(counter(lit, "triangles_light_views"), counter(full, "triangles_light_views"));
+    EXPECT_LT(litError, 0.05);
+    EXPECT_EQ(badValues(lit), 0u);
 }
 
 TEST_F(LodGl, TilesChooseTheLevelsOfTheWholeImage) {
