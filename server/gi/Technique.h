@@ -80,6 +80,13 @@ struct FrameInputs {
     /// A later VPL part of the image the previous frame rendered (same size, window, camera and
     /// parameters): what a technique derived from the G-buffer alone (the eye hierarchy) still holds.
     bool sameImageAsLastPart = false;
+    /// Refinement's interruption (FrameRenderer::setInterruptCheck): says true once input waits and
+    /// the frame will be dropped. A technique asks between its stages, where returning at once leaves
+    /// whole what it keeps for later frames; empty: frames run to the end.
+    std::function<bool()> interruptCheck;
+
+    /// Whether the frame should stop here (interruptCheck, when set).
+    bool interrupted() const { return interruptCheck && interruptCheck(); }
 
     /// The resource `name`, or nullptr when the frame did not produce it.
     const gl::Texture* find(const std::string& name) const {

@@ -520,6 +520,23 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
 
+    // Refinement's interruption (setInterruptCheck): latched, so that the technique's checks and the
+    // renderer's agree once it said stop.
+    bool stopAsked = false;
+    auto interrupted = [&] {
+        if (!stopAsked && mInterruptCheck) stopAsked = mInterruptCheck();
+        return stopAsked;
+    };
+    auto interruptedOutput = [&] {
+        // The next VPL part starts a new mean rather than following one this frame did not add to.
+        mPartAverage.averaged = 0;
+        FrameOutput out;
+        out.width = state.width;
+        out.height = state.height;
+        out.interrupted = true;
+        return out;
+    };
+
     mTimer.beginFrame();
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
@@ -547,11 +564,15 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
                                          {"lights.rsm.specular", &mRsmSpecular}})
                 mResources.publish(name, "rsm", *texture);
     } else {
+        // Until this frame's maps are whole, no later frame may take them for kept ones.
+        mLightPassesValid = false;
         lightDraws += renderShadowMaps(views, lightViewLods(lightSet, lightLodTexels, lightSet.shadowSide));
+        if (interrupted()) return interruptedOutput();
     }
     // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
     if (readsRsm && !reuseLights) {
         lightDraws += renderRsms(views, lightViewLods(lightSet, lightLodTexels, lightSet.rsmSide));
+        if (interrupted()) return interruptedOutput();
         measureViewFlux(views);
         // Several views: the VPL split needs the sums before the technique's extraction is dispatched,
         // so they are read now (a small synchronous read; the previous frame's would make a single
@@ -568,6 +589,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         state.vplPart.active() && techniqueInfo.vplParts && techniqueInfo.vplParts(state.techniqueParams);
     // Decided before the part joins the mean (averageVplPart records it as the last part).
     const bool followsLast = vplParts && followsLastPart(state, u.viewProj);
+    // A frame that does not follow the parts in the mean draws over the G-buffer and the eye hierarchy
+    // they keep: whatever part comes next starts a new mean.
+    if (!followsLast) mPartAverage.averaged = 0;
     // A later VPL part of the same image under the same lights and frame parameters sees the same
     // G-buffer and direct light as the part before: they are kept rather than drawn again.
     const bool keepEyePasses =
@@ -579,6 +603,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     } else {
         eyeDraws = renderGBuffer(state.width, state.height, u.viewProj, lod);
         renderDirect();
+        if (interrupted()) return interruptedOutput();
     }
 
     // The technique's indirect passes read the G-buffer, the RSM and the direct light by name.
@@ -627,9 +652,11 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         in.sameImageAsLastPart = followsLast;
         if (followsLast) counters["vpl_part_same_image"] = 1;
     }
+    if (mInterruptCheck) in.interruptCheck = interrupted;
     const size_t techniqueFirstPass = mTimer.passCount();
     mTechnique->execute(in, state.techniqueParams, mTimer, counters);
     const size_t techniqueEndPass = mTimer.passCount();
+    if (interrupted()) return interruptedOutput();
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     const gl::Texture* indirect = mTechnique->indirect();

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -49,6 +50,9 @@ struct FrameOutput {
     /// The direct pass alone (direct light and emission), linear RGBA like `linear` (when requested):
     /// linear minus this is the technique's indirect light and reflections.
     std::vector<float> linearDirect;
+    /// render() stopped between two stages because its interrupt check said so
+    /// (FrameRenderer::setInterruptCheck): no image, no stats.
+    bool interrupted = false;
     /// The stats object documented in protocol/PROTOCOL.md: technique, size, frame_ms, passes,
     /// counts, params.
     nlohmann::json stats;
@@ -72,6 +76,12 @@ public:
     /// the same (the stats' counts then have `light_views_reused`). Off by default, so that benchmarks
     /// and tests time every pass of every frame; the service turns it on.
     void setReuseLightPasses(bool reuse) { mReuseLightPasses = reuse; }
+    /// Refinement's interruption: while `check` is set, render() asks it between its stages (after the
+    /// shadow maps, the RSMs, the eye passes and the technique, and inside a technique where it asks,
+    /// FrameInputs::interrupted) and stops at the first true, returning an `interrupted` output. What
+    /// the frame began is not kept for the next (redrawn light views, the VPL parts' mean); GL work
+    /// already issued still runs. Empty (the default): every frame runs to the end.
+    void setInterruptCheck(std::function<bool()> check) { mInterruptCheck = std::move(check); }
     /// Levels of detail (lod_pixels): on demand (the default) the first frame that asks for them builds
     /// them on this thread (CLI renders, benchmarks, tests); a session turns that off, builds them on a
     /// thread of its own and hands them in with setSceneLevels (until then its frames draw every
@@ -197,6 +207,8 @@ private:
     void publishGBuffer();
 
     Reflections mReflections;
+
+    std::function<bool()> mInterruptCheck;
 
     bool mReuseLightPasses = false;
     bool mLightPassesValid = false; ///< the maps hold mLightPassBlock's views

@@ -1036,10 +1036,20 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
              "the view is still: rendering the " + stepLabel + " step in tiles of about " +
                  std::to_string(sliceMs) + " ms" + (note.empty() ? std::string() : "; " + note));
     double shareDone = 0.0; // tiles and parts rendered (plan.shareDone() counts a tile once it starts)
-    auto abandoned = [&] {
-        progress("abandoned", shareDone, 0.0, "input arrived: the frame answers it first");
+    auto abandoned = [&](bool midPart = false) {
+        progress("abandoned", shareDone, 0.0,
+                 midPart ? "input arrived: the tile in progress stopped early and the frame answers it first"
+                         : "input arrived: the frame answers it first");
         return RefineResult::Abandoned;
     };
+    // Input stops the part in progress at its next stage (light views, eye passes, eye hierarchy,
+    // technique) rather than at its end: its wait is one stage, not one part. Only refinement is
+    // interrupted; a frame that answers input runs to the end.
+    w.renderer->setInterruptCheck([this] { return inputPending(); });
+    struct EndInterrupts {
+        FrameRenderer& renderer;
+        ~EndInterrupts() { renderer.setInterruptCheck({}); }
+    } endInterrupts{*w.renderer};
     while (!plan.done()) {
         if (inputPending()) return abandoned();
         // Until a tile of this step was measured, its predicted cost is trusted three times over (the
@@ -1070,6 +1080,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
             Rendered rendered;
             if (const RenderStatus status = renderAdmitted(w, piece, rendered); status != RenderStatus::Ok)
                 return status == RenderStatus::Failed ? RefineResult::Failed : RefineResult::Abandoned;
+            if (rendered.frame.interrupted) return abandoned(true);
             const FrameOutput& frame = rendered.frame;
             tileMs += rendered.renderMs;
             const bool oneTime = !skippedOneTimeWork && drewOneTimeWork(frame);

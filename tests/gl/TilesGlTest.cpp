@@ -251,5 +251,88 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
     EXPECT_EQ(ssbcPart.rgba8, ssbcWhole.rgba8);
 }
 
+// Refinement's interruption (FrameRenderer::setInterruptCheck): a frame stops at the first check that
+// says true, and keeps nothing half done: the frame after it is the one an uninterrupted renderer draws,
+// at whichever stage it stopped.
+TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
+    sharedContext();
+    const Scene scene = loadScene("builtin:cornell");
+    const auto shared = std::make_shared<const Scene>(scene);
+    auto reusingRenderer = [&] {
+        auto r = std::make_unique<FrameRenderer>();
+        r->setReuseLightPasses(true); // as sessions render: kept light views are what could go stale
+        r->setScene(shared);
+        return r;
+    };
+    for (const std::string technique : {"multires_gather", "rsm_gather", "hier_isr"}) {
+        const FrameState lit = stateFor(scene, technique, 96, 80);
+        ASSERT_FALSE(lit.lights.empty());
+        FrameState moved = lit; // another light: its views are drawn again
+        moved.lights[0].light.position += glm::vec3(0.1f, 0.0f, 0.0f);
+        const FrameOutput expected = reusingRenderer()->render(lit);
+
+        // An uninterrupted frame that draws its light views: how many checks it passes.
+        int checks = 0;
+        {
+            auto counting = reusingRenderer();
+            counting->setInterruptCheck([&] {
+                ++checks;
+                return false;
+            });
+            const FrameOutput out = counting->render(lit);
+            EXPECT_FALSE(out.interrupted);
+            EXPECT_EQ(out.rgba8, expected.rgba8) << technique;
+        }
+        // Shadow maps, RSMs, eye passes, after the technique; the hierarchical ones and rsm_gather
+        // once more inside it.
+        EXPECT_EQ(checks, 5) << technique;
+
+        for (int stopAt = 1; stopAt <= checks; ++stopAt) {
+            auto renderer = reusingRenderer();
+            renderer->render(lit); // the light views of `lit`, kept
+            int asked = 0;
+            renderer->setInterruptCheck([&] { return ++asked >= stopAt; });
+            const FrameOutput stopped = renderer->render(moved);
+            EXPECT_TRUE(stopped.interrupted) << technique << " check " << stopAt;
+            EXPECT_TRUE(stopped.rgba8.empty());
+            EXPECT_EQ(asked, stopAt) << technique << ": the frame stops at the first true";
+            renderer->setInterruptCheck({});
+            // Back to the first light: its views were partly drawn over, so they are drawn again.
+            const FrameOutput next = renderer->render(lit);
+            EXPECT_FALSE(next.interrupted);
+            EXPECT_GT(counter(next, "triangles_light_views"), 0.0) << technique << " check " << stopAt;
+            EXPECT_EQ(next.rgba8, expected.rgba8) << technique << " stopped at check " << stopAt;
+        }
+    }
+
+    // VPL parts: a part of another image stopped after its eye passes drew over the G-buffer that
+    // the parts keep, so the next part of the first image starts a new mean and draws its own.
+    auto renderer = reusingRenderer();
+    FrameState image = stateFor(scene, "multires_gather", 96, 80);
+    image.vplPart = {0, 3};
+    renderer->render(image);
+    FrameState other = image;
+    other.camera.position += glm::vec3(0.05f, 0.0f, 0.0f);
+    int asked = 0;
+    renderer->setInterruptCheck([&] { return ++asked >= 1; });
+    EXPECT_TRUE(renderer->render(other).interrupted);
+    EXPECT_EQ(asked, 1) << "light views kept: the eye passes' check is the first";
+    renderer->setInterruptCheck({});
+    image.vplPart = {1, 3};
+    const FrameOutput afterStop = renderer->render(image);
+    EXPECT_EQ(counter(afterStop, "vpl_parts_averaged"), 1.0);
+    EXPECT_EQ(counter(afterStop, "vpl_part_kept_gbuffer"), 0.0);
+    // So does a whole frame of another image between two parts.
+    image.vplPart = {0, 3};
+    renderer->render(image);
+    FrameState whole = other;
+    whole.vplPart = {};
+    renderer->render(whole);
+    image.vplPart = {1, 3};
+    const FrameOutput afterWhole = renderer->render(image);
+    EXPECT_EQ(counter(afterWhole, "vpl_parts_averaged"), 1.0);
+    EXPECT_EQ(counter(afterWhole, "vpl_part_kept_gbuffer"), 0.0);
+}
+
 } // namespace
 } // namespace gis::test

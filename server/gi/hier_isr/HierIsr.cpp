@@ -91,6 +91,8 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
                       Counters& counters) {
     mTree.build(in, timer, counters);
     mEye.build(in, params, timer);
+    // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
+    if (in.interrupted()) return;
 
     const GLuint zero[6] = {};
     mStats.upload(0, sizeof zero, zero);

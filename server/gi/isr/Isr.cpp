@@ -93,6 +93,8 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
     mVplCount = mTree.valid() ? select(params, timer, counters) : 0;
     if (!mTree.valid()) counters["vpl_count"] = 0;
     mEye.build(in, params, timer);
+    // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
+    if (in.interrupted()) return;
 
     {
         gl::Pass pass(timer, "vpl_gather");

@@ -25,6 +25,8 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
                              Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mEye.build(in, params, timer);
+    // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
+    if (in.interrupted()) return;
     if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
 
     {

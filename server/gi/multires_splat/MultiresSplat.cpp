@@ -173,6 +173,8 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
                             Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mEye.build(in, params, timer);
+    // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
+    if (in.interrupted()) return;
     const bool perVpl = params.getEnum("refinement") == "illumination";
     // A once-per-frame list holds each texel at most once: no need for the per-VPL capacity.
     long long texels = 0;

@@ -30,6 +30,8 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
                         Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
     mShadows.render(in, params, mVpls.buffer(), vplCount, timer, counters);
+    // The VPLs and their shadow maps are whole: input may stop the frame before the gather.
+    if (in.interrupted()) return;
     if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
 
     {
