@@ -245,7 +245,16 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
     const float extent = std::max(glm::length(bounds.max - bounds.min), 1e-3f);
     const float zNear = std::max(1e-3f * extent, 1e-4f), zFar = 1.01f * extent + zNear;
 
+    // Input may stop the frame between a probe's faces and its prefilter and between probes (the
+    // first tile after a light change renders them, up to the whole frame target in the final step):
+    // cubes left half rendered must not be kept, so the next frame renders them all again.
+    auto stopped = [&] {
+        if (!in.interrupted()) return false;
+        m.cubesKey.clear();
+        return true;
+    };
     for (size_t p = 0; p < probes.size() && !keepCubes; ++p) {
+        if (p > 0 && stopped()) return;
         const glm::vec3 probe = probes[p].position;
         const gl::Texture& prefiltered = m.prefiltered[p];
 
@@ -270,6 +279,7 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
             }
             m.source.generateMipmap();
         }
+        if (stopped()) return;
 
         // 2. Prefilter: level 0 is the source itself, levels >= 1 one dispatch each.
         {

@@ -527,9 +527,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         if (!stopAsked && mInterruptCheck) stopAsked = mInterruptCheck();
         return stopAsked;
     };
+    // What an interrupted frame drew is not kept: redrawn light views and environment cubes are marked
+    // stale before they are drawn, and the VPL parts' mean follows only a frame that completed (a
+    // frame that does not follow it resets it before drawing over the G-buffer it keeps).
     auto interruptedOutput = [&] {
-        // The next VPL part starts a new mean rather than following one this frame did not add to.
-        mPartAverage.averaged = 0;
         FrameOutput out;
         out.width = state.width;
         out.height = state.height;
@@ -676,7 +677,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     rin.sceneGpu = mSceneGpu.get();
     rin.lightViewsReused = reuseLights;
     rin.envMaxRoughness = nonDiffuse.glossy ? fp.getFloat("glossy_split") : 1.01f;
+    if (mInterruptCheck) rin.interruptCheck = interrupted;
     const gl::Texture* reflection = mReflections.execute(nonDiffuse, rin, fp, mTimer, counters);
+    if (reflection && interrupted()) return interruptedOutput();
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
     if (reflection)

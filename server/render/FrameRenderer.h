@@ -77,10 +77,11 @@ public:
     /// and tests time every pass of every frame; the service turns it on.
     void setReuseLightPasses(bool reuse) { mReuseLightPasses = reuse; }
     /// Refinement's interruption: while `check` is set, render() asks it between its stages (after the
-    /// shadow maps, the RSMs, the eye passes and the technique, and inside a technique where it asks,
-    /// FrameInputs::interrupted) and stops at the first true, returning an `interrupted` output. What
-    /// the frame began is not kept for the next (redrawn light views, the VPL parts' mean); GL work
-    /// already issued still runs. Empty (the default): every frame runs to the end.
+    /// shadow maps, the RSMs, the eye passes, the technique and the reflections, and inside a technique
+    /// or the environment probes where they ask, FrameInputs::interrupted, ReflectionInputs::interrupted)
+    /// and stops at the first true, returning an `interrupted` output. What the frame began is not kept
+    /// for the next (redrawn light views, environment cubes; the VPL parts' mean is not added to); GL
+    /// work already issued still runs. Empty (the default): every frame runs to the end.
     void setInterruptCheck(std::function<bool()> check) { mInterruptCheck = std::move(check); }
     /// Levels of detail (lod_pixels): on demand (the default) the first frame that asks for them builds
     /// them on this thread (CLI renders, benchmarks, tests); a session turns that off, builds them on a

@@ -13,6 +13,7 @@
 // and its reason are in the frame stats ("nondiffuse").
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,12 @@ struct ReflectionInputs {
     /// True when the lights, their shadow maps and the scene are last frame's (FrameRenderer's light
     /// view reuse): the environment probes, lit by them only and not by the camera, may keep theirs.
     bool lightViewsReused = false;
+    /// Refinement's interruption (FrameRenderer::setInterruptCheck, as FrameInputs::interruptCheck):
+    /// the environment probes ask it between their cubes; empty: they render to the end.
+    std::function<bool()> interruptCheck;
+
+    /// Whether the frame should stop here (interruptCheck, when set).
+    bool interrupted() const { return interruptCheck && interruptCheck(); }
 
     /// The resource `name`, or nullptr when the frame did not produce it.
     const gl::Texture* find(const std::string& name) const {

@@ -256,59 +256,112 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
 // at whichever stage it stopped.
 TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
     sharedContext();
-    const Scene scene = loadScene("builtin:cornell");
-    const auto shared = std::make_shared<const Scene>(scene);
-    auto reusingRenderer = [&] {
+    const auto shared = std::make_shared<const Scene>(loadScene("builtin:cornell"));
+    // A file written by another tool: Blender's point lamps (tests/data/corpus/generate.py), one light
+    // view per cube face.
+    const auto lamps = std::make_shared<const Scene>(
+        loadScene(std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/point_lamps.glb"));
+    auto reusingRenderer = [&](const std::shared_ptr<const Scene>& scene) {
         auto r = std::make_unique<FrameRenderer>();
         r->setReuseLightPasses(true); // as sessions render: kept light views are what could go stale
-        r->setScene(shared);
+        r->setScene(scene);
         return r;
     };
-    for (const std::string technique : {"multires_gather", "rsm_gather", "hier_isr"}) {
-        const FrameState lit = stateFor(scene, technique, 96, 80);
+    for (const auto& [scene, technique] : {std::pair{shared, std::string("multires_gather")},
+                                           {shared, "rsm_gather"},
+                                           {shared, "hier_isr"},
+                                           {lamps, "multires_gather"}}) {
+        const FrameState lit = stateFor(*scene, technique, 96, 80);
         ASSERT_FALSE(lit.lights.empty());
         FrameState moved = lit; // another light: its views are drawn again
         moved.lights[0].light.position += glm::vec3(0.1f, 0.0f, 0.0f);
-        const FrameOutput expected = reusingRenderer()->render(lit);
+        const FrameOutput expected = reusingRenderer(scene)->render(lit);
 
         // An uninterrupted frame that draws its light views: how many checks it passes.
         int checks = 0;
         {
-            auto counting = reusingRenderer();
+            auto counting = reusingRenderer(scene);
             counting->setInterruptCheck([&] {
                 ++checks;
                 return false;
             });
             const FrameOutput out = counting->render(lit);
             EXPECT_FALSE(out.interrupted);
-            EXPECT_EQ(out.rgba8, expected.rgba8) << technique;
+            EXPECT_EQ(out.rgba8, expected.rgba8) << scene->name << " " << technique;
         }
         // Shadow maps, RSMs, eye passes, after the technique; the hierarchical ones and rsm_gather
         // once more inside it.
-        EXPECT_EQ(checks, 5) << technique;
+        EXPECT_EQ(checks, 5) << scene->name << " " << technique;
 
         for (int stopAt = 1; stopAt <= checks; ++stopAt) {
-            auto renderer = reusingRenderer();
+            auto renderer = reusingRenderer(scene);
             renderer->render(lit); // the light views of `lit`, kept
             int asked = 0;
             renderer->setInterruptCheck([&] { return ++asked >= stopAt; });
             const FrameOutput stopped = renderer->render(moved);
-            EXPECT_TRUE(stopped.interrupted) << technique << " check " << stopAt;
+            EXPECT_TRUE(stopped.interrupted) << scene->name << " " << technique << " check " << stopAt;
             EXPECT_TRUE(stopped.rgba8.empty());
-            EXPECT_EQ(asked, stopAt) << technique << ": the frame stops at the first true";
+            EXPECT_EQ(asked, stopAt) << scene->name << " " << technique
+                                     << ": the frame stops at the first true";
             renderer->setInterruptCheck({});
             // Back to the first light: its views were partly drawn over, so they are drawn again.
             const FrameOutput next = renderer->render(lit);
             EXPECT_FALSE(next.interrupted);
-            EXPECT_GT(counter(next, "triangles_light_views"), 0.0) << technique << " check " << stopAt;
-            EXPECT_EQ(next.rgba8, expected.rgba8) << technique << " stopped at check " << stopAt;
+            EXPECT_GT(counter(next, "triangles_light_views"), 0.0)
+                << scene->name << " " << technique << " check " << stopAt;
+            EXPECT_EQ(next.rgba8, expected.rgba8)
+                << scene->name << " " << technique << " stopped at check " << stopAt;
+        }
+    }
+
+    // Environment probes (gallery: a room probe and two local ones), rendered again for another face size
+    // under kept light views: a frame stopped between their cubes leaves none to be kept.
+    {
+        const auto gallery = std::make_shared<const Scene>(loadScene("builtin:gallery"));
+        FrameState cubes = stateFor(*gallery, "multires_gather", 96, 80);
+        FrameState resized = cubes;
+        resized.frameParams.set("env_size", 32);
+        FrameRenderer fresh;
+        fresh.setScene(gallery);
+        const FrameOutput expected = fresh.render(resized);
+        ASSERT_EQ(counter(expected, "env_probes"), 3.0);
+        int checks = 0;
+        {
+            FrameRenderer counting;
+            counting.setReuseLightPasses(true);
+            counting.setScene(gallery);
+            counting.render(cubes);
+            counting.setInterruptCheck([&] {
+                ++checks;
+                return false;
+            });
+            EXPECT_EQ(counting.render(resized).rgba8, expected.rgba8);
+        }
+        // Eye passes, the technique (2), the room probe's faces, before each local probe and after its
+        // faces (2 x 2), after the reflections; the light views are kept.
+        EXPECT_EQ(checks, 9);
+        for (int stopAt = 4; stopAt <= checks; ++stopAt) {
+            FrameRenderer renderer;
+            renderer.setReuseLightPasses(true);
+            renderer.setScene(gallery);
+            renderer.render(cubes);
+            int asked = 0;
+            renderer.setInterruptCheck([&] { return ++asked >= stopAt; });
+            EXPECT_TRUE(renderer.render(resized).interrupted);
+            renderer.setInterruptCheck({});
+            const FrameOutput next = renderer.render(resized);
+            EXPECT_GT(counter(next, "light_views_reused"), 0.0) << "what would have kept the cubes";
+            // Stopped after the reflections, the cubes were whole and are kept.
+            EXPECT_EQ(counter(next, "env_cubes_reused"), stopAt < checks ? 0.0 : 1.0)
+                << "stopped at check " << stopAt;
+            EXPECT_EQ(next.rgba8, expected.rgba8) << "environment probes stopped at check " << stopAt;
         }
     }
 
     // VPL parts: a part of another image stopped after its eye passes drew over the G-buffer that
     // the parts keep, so the next part of the first image starts a new mean and draws its own.
-    auto renderer = reusingRenderer();
-    FrameState image = stateFor(scene, "multires_gather", 96, 80);
+    auto renderer = reusingRenderer(shared);
+    FrameState image = stateFor(*shared, "multires_gather", 96, 80);
     image.vplPart = {0, 3};
     renderer->render(image);
     FrameState other = image;
