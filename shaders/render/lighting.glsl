@@ -19,7 +19,40 @@ int shadowViewOf(int i, vec3 fromLight) {
     return first + (fromLight.z >= 0.0 ? 4 : 5);
 }
 
-// Fraction of light i reaching p (PCF over (2r + 1)^2 taps). `l` is the unit direction to the light.
+// Weight and position (texel units) of tap k of 0..r along one axis of pcfFiltered: the pair of
+// texels i0 - r + 2k and the one after, weighted (1 - f, 1) for the first pair, (1, f) for the last
+// and (1, 1) between, as one bilinear tap placed at the pair's weighted centre.
+vec2 pcfPairTap(int k, int r, float i0, float f) {
+    float first = k == 0 ? 1.0 - f : 1.0;
+    float second = k == r ? f : 1.0;
+    float weight = first + second; // >= 1 for r >= 1: each pair holds a texel of weight 1
+    return vec2(weight, i0 - float(r) + 2.0 * float(k) + 0.5 + second / weight);
+}
+
+// Mean of the (2r + 1)^2 hardware 2x2-PCF taps at whole-texel offsets around uv in layer `layer`,
+// in (r + 1)^2 taps. The taps weigh the (2r + 2)^2 texels under them separably, with per-axis
+// weights (1 - f, 1, ..., 1, f) where f is uv's fraction past the texel centre below; neighbouring
+// pairs of texels are one bilinear tap each, so the filter is the same (up to the filtering's
+// rounding) in 4 taps instead of 9 at r = 1. Clamping to the edge maps each texel alike in both.
+float pcfFiltered(vec3 uvz, float layer, int r, float side) {
+    if (r <= 0) return texture(gShadowMap, vec4(uvz.xy, layer, uvz.z));
+    vec2 t = uvz.xy * side - 0.5;
+    vec2 i0 = floor(t);
+    vec2 f = t - i0;
+    float sum = 0.0;
+    for (int y = 0; y <= r; ++y) {
+        vec2 ty = pcfPairTap(y, r, i0.y, f.y);
+        for (int x = 0; x <= r; ++x) {
+            vec2 tx = pcfPairTap(x, r, i0.x, f.x);
+            sum += tx.x * ty.x * texture(gShadowMap, vec4(vec2(tx.y, ty.y) / side, layer, uvz.z));
+        }
+    }
+    float taps = float(2 * r + 1);
+    return min(sum / (taps * taps), 1.0); // the weights' float sum may round a whole tap to 1 + 1 ulp
+}
+
+// Fraction of light i reaching p (PCF over (2r + 1)^2 texel offsets, pcfFiltered). `l` is the unit
+// direction to the light.
 float shadowVisibility(int i, vec3 worldPos, vec3 n, vec3 l) {
     int v = shadowViewOf(i, -l);
     LightView view = gLights.views[v];
@@ -39,16 +72,7 @@ float shadowVisibility(int i, vec3 worldPos, vec3 n, vec3 l) {
     if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(1.0)))) return 0.0;
     // Past the far plane of an orthographic view (nothing there casts a shadow): lit.
     uvz.z = min(uvz.z, 1.0);
-    int r = int(gFrame.rsmInfo.w);
-    float texel = 1.0 / gFrame.rsmInfo.z;
-    float sum = 0.0;
-    float count = 0.0;
-    for (int y = -r; y <= r; ++y)
-        for (int x = -r; x <= r; ++x) {
-            sum += texture(gShadowMap, vec4(uvz.xy + vec2(x, y) * texel, float(v), uvz.z));
-            count += 1.0;
-        }
-    return sum / count;
+    return pcfFiltered(uvz, float(v), int(gFrame.rsmInfo.w), max(gFrame.rsmInfo.z, 1.0));
 }
 
 // Reflected radiance of every light towards `toViewer` (unit) at a surface point: diffuse rho_d / pi
