@@ -150,6 +150,12 @@ export function lightStatuses(lights, lighting) {
     });
 }
 
+/** An EV value as the server writes it: signed, one decimal ("+1.5 EV", "-10.9 EV"). */
+export function formatEv(ev) {
+    const r = Math.round(ev * 10) / 10;
+    return `${r >= 0 ? '+' : '-'}${Math.abs(r).toFixed(1)} EV`;
+}
+
 /** The sentences the Light section shows for a frame's stats.lighting (or a state's lighting). */
 export function lightingLines(lighting) {
     if (!lighting) return [];
@@ -157,6 +163,14 @@ export function lightingLines(lighting) {
     if (lighting.note) {
         const from = { scene: 'Lights from the scene', default: 'Default lighting', request: 'Lights from the request' };
         lines.push({ kind: 'note', text: `${from[lighting.source] ?? 'Lighting'}: ${lighting.note}` });
+    }
+    const exposure = lighting.exposure;
+    if (exposure && typeof exposure.note === 'string') {
+        // The base the exposure parameter adds to: a file's lamps metered, or the scene's own.
+        const ev = Number(exposure.ev), base = Number(exposure.base_ev);
+        const added = Number.isFinite(ev) && Number.isFinite(base) && Math.abs(ev - base) > 1e-9
+            ? `; with exposure ${formatEv(ev - base)}: ${formatEv(ev)}` : '';
+        lines.push({ kind: 'note', text: `Exposure: ${exposure.note}${added}` });
     }
     if (lighting.warning) lines.push({ kind: 'warning', text: lighting.warning });
     for (const s of Array.isArray(lighting.skipped) ? lighting.skipped : []) {

@@ -14,7 +14,7 @@ import {
     safeDirection, viewBasis,
 } from '../light.js';
 import {
-    LIGHT_TYPES, applyLightChanges, intensityUnit, lightLabel, lightStatuses, lightType, lightingLines, lightsOfState,
+    LIGHT_TYPES, applyLightChanges, formatEv, intensityUnit, lightLabel, lightStatuses, lightType, lightingLines, lightsOfState,
     newLightFor, pickSelection, requestLight,
 } from '../lights.js';
 import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
@@ -265,6 +265,16 @@ test('what a frame says about each light: rendered, or skipped and why', () => {
     assert.match(lines[2].text, /^not rendered: light 'fill' \(light1\): disabled$/);
     assert.match(lightingLines({ source: 'default', note: 'the scene has no lights' })[0].text, /^Default lighting: /);
     assert.deepEqual(lightingLines(null), []);
+    // The exposure's base: a Blender file's lamps metered, then the exposure parameter on top.
+    const metered = { source: 'scene', note: 'the scene\'s 3 lights',
+        exposure: { base_ev: -10.88, ev: -10.88, source: 'metered', note: 'metered for the scene\'s lights: -10.9 EV' } };
+    assert.deepEqual(lightingLines(metered).map((l) => l.text),
+        ['Lights from the scene: the scene\'s 3 lights', 'Exposure: metered for the scene\'s lights: -10.9 EV']);
+    assert.equal(lightingLines({ ...metered, exposure: { ...metered.exposure, ev: -9.38 } })[1].text,
+        'Exposure: metered for the scene\'s lights: -10.9 EV; with exposure +1.5 EV: -9.4 EV');
+    assert.equal(formatEv(0), '+0.0 EV');
+    assert.equal(formatEv(-0.04), '+0.0 EV');
+    assert.equal(formatEv(-2.25), '-2.2 EV');
 });
 
 // ---- parameters ---------------------------------------------------------------------------------

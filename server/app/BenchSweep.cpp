@@ -21,6 +21,7 @@
 #include "app/BenchCommon.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "frame/Exposure.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
 #include "reference/ReferenceRenderer.h"
@@ -410,6 +411,7 @@ int sweep(const std::vector<std::string>& args) {
     auto measureScene = [&](SceneWork& w) {
         auto accuracy = [&](const FrameOutput& f) {
             AccuracyInputs in;
+            in.exposureEv = baseExposure(*w.scene).ev; // sweeps leave exposure and metering at their defaults
             in.test = ImageView(f.linear, f.width, f.height, 4);
             in.reference = ImageView(w.reference.rgb, w.reference.width, w.reference.height, 3);
             in.referenceVariance = w.reference.variance;

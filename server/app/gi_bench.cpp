@@ -26,6 +26,7 @@
 #include "app/BenchCommon.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "frame/Exposure.h"
 #include "gl/Platform.h"
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
@@ -292,6 +293,7 @@ int table(const std::vector<std::string>& args) {
                               {"params", s["params"]}};
         for (size_t r = 0; r < refs.size(); ++r) {
             gis::AccuracyInputs in;
+            in.exposureEv = gis::frameExposureEv(states[i]); // SSIM and FLIP compare what a viewer sees
             in.test = gis::ImageView(f.linear, f.width, f.height, 4);
             in.testDirect = gis::ImageView(f.linearDirect, f.width, f.height, 4);
             in.reference = gis::ImageView(refs[r].rgb, refs[r].width, refs[r].height, 3);

@@ -23,6 +23,7 @@
 #include "analysis/Metrics.h"
 #include "gi/Technique.h"
 #include "gl/Platform.h"
+#include "frame/Exposure.h"
 #include "frame/FrameParams.h"
 #include "reference/ReferenceRenderer.h"
 #include "render/FrameRenderer.h"
@@ -107,8 +108,7 @@ nlohmann::json renderReference(const Options& o, const gis::Scene& scene, const 
             gis::writeReferenceExr(o.out, image);
         } else {
             gis::ImageView view(rgba.data(), image.width, image.height, 4);
-            const std::vector<std::uint8_t> rgba8 =
-                gis::toneMapToRgba8(view, state.frameParams.getFloat("exposure"));
+            const std::vector<std::uint8_t> rgba8 = gis::toneMapToRgba8(view, gis::frameExposureEv(state));
             gis::writeImageFile(o.out, image.width, image.height, rgba8, rgba, {{"gi:reference", ro.mode}},
                                 o.quality);
         }

@@ -12,8 +12,17 @@ const ParamTable& frameParamTable() {
          .min = -10.0,
          .max = 10.0,
          .unit = "EV",
-         .help = "exposure compensation before tone mapping (scale 2^EV)",
+         .help = "exposure compensation before tone mapping (scale 2^EV), added to the scene's base "
+                 "exposure (stats lighting.exposure; see metering)",
          .source = "eng"},
+        {.name = "metering",
+         .type = ParamType::Enum,
+         .defaultValue = 0,
+         .help = "base exposure: auto (built-in scenes and the default lighting as made, a file's own "
+                 "lights metered so the model is neither black nor white) or off (exposure is absolute, "
+                 "to compare light strengths)",
+         .source = "eng",
+         .options = {"auto", "off"}},
         {.name = "tonemap",
          .type = ParamType::Enum,
          .defaultValue = 0,

@@ -6,6 +6,7 @@
 #include "core/Log.h"
 #include "gi/Catalog.h"
 #include "frame/DefaultLighting.h"
+#include "frame/Exposure.h"
 #include "frame/FrameParams.h"
 
 namespace gis {
@@ -25,6 +26,7 @@ FrameState makeFrameState(const Scene& scene, const std::string& technique) {
         s.lightSource = "default";
         s.lightNote = fallback.reason;
     }
+    s.baseExposure = baseExposure(scene);
     s.frameParams = ParamSet(frameParamTable());
     setTechnique(s, technique);
     return s;

@@ -18,6 +18,13 @@ struct FrameLight {
     bool enabled = true;
 };
 
+/// The exposure a frame's `exposure` parameter adds to (frame/Exposure.h).
+struct BaseExposure {
+    double ev = 0.0;                 ///< EV; finite, within frame/Exposure.h's kMeterEvLimit
+    std::string source = "authored"; ///< "authored" (the scene says), "default" (the default rig), "metered"
+    std::string note;                ///< one sentence for the stats and the client
+};
+
 struct FrameState {
     Camera camera;
     /// Every light the frame may render, in order: the file's lights (all KHR_lights_punctual types),
@@ -30,6 +37,8 @@ struct FrameState {
     /// keeps the source: they are still those lights, edited.
     std::string lightSource = "scene";
     std::string lightNote;
+    /// The scene's base exposure (frame/Exposure.h baseExposure): lights edited later keep it.
+    BaseExposure baseExposure;
     int width = 512;
     int height = 512;
     /// A tile of a larger image (tiled refinement, frame/Tiles.h): this frame renders the pixels

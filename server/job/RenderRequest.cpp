@@ -10,6 +10,7 @@
 #include "core/Error.h"
 #include "core/JsonSchema.h"
 #include "core/Timer.h"
+#include "frame/Exposure.h"
 #include "frame/FrameParams.h"
 #include "frame/Presets.h"
 #include "frame/StateJson.h"
@@ -275,7 +276,7 @@ nlohmann::json compareWithReference(const Scene& scene, const FrameState& state,
     in.test = ImageView(frame.linear, frame.width, frame.height, 4);
     in.reference = ImageView(reference.rgb, reference.width, reference.height, 3);
     in.referenceVariance = reference.variance;
-    in.exposureEv = state.frameParams.has("exposure") ? state.frameParams.getFloat("exposure") : 0.0;
+    in.exposureEv = frameExposureEv(state);
     // The reference's own direct light at pixel centres (exact, fast; cached beside the reference):
     // the split into indirect light and direct pass. A direct reference has nothing to split.
     ReferenceImage direct;
@@ -353,7 +354,7 @@ RenderResult executeRenderJob(FrameRenderer& renderer, const RenderJob& job,
         result.stats["compare"] = std::move(compare);
         // The reference as a PNG through the same display transform as gi-render --reference, so a
         // client can show it beside the frame.
-        const std::vector<std::uint8_t> rgba8 = toneMapToRgba8(truth, state.frameParams.getFloat("exposure"));
+        const std::vector<std::uint8_t> rgba8 = toneMapToRgba8(truth, frameExposureEv(state));
         result.referenceImage = encodePng(rgba8.data(), reference.width, reference.height);
 #else
         throw InputError("/compare", "this build has no CPU reference renderer (Embree): leave out compare");

@@ -10,6 +10,7 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/Timer.h"
+#include "frame/Exposure.h"
 #include "frame/LightModel.h"
 #include "gl/Pass.h"
 #include "gl/ShaderShared.h"
@@ -100,10 +101,10 @@ nlohmann::json lightingStats(const FrameState& state, const LightSetModel& set,
         }
         rendered.push_back(std::move(entry));
     }
-    nlohmann::json out = {{"source", state.lightSource},     {"note", state.lightNote},
-                          {"rendered", std::move(rendered)}, {"skipped", set.skipped},
-                          {"views", set.views.size()},       {"shadow_side", set.shadowSide},
-                          {"rsm_side", set.rsmSide}};
+    nlohmann::json out = {
+        {"source", state.lightSource},     {"note", state.lightNote}, {"exposure", baseExposureJson(state)},
+        {"rendered", std::move(rendered)}, {"skipped", set.skipped},  {"views", set.views.size()},
+        {"shadow_side", set.shadowSide},   {"rsm_side", set.rsmSide}};
     if (set.lights.empty()) {
         out["warning"] = state.lights.empty()
                              ? "there are no lights: the view shows emission only"
@@ -510,9 +511,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
     u.rsmInfo = glm::vec4(lightSet.rsmSide, widestTan > 0.0f ? widestTan : 1.0f, lightSet.shadowSide,
                           fp.getInt("pcf_radius"));
-    u.toneInfo =
-        glm::vec4(std::exp2(fp.getFloat("exposure")), fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f,
-                  lightOn ? 1.0f : 0.0f, fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
+    u.toneInfo = glm::vec4(static_cast<float>(std::exp2(frameExposureEv(state))),
+                           fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f, lightOn ? 1.0f : 0.0f,
+                           fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
     u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f,
                               fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
     mFrameUbo.upload(0, sizeof u, &u);

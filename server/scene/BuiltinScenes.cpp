@@ -574,6 +574,7 @@ Scene makeBuiltinScene(const std::string& name) {
         throw InputError("builtin:" + name, "unknown built-in scene; known: " + known);
     }
     scene.name = "builtin:" + name;
+    scene.authoredExposureEv = 0.0f; // every built-in scene's lights are chosen for the default exposure
     finalizeScene(scene, scene.name);
     return scene;
 }

@@ -151,6 +151,10 @@ struct Scene {
     std::vector<Camera> cameras; ///< never empty after loading (a framing camera is added)
     Bounds bounds;
     std::vector<NotShown> notShown; ///< what the file uses and the renderer does not show
+    /// The exposure (EV) the scene's lights were made for, where someone chose it: the built-in
+    /// scenes are lit for 0. Empty for files, whose lights come in any units and strengths: the frame
+    /// meters them (frame/Exposure.h).
+    std::optional<float> authoredExposureEv;
 
     /// Triangles drawn (an instanced mesh counts once per placement).
     std::size_t triangleCount() const;

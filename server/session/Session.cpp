@@ -13,6 +13,7 @@
 #include "core/Log.h"
 #include "core/Timer.h"
 #include "gi/Technique.h"
+#include "frame/Exposure.h"
 #include "frame/FrameParams.h"
 #include "frame/VplBudget.h"
 #include "render/FrameRenderer.h"
@@ -124,7 +125,10 @@ nlohmann::json Session::stateJsonLocked() const {
             {"camera", cameraJson(mDesired.camera)},
             {"light", lightJson(mDesired)},
             {"lights", lightsJson(mDesired)},
-            {"lighting", {{"source", mDesired.lightSource}, {"note", mDesired.lightNote}}},
+            {"lighting",
+             {{"source", mDesired.lightSource},
+              {"note", mDesired.lightNote},
+              {"exposure", baseExposureJson(mDesired)}}},
             {"scene_camera", cameraJson(mSceneCamera)},
             {"load", mSceneLoad.is_null() ? nlohmann::json(nullptr) : mSceneLoad},
             {"bounds",
@@ -762,6 +766,7 @@ void Session::continueUpload(Worker& w) {
         mDesired.lights = fresh.lights;
         mDesired.lightSource = fresh.lightSource;
         mDesired.lightNote = fresh.lightNote;
+        mDesired.baseExposure = fresh.baseExposure;
         mScene = next;
         mSceneName = finished->request;
         mSceneLoad = std::move(finished->info);

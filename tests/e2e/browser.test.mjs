@@ -551,6 +551,20 @@ test('a .glb dropped on the view is uploaded with progress and shown', async () 
     await until('nothing is listed for the Cornell box', () => document.querySelector('[data-block="not-shown"]').hidden);
 });
 
+test('a Blender file with its own lamps is metered, and the Light section says so', async () => {
+    // Blender exports lamp watts as candela: about ten stops brighter than the built-in scenes.
+    await page.setInputFiles('#file-input', path.join(REPO, 'tests/data/corpus/point_lamps.glb'));
+    await until('the lamps scene renders', () => window.giClient.lastStats?.scene === 'upload:point_lamps.glb');
+    const exposure = (await page.evaluate(() => window.giClient.lastStats.lighting)).exposure;
+    assert.equal(exposure.source, 'metered');
+    assert.ok(exposure.base_ev < -8, `metered down by about ten stops: ${JSON.stringify(exposure)}`);
+    await until('the exposure is explained', () => [...document.querySelectorAll('p')]
+        .some((p) => p.textContent.startsWith('Exposure: metered for the scene\'s lights: -')));
+    await control('scene', 'select').selectOption('builtin:cornell');
+    await until('back on the Cornell box', () => window.giClient.lastStats?.scene === 'builtin:cornell');
+    assert.equal((await page.evaluate(() => window.giClient.lastStats.lighting)).exposure.source, 'authored');
+});
+
 test('a zipped .gltf chosen in the file picker is uploaded and shown', async () => {
     // glTF Transform's .gltf + .bin + PNG of the corpus box, zipped (tests/data/corpus/compress.sh).
     await page.setInputFiles('#file-input', path.join(REPO, 'tests/data/corpus/textured_box_gltf.zip'));

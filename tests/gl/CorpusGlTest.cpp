@@ -58,6 +58,45 @@ TEST(Corpus, BlenderExportsRenderLit) {
     }
 }
 
+// Blender exports its lamps' watts as candela and its sun as lux, about ten stops above the built-in
+// scenes: at EV 0 these files were a white frame. Metered (frame/Exposure.h), the model is neither
+// black nor white; with metering off they are white again, which is what the meter fixes.
+TEST(Corpus, BlenderLampsAreExposedToShowTheModel) {
+    for (const char* name : {"point_lamps", "colonnade"}) {
+        SCOPED_TRACE(name);
+        const std::string path = std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/" + name + ".glb";
+        // Share of covered pixels whose tone-mapped colour is clipped white, and their mean (0..255).
+        auto look = [](const FrameOutput& f) {
+            size_t covered = 0, white = 0;
+            double sum = 0;
+            for (size_t i = 0; i + 3 < f.rgba8.size(); i += 4) {
+                if (f.linear[i] + f.linear[i + 1] + f.linear[i + 2] <= 0.0f) continue; // background
+                ++covered;
+                const int lo = std::min({f.rgba8[i], f.rgba8[i + 1], f.rgba8[i + 2]});
+                if (lo >= 250) ++white;
+                sum += (f.rgba8[i] + f.rgba8[i + 1] + f.rgba8[i + 2]) / 3.0;
+            }
+            return std::pair{covered ? static_cast<double>(white) / covered : 1.0,
+                             covered ? sum / covered : 0.0};
+        };
+        const FrameOutput metered = renderScene(path, "multires_gather", 64, 64);
+        ASSERT_TRUE(metered.stats["lighting"].contains("exposure"));
+        const nlohmann::json& exposure = metered.stats["lighting"]["exposure"];
+        EXPECT_EQ(exposure["source"], "metered") << exposure.dump();
+        const auto [white, mean] = look(metered);
+        EXPECT_LT(white, 0.05) << "clipped white: " << exposure.dump();
+        EXPECT_GT(mean, 30.0) << "too dark: " << exposure.dump();
+        EXPECT_LT(mean, 200.0) << "too bright: " << exposure.dump();
+        const FrameOutput absolute = renderScene(path, "multires_gather", 64, 64, {{"metering", "off"}});
+        EXPECT_EQ(absolute.stats["lighting"]["exposure"]["source"], "off");
+        const auto [whiteBefore, meanBefore] = look(absolute);
+        std::printf("%s: %s: %.0f%% clipped, mean %.0f / 255; metering off: %.0f%% clipped, mean %.0f\n",
+                    name, exposure["note"].get<std::string>().c_str(), 100.0 * white, mean,
+                    100.0 * whiteBefore, meanBefore);
+        EXPECT_GT(whiteBefore, 0.5) << "without the meter the file's lamps clip the frame white";
+    }
+}
+
 // The compressed copies (tests/data/corpus/compress.sh: glTF Transform's Draco, gltfpack's meshopt and
 // quantization) render as their originals, up to the encoders' quantization.
 TEST(Corpus, CompressedCopiesRenderAsTheirOriginals) {
