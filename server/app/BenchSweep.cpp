@@ -409,9 +409,9 @@ int sweep(const std::vector<std::string>& args) {
     const std::string glName = context->info().renderer;
     size_t index = 0, measured = 0, skipped = 0;
     auto measureScene = [&](SceneWork& w) {
-        auto accuracy = [&](const FrameOutput& f) {
+        auto accuracy = [&](const FrameOutput& f, const FrameState& rendered) {
             AccuracyInputs in;
-            in.exposureEv = baseExposure(*w.scene).ev; // sweeps leave exposure and metering at their defaults
+            in.exposureEv = frameExposureEv(rendered); // SSIM and FLIP compare what a viewer sees
             in.test = ImageView(f.linear, f.width, f.height, 4);
             in.reference = ImageView(w.reference.rgb, w.reference.width, w.reference.height, 3);
             in.referenceVariance = w.reference.variance;
@@ -486,7 +486,7 @@ int sweep(const std::vector<std::string>& args) {
                         // measured again (untimed) against this one; the appended row supersedes it.
                         const FrameOutput f = render(p.params, p.width, p.height, false).last;
                         image = f.linear;
-                        row["error"] = accuracy(f);
+                        row["error"] = accuracy(f, state);
                         row["reference"] = referenceRecord;
                         jsonl << row.dump() << "\n" << std::flush;
                         csv << csvRow(row) << "\n" << std::flush;
@@ -534,7 +534,7 @@ int sweep(const std::vector<std::string>& args) {
                            {"error", nullptr},
                            {"reference", nullptr}};
                     if (atSweepSize) {
-                        row["error"] = accuracy(m.last);
+                        row["error"] = accuracy(m.last, state);
                         row["reference"] = referenceRecord;
                     }
                     if (!p.baseline.is_null()) {

@@ -521,10 +521,9 @@ int run(int argc, char** argv) {
     if (state.lightSource == "default") {
         gis::logWarn("gi-render: default lighting: " + state.lightNote + " (--lights FILE places your own)");
     }
-    if (state.baseExposure.source == "metered" && state.frameParams.getEnum("metering") != "off") {
-        char ev[32];
-        std::snprintf(ev, sizeof ev, "%+.1f EV", gis::frameExposureEv(state));
-        gis::logInfo("gi-render: exposure " + std::string(ev) + ": " + state.baseExposure.note +
+    if (const nlohmann::json exposure = gis::baseExposureJson(state); exposure["source"] == "metered") {
+        gis::logInfo("gi-render: exposure " + gis::evText(exposure["ev"].get<double>()) + ": " +
+                     exposure["note"].get<std::string>() +
                      " (--param exposure=EV adds to it; --param metering=off makes it absolute)");
     }
     return 0;

@@ -10,17 +10,17 @@ namespace gis {
 
 namespace {
 
-double luminance(const glm::dvec3& c) {
-    return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+bool meteringOff(const FrameState& state) {
+    return state.frameParams.has("metering") && state.frameParams.getEnum("metering") == "off";
 }
+
+} // namespace
 
 std::string evText(double ev) {
     char text[32];
     std::snprintf(text, sizeof text, "%+.1f EV", ev);
     return text;
 }
-
-} // namespace
 
 MeteredLight meterLight(const Scene& scene, const std::vector<FrameLight>& lights) {
     std::vector<LightModel> models;
@@ -100,12 +100,6 @@ BaseExposure baseExposure(const Scene& scene) {
                   evText(ev).c_str(), m.key, 100.0 * m.litArea);
     return {ev, "metered", text};
 }
-
-namespace {
-bool meteringOff(const FrameState& state) {
-    return state.frameParams.has("metering") && state.frameParams.getEnum("metering") == "off";
-}
-} // namespace
 
 double frameExposureEv(const FrameState& state) {
     const double base = meteringOff(state) ? 0.0 : state.baseExposure.ev;

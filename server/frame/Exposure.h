@@ -38,10 +38,9 @@ constexpr double kMeterKeyIlluminance = 0.75;
 constexpr double kMeterEvLimit = 24.0;
 
 struct MeteredLight {
-    double key =
-        0.0; ///< the area-weighted geometric mean illuminance (luminance of E) of lit samples; 0 if none
+    double key = 0.0;        ///< area-weighted geometric mean illuminance (lux) of the lit ones; 0: none
     std::size_t samples = 0; ///< triangles visited
-    std::size_t lit = 0;     ///< of which received light or glow
+    std::size_t lit = 0;     ///< of which some light reached
     double litArea = 0.0;    ///< their area over the visited area, in [0, 1]
 };
 
@@ -56,6 +55,9 @@ BaseExposure baseExposure(const Scene& scene);
 /// The stats' and state's `lighting.exposure`: {base_ev (as metering applies it), source, note,
 /// ev (what the frame tone-maps with)}.
 nlohmann::json baseExposureJson(const FrameState& state);
+
+/// An EV value for messages: signed, one decimal ("-11.3 EV").
+std::string evText(double ev);
 
 /// The EV a frame tone-maps with: the base (unless `metering` is off) plus the `exposure` parameter.
 double frameExposureEv(const FrameState& state);

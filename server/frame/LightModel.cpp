@@ -134,16 +134,15 @@ bool LightModel::incidence(const glm::vec3& p, glm::vec3& toLight, float& distan
 }
 
 double LightModel::sceneFlux(float sceneRadius) const {
-    const glm::vec3 c = color * intensity;
-    const double luminance = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+    const double y = luminance(glm::dvec3(color * intensity));
     constexpr double kPi = 3.14159265358979323846;
     switch (type) {
     case LightType::Directional:
-        return luminance * kPi * double(sceneRadius) * double(sceneRadius);
+        return y * kPi * double(sceneRadius) * double(sceneRadius);
     case LightType::Point:
-        return luminance * 4.0 * kPi;
+        return y * 4.0 * kPi;
     case LightType::Spot:
-        return luminance * 2.0 * kPi * (1.0 - double(cosOuter));
+        return y * 2.0 * kPi * (1.0 - double(cosOuter));
     }
     return 0.0;
 }

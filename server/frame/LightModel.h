@@ -87,6 +87,11 @@ struct LightModel {
     double sceneFlux(float sceneRadius) const;
 };
 
+/// Luminance of a linear Rec. 709 colour (its Y): the weight every light measure uses.
+inline double luminance(const glm::dvec3& c) {
+    return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
 /// The lights a frame renders, their views, and what was left out and why.
 struct LightSetModel {
     std::vector<LightModel> lights; ///< the rendered ones, in the state's order
