@@ -169,14 +169,19 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     mShadowPass = buildMeshPass("render/shadow.frag", MeshMaterials::None, false);
     mRsmPass = buildMeshPass("render/rsm.frag", MeshMaterials::Used, false);
     mGBufferPass = buildMeshPass("render/gbuffer.frag", MeshMaterials::All, false);
-    mDirectPass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}});
-    const gl::Program& d = mDirectPass.program;
-    mDirectPass.position = d.textureUnit("gPosition");
-    mDirectPass.normal = d.textureUnit("gNormal");
-    mDirectPass.albedo = d.textureUnit("gAlbedo");
-    mDirectPass.emissive = d.textureUnit("gEmissive");
-    mDirectPass.shadow = d.textureUnit("gShadowMap");
-    mDirectPass.specular = d.textureUnit("gSpecular");
+    // Diffuse only, GGX, Phong: the order of mDirectCase.
+    const char* const specularCases[3] = {"GIS_SPECULAR_OFF", "GIS_LOBE_GGX", "GIS_LOBE_PHONG"};
+    for (size_t k = 0; k < mDirectPasses.size(); ++k) {
+        DirectPass& d = mDirectPasses[k];
+        d.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/direct.frag"}},
+                                       {{"GIS_SPECULAR", specularCases[k]}});
+        d.position = d.program.textureUnit("gPosition");
+        d.normal = d.program.textureUnit("gNormal");
+        d.albedo = d.program.textureUnit("gAlbedo");
+        d.emissive = d.program.textureUnit("gEmissive");
+        d.shadow = d.program.textureUnit("gShadowMap");
+        d.specular = d.program.optionalTextureUnit("gSpecular"); // unused without a specular lobe
+    }
     mCompositePass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/composite.frag"}});
     const gl::Program& c = mCompositePass.program;
     mCompositePass.direct = c.textureUnit("gDirect");
@@ -384,7 +389,7 @@ void FrameRenderer::renderDirect() {
     // The viewport is the G-buffer's, set by the pass before.
     gl::Pass pass(mTimer, "direct");
     glBindFramebuffer(GL_FRAMEBUFFER, mDirectFbo.id());
-    const DirectPass& d = mDirectPass;
+    const DirectPass& d = mDirectPasses[mDirectCase];
     pass.use(d.program)
         .texture(d.position, mResources.get("gbuffer.position"))
         .texture(d.normal, mResources.get("gbuffer.normal"))
@@ -514,8 +519,10 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     u.toneInfo = glm::vec4(static_cast<float>(std::exp2(frameExposureEv(state))),
                            fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f, lightOn ? 1.0f : 0.0f,
                            fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
-    u.shadingInfo = glm::vec4(fp.getEnum("specular_lobe") == "phong" ? 1.0f : 0.0f,
-                              fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
+    const bool phong = fp.getEnum("specular_lobe") == "phong";
+    u.shadingInfo =
+        glm::vec4(phong ? 1.0f : 0.0f, fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
+    mDirectCase = !nonDiffuse.specular ? 0 : phong ? 2 : 1;
     mFrameUbo.upload(0, sizeof u, &u);
     mLightUbo.upload(0, sizeof lights, &lights);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());

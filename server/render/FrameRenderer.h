@@ -158,7 +158,11 @@ private:
     struct DirectPass {
         gl::Program program;
         gl::TextureUnit position, normal, albedo, emissive, shadow, specular;
-    } mDirectPass;
+    };
+    /// The direct pass per specular case (shaders/render/lighting.glsl, GIS_SPECULAR): none, GGX,
+    /// Phong. The frame's uniforms choose mDirectCase.
+    std::array<DirectPass, 3> mDirectPasses;
+    size_t mDirectCase = 0;
     struct CompositePass {
         gl::Program program;
         gl::TextureUnit direct, indirect, reflection, albedo;

@@ -8,6 +8,18 @@
 
 layout(binding = 4) uniform sampler2DArrayShadow gShadowMap;
 
+// The specular lobe a program evaluates. llvmpipe runs both sides of every branch, even one on a
+// uniform that is the same for all fragments (a uniform-false branch around the upsample's edge
+// weights cost as much as running them), so a pass drawn over every pixel is built per case instead
+// of testing gFrame.shadingInfo: the direct pass has a program with no specular lobe, one with GGX
+// and one with Phong (FrameRenderer::directProgram). Programs drawn rarely (reflections) keep the
+// per-frame test.
+#define GIS_SPECULAR_PER_FRAME -1 // both lobes compiled, chosen by gFrame.shadingInfo
+#define GIS_SPECULAR_OFF -2       // diffuse only
+#ifndef GIS_SPECULAR
+#define GIS_SPECULAR GIS_SPECULAR_PER_FRAME
+#endif
+
 // The view of light i that sees direction `fromLight`: its only view, or for a point light the cube
 // face of the direction's major axis (+X, -X, +Y, -Y, +Z, -Z).
 int shadowViewOf(int i, vec3 fromLight) {
@@ -25,7 +37,7 @@ int shadowViewOf(int i, vec3 fromLight) {
 vec2 pcfPairTap(int k, int r, float i0, float f) {
     float first = k == 0 ? 1.0 - f : 1.0;
     float second = k == r ? f : 1.0;
-    float weight = first + second; // >= 1 for r >= 1: each pair holds a texel of weight 1
+    float weight = r == 0 ? 1.0 : first + second; // >= 1: each pair holds a texel of weight 1
     return vec2(weight, i0 - float(r) + 2.0 * float(k) + 0.5 + second / weight);
 }
 
@@ -34,8 +46,10 @@ vec2 pcfPairTap(int k, int r, float i0, float f) {
 // weights (1 - f, 1, ..., 1, f) where f is uv's fraction past the texel centre below; neighbouring
 // pairs of texels are one bilinear tap each, so the filter is the same (up to the filtering's
 // rounding) in 4 taps instead of 9 at r = 1. Clamping to the edge maps each texel alike in both.
+// r = 0 is the loop's single tap at uv itself (weight 1, the pair being the texel and the next one
+// weighted 1 - f and f), not a branch of its own: llvmpipe would take that tap for every r.
 float pcfFiltered(vec3 uvz, float layer, int r, float side) {
-    if (r <= 0) return texture(gShadowMap, vec4(uvz.xy, layer, uvz.z));
+    r = max(r, 0);
     vec2 t = uvz.xy * side - 0.5;
     vec2 i0 = floor(t);
     vec2 f = t - i0;
@@ -76,7 +90,8 @@ float shadowVisibility(int i, vec3 worldPos, vec3 n, vec3 l) {
 }
 
 // Reflected radiance of every light towards `toViewer` (unit) at a surface point: diffuse rho_d / pi
-// plus the specular lobe when `withSpecular`, shadowed. A light at p itself adds 0 (S.4 case 1).
+// plus the specular lobe when `withSpecular` (and the program has one, GIS_SPECULAR), shadowed. A
+// light at p itself adds 0 (S.4 case 1).
 vec3 lightsReflected(vec3 p, vec3 n, vec3 albedo, vec4 spec, vec3 toViewer, bool withSpecular) {
     if (!(gFrame.toneInfo.z > 0.5)) return vec3(0.0);
     vec3 sum = vec3(0.0);
@@ -88,7 +103,11 @@ vec3 lightsReflected(vec3 p, vec3 n, vec3 albedo, vec4 spec, vec3 toViewer, bool
         vec3 e = irradiance * cosTheta;
         if (!(max(e.r, max(e.g, e.b)) > 0.0)) continue;
         vec3 f = albedo * kInvPi;
+#if GIS_SPECULAR == GIS_SPECULAR_PER_FRAME
         if (withSpecular) f += brdfSpecular(spec.rgb, spec.a, int(gFrame.shadingInfo.x), n, l, toViewer);
+#elif GIS_SPECULAR != GIS_SPECULAR_OFF
+        if (withSpecular) f += brdfSpecular(spec.rgb, spec.a, GIS_SPECULAR, n, l, toViewer);
+#endif
         sum += f * e * shadowVisibility(i, p, n, l);
     }
     return sum;
