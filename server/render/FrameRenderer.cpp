@@ -151,10 +151,11 @@ void writeLightUniforms(const LightSetModel& set, shader::LightUniforms& u) {
 }
 
 FrameRenderer::MeshPass FrameRenderer::buildMeshPass(const char* fragment, MeshMaterials materials,
-                                                     bool cutout) {
+                                                     bool cutout, bool plain) {
     const gl::ShaderStage meshVert{GL_VERTEX_SHADER, "render/mesh.vert"};
     std::vector<std::pair<std::string, std::string>> defines;
     if (cutout) defines.emplace_back("GIS_ALPHA_CUTOUT", "1");
+    if (plain) defines.emplace_back("GIS_MATERIAL_PLAIN", "1");
     MeshPass p{gl::Program::build({meshVert, {GL_FRAGMENT_SHADER, fragment}}, defines), {}, {}};
     p.view = p.program.location("uView");
     // A cut-out shadow map reads the base colour's alpha: it needs the materials too.
@@ -169,6 +170,8 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     mShadowPass = buildMeshPass("render/shadow.frag", MeshMaterials::None, false);
     mRsmPass = buildMeshPass("render/rsm.frag", MeshMaterials::Used, false);
     mGBufferPass = buildMeshPass("render/gbuffer.frag", MeshMaterials::All, false);
+    mPlainRsmPass = buildMeshPass("render/rsm.frag", MeshMaterials::Used, false, true);
+    mPlainGBufferPass = buildMeshPass("render/gbuffer.frag", MeshMaterials::Used, false, true);
     // Diffuse only, GGX, Phong: the order of mDirectCase.
     const char* const specularCases[3] = {"GIS_SPECULAR_OFF", "GIS_LOBE_GGX", "GIS_LOBE_PHONG"};
     for (size_t k = 0; k < mDirectPasses.size(); ++k) {
@@ -222,6 +225,10 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene, std::unique_ptr
     mSceneGpu = std::move(uploaded);
     mSceneCutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
                                 [](const Material& m) { return m.cutsOut(); });
+    mScenePlain = std::none_of(scene->materials.begin(), scene->materials.end(),
+                               [](const Material& m) { return m.hasMaps(); }) &&
+                  std::all_of(scene->meshes.begin(), scene->meshes.end(),
+                              [](const Mesh& m) { return m.colors.empty(); });
     mSceneHasOcclusionMaps = std::any_of(scene->materials.begin(), scene->materials.end(),
                                          [](const Material& m) { return m.occlusionTexture >= 0; });
     if (mSceneCutsOut && !mCutoutPasses)

@@ -142,8 +142,14 @@ private:
     /// Which material uniforms a mesh pass reads: none (depth only), those it uses, or all of them
     /// (the G-buffer, where a missing one is a misspelling).
     enum class MeshMaterials { None, Used, All };
-    static MeshPass buildMeshPass(const char* fragment, MeshMaterials materials, bool cutout);
+    /// `plain`: built with GIS_MATERIAL_PLAIN (no maps, no vertex colours; shaders/render/material.glsl).
+    static MeshPass buildMeshPass(const char* fragment, MeshMaterials materials, bool cutout,
+                                  bool plain = false);
     MeshPass mShadowPass, mRsmPass, mGBufferPass;
+    /// The RSM and G-buffer for scenes whose materials have no maps and whose meshes no vertex
+    /// colours (mScenePlain): the maps' code compiled out (llvmpipe would run it for every fragment).
+    MeshPass mPlainRsmPass, mPlainGBufferPass;
+    bool mScenePlain = false;
     /// The same passes built with GIS_ALPHA_CUTOUT, for scenes with cut-out materials (built with
     /// the first such scene; discarding fragments costs the others their early depth test).
     struct CutoutPasses {
@@ -153,8 +159,12 @@ private:
     bool mSceneCutsOut = false;
     bool mSceneHasOcclusionMaps = false; ///< a material has a glTF occlusion texture
     const MeshPass& shadowPass() const { return mSceneCutsOut ? mCutoutPasses->shadow : mShadowPass; }
-    const MeshPass& rsmPass() const { return mSceneCutsOut ? mCutoutPasses->rsm : mRsmPass; }
-    const MeshPass& gbufferPass() const { return mSceneCutsOut ? mCutoutPasses->gbuffer : mGBufferPass; }
+    const MeshPass& rsmPass() const {
+        return mSceneCutsOut ? mCutoutPasses->rsm : mScenePlain ? mPlainRsmPass : mRsmPass;
+    }
+    const MeshPass& gbufferPass() const {
+        return mSceneCutsOut ? mCutoutPasses->gbuffer : mScenePlain ? mPlainGBufferPass : mGBufferPass;
+    }
     struct DirectPass {
         gl::Program program;
         gl::TextureUnit position, normal, albedo, emissive, shadow, specular;

@@ -60,6 +60,11 @@ struct Material {
     /// Whether some of the surface may be cut out, and below which alpha.
     bool cutsOut() const { return alphaMode != Alpha::Opaque; }
     float cutoff() const { return alphaMode == Alpha::Blend ? 0.5f : alphaCutoff; }
+    /// Whether any texture map modulates the factors (the render passes' plain programs need none).
+    bool hasMaps() const {
+        return baseColorTexture >= 0 || metallicRoughnessTexture >= 0 || emissiveTexture >= 0 ||
+               normalTexture >= 0 || occlusionTexture >= 0;
+    }
     /// glTF doubleSided. False (glTF's default): the camera does not see the back faces (culled in the
     /// G-buffer, the environment-probe faces and mirrored views; passed by the reference's camera
     /// rays), so an interior of one-sided walls can be looked into from outside; light views still

@@ -1,4 +1,14 @@
 // Per-draw material inputs (set by the scene drawer).
+
+// GIS_MATERIAL_PLAIN: a program for scenes with no texture maps and no vertex colours
+// (FrameRenderer's plain passes). llvmpipe runs both sides of a branch even on a uniform, so the
+// maps' code (a tangent frame, five texture lookups) would cost every fragment of such a scene; the
+// plain program compiles it out, and the uniforms it no longer reads are skipped by the drawer.
+#ifdef GIS_MATERIAL_PLAIN
+#define GIS_MATERIAL_HAS(flag) false
+#else
+#define GIS_MATERIAL_HAS(flag) (flag == 1)
+#endif
 uniform vec4 uBaseColor;      // linear RGBA factor
 uniform vec3 uEmissive;       // linear radiance
 uniform int uHasTexture;      // 1 when uBaseColorTex holds the base colour texture
@@ -10,7 +20,7 @@ uniform int uHasVertexColor;
 // The base colour factor times the vertex colour, where the mesh has one (others skip the multiply,
 // which is not exact in every interpolation of a constant white).
 vec4 materialFactor() {
-    return uHasVertexColor == 1 ? uBaseColor * vColor : uBaseColor;
+    return GIS_MATERIAL_HAS(uHasVertexColor) ? uBaseColor * vColor : uBaseColor;
 }
 // glTF metallicRoughnessTexture (linear: b scales metallic, g roughness) and emissiveTexture (sRGB),
 // on the base colour texture's coordinates; unit 1 and 2.
@@ -25,7 +35,7 @@ uniform int uHasOcclusionTex;
 uniform float uOcclusionStrength;
 layout(binding = 4) uniform sampler2D uOcclusionTex;
 float materialOcclusion(vec2 uv) {
-    if (uHasOcclusionTex != 1) return 1.0;
+    if (!GIS_MATERIAL_HAS(uHasOcclusionTex)) return 1.0;
     float ao = 1.0 + uOcclusionStrength * (texture(uOcclusionTex, uv).r - 1.0);
     return isnan(ao) ? 1.0 : clamp(ao, 0.0, 1.0);
 }
@@ -40,7 +50,7 @@ layout(binding = 3) uniform sampler2D uNormalTex;
 // side and the result is turned as n was, as the reference does (reference/RayScene.cpp). Unchanged
 // without a map or a usable tangent.
 vec3 materialNormal(vec3 n, vec3 interpolated, vec4 tangent, vec2 uv) {
-    if (uHasNormalTex != 1) return n;
+    if (!GIS_MATERIAL_HAS(uHasNormalTex)) return n;
     float side = dot(n, interpolated) < 0.0 ? -1.0 : 1.0;
     vec3 base = side * n;
     vec3 t = tangent.xyz - base * dot(base, tangent.xyz);
@@ -59,7 +69,7 @@ vec3 materialNormal(vec3 n, vec3 interpolated, vec4 tangent, vec2 uv) {
 // x metallic, y perceptual roughness, z specular factor; each in [0, 1].
 vec3 materialMetalRoughSpec(vec2 uv) {
     vec3 m = uMetalRoughSpec;
-    if (uHasMetalRoughTex == 1) {
+    if (GIS_MATERIAL_HAS(uHasMetalRoughTex)) {
         vec4 t = texture(uMetalRoughTex, uv);
         m.x *= t.b;
         m.y *= t.g;
@@ -69,7 +79,7 @@ vec3 materialMetalRoughSpec(vec2 uv) {
 
 vec3 materialEmissive(vec2 uv) {
     vec3 e = uEmissive;
-    if (uHasEmissiveTex == 1) e *= texture(uEmissiveTex, uv).rgb;
+    if (GIS_MATERIAL_HAS(uHasEmissiveTex)) e *= texture(uEmissiveTex, uv).rgb;
     return e;
 }
 
@@ -81,7 +91,7 @@ uniform float uAlphaCutoff; // cut out below this alpha (base colour factor x te
 bool materialCutOut(vec2 uv) {
     if (uAlphaCutoff < 0.0) return false;
     float alpha = materialFactor().a;
-    if (uHasTexture == 1) alpha *= texture(uBaseColorTex, uv).a;
+    if (GIS_MATERIAL_HAS(uHasTexture)) alpha *= texture(uBaseColorTex, uv).a;
     return !(alpha >= uAlphaCutoff); // NaN alpha cuts out
 }
 #define CUT_OUT(uv) if (materialCutOut(uv)) discard
@@ -91,7 +101,7 @@ bool materialCutOut(vec2 uv) {
 
 vec3 materialBaseColor(vec2 uv) {
     vec4 c = materialFactor();
-    if (uHasTexture == 1) c *= texture(uBaseColorTex, uv);
+    if (GIS_MATERIAL_HAS(uHasTexture)) c *= texture(uBaseColorTex, uv);
     return clamp(c.rgb, 0.0, 1.0);
 }
 
