@@ -185,15 +185,17 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
         d.shadow = d.program.textureUnit("gShadowMap");
         d.specular = d.program.optionalTextureUnit("gSpecular"); // unused without a specular lobe
     }
-    mCompositePass.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/composite.frag"}});
-    const gl::Program& c = mCompositePass.program;
-    mCompositePass.direct = c.textureUnit("gDirect");
-    mCompositePass.indirect = c.textureUnit("gIndirect");
-    mCompositePass.reflection = c.textureUnit("gReflection");
-    mCompositePass.hasIndirect = c.location("uHasIndirect");
-    mCompositePass.hasReflection = c.location("uHasReflection");
-    mCompositePass.albedo = c.textureUnit("gAlbedo");
-    mCompositePass.applyOcclusion = c.location("uApplyOcclusion");
+    for (size_t reflection = 0; reflection < mCompositePasses.size(); ++reflection) {
+        CompositePass& c = mCompositePasses[reflection];
+        c.program = gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/composite.frag"}},
+                                       {{"GIS_COMPOSITE_REFLECTION", reflection ? "1" : "0"}});
+        c.direct = c.program.textureUnit("gDirect");
+        c.indirect = c.program.textureUnit("gIndirect");
+        c.reflection = reflection ? c.program.textureUnit("gReflection") : gl::TextureUnit{gl::kNoUnit};
+        c.hasIndirect = c.program.location("uHasIndirect");
+        c.albedo = c.program.textureUnit("gAlbedo");
+        c.applyOcclusion = c.program.location("uApplyOcclusion");
+    }
     mPartAverage.program =
         gl::Program::build({fullscreen, {GL_FRAGMENT_SHADER, "render/vpl_part_average.frag"}});
     mPartAverage.part = mPartAverage.program.textureUnit("gPart");
@@ -411,12 +413,10 @@ void FrameRenderer::renderDirect() {
 void FrameRenderer::composite(int width, int height, const gl::Texture* indirect,
                               const gl::Texture* reflection, bool applyOcclusion) {
     gl::Pass pass(mTimer, "composite");
-    const CompositePass& c = mCompositePass;
+    const CompositePass& c = mCompositePasses[reflection ? 1 : 0];
     const gl::Texture& direct = mResources.get("direct");
     pass.target(mCompositeFbo, width, height).use(c.program);
-    pass.set(c.hasIndirect, indirect ? 1 : 0)
-        .set(c.hasReflection, reflection ? 1 : 0)
-        .set(c.applyOcclusion, indirect && applyOcclusion ? 1 : 0);
+    pass.set(c.hasIndirect, indirect ? 1 : 0).set(c.applyOcclusion, indirect && applyOcclusion ? 1 : 0);
     pass.texture(c.direct, direct)
         .texture(c.indirect, indirect ? *indirect : direct)
         .texture(c.reflection, reflection ? *reflection : direct)

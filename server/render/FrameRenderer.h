@@ -176,8 +176,10 @@ private:
     struct CompositePass {
         gl::Program program;
         gl::TextureUnit direct, indirect, reflection, albedo;
-        gl::UniformLocation hasIndirect, hasReflection, applyOcclusion;
-    } mCompositePass;
+        gl::UniformLocation hasIndirect, applyOcclusion;
+    };
+    /// Without and with reflections (GIS_COMPOSITE_REFLECTION in composite.frag).
+    std::array<CompositePass, 2> mCompositePasses;
     struct FluxPass {
         gl::Program program;
         gl::UniformLocation rsmSize;

@@ -9,7 +9,11 @@ layout(binding = 2) uniform sampler2D gReflection; // env probe + planar mirrors
 layout(binding = 3) uniform sampler2D gAlbedo;     // a: glTF occlusion (1 without a map)
 uniform int uHasIndirect;
 uniform int uApplyOcclusion; // 1: the indirect light is multiplied by the occlusion map
-uniform int uHasReflection;
+// Frames with reflections get a program of their own: llvmpipe runs both sides of a branch on a
+// uniform, so the others would fetch and sanitise a reflection for every pixel.
+#ifndef GIS_COMPOSITE_REFLECTION
+#define GIS_COMPOSITE_REFLECTION 1
+#endif
 
 layout(location = 0) out vec4 outDisplay; // RGBA8: tone-mapped sRGB
 layout(location = 1) out vec4 outLinear;  // RGBA32F: linear radiance
@@ -34,7 +38,9 @@ void main() {
         if (uApplyOcclusion == 1) indirect *= ao >= 0.0 ? min(ao, 1.0) : 1.0; // NaN: no occlusion
         c += indirect;
     }
-    if (uHasReflection == 1) c += max(sanitize(texelFetch(gReflection, px, 0).rgb), vec3(0.0));
+#if GIS_COMPOSITE_REFLECTION
+    c += max(sanitize(texelFetch(gReflection, px, 0).rgb), vec3(0.0));
+#endif
     c = max(c, vec3(0.0));
     outLinear = vec4(c, 1.0);
     vec3 exposed = c * gFrame.toneInfo.x;
