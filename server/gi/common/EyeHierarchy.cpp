@@ -46,7 +46,7 @@ EyeHierarchy::ReduceProgram::ReduceProgram(gl::Program built)
           program.optionalTextureUnit("uNormalMin"),   program.optionalTextureUnit("uNormalMax")},
       inputs(program) {}
 
-EyeHierarchy::EyeHierarchy() {
+EyeHierarchy::EyeHierarchy(bool patchAlbedo) : mPatchAlbedo(patchAlbedo) {
     // Every pass is a full-screen draw clipped by the viewport to one level: llvmpipe shades
     // fragments faster than it runs image load/store compute (the mipmap: 36 ms as compute, 23 ms
     // as fragments at 512^2).
@@ -55,22 +55,27 @@ EyeHierarchy::EyeHierarchy() {
         return gl::Program::build(
             {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, fragment}}, defines);
     };
+    const char* albedo = patchAlbedo ? "1" : "0";
     for (int metrics = 0; metrics < 2; ++metrics)
         mReduceFromPixels[static_cast<size_t>(metrics)] = std::make_unique<ReduceProgram>(
-            build("gi/common/eye_mip_reduce.frag",
-                  {{"GIS_FROM_GBUFFER", "1"}, {"GIS_EYE_PIXEL_METRICS", metrics ? "1" : "0"}}));
-    mReduce = std::make_unique<ReduceProgram>(build("gi/common/eye_mip_reduce.frag"));
+            build("gi/common/eye_mip_reduce.frag", {{"GIS_FROM_GBUFFER", "1"},
+                                                    {"GIS_EYE_PIXEL_METRICS", metrics ? "1" : "0"},
+                                                    {"GIS_EYE_ALBEDO", albedo}}));
+    mReduce =
+        std::make_unique<ReduceProgram>(build("gi/common/eye_mip_reduce.frag", {{"GIS_EYE_ALBEDO", albedo}}));
 
     mFlagsProgram.program = build("gi/common/eye_flags.frag");
     mFlagsProgram.level = mFlagsProgram.program.location("uLevel");
     mFlagsProgram.discFlags = mFlagsProgram.program.textureUnit("uDiscFlags");
     mFlagsProgram.flags = mFlagsProgram.program.textureUnit("uFlags");
 
-    ReceiversProgram& r = mReceivers;
-    r.program = build("gi/common/eye_receivers.frag");
-    r.level = r.program.location("uLevel");
-    r.flags = r.program.textureUnit("uFlags");
-    r.inputs = EyeInputHandles(r.program);
+    for (ReceiversProgram* r : {&mPixelReceivers, &mPatchReceivers}) {
+        const bool pixels = r == &mPixelReceivers;
+        r->program = build("gi/common/eye_receivers.frag", {{"GIS_EYE_PIXEL_LEVEL", pixels ? "1" : "0"}});
+        r->level = pixels ? r->program.optionalLocation("uLevel") : r->program.location("uLevel");
+        r->flags = r->program.textureUnit("uFlags");
+        r->inputs = EyeInputHandles(r->program);
+    }
 
     UpsampleProgram& u = mUpsample;
     u.program = build("gi/common/eye_upsample.frag");
@@ -111,9 +116,13 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     mNormalMax = gl::Texture::create2D(GL_RGBA16F, aw, ah);
     mFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
     mDiscFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
-    mGeoFbo =
-        gl::Framebuffer::of("eye hierarchy mipmaps", {&mGeoPosition, &mGeoNormal, &mGeoAlbedo, &mDepthInfo,
-                                                      &mNormalMin, &mNormalMax, &mDiscFlags});
+    // The albedo last, so that a hierarchy without it attaches one target fewer.
+    mGeoFbo = mPatchAlbedo
+                  ? gl::Framebuffer::of("eye hierarchy mipmaps",
+                                        {&mGeoPosition, &mGeoNormal, &mDepthInfo, &mNormalMin, &mNormalMax,
+                                         &mDiscFlags, &mGeoAlbedo})
+                  : gl::Framebuffer::of("eye hierarchy mipmaps", {&mGeoPosition, &mGeoNormal, &mDepthInfo,
+                                                                  &mNormalMin, &mNormalMax, &mDiscFlags});
     mFlagsFbo = gl::Framebuffer::of("eye refinement flags", {&mFlags});
     mIllumination = gl::Texture::create2D(GL_RGBA32F, aw, ah);
     mReconstructed = gl::Texture::create2D(GL_RGBA32F, aw, ah);
@@ -225,12 +234,15 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
 
     gl::Pass pass(timer, "stencil_setup");
     pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight).clearColor(1).clearDepthStencil(1.0f, 0);
-    pass.use(mReceivers.program).texture(mReceivers.flags, mFlags);
-    bindInputs(pass, mReceivers.inputs, in);
     pass.noColorWrites().stencilTest(true).stencilFunc(GL_ALWAYS, 1);
     // One draw per level, each counted: the padding between levels is never shaded.
     for (size_t l = 0; l < mLevels.size(); ++l) {
-        pass.set(mReceivers.level, static_cast<int>(l))
+        const ReceiversProgram& r = l == 0 ? mPixelReceivers : mPatchReceivers;
+        if (l <= 1) {
+            pass.use(r.program).texture(r.flags, mFlags);
+            bindInputs(pass, r.inputs, in);
+        }
+        pass.set(r.level, static_cast<int>(l))
             .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
             .drawFullscreenCounted(mEmptyVao, mReceiverQueries[l]);
     }

@@ -51,7 +51,9 @@ struct EyeInputHandles {
 
 class EyeHierarchy {
 public:
-    EyeHierarchy();
+    /// `patchAlbedo`: the mipmap also averages the albedo (uAtlasAlbedo, eye_patch.glsl), which only
+    /// multires_splat's patches read; the others leave it out (GIS_EYE_ALBEDO in eye_mip_reduce.frag).
+    explicit EyeHierarchy(bool patchAlbedo = false);
     /// (Re)allocates the atlas when the size or coarsest level changes; may throw gis::Error.
     void ensureLayout(int width, int height, int coarsestSize);
 
@@ -131,8 +133,11 @@ private:
     std::array<std::unique_ptr<ReduceProgram>, 2> mReduceFromPixels;
     std::unique_ptr<ReduceProgram> mReduce;
     bool mPixelMetrics = false; ///< the depth or normal metric reads the pixels' neighbours
+    bool mPatchAlbedo = false;  ///< the mipmap writes mGeoAlbedo (its last attachment)
     FlagsProgram mFlagsProgram;
-    ReceiversProgram mReceivers;
+    /// The stencil's receiver test on level 0 (the G-buffer's pixels) and on the coarser levels
+    /// (GIS_EYE_PIXEL_LEVEL in eye_receivers.frag).
+    ReceiversProgram mPixelReceivers, mPatchReceivers;
     UpsampleProgram mUpsample;
     ResolveProgram mResolve;
     gl::VertexArray mEmptyVao;

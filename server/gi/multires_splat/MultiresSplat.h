@@ -15,10 +15,10 @@
 //      geometry refinement draws it instanced once per VPL.
 //   5. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel (geometry).
 //
-// Parameters: the VPL ones (vpl_grid 16, kernel point, min_distance 0.05 of the scene's size), the eye hierarchy's,
-// refinement geometry|illumination, illum_threshold (radiance), phong_ks [0, 1] (0 = Lambertian),
-// phong_exponent [1, 1000], max_subsplats (list capacity; items past it are splatted unrefined and
-// counted in subsplat_capped, so an explosion degrades resolution and never overruns memory).
+// Parameters: the VPL ones (vpl_grid 16, kernel point, min_distance 0.05 of the scene's size), the eye
+// hierarchy's, refinement geometry|illumination, illum_threshold (radiance), phong_ks [0, 1] (0 =
+// Lambertian), phong_exponent [1, 1000], max_subsplats (list capacity; items past it are splatted unrefined
+// and counted in subsplat_capped, so an explosion degrades resolution and never overruns memory).
 //
 // list_builder: 000's geometry shader with transform feedback (default for geometry refinement; one
 // TF object per level, stream 0 = next list, stream 1 = splat list, each sized by its level's texel
@@ -114,7 +114,7 @@ private:
     void splatFeedbackLists(int vplCount);
 
     VplGrid mVpls;
-    EyeHierarchy mEye;
+    EyeHierarchy mEye{true}; // the splats' patches read the mean albedo
     BiasCompensation mSsbc;
     SeedProgram mSeed;
     std::unique_ptr<RefineProgram> mRefine;

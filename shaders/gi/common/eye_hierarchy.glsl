@@ -83,16 +83,18 @@ float eyePixelFootprint(vec3 p) {
 }
 
 // How far a coarse neighbour's surface agrees with the fine texel's (1 same surface, 0 another):
-// its plane distance (either tangent plane) against the coarse texel's footprint (m, from
-// eyePixelFootprint scaled to the coarse level), 1 up to 1/4 of it and 0 from 1/2 (a continuous
-// surface's neighbours lie in its tangent plane up to its curvature), times the normals' agreement,
-// 1 up to 26 degrees and 0 from 60 degrees apart.
-float eyeGeometricWeight(EyeGeometry fine, vec3 coarsePos, vec3 coarseNormal, float coarseFootprint) {
+// its plane distance (either tangent plane) against the coarse texel's footprint F (m, from
+// eyePixelFootprint scaled to the coarse level), 1 up to F/4 and 0 from F/2 (a continuous surface's
+// neighbours lie in its tangent plane up to its curvature), times the normals' agreement, 1 up to
+// 26 degrees and 0 from 60 degrees apart. `fourOverFootprint` is 4 / F (1/m), computed once per texel
+// for its four neighbours. A NaN weight (from a NaN position) fails the comparison and reads 0.
+float eyeGeometricWeight(EyeGeometry fine, vec3 coarsePos, vec3 coarseNormal, float fourOverFootprint) {
     vec3 v = coarsePos - fine.position.xyz;
     float plane = max(abs(dot(fine.normal, v)), abs(dot(coarseNormal, v)));
-    float wd = clamp(2.0 - 4.0 * plane / max(coarseFootprint, 1e-30), 0.0, 1.0);
+    float wd = clamp(2.0 - plane * fourOverFootprint, 0.0, 1.0);
     float wn = clamp((dot(fine.normal, coarseNormal) - 0.5) * 2.5, 0.0, 1.0);
-    return isBad(wd * wn) ? 0.0 : wd * wn;
+    float w = wd * wn;
+    return w > 0.0 ? w : 0.0;
 }
 
 // Coarse-to-fine reconstruction step (000 §3.5, digest S.3 U1) for texel t of level `coarse - 1`:
@@ -117,7 +119,8 @@ vec4 eyeInterpolateCoarse(sampler2D reconstructed, sampler2D atlasPosition, samp
     vec2 f = c - vec2(base);
     // The parent t >> 1 is one of the four: base + 1 on an axis where t is even, base where odd.
     ivec2 parentCorner = ivec2(1) - (t & 1);
-    float coarseFootprint = float(1 << coarse) * eyePixelFootprint(fine.position.xyz);
+    // 4 / the coarse texel's footprint (1/m); a zero footprint (a point at the eye) leaves 4e30.
+    float fourOverFootprint = 4.0 / max(float(1 << coarse) * eyePixelFootprint(fine.position.xyz), 1e-30);
     bool hasGeometry = fine.position.w > 0.0;
     vec4 parent = vec4(0.0);
     vec3 sum = vec3(0.0);
@@ -129,7 +132,7 @@ vec4 eyeInterpolateCoarse(sampler2D reconstructed, sampler2D atlasPosition, samp
             vec4 v = texelFetch(reconstructed, a, 0);
             parent = ivec2(i, j) == parentCorner ? v : parent;
             float g = eyeGeometricWeight(fine, texelFetch(atlasPosition, a, 0).xyz, texelFetch(atlasNormal, a, 0).xyz,
-                                         coarseFootprint);
+                                         fourOverFootprint);
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y) * (hasGeometry ? g : 1.0);
             bool used = eyeInLevel(coarse, q) && v.a > 0.0 && w > 0.0;
             sum += used ? w * v.rgb : vec3(0.0);

@@ -16,6 +16,11 @@
 #ifndef GIS_EYE_PIXEL_METRICS
 #define GIS_EYE_PIXEL_METRICS 0
 #endif
+// The mean albedo only for hierarchies whose patches read it (EyeHierarchy's patchAlbedo): its fetches
+// and its target cost every texel otherwise.
+#ifndef GIS_EYE_ALBEDO
+#define GIS_EYE_ALBEDO 1
+#endif
 
 layout(binding = 0) uniform sampler2D uGeoPosition; // xyz mean position (m); w covered pixels
 layout(binding = 1) uniform sampler2D uGeoNormal;   // xyz mean unit normal
@@ -26,11 +31,13 @@ layout(binding = 5) uniform sampler2D uNormalMax;   // xyz per-component max
 
 layout(location = 0) out vec4 outGeoPosition;
 layout(location = 1) out vec4 outGeoNormal;
-layout(location = 2) out vec4 outGeoAlbedo;
-layout(location = 3) out vec4 outDepthInfo;
-layout(location = 4) out vec4 outNormalMin;
-layout(location = 5) out vec4 outNormalMax;
-layout(location = 6) out uint outDiscFlags; // covered | discontinuous (the flags pass adds the diagonal rule)
+layout(location = 2) out vec4 outDepthInfo;
+layout(location = 3) out vec4 outNormalMin;
+layout(location = 4) out vec4 outNormalMax;
+layout(location = 5) out uint outDiscFlags; // covered | discontinuous (the flags pass adds the diagonal rule)
+#if GIS_EYE_ALBEDO
+layout(location = 6) out vec4 outGeoAlbedo;
+#endif
 
 uniform int uLevel; // the level written (>= 1)
 
@@ -46,7 +53,11 @@ PatchStats childStats(ivec2 c) {
 #if GIS_FROM_GBUFFER
     vec4 p = texelFetch(gPosition, c, 0);
     s.normal = texelFetch(gNormal, c, 0).xyz;
+#if GIS_EYE_ALBEDO
     s.albedo = texelFetch(gAlbedo, c, 0).rgb;
+#else
+    s.albedo = vec3(0.0);
+#endif
     bool covered = p.w > 0.5 && !any(isnan(p.xyz)) && !any(isinf(p.xyz)) && !any(isnan(s.normal)) &&
                    !any(isinf(s.normal));
     s.count = covered ? 1.0 : 0.0;
@@ -67,7 +78,11 @@ PatchStats childStats(ivec2 c) {
     s.pos = gp.xyz;
     s.depth = texelFetch(uDepthInfo, a, 0);
     s.normal = texelFetch(uGeoNormal, a, 0).xyz;
+#if GIS_EYE_ALBEDO
     s.albedo = texelFetch(uGeoAlbedo, a, 0).rgb;
+#else
+    s.albedo = vec3(0.0);
+#endif
     s.nmin = texelFetch(uNormalMin, a, 0).xyz;
     s.nmax = texelFetch(uNormalMax, a, 0).xyz;
 #endif
@@ -105,7 +120,9 @@ void main() {
     outDiscFlags = (count > 0.0 ? GIS_EYE_FLAG_COVERED : 0u) | (discontinuous ? GIS_EYE_FLAG_DISCONTINUOUS : 0u);
     outGeoPosition = vec4(pos * inv, count);
     outGeoNormal = vec4(n, 0.0);
+#if GIS_EYE_ALBEDO
     outGeoAlbedo = vec4(alb * inv, 0.0);
+#endif
     outDepthInfo = depth;
     outNormalMin = vec4(nmin, 0.0);
     outNormalMax = vec4(nmax, 0.0);

@@ -14,7 +14,18 @@ layout(binding = 6) uniform usampler2D uFlags;
 
 uniform int uLevel;
 
+// Level 0 (the G-buffer's pixels) and the coarser levels are programs of their own: llvmpipe would
+// run the pixel coverage test for every patch and the patch flag fetch for every pixel.
+#ifndef GIS_EYE_PIXEL_LEVEL
+#define GIS_EYE_PIXEL_LEVEL 0
+#endif
+
 void main() {
+#if GIS_EYE_PIXEL_LEVEL
+    ivec2 t = ivec2(gl_FragCoord.xy) - gEye.level[0].xy;
+    if (!eyeIsReceiver(uFlags, 0, t, eyePixelCovered(t))) discard;
+#else
     ivec2 t = ivec2(gl_FragCoord.xy) - gEye.level[uLevel].xy;
-    if (!eyeIsReceiver(uFlags, uLevel, t, uLevel == 0 && eyePixelCovered(t))) discard;
+    if (!eyeIsReceiver(uFlags, uLevel, t, false)) discard;
+#endif
 }
