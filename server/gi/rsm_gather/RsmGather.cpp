@@ -17,8 +17,10 @@ RsmGather::GatherProgram::GatherProgram(gl::Program built)
       shadows(program) {}
 
 RsmGather::RsmGather() {
-    mGather = KernelPrograms<GatherProgram>(
-        {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/rsm_gather/gather.frag"}});
+    const std::vector<gl::ShaderStage> stages = {{GL_VERTEX_SHADER, "render/fullscreen.vert"},
+                                                 {GL_FRAGMENT_SHADER, "gi/rsm_gather/gather.frag"}};
+    mGather = KernelPrograms<GatherProgram>(stages, {{"GIS_VPL_SHADOWED", "0"}});
+    mShadowedGather = KernelPrograms<GatherProgram>(stages, {{"GIS_VPL_SHADOWED", "1"}});
     mEmptyVao = gl::VertexArray::create();
 }
 
@@ -29,7 +31,7 @@ void RsmGather::resize(int width, int height) {
 void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                         Counters& counters) {
     const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
-    mShadows.render(in, params, mVpls.buffer(), vplCount, timer, counters);
+    const bool shadowed = mShadows.render(in, params, mVpls.buffer(), vplCount, timer, counters) > 0;
     // The VPLs and their shadow maps are whole: input may stop the frame before the gather.
     if (in.interrupted()) return;
     if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
@@ -38,7 +40,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
         gl::Pass pass(timer, "vpl_gather");
         pass.target(mIndirect.framebuffer, in.width, in.height).clearColor(1);
         if (vplCount > 0) {
-            const GatherProgram& g = mGather.get(vplKernel(params));
+            const GatherProgram& g = (shadowed ? mShadowedGather : mGather).get(vplKernel(params));
             const bool glossy = in.glossy && in.find("gbuffer.specular") != nullptr;
             pass.use(g.program).set(g.minDistance, vplMinDistance(params, in.sceneSize));
             mShadows.bind(pass, g.shadows, in, params);

@@ -59,7 +59,8 @@ private:
         VplTransportHandles transport;
         VplShadowHandles shadows;
     };
-    KernelPrograms<GatherProgram> mGather;
+    /// Without and with the VPL shadow lookup (GIS_VPL_SHADOWED in gather.frag).
+    KernelPrograms<GatherProgram> mGather, mShadowedGather;
     BiasCompensation mSsbc;
     IndirectTarget mIndirect;
     gl::VertexArray mEmptyVao;

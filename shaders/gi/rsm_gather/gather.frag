@@ -8,8 +8,19 @@
 // (gi/common/vpl_glossy.glsl).
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
+// VPL visibility is a program of its own (GIS_VPL_SHADOWED, RsmGather): llvmpipe runs both sides of
+// a branch even on a uniform, and the lookup behind `uVplShadows` cost a third of the gather with the
+// shadows off.
+#ifndef GIS_VPL_SHADOWED
+#define GIS_VPL_SHADOWED 1
+#endif
+#if GIS_VPL_SHADOWED
 #define GIS_VPL_SHADOW_LOOKUP 1
+#endif
 #include "gi/common/vpl_shadow.glsl"
+#if !GIS_VPL_SHADOWED
+float vplVisibility(int index, vec3 vplPos, vec3 receiverPos, vec3 receiverNormal) { return 1.0; }
+#endif
 #include "render/brdf.glsl"
 #include "gi/common/vpl_glossy.glsl"
 
