@@ -168,10 +168,6 @@ FrameRenderer::FrameRenderer(bool useTimerQueries) : mTimer(useTimerQueries) {
     const gl::ShaderStage fullscreen{GL_VERTEX_SHADER, "render/fullscreen.vert"};
     // The shadow map draws depth only: its program reads no material.
     mShadowPass = buildMeshPass("render/shadow.frag", MeshMaterials::None, false);
-    mRsmPass = buildMeshPass("render/rsm.frag", MeshMaterials::Used, false);
-    mGBufferPass = buildMeshPass("render/gbuffer.frag", MeshMaterials::All, false);
-    mPlainRsmPass = buildMeshPass("render/rsm.frag", MeshMaterials::Used, false, true);
-    mPlainGBufferPass = buildMeshPass("render/gbuffer.frag", MeshMaterials::Used, false, true);
     // Diffuse only, GGX, Phong: the order of mDirectCase.
     const char* const specularCases[3] = {"GIS_SPECULAR_OFF", "GIS_LOBE_GGX", "GIS_LOBE_PHONG"};
     for (size_t k = 0; k < mDirectPasses.size(); ++k) {
@@ -224,20 +220,30 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene,
 
 void FrameRenderer::setScene(std::shared_ptr<const Scene> scene, std::unique_ptr<SceneGpu> uploaded) {
     GIS_ASSERT(scene != nullptr && uploaded != nullptr && uploaded->complete());
-    mSceneGpu = std::move(uploaded);
-    mSceneCutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
-                                [](const Material& m) { return m.cutsOut(); });
-    mScenePlain = std::none_of(scene->materials.begin(), scene->materials.end(),
-                               [](const Material& m) { return m.hasMaps(); }) &&
-                  std::all_of(scene->meshes.begin(), scene->meshes.end(),
-                              [](const Mesh& m) { return m.colors.empty(); });
-    mSceneHasOcclusionMaps = std::any_of(scene->materials.begin(), scene->materials.end(),
-                                         [](const Material& m) { return m.occlusionTexture >= 0; });
-    if (mSceneCutsOut && !mCutoutPasses)
+    const bool cutsOut = std::any_of(scene->materials.begin(), scene->materials.end(),
+                                     [](const Material& m) { return m.cutsOut(); });
+    const bool plain = std::none_of(scene->materials.begin(), scene->materials.end(),
+                                    [](const Material& m) { return m.hasMaps(); }) &&
+                       std::all_of(scene->meshes.begin(), scene->meshes.end(),
+                                   [](const Mesh& m) { return m.colors.empty(); });
+    // The scene's programs first, each kind built once: a build that throws leaves the renderer as
+    // it was.
+    std::unique_ptr<MaterialPasses>& materials = plain ? mPlainPasses : mMappedPasses;
+    if (!cutsOut && !materials)
+        materials = std::make_unique<MaterialPasses>(
+            MaterialPasses{buildMeshPass("render/rsm.frag", MeshMaterials::Used, false, plain),
+                           buildMeshPass("render/gbuffer.frag",
+                                         plain ? MeshMaterials::Used : MeshMaterials::All, false, plain)});
+    if (cutsOut && !mCutoutPasses)
         mCutoutPasses = std::make_unique<CutoutPasses>(
             CutoutPasses{buildMeshPass("render/shadow.frag", MeshMaterials::None, true),
                          buildMeshPass("render/rsm.frag", MeshMaterials::Used, true),
                          buildMeshPass("render/gbuffer.frag", MeshMaterials::All, true)});
+    mSceneGpu = std::move(uploaded);
+    mSceneCutsOut = cutsOut;
+    mScenePlain = plain;
+    mSceneHasOcclusionMaps = std::any_of(scene->materials.begin(), scene->materials.end(),
+                                         [](const Material& m) { return m.occlusionTexture >= 0; });
     // The scene's stats.not_shown, built once: every frame carries it.
     mNotShown = nlohmann::json::array();
     for (const NotShown& n : scene->notShown)

@@ -145,10 +145,14 @@ private:
     /// `plain`: built with GIS_MATERIAL_PLAIN (no maps, no vertex colours; shaders/render/material.glsl).
     static MeshPass buildMeshPass(const char* fragment, MeshMaterials materials, bool cutout,
                                   bool plain = false);
-    MeshPass mShadowPass, mRsmPass, mGBufferPass;
-    /// The RSM and G-buffer for scenes whose materials have no maps and whose meshes no vertex
-    /// colours (mScenePlain): the maps' code compiled out (llvmpipe would run it for every fragment).
-    MeshPass mPlainRsmPass, mPlainGBufferPass;
+    MeshPass mShadowPass;
+    /// The RSM and G-buffer with the materials' maps, and plain ones for scenes whose materials have
+    /// no maps and whose meshes no vertex colours (mScenePlain: the maps' code compiled out, which
+    /// llvmpipe would run for every fragment). Each pair is built with the first scene that needs it.
+    struct MaterialPasses {
+        MeshPass rsm, gbuffer;
+    };
+    std::unique_ptr<MaterialPasses> mMappedPasses, mPlainPasses;
     bool mScenePlain = false;
     /// The same passes built with GIS_ALPHA_CUTOUT, for scenes with cut-out materials (built with
     /// the first such scene; discarding fragments costs the others their early depth test).
@@ -159,11 +163,10 @@ private:
     bool mSceneCutsOut = false;
     bool mSceneHasOcclusionMaps = false; ///< a material has a glTF occlusion texture
     const MeshPass& shadowPass() const { return mSceneCutsOut ? mCutoutPasses->shadow : mShadowPass; }
-    const MeshPass& rsmPass() const {
-        return mSceneCutsOut ? mCutoutPasses->rsm : mScenePlain ? mPlainRsmPass : mRsmPass;
-    }
+    const MaterialPasses& materialPasses() const { return mScenePlain ? *mPlainPasses : *mMappedPasses; }
+    const MeshPass& rsmPass() const { return mSceneCutsOut ? mCutoutPasses->rsm : materialPasses().rsm; }
     const MeshPass& gbufferPass() const {
-        return mSceneCutsOut ? mCutoutPasses->gbuffer : mScenePlain ? mPlainGBufferPass : mGBufferPass;
+        return mSceneCutsOut ? mCutoutPasses->gbuffer : materialPasses().gbuffer;
     }
     struct DirectPass {
         gl::Program program;

@@ -12,7 +12,7 @@ layout(binding = 4) uniform sampler2DArrayShadow gShadowMap;
 // uniform that is the same for all fragments (a uniform-false branch around the upsample's edge
 // weights cost as much as running them), so a pass drawn over every pixel is built per case instead
 // of testing gFrame.shadingInfo: the direct pass has a program with no specular lobe, one with GGX
-// and one with Phong (FrameRenderer::directProgram). Programs drawn rarely (reflections) keep the
+// and one with Phong (FrameRenderer's mDirectPasses). Programs drawn rarely (reflections) keep the
 // per-frame test.
 #define GIS_SPECULAR_PER_FRAME -1 // both lobes compiled, chosen by gFrame.shadingInfo
 #define GIS_SPECULAR_OFF -2       // diffuse only
