@@ -19,6 +19,17 @@ void Buffer::upload(GLintptr offset, GLsizeiptr bytes, const void* data) {
     glNamedBufferSubData(id(), offset, bytes, data);
 }
 
+BufferTexture BufferTexture::create() {
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &id);
+    return BufferTexture(id);
+}
+
+void BufferTexture::view(const Buffer& buffer, GLenum internalFormat, GLintptr offset, GLsizeiptr bytes) {
+    GIS_ASSERT(offset >= 0 && offset % 256 == 0 && bytes > 0 && offset + bytes <= buffer.size());
+    glTextureBufferRange(id(), internalFormat, buffer.id(), offset, bytes);
+}
+
 Texture Texture::allocate(GLenum target, GLenum internalFormat, int width, int height, int levels,
                           int layers) {
     GLuint id = 0;

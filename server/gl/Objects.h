@@ -106,6 +106,20 @@ private:
     GLenum mFormat = 0;
 };
 
+/// A buffer's bytes read as texels (GL_TEXTURE_BUFFER; samplerBuffer in GLSL): a view, not a copy,
+/// so the buffer must outlive the texture's use.
+class BufferTexture : public Object<TextureTraits> {
+public:
+    BufferTexture() = default;
+    static BufferTexture create();
+    /// Views `bytes` of `buffer` from `offset` as `internalFormat` texels. `offset` must be a multiple
+    /// of 256, the largest GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT an implementation may ask for.
+    void view(const Buffer& buffer, GLenum internalFormat, GLintptr offset, GLsizeiptr bytes);
+
+private:
+    using Object::Object;
+};
+
 class Framebuffer : public Object<FramebufferTraits> {
 public:
     Framebuffer() = default;

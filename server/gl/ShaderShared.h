@@ -27,7 +27,12 @@ static_assert(sizeof(LightUniforms) <= 65536, "the light block must fit the 64 K
 static_assert(offsetof(LightUniforms, counts) == GIS_MAX_LIGHTS * 64 + GIS_MAX_LIGHT_VIEWS * 112);
 static_assert(sizeof(Vpl) == 48, "Vpl must be three vec4s in std140 and std430");
 static_assert(sizeof(VplGlossy) == 32, "VplGlossy must be two vec4s in std430");
-static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) <= 65536, "a VPL batch must fit the 64 KiB UBO limit");
+// A VPL batch is a buffer-texture view (gi/common/vpl_batch.glsl): its texels within the 65,536 every
+// implementation allows, and every batch's first byte on the strictest offset alignment (256).
+static_assert(GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl) / 16 <= 65536,
+              "a VPL batch must fit the smallest texel buffer");
+static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) % 256 == 0,
+              "VPL batches must start on 256-byte offsets");
 static_assert(sizeof(EyeHierarchyUniforms) == GIS_MAX_EYE_LEVELS * 16 + 2 * 16,
               "EyeHierarchyUniforms drifted");
 static_assert(offsetof(EyeHierarchyUniforms, info) == GIS_MAX_EYE_LEVELS * 16);

@@ -5,8 +5,9 @@
 #define GIS_SHARED_FRAME_DATA_H
 
 #define GIS_UBO_FRAME 0
-#define GIS_UBO_VPLS 1
 #define GIS_UBO_LIGHTS 5
+// The gathers' VPL batch: a buffer texture at this texture unit (gi/common/vpl_batch.glsl).
+#define GIS_TEXTURE_VPLS 15
 #define GIS_MAX_VPLS_PER_BATCH 1024
 
 // Punctual lights (glTF KHR_lights_punctual) and the views their shadow maps and RSMs are rendered

@@ -120,27 +120,31 @@ int VplGrid::extract(const FrameInputs& in, int grid, gl::PassTimer& timer, Coun
         pass.dispatch((side * side + 63) / 64);
         offset += side * side;
     }
-    pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     mExtracted = true;
     mExtractedSides = sides;
     mExtractedRsmSize = in.rsmSize;
     return mCount;
 }
 
-int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(int batchCount)>& draw) {
+VplBatches::VplBatches() : mView(gl::BufferTexture::create()) {}
+
+int VplBatches::forEach(const gl::Buffer& vpls, int count,
+                        const std::function<void(int batchCount, int first)>& draw) {
     int batches = 0;
     for (int first = 0; first < count; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
         const int n = std::min(GIS_MAX_VPLS_PER_BATCH, count - first);
-        glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, vpls.id(),
-                          static_cast<GLintptr>(first) * static_cast<GLintptr>(sizeof(shader::Vpl)),
-                          static_cast<GLsizeiptr>(n) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
-        draw(n);
+        mView.view(vpls, GL_RGBA32F,
+                   static_cast<GLintptr>(first) * static_cast<GLintptr>(sizeof(shader::Vpl)),
+                   static_cast<GLsizeiptr>(n) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
+        glBindTextureUnit(GIS_TEXTURE_VPLS, mView.id());
+        draw(n, first);
     }
     return batches;
 }
 
-int VplGrid::forEachBatch(const std::function<void(int batchCount)>& draw) const {
-    return forEachVplBatch(mVpls, mCount, draw);
+int VplGrid::forEachBatch(const std::function<void(int batchCount, int first)>& draw) {
+    return mBatches.forEach(mVpls, mCount, draw);
 }
 
 int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
@@ -158,20 +162,12 @@ int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
         .set(mInterleave.parts, parts);
     pass.buffer(mInterleave.in, mVpls).buffer(mInterleave.out, mPartVpls);
     pass.dispatch((mPartCount + 63) / 64);
-    pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     return mPartCount;
 }
 
-int VplGrid::forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) const {
-    int batches = 0;
-    for (int first = 0; first < mPartCount; first += GIS_MAX_VPLS_PER_BATCH, ++batches) {
-        const int n = std::min(GIS_MAX_VPLS_PER_BATCH, mPartCount - first);
-        glBindBufferRange(GL_UNIFORM_BUFFER, GIS_UBO_VPLS, mPartVpls.id(),
-                          static_cast<GLintptr>(first) * static_cast<GLintptr>(sizeof(shader::Vpl)),
-                          static_cast<GLsizeiptr>(n) * static_cast<GLsizeiptr>(sizeof(shader::Vpl)));
-        draw(n, first);
-    }
-    return batches;
+int VplGrid::forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) {
+    return mBatches.forEach(mPartVpls, mPartCount, draw);
 }
 
 } // namespace gis

@@ -1,6 +1,6 @@
 // Shared by every technique that uses VPL set A (digest S.3 P4): the regular-grid VPL extraction
 // (000 §3 step 3) into one compact buffer (001 §3.2.2's VPL cache), the kernel parameters every VPL
-// technique exposes, and the batched binding of that buffer as the gather passes' uniform block.
+// technique exposes, and the batched binding of that buffer for the gather passes (VplBatches).
 #pragma once
 
 #include <functional>
@@ -59,9 +59,21 @@ struct VplTransportHandles {
 /// measure no flux share evenly. Pure (unit-tested).
 std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int views, int rsmSide);
 
-/// Binds the first `count` VPLs of `vpls` batch by batch (GIS_MAX_VPLS_PER_BATCH each) at
-/// GIS_UBO_VPLS and calls `draw(batchCount)` for each batch. Returns the number of batches.
-int forEachVplBatch(const gl::Buffer& vpls, int count, const std::function<void(int batchCount)>& draw);
+/// The gathers' VPLs, batch by batch (gi/common/vpl_batch.glsl): each batch of up to
+/// GIS_MAX_VPLS_PER_BATCH VPLs of a buffer is viewed as RGBA32F texels, three per shader::Vpl, at
+/// texture unit GIS_TEXTURE_VPLS. A buffer texture rather than a uniform block: llvmpipe reads a
+/// block's array at a loop index one float per lane, a texel fetch one vec4 per lane (docs/multires.md).
+class VplBatches {
+public:
+    VplBatches(); ///< needs the context current
+    /// Binds the first `count` VPLs of `vpls` batch by batch and calls `draw(batchCount, first)` for
+    /// each, `first` being the index in `vpls` of the batch's first VPL. Returns the number of batches.
+    int forEach(const gl::Buffer& vpls, int count,
+                const std::function<void(int batchCount, int first)>& draw);
+
+private:
+    gl::BufferTexture mView;
+};
 
 class VplGrid {
 public:
@@ -74,9 +86,9 @@ public:
     /// The VPLs' glossy data (shader::VplGlossy), indexed like buffer().
     const gl::Buffer& glossyBuffer() const { return mGlossy; }
     int count() const { return mCount; }
-    /// Binds the VPLs batch by batch (GIS_MAX_VPLS_PER_BATCH each) at GIS_UBO_VPLS and calls
-    /// `draw(batchCount)` for each batch. Returns the number of batches.
-    int forEachBatch(const std::function<void(int batchCount)>& draw) const;
+    /// Binds the VPLs batch by batch (VplBatches) and calls `draw(batchCount, first)` for each batch.
+    /// Returns the number of batches.
+    int forEachBatch(const std::function<void(int batchCount, int first)>& draw);
     /// Refinement's VPL parts (FrameInputs::vplPart): copies the VPLs part, part + parts, ... of the
     /// extracted set into one run (pass "vpl_interleave", gi/common/vpl_interleave.comp) for
     /// forEachPartBatch(); returns how many there are. The set's index of the part's k-th VPL is
@@ -84,7 +96,7 @@ public:
     int preparePart(int part, int parts, gl::PassTimer& timer);
     /// Like forEachBatch() over the prepared part's VPLs; `draw(batchCount, first)` gets the index in
     /// the part of the batch's first VPL.
-    int forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) const;
+    int forEachPartBatch(const std::function<void(int batchCount, int first)>& draw);
 
 private:
     struct ExtractProgram {
@@ -101,6 +113,7 @@ private:
     gl::Buffer mVpls;
     gl::Buffer mGlossy;
     gl::Buffer mPartVpls; ///< the prepared part's VPLs (preparePart)
+    VplBatches mBatches;
     int mCount = 0;
     int mPartCount = 0;
     /// What the buffer holds: the sides and RSM size of the last extraction (valid when mExtracted).

@@ -77,7 +77,7 @@ int Isr::select(const ParamSet& params, gl::PassTimer& timer, Counters& counters
             .set(s.normalThreshold, static_cast<float>(params.getFloat("light_normal_threshold")));
         for (int phase = 0; phase < 2; ++phase)
             pass.set(s.phase, phase).dispatch(groups).barrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        pass.barrier(GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glGetNamedBufferSubData(mCounts.id(), 0, header, counts);
     }
 
@@ -103,7 +103,7 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
             pass.use(g.program);
             g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
             mEye.beginIlluminationPass(pass, g.eye, in, true);
-            counters["vpl_batches"] = forEachVplBatch(mVpls, mVplCount, [&](int count) {
+            counters["vpl_batches"] = mBatches.forEach(mVpls, mVplCount, [&](int count, int) {
                 pass.set(g.vplCount, count).set(g.vplScale, 1.0f).drawFullscreen(mEye.emptyVao());
             });
         }

@@ -83,6 +83,7 @@ private:
         EyeInputHandles eye;
     } mGather;
     gl::Buffer mVpls, mCounts;
+    VplBatches mBatches;
     int mVplCount = 0;
     IndirectTarget mIndirect;
 };

@@ -46,7 +46,7 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
                 counters["vpl_parts"] = parts;
             } else {
                 counters["vpl_batches"] = mVpls.forEachBatch(
-                    [&](int count) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
+                    [&](int count, int) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
             }
         }
     }

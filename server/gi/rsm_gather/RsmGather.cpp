@@ -65,11 +65,7 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
                 counters["vpl_part"] = part;
                 counters["vpl_parts"] = parts;
             } else {
-                int first = 0;
-                counters["vpl_batches"] = mVpls.forEachBatch([&](int count) {
-                    drawBatch(count, first);
-                    first += count;
-                });
+                counters["vpl_batches"] = mVpls.forEachBatch(drawBatch);
             }
         }
     }

@@ -9,7 +9,7 @@
 //   1. (renderer) an RSM per light view: position, normal, reflected flux per texel
 //   2. vpl_extract: a compute pass turns each of vpl_grid^2 cells into one VPL (centre texel's
 //      position and normal, the cell's summed flux) written to a buffer
-//   3. vpl_gather: a full-screen pass per batch of up to 1024 VPLs (read as a uniform block)
+//   3. vpl_gather: a full-screen pass per batch of up to 1024 VPLs (read as buffer-texture texels)
 //      evaluates the clamped point kernel at every covered pixel, blended additively
 //   4. output: linear radiance albedo/pi * E, sanitised and >= 0
 //   A refinement VPL part (FrameInputs::vplPart, without bias compensation) gathers in 3 only every

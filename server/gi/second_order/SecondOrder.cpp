@@ -288,7 +288,7 @@ int SecondOrder::placePositive(const FrameInputs& in, gl::PassTimer& timer, Coun
             // Each dispatch adds to the counts the previous one wrote.
             pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT);
         }
-        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     }
     return total;
 }
@@ -365,7 +365,7 @@ int SecondOrder::placeNegative(const FrameInputs& in, const ParamSet& params, in
             .set(p.minCosView, kMinCosView);
         pass.texture(p.position, in.get("gbuffer.position")).texture(p.normal, in.get("gbuffer.normal"));
         pass.buffer(p.vpls, mVpls).buffer(p.candidates, mCandidates).buffer(p.stats, mStats);
-        pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+        pass.dispatch(1).barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     }
     return mNegativeSlots;
 }
@@ -377,10 +377,8 @@ void SecondOrder::gather(gl::Pass& pass, const gl::Texture& position, const gl::
     g.transport.set(pass, params, sceneSize, false, 0.0f, nullptr);
     pass.texture(g.position, position).texture(g.normal, normal).buffer(g.stats, mStats);
     pass.blendAdd(); // signed sums: negative lights carry negative flux
-    int first = 0;
-    counters["vpl_batches"] = forEachVplBatch(mVpls, slots, [&](int count) {
+    counters["vpl_batches"] = mBatches.forEach(mVpls, slots, [&](int count, int first) {
         pass.set(g.vplCount, count).set(g.batchFirst, first).drawFullscreen(mEmptyVao);
-        first += count;
     });
 }
 

@@ -134,6 +134,7 @@ private:
     BiasCompensation mSsbc;
     gl::VertexArray mEmptyVao;
     gl::Buffer mSamples, mCandidates, mVpls, mStats;
+    VplBatches mBatches;
     gl::Query mFlaggedQuery, mCoveredQuery;
     int mPositiveSlots = 0, mNegativeSlots = 0;
 

@@ -1,7 +1,7 @@
 #version 450 core
 // Refinement's VPL parts (FrameInputs::vplPart) in a contiguous run: part p of P is the VPLs p, p + P,
 // p + 2P, ... of the set, copied to 0, 1, 2, ... of a second buffer, so the part's gather reads its
-// VPLs batch by batch through the uniform block like a whole set. The glossy data and shadow maps keep
+// VPLs batch by batch (gi/common/vpl_batch.glsl) like a whole set. The glossy data and shadow maps keep
 // the set's indices.
 #include "common.glsl"
 

@@ -2,11 +2,12 @@
 // Stenciled multiresolution gather (001 §3.2.2): one full-screen pass over the flattened
 // multiresolution buffer per batch of VPLs; the early stencil test leaves only receiver patches,
 // each of which sums the irradiance of every VPL in the batch (the VPL cache is the compact VPL
-// buffer bound as a uniform block) at its mean position and normal. Irradiance only: the albedo is
+// buffer, read as texels: gi/common/vpl_batch.glsl) at its mean position and normal. Irradiance only: the albedo is
 // applied per pixel after reconstruction. A VPL part (refinement, FrameInputs::vplPart) gathers the
 // batches of its own VPLs (vpl_interleave.comp), scaled by the number of parts uVplScale.
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
+#include "gi/common/vpl_batch.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -14,10 +15,6 @@ layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position,
 layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
 layout(binding = 8) uniform sampler2D gPosition;    // level 0 is the G-buffer itself
 layout(binding = 9) uniform sampler2D gNormal;
-
-layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
-    Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
-};
 
 uniform int uVplCount;
 uniform float uVplScale = 1.0; // the number of VPL parts (1 without parts, and when not set)
@@ -31,6 +28,7 @@ void main() {
     vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
     vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
     vec3 e = vec3(0.0);
-    for (int i = 0; i < uVplCount; ++i) e += vplIrradianceSelected(pos, n, gVpls[i], uMinDistance);
+#define GATHER_TERM(i) vplIrradianceSelected(pos, n, batchVpl(i), uMinDistance)
+    GIS_SUM_OVER_BATCH(e, uVplCount, GATHER_TERM)
     outIrradiance = vec4(max(sanitize(e * uVplScale), vec3(0.0)), 1.0);
 }

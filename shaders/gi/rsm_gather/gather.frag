@@ -8,6 +8,7 @@
 // (gi/common/vpl_glossy.glsl).
 #include "common.glsl"
 #include "gi/common/vpl_transport.glsl"
+#include "gi/common/vpl_batch.glsl"
 // VPL visibility is a program of its own (GIS_VPL_SHADOWED, RsmGather): llvmpipe runs both sides of
 // a branch even on a uniform, and the lookup behind `uVplShadows` cost 195 of the gather's 441 ms
 // with the shadows off (cornell, 512^2, 256 VPLs; docs/multires.md).
@@ -29,10 +30,6 @@ layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gAlbedo;
 layout(binding = 3) uniform sampler2D gSpecular; // rgb F0, a roughness
 
-layout(std140, binding = GIS_UBO_VPLS) uniform VplBlock {
-    Vpl gVpls[GIS_MAX_VPLS_PER_BATCH];
-};
-
 uniform int uVplCount;       // VPLs in this batch
 uniform int uVplFirst;       // index of the batch's first VPL (in its part's sequence)
 uniform int uVplPhase;       // the part (0 without parts)
@@ -41,6 +38,13 @@ uniform float uMinDistance;  // m, point kernel only
 
 // The set's index of the batch's VPL i: its shadow map layers and glossy data.
 int setIndex(int i) { return uVplPhase + (uVplFirst + i) * uVplStride; }
+
+// The batch's VPL i at a receiver, through its visibility.
+vec3 shadedIrradiance(vec3 receiverPos, vec3 receiverNormal, int i) {
+    Vpl v = batchVpl(i);
+    return vplIrradianceSelected(receiverPos, receiverNormal, v, uMinDistance) *
+           vplVisibility(setIndex(i), v.position.xyz, receiverPos, receiverNormal);
+}
 
 layout(location = 0) out vec4 outRadiance;
 
@@ -55,10 +59,8 @@ void main() {
     vec3 e = vec3(0.0);
     vec3 albedo = texelFetch(gAlbedo, px, 0).rgb;
     if (uGlossy == 0) {
-        for (int i = 0; i < uVplCount; ++i) {
-            Vpl v = gVpls[i];
-            e += vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vplVisibility(setIndex(i), v.position.xyz, pos.xyz, n);
-        }
+#define SHADED_TERM(i) shadedIrradiance(pos.xyz, n, i)
+        GIS_SUM_OVER_BATCH(e, uVplCount, SHADED_TERM)
         outRadiance = vec4(max(sanitize(albedo * kInvPi * e * float(uVplStride)), vec3(0.0)), 1.0);
         return;
     }
@@ -69,7 +71,7 @@ void main() {
     vec3 wo = e2 > 1e-20 ? toEye * inversesqrt(e2) : n;
     vec3 eExtra = vec3(0.0), lGlossy = vec3(0.0);
     for (int i = 0; i < uVplCount; ++i) {
-        Vpl v = gVpls[i];
+        Vpl v = batchVpl(i);
         float vis = vplVisibility(setIndex(i), v.position.xyz, pos.xyz, n);
         vec3 ei = vplIrradianceSelected(pos.xyz, n, v, uMinDistance) * vis;
         e += ei;
