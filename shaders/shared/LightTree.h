@@ -11,6 +11,8 @@
 
 #define GIS_UBO_LIGHT_TREE 4
 #define GIS_SSBO_LIGHT_NODES 2
+// The same nodes as RGBA32F texels, five per LightNode, for the traversal's reads (light_tree.glsl).
+#define GIS_TEXTURE_LIGHT_NODES 14
 #define GIS_MAX_LIGHT_LEVELS                                                                                 \
     13 // a mosaic of light views at most 2.5 x 1024 texels wide gives at most 13 levels
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/Error.h"
+#include "core/Log.h"
 #include "gl/Pass.h"
 
 namespace gis {
@@ -37,6 +38,8 @@ LightTree::LightTree() {
               p.textureUnit("uRsmFlux")};
     mBuild.program = std::move(p);
     mUbo = gl::Buffer::create(sizeof(shader::LightTreeUniforms));
+    mNodeTexels = gl::BufferTexture::create();
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &mMaxTexels);
 }
 
 void LightTree::ensureLayout(int rsmSize) {
@@ -46,6 +49,7 @@ void LightTree::ensureLayout(int rsmSize) {
     const int nodeCount = last.offset + last.side * last.side;
     mNodes = gl::Buffer::create(static_cast<GLsizeiptr>(nodeCount) *
                                 static_cast<GLsizeiptr>(sizeof(shader::LightNode)));
+    mNodeTexels.view(mNodes, GL_RGBA32F, 0, mNodes.size());
     shader::LightTreeUniforms u{};
     for (size_t l = 0; l < mLevels.size(); ++l)
         u.level[l] = glm::ivec4(mLevels[l].offset, mLevels[l].side, 1 << l, 0);
@@ -57,6 +61,7 @@ void LightTree::ensureLayout(int rsmSize) {
 void LightTree::bind() const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GIS_SSBO_LIGHT_NODES, mNodes.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHT_TREE, mUbo.id());
+    glBindTextureUnit(GIS_TEXTURE_LIGHT_NODES, mNodeTexels.id());
 }
 
 int lightTreeTiles(int views) {
@@ -75,6 +80,16 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
     mTiles = tiles;
     counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
     counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);
+    // The traversal reads the nodes as texels (five each); a GL whose texel buffers are smaller than
+    // the tree gets no tree (and so no indirect light from it) rather than nodes read as zeros.
+    if (static_cast<long long>(mLevels.back().offset + 1) * 5 > mMaxTexels) {
+        if (!mWarnedTexels)
+            logWarn("light tree: " + std::to_string(mLevels.back().offset + 1) +
+                    " nodes need more than this GL's " + std::to_string(mMaxTexels) +
+                    " texels per buffer texture; lower rsm_size");
+        mWarnedTexels = true;
+        return;
+    }
     if (!in.lightEnabled || in.lightViews <= 0) return;
 
     {
@@ -90,7 +105,8 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
             const int count = mLevels[l].side * mLevels[l].side;
             pass.set(mBuild.level, static_cast<int>(l)).dispatch((count + 63) / 64);
         }
-        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                     GL_BUFFER_UPDATE_BARRIER_BIT);
     }
     mValid = true;
 }

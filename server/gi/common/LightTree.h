@@ -56,7 +56,8 @@ public:
     /// Views per mosaic row of level 0 (view v at tile (v % tiles, v / tiles)).
     int tiles() const { return mTiles; }
     const gl::Buffer& nodes() const { return mNodes; }
-    /// Binds the nodes at GIS_SSBO_LIGHT_NODES and the level table at GIS_UBO_LIGHT_TREE.
+    /// Binds the nodes at GIS_SSBO_LIGHT_NODES and as texels at GIS_TEXTURE_LIGHT_NODES, and the level
+    /// table at GIS_UBO_LIGHT_TREE.
     void bind() const;
 
     /// Test hooks: the nodes read back (synchronises), and the inputs of the last build (the
@@ -73,6 +74,9 @@ private:
         gl::TextureUnit position, normal, flux;
     } mBuild;
     gl::Buffer mNodes, mUbo;
+    gl::BufferTexture mNodeTexels; ///< mNodes as RGBA32F texels (light_tree.glsl, lightNodeTexel)
+    int mMaxTexels = 0;            ///< GL_MAX_TEXTURE_BUFFER_SIZE
+    bool mWarnedTexels = false;
     std::vector<LightLevel> mLevels;
     int mRsmSize = 0; ///< side of level 0: the mosaic of every view's RSM
     int mTiles = 1;

@@ -14,6 +14,21 @@ layout(std430, binding = GIS_SSBO_LIGHT_NODES) GIS_LIGHT_NODES_QUALIFIER buffer 
     LightNode gLightNodes[];
 };
 
+// The nodes as texels of a buffer texture over the same buffer (LightTree::bind), for passes that
+// only read them in a loop: llvmpipe (Mesa 22.3) loads a storage buffer's element float by float and
+// lane by lane, a texel fetch each lane's vec4 at once (hier_isr's traversal 3x faster,
+// docs/multires.md). The lo member is not read: no reader needs it.
+layout(binding = GIS_TEXTURE_LIGHT_NODES) uniform samplerBuffer uLightNodeTexels;
+LightNode lightNodeTexel(int index) {
+    LightNode node;
+    node.position = texelFetch(uLightNodeTexels, 5 * index);
+    node.normal = texelFetch(uLightNodeTexels, 5 * index + 1);
+    node.flux = texelFetch(uLightNodeTexels, 5 * index + 2);
+    node.lo = vec4(0.0);
+    node.hi = texelFetch(uLightNodeTexels, 5 * index + 4);
+    return node;
+}
+
 int lightLevelCount() { return gLightTree.info.x; }
 int lightLevelSide(int level) { return gLightTree.level[level].y; }
 int lightNodeIndex(int level, ivec2 t) { return gLightTree.level[level].x + t.y * gLightTree.level[level].y + t.x; }

@@ -65,7 +65,7 @@ void main() {
             uint s = stack[--sp];
             int level = int(s & 15u);
             ivec2 p = ivec2(int((s >> 4) & 0x3FFFu), int(s >> 18));
-            LightNode node = gLightNodes[lightNodeIndex(level, p)];
+            LightNode node = lightNodeTexel(lightNodeIndex(level, p));
             ++visited;
             if (node.position.w < 0.5) continue; // empty: no flux below it
             bool refine = false;
