@@ -22,7 +22,9 @@ async function receiveFrame(what, match) {
 }
 
 before(async () => {
-    server = await ServerProcess.start(['--scene', 'builtin:cornell', '--client-dir', path.join(REPO, 'client')]);
+    // A VPL-grid technique rather than the presets' default: step d sets `vpl_grid` and counts the VPLs.
+    server = await ServerProcess.start(['--scene', 'builtin:cornell', '--technique', 'multires_gather', '--client-dir',
+        path.join(REPO, 'client')]);
 });
 
 after(async () => {
