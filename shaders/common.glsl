@@ -14,6 +14,16 @@ vec3 sanitize(vec3 c) {
     return vec3(isBad(c.r) ? 0.0 : c.r, isBad(c.g) ? 0.0 : c.g, isBad(c.b) ? 0.0 : c.b);
 }
 
+// A Vpl stored as three RGBA32F texels from `first` (position, normal, flux) of a buffer texture:
+// the gathers' VPL batches and the light tree's nodes, which start with a Vpl's layout.
+Vpl vplFromTexels(samplerBuffer texels, int first) {
+    Vpl v;
+    v.position = texelFetch(texels, first);
+    v.normal = texelFetch(texels, first + 1);
+    v.flux = texelFetch(texels, first + 2);
+    return v;
+}
+
 layout(std140, binding = GIS_UBO_LIGHTS) uniform LightBlock {
     LightUniforms gLights;
 };

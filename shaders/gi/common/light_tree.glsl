@@ -20,10 +20,11 @@ layout(std430, binding = GIS_SSBO_LIGHT_NODES) GIS_LIGHT_NODES_QUALIFIER buffer 
 // docs/multires.md). The lo member is not read: no reader needs it.
 layout(binding = GIS_TEXTURE_LIGHT_NODES) uniform samplerBuffer uLightNodeTexels;
 LightNode lightNodeTexel(int index) {
+    Vpl v = vplFromTexels(uLightNodeTexels, 5 * index); // a node starts with a Vpl's layout
     LightNode node;
-    node.position = texelFetch(uLightNodeTexels, 5 * index);
-    node.normal = texelFetch(uLightNodeTexels, 5 * index + 1);
-    node.flux = texelFetch(uLightNodeTexels, 5 * index + 2);
+    node.position = v.position;
+    node.normal = v.normal;
+    node.flux = v.flux;
     node.lo = vec4(0.0);
     node.hi = texelFetch(uLightNodeTexels, 5 * index + 4);
     return node;

@@ -5,13 +5,7 @@
 // were most of a gather's time (docs/multires.md, "VPLs as texels").
 layout(binding = GIS_TEXTURE_VPLS) uniform samplerBuffer uBatchVpls;
 
-Vpl batchVpl(int i) {
-    Vpl v;
-    v.position = texelFetch(uBatchVpls, 3 * i);
-    v.normal = texelFetch(uBatchVpls, 3 * i + 1);
-    v.flux = texelFetch(uBatchVpls, 3 * i + 2);
-    return v;
-}
+Vpl batchVpl(int i) { return vplFromTexels(uBatchVpls, 3 * i); }
 
 // sum += TERM(i) for i = 0, 1, ..., count - 1, in that order (so the sum is the plain loop's, bit for
 // bit), four terms per iteration: llvmpipe pays a loop's per-iteration lane-mask work once per four
