@@ -28,6 +28,10 @@ struct TechniqueInfo {
     /// the session's frame budget (session/FrameBudget.h) makes an interactive frame cheaper. Empty:
     /// the count cannot be capped (hier_isr's cut adapts per receiver instead).
     std::function<void(ParamSet& technique, long vpls)> limitVpls;
+    /// How the technique's passes' time grows with vplEstimate: about vpls^vplCostExponent (at a fixed
+    /// size). 1 for the techniques that sum over every VPL; below 1 for a traversal whose cut grows
+    /// much more slowly than its leaves (hier_isr). The frame budget models and caps with it.
+    double vplCostExponent = 1.0;
     /// Effect knobs the effect plan may set (docs/effects.md): the multiresolution eye hierarchy
     /// (coarsest_size and the discontinuity thresholds of gi/common/ParamSpecs.h), VPL visibility
     /// (vpl_shadows) and bias compensation (clamp_b, ssbc_iterations).

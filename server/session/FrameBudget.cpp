@@ -34,13 +34,19 @@ double FrameBudget::predictMs(const std::string& key, double pixels, long vpls) 
     const auto it = mRates.find(key);
     if (it == mRates.end() || it->second.frames == 0) return 0.0;
     const Rates& r = it->second;
-    const double technique = vpls > 0 ? r.vpl * pixels * static_cast<double>(vpls) : r.tech * pixels;
+    const double technique =
+        vpls > 0 ? r.vpl * pixels * std::pow(static_cast<double>(vpls), r.exponent) : r.tech * pixels;
     return pixels * (r.base + r.encode) + technique;
 }
 
 double FrameBudget::msPerPixelVpl(const std::string& key) const {
     const auto it = mRates.find(key);
-    return it == mRates.end() || it->second.frames == 0 ? 0.0 : it->second.vpl;
+    if (it == mRates.end() || it->second.frames == 0) return 0.0;
+    const Rates& r = it->second;
+    // d/dv of v^e at the last count, v^(e-1) e, would understate a step's whole cost; the mean rate
+    // v^e / v is what a linear caller (the refinement's tile cap) scales by.
+    const double v = static_cast<double>(std::max(1L, r.lastVpls));
+    return r.vpl * std::pow(v, r.exponent) / v;
 }
 
 void FrameBudget::record(const std::string& key, const FrameCost& cost) {
@@ -49,13 +55,22 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     const double technique = std::clamp(cost.techniqueMs, 0.0, cost.frameMs);
     const double base = (cost.frameMs - technique) / cost.pixels;
     const double encode = std::max(cost.encodeMs, 0.0) / cost.pixels;
-    const double vpl = cost.vpls > 0 ? technique / (cost.pixels * static_cast<double>(cost.vpls)) : 0.0;
+    // Exponents outside (0, 1] would model a technique whose VPLs cost more than linearly, or nothing.
+    const double exponent =
+        std::isfinite(cost.vplCostExponent) ? std::clamp(cost.vplCostExponent, 0.05, 1.0) : 1.0;
+    if (exponent != r.exponent) r.frames = 0; // another model: start its means again
+    r.exponent = exponent;
+    const double vpl =
+        cost.vpls > 0 ? technique / (cost.pixels * std::pow(static_cast<double>(cost.vpls), exponent)) : 0.0;
     const double tech = technique / cost.pixels;
     // Half the weight on the newest frame: one noisy frame moves the choice, two confirm it.
     const double a = r.frames == 0 ? 1.0 : 0.5;
     r.base += a * (base - r.base);
     r.encode += a * (encode - r.encode);
-    if (cost.vpls > 0) r.vpl += a * (vpl - r.vpl);
+    if (cost.vpls > 0) {
+        r.vpl += a * (vpl - r.vpl);
+        r.lastVpls = cost.vpls;
+    }
     r.tech += a * (tech - r.tech);
     ++r.frames;
 }

@@ -5,7 +5,8 @@
 // (docs/interactive.md).
 //
 // Model, per scene and technique, from the last interactive frames (exponential means):
-//   ms(pixels, vpls) = pixels * (baseRate + encodeRate) + pixels * vpls * vplRate
+//   ms(pixels, vpls) = pixels * (baseRate + encodeRate) + pixels * vpls^e * vplRate
+// with e the technique's vplCostExponent (1 for a sum over every VPL, 0.4 for hier_isr's traversal).
 // where baseRate comes from the renderer's own stages (shadow maps, G-buffer, direct, composite,
 // reflections, overheads) and vplRate from the technique's passes. Counting all of the technique's
 // passes as VPL-bound over-predicts what more VPLs cost, so the budget climbs cautiously.
@@ -25,6 +26,8 @@ struct FrameCost {
     double frameMs = 0;     ///< the renderer's frame_ms
     double techniqueMs = 0; ///< the technique's passes within it
     double encodeMs = 0;
+    /// The technique's passes cost about pixels x vpls^vplCostExponent (TechniqueInfo::vplCostExponent).
+    double vplCostExponent = 1.0;
 };
 
 /// What the next interactive frame renders with, and why.
@@ -59,13 +62,16 @@ public:
     void record(const std::string& key, const FrameCost& cost);
     /// Predicted ms of a frame of `key` at `pixels` with `vpls`; 0 when nothing is measured.
     double predictMs(const std::string& key, double pixels, long vpls) const;
-    /// The measured ms per pixel and VPL of the technique's passes; 0 when nothing is measured.
+    /// The measured ms per pixel and VPL of the technique's passes, at the last frame's VPL count (the
+    /// local rate where the cost is not linear in the VPLs); 0 when nothing is measured.
     double msPerPixelVpl(const std::string& key) const;
 
 private:
     struct Rates {
-        double base = 0, encode = 0, vpl = 0; ///< ms per pixel, ms per pixel, ms per pixel per VPL
-        double tech = 0;                      ///< ms per pixel of the technique when it has no VPLs
+        double base = 0, encode = 0, vpl = 0; ///< ms per pixel, ms per pixel, ms per pixel per VPL^exponent
+        double exponent = 1.0;                ///< FrameCost::vplCostExponent of the last frame
+        long lastVpls = 0;
+        double tech = 0; ///< ms per pixel of the technique when it has no VPLs
         int frames = 0;
         int level = -1; ///< index of the last choice in the candidate ladder
     };

@@ -1413,6 +1413,7 @@ void Session::workerMain() {
             FrameCost cost;
             cost.pixels = static_cast<double>(frame.width) * frame.height;
             cost.vpls = vplEstimate(state);
+            cost.vplCostExponent = findTechniqueInfo(state.technique).vplCostExponent;
             cost.frameMs = frameMs;
             cost.techniqueMs = techniqueMs;
             {

@@ -54,6 +54,11 @@ TechniqueInfo hierIsrInfo() {
         if (side < p.getInt("max_depth")) p.set("max_depth", side);
         if (p.getInt("hier_coarsest") > p.getInt("max_depth")) p.set("hier_coarsest", p.getInt("max_depth"));
     };
+    // The traversal's time grows far more slowly than the leaves below max_depth: its gather at
+    // 288 x 240 (cornell, hier_coarsest 1) took 2.8, 24.7, 58.9 and 87.6 ms at max_depth 4, 16, 64 and
+    // 256, 31x over 4,096x the leaves, leaves^0.41 (docs/interactive.md). A linear model fitted on a
+    // capped frame never let the frame budget lift the cap (max_depth 4 at 20 ms against 80).
+    info.vplCostExponent = 0.4;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     return info;

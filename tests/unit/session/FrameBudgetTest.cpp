@@ -1,3 +1,5 @@
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "session/FrameBudget.h"
@@ -89,6 +91,50 @@ TEST(FrameBudget, NoisyMeasurementsDoNotFlicker) {
         budget.record("k", cost);
     }
     EXPECT_LE(changes, 6);
+}
+
+// hier_isr's traversal: its cap is max_depth, a power-of-two side (so a cap of 52 leaves renders 16),
+// and its time grows as about leaves^0.4 (the cut below that depth), not linearly. Scaled to what it
+// measured at 288 x 240 on cornell (the rest of the frame 22 ms, the gather 87.6 ms at 65,536
+// leaves): modelled linearly, a capped frame predicts every larger count far too dear and the cap
+// stays where a first cheap frame put it; with the exponent the budget settles near the target.
+TEST(FrameBudget, ASublinearCostLiftsTheCapToTheTarget) {
+    const double fullPixels = 960.0 * 800.0;
+    const double base = 22.0 / (288.0 * 240.0);                             // ms per pixel
+    const double perUnit = 87.6 / (288.0 * 240.0 * std::pow(65536.0, 0.4)); // ms per pixel per leaf^0.4
+    auto leavesUnder = [](long cap) {
+        long side = 1;
+        while ((side * 2) * (side * 2) <= cap) side *= 2;
+        return side * side;
+    };
+    auto run = [&](double modelExponent, double* lastMs) {
+        FrameBudget budget(FrameBudget::Config{});
+        BudgetChoice c;
+        for (int i = 0; i < 16; ++i) {
+            c = budget.choose("k", 65536, true, fullPixels);
+            const double pixels = fullPixels * c.scale * c.scale;
+            const long leaves = c.vplCap > 0 ? leavesUnder(c.vplCap) : 65536;
+            FrameCost cost;
+            cost.pixels = pixels;
+            cost.vpls = leaves;
+            cost.techniqueMs = pixels * std::pow(static_cast<double>(leaves), 0.4) * perUnit;
+            cost.frameMs = pixels * base + cost.techniqueMs;
+            cost.vplCostExponent = modelExponent;
+            *lastMs = cost.frameMs;
+            budget.record("k", cost);
+        }
+        return c;
+    };
+    double linearMs = 0, sublinearMs = 0;
+    const BudgetChoice linear = run(1.0, &linearMs);
+    const BudgetChoice sublinear = run(0.4, &sublinearMs);
+    const long linearLeaves = linear.vplCap > 0 ? leavesUnder(linear.vplCap) : 65536;
+    const long sublinearLeaves = sublinear.vplCap > 0 ? leavesUnder(sublinear.vplCap) : 65536;
+    EXPECT_LE(sublinearMs, 80.0 * 1.05) << sublinear.reason;
+    EXPECT_GE(sublinearMs, 80.0 * 0.6)
+        << "the frame uses the target, not a fraction of it: " << sublinear.reason;
+    EXPECT_GE(sublinearLeaves, 16 * linearLeaves)
+        << "linear model: " << linear.reason << " (" << linearMs << " ms); sublinear: " << sublinear.reason;
 }
 
 TEST(FrameBudget, GarbageMeasurementsAreIgnored) {
