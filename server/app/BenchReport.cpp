@@ -4,13 +4,13 @@
 // chosen from the fronts (presets/presets.json, read by frame/Presets.h).
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
