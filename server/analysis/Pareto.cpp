@@ -72,4 +72,26 @@ PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budge
     return c;
 }
 
+int chooseDefaultTechnique(const std::vector<TechniquePresets>& techniques, double budgetMs,
+                           double errorTolerance) {
+    int best = -1;
+    for (int i = 0; i < static_cast<int>(techniques.size()); ++i) {
+        const TechniquePresets& p = techniques[static_cast<std::size_t>(i)];
+        if (p.interactive.timeMs > budgetMs) continue;
+        if (best < 0) {
+            best = i;
+            continue;
+        }
+        const TechniquePresets& b = techniques[static_cast<std::size_t>(best)];
+        if (p.interactive.error + errorTolerance < b.interactive.error) {
+            best = i;
+        } else if (p.interactive.error <= b.interactive.error + errorTolerance) {
+            const bool moreAccurateFinal = p.final.error + errorTolerance < b.final.error;
+            const bool equalFinal = p.final.error <= b.final.error + errorTolerance;
+            if (moreAccurateFinal || (equalFinal && p.interactive.timeMs < b.interactive.timeMs)) best = i;
+        }
+    }
+    return best;
+}
+
 } // namespace gis

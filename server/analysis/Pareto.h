@@ -39,4 +39,16 @@ struct PresetChoice {
 PresetChoice choosePresets(const std::vector<TradeoffPoint>& front, double budgetMs,
                            double errorTolerance = 0, double finalBudgetMs = 0);
 
+/// One technique's interactive and final presets as measured (gi-bench report).
+struct TechniquePresets {
+    TradeoffPoint interactive, final;
+};
+
+/// The service's default technique: index into `techniques` of the most accurate interactive preset
+/// with time <= budgetMs; -1 when none is that fast. Errors within `errorTolerance` count as equal; of
+/// equals, the one whose final preset is more accurate beyond the tolerance wins (the frame budget
+/// sizes either's live frames, and a still view shows the final step longest), then the faster.
+int chooseDefaultTechnique(const std::vector<TechniquePresets>& techniques, double budgetMs,
+                           double errorTolerance = 0);
+
 } // namespace gis

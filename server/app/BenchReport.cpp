@@ -345,19 +345,17 @@ std::vector<PresetRow> choose(const Data& d, double budgetMs, double finalMs, js
             if (p.technique == technique && p.name == "final") return p.error;
         return std::numeric_limits<double>::infinity();
     };
-    const PresetRow* best = nullptr;
-    const PresetRow* lowest = nullptr; // the lowest error, which the noise may tie with best's
+    std::vector<const PresetRow*> candidates;
+    std::vector<TechniquePresets> measured;
+    const PresetRow* lowest = nullptr; // the lowest error, which the noise may tie with the chosen one's
     for (const PresetRow& p : out) {
-        if (p.name != "interactive" || p.technique == "none" || p.timeMs > budgetMs) continue;
-        if (!lowest || p.error < lowest->error) lowest = &p;
-        if (!best || p.error + tolerance < best->error) {
-            best = &p;
-            continue;
-        }
-        if (p.error > best->error + tolerance) continue;
-        const double mine = finalError(p.technique), theirs = finalError(best->technique);
-        if (mine + tolerance < theirs || (mine <= theirs + tolerance && p.timeMs < best->timeMs)) best = &p;
+        if (p.name != "interactive" || p.technique == "none") continue;
+        candidates.push_back(&p);
+        measured.push_back({{p.timeMs, p.error}, {0.0, finalError(p.technique)}});
+        if (p.timeMs <= budgetMs && (!lowest || p.error < lowest->error)) lowest = &p;
     }
+    const int chosen = chooseDefaultTechnique(measured, budgetMs, tolerance);
+    const PresetRow* best = chosen >= 0 ? candidates[static_cast<size_t>(chosen)] : nullptr;
     if (best) {
         const std::string preset = "its interactive preset (" + best->changes + ")";
         const std::string within =

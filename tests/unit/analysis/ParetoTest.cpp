@@ -109,3 +109,29 @@ TEST(SweepGrid, KnobsRestrictAndUnknownKnobsAreNamed) {
 }
 
 } // namespace
+
+namespace {
+
+// The service's default: the most accurate interactive preset within the budget; within the noise,
+// the more accurate final preset, then the faster. The first case is the 128 x 128 rerun's
+// (docs/accuracy-texels.md): multires_gather's 64^2 VPLs against hier_isr's hier_coarsest 1.
+TEST(DefaultTechnique, NoiseTiesGoToTheMoreAccurateFinalThenTheFaster) {
+    const double noise = 0.0139;
+    const gis::TechniquePresets gather{{91.8, 0.2244}, {387.2, 0.1716}};
+    const gis::TechniquePresets traversal{{78.5, 0.2183}, {120.0, 0.2089}};
+    EXPECT_EQ(gis::chooseDefaultTechnique({gather, traversal}, 100, noise), 0);
+    EXPECT_EQ(gis::chooseDefaultTechnique({traversal, gather}, 100, noise), 1) << "independent of the order";
+    // Finals within the noise of each other: the faster interactive preset.
+    const gis::TechniquePresets traversalBetterFinal{{78.5, 0.2183}, {120.0, 0.1800}};
+    EXPECT_EQ(gis::chooseDefaultTechnique({gather, traversalBetterFinal}, 100, noise), 1);
+    // An interactive error lower beyond the noise wins whatever the finals.
+    const gis::TechniquePresets clearlyBetter{{95.0, 0.1900}, {300.0, 0.2500}};
+    EXPECT_EQ(gis::chooseDefaultTechnique({gather, clearlyBetter}, 100, noise), 1);
+    // Over the budget: not a candidate; none within it: -1.
+    EXPECT_EQ(gis::chooseDefaultTechnique({clearlyBetter, gather}, 92, noise), 1);
+    EXPECT_EQ(gis::chooseDefaultTechnique({gather, clearlyBetter}, 50, noise), -1);
+    // Without noise the lower error wins outright.
+    EXPECT_EQ(gis::chooseDefaultTechnique({gather, traversal}, 100, 0.0), 1);
+}
+
+} // namespace
