@@ -36,6 +36,8 @@ static_assert((GIS_MAX_VPLS_PER_BATCH * sizeof(Vpl)) % 256 == 0,
 static_assert(sizeof(EyeHierarchyUniforms) == GIS_MAX_EYE_LEVELS * 16 + 2 * 16,
               "EyeHierarchyUniforms drifted");
 static_assert(offsetof(EyeHierarchyUniforms, info) == GIS_MAX_EYE_LEVELS * 16);
+static_assert(sizeof(EyeReceiverListHeader) == 32, "EyeReceiverListHeader must be two uvec4s in std430");
+static_assert(offsetof(EyeReceiverListHeader, counts) == 16);
 static_assert(sizeof(LightNode) == 80, "LightNode must be five vec4s in std430");
 static_assert(offsetof(LightNode, flux) == offsetof(Vpl, flux), "a LightNode starts with a Vpl's layout");
 static_assert(sizeof(LightTreeUniforms) == GIS_MAX_LIGHT_LEVELS * 16 + 16, "LightTreeUniforms drifted");

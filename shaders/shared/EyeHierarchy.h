@@ -22,6 +22,22 @@
 #define GIS_EYE_FLAG_DISCONTINUOUS 4u // the patch itself holds a discontinuity (before the diagonal rule)
 #define GIS_EYE_FLAG_SUBDIVIDED 8u // this patch and every ancestor refine: its children are visited
 
+// The receiver list (std430): the stencil pass appends each receiver's atlas texel, packed
+// y << 16 | x (atlas sides < 65536), and the gathers run one compute invocation per item
+// (eye_receiver_list.glsl). On llvmpipe a stencilled full-screen pass shades the receivers in
+// 8-pixel groups, most of whose lanes are dead along the thin level-0 edges; a packed list keeps
+// every lane busy.
+#define GIS_SSBO_EYE_RECEIVERS 6
+#define GIS_IMAGE_EYE_ILLUMINATION 0
+#define GIS_EYE_RECEIVER_GROUP 64
+// GL guarantees GL_MAX_COMPUTE_WORK_GROUP_COUNT >= 65535 per dimension: longer lists run in 2D.
+#define GIS_EYE_RECEIVER_MAX_GROUPS_X 65535u
+
+struct EyeReceiverListHeader {
+    uvec4 dispatch; // xyz: work groups of the receiver passes (glDispatchComputeIndirect); w: unused
+    uvec4 counts;   // x: receivers appended; yzw: unused
+};
+
 struct EyeHierarchyUniforms {
     ivec4 level[GIS_MAX_EYE_LEVELS]; // xy: atlas offset (texels); zw: level size (texels)
     ivec4 info;                      // x: level count C + 1; y, z: full-resolution W, H; w: option bits

@@ -10,15 +10,14 @@
 #include "gi/multires_splat/MultiresSplat.h"
 
 using namespace gis;
+using gis::test::renderScene;
 using test::badValues;
 using test::counter;
 using test::relativeRmseOf;
-using gis::test::renderScene;
 
 namespace {
 
 using PatchSet = std::vector<std::array<int, 3>>;
-
 
 // Covered pixels of the last frame: the coarsest level's coverage counts sum to them (-1 when the
 // image is a single level, which lives in the G-buffer rather than the atlas).
@@ -100,6 +99,35 @@ TEST(Multires, StencilReceiversEqualIterativeRefinement) {
     EXPECT_TRUE(sawCoarsest && sawFinest) << "the cases must exercise both boundary levels";
 }
 
+// The gathers run one invocation per item of the receiver list the stencil pass appends: the list
+// must hold each receiver of the stencil exactly once, and the dispatch it sets up must cover it.
+TEST(Multires, ReceiverListHoldsEachStencilReceiverOnce) {
+    const SetCase cases[] = {
+        {"builtin:cornell", 128, 128, nlohmann::json::object()},
+        {"builtin:cornell", 97, 61, nlohmann::json::object()},
+        {"builtin:cornell", 96, 80, {{"depth_threshold", 0.0}, {"normal_threshold", 0.0}}}, // every pixel
+        {"builtin:crease", 128, 128, {{"coarsest_size", 8}, {"normal_threshold", 0.05}}},
+        {"builtin:cornell-empty", 16, 16, nlohmann::json::object()}, // one level only
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(std::string(c.scene) + " " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                     " " + c.params.dump());
+        nlohmann::json params = c.params;
+        params["vpl_grid"] = 4;
+        renderScene(c.scene, "multires_gather", c.width, c.height, params);
+        auto* gather = dynamic_cast<MultiresGather*>(test::sharedRenderer().technique());
+        ASSERT_NE(gather, nullptr);
+        shader::EyeReceiverListHeader header{};
+        const PatchSet list = gather->hierarchy().readReceiverList(&header);
+        const PatchSet stencil = gather->hierarchy().readReceiverSet();
+        ASSERT_FALSE(stencil.empty());
+        EXPECT_EQ(list, stencil); // both sorted: equal means no receiver missing, doubled or misplaced
+        EXPECT_EQ(header.counts.x, list.size());
+        const unsigned groups = (header.counts.x + GIS_EYE_RECEIVER_GROUP - 1) / GIS_EYE_RECEIVER_GROUP;
+        EXPECT_EQ(header.dispatch, glm::uvec4(groups, 1, 1, 0));
+    }
+}
+
 // 001 Fig. 9: thresholds of 0 refine every varying patch to single pixels, which is the
 // full-resolution gather with the same VPLs.
 TEST(Multires, ZeroThresholdsReproduceFullResolutionGather) {
@@ -115,6 +143,16 @@ TEST(Multires, ZeroThresholdsReproduceFullResolutionGather) {
         EXPECT_LT(relativeRmseOf(gather, full), 1e-3);
         EXPECT_LT(relativeRmseOf(splat, full), 1e-3);
     }
+    // More VPLs than one batch holds: the gather adds one dispatch per batch into the same texels.
+    static_assert(40 * 40 > GIS_MAX_VPLS_PER_BATCH);
+    const nlohmann::json batches = {{"vpl_grid", 40}, {"kernel", "disk"}};
+    nlohmann::json zero = batches;
+    zero["depth_threshold"] = 0.0;
+    zero["normal_threshold"] = 0.0;
+    FrameOutput full = renderScene("builtin:cornell", "rsm_gather", 96, 80, batches);
+    FrameOutput gather = renderScene("builtin:cornell", "multires_gather", 96, 80, zero);
+    EXPECT_GE(counter(gather, "vpl_batches"), 2.0);
+    EXPECT_LT(relativeRmseOf(gather, full), 1e-3);
 }
 
 // 001: "scattering and gathering give results of equal quality": same VPLs, same receivers, same

@@ -38,6 +38,9 @@ EyeInputHandles::EyeInputHandles(const gl::Program& p) {
     atlasAlbedo = unit("uAtlasAlbedo");
 }
 
+EyeReceiverPassHandles::EyeReceiverPassHandles(const gl::Program& p)
+    : inputs(p), list(p.storageBlock("EyeReceiverList")), illumination(p.imageUnit("uEyeIllumination")) {}
+
 EyeHierarchy::ReduceProgram::ReduceProgram(gl::Program built)
     : program(std::move(built)), level(program.location("uLevel")),
       // Level 1 (GIS_FROM_GBUFFER) reads the G-buffer instead of the level below.
@@ -46,7 +49,7 @@ EyeHierarchy::ReduceProgram::ReduceProgram(gl::Program built)
           program.optionalTextureUnit("uNormalMin"),   program.optionalTextureUnit("uNormalMax")},
       inputs(program) {}
 
-EyeHierarchy::EyeHierarchy(bool patchAlbedo) : mPatchAlbedo(patchAlbedo) {
+EyeHierarchy::EyeHierarchy(EyeHierarchyOptions options) : mOptions(options) {
     // Every pass is a full-screen draw clipped by the viewport to one level: llvmpipe shades
     // fragments faster than it runs image load/store compute (the mipmap: 36 ms as compute, 23 ms
     // as fragments at 512^2).
@@ -55,7 +58,7 @@ EyeHierarchy::EyeHierarchy(bool patchAlbedo) : mPatchAlbedo(patchAlbedo) {
         return gl::Program::build(
             {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, fragment}}, defines);
     };
-    const char* albedo = patchAlbedo ? "1" : "0";
+    const char* albedo = options.patchAlbedo ? "1" : "0";
     for (int metrics = 0; metrics < 2; ++metrics)
         mReduceFromPixels[static_cast<size_t>(metrics)] = std::make_unique<ReduceProgram>(
             build("gi/common/eye_mip_reduce.frag", {{"GIS_FROM_GBUFFER", "1"},
@@ -71,10 +74,18 @@ EyeHierarchy::EyeHierarchy(bool patchAlbedo) : mPatchAlbedo(patchAlbedo) {
 
     for (ReceiversProgram* r : {&mPixelReceivers, &mPatchReceivers}) {
         const bool pixels = r == &mPixelReceivers;
-        r->program = build("gi/common/eye_receivers.frag", {{"GIS_EYE_PIXEL_LEVEL", pixels ? "1" : "0"}});
+        r->program = build("gi/common/eye_receivers.frag",
+                           {{"GIS_EYE_PIXEL_LEVEL", pixels ? "1" : "0"},
+                            {"GIS_EYE_RECEIVER_LIST", options.receiverList ? "1" : "0"}});
         r->level = pixels ? r->program.optionalLocation("uLevel") : r->program.location("uLevel");
         r->flags = r->program.textureUnit("uFlags");
         r->inputs = EyeInputHandles(r->program);
+        if (options.receiverList) r->list = r->program.storageBlock("EyeReceiverList");
+    }
+    if (options.receiverList) {
+        mReceiverDispatch.program =
+            gl::Program::build({{GL_COMPUTE_SHADER, "gi/common/eye_receiver_dispatch.comp"}});
+        mReceiverDispatch.list = mReceiverDispatch.program.storageBlock("EyeReceiverList");
     }
 
     UpsampleProgram& u = mUpsample;
@@ -117,7 +128,7 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     mFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
     mDiscFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
     // The albedo last, so that a hierarchy without it attaches one target fewer.
-    mGeoFbo = mPatchAlbedo
+    mGeoFbo = mOptions.patchAlbedo
                   ? gl::Framebuffer::of("eye hierarchy mipmaps",
                                         {&mGeoPosition, &mGeoNormal, &mDepthInfo, &mNormalMin, &mNormalMax,
                                          &mDiscFlags, &mGeoAlbedo})
@@ -129,6 +140,10 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     mStencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, aw, ah);
     mIllumFbo = gl::Framebuffer::of("multiresolution illumination buffer", {&mIllumination}, &mStencil);
     mReconFbo = gl::Framebuffer::of("reconstructed illumination", {&mReconstructed});
+    if (mOptions.receiverList)
+        mReceiverList =
+            gl::Buffer::create(sizeof(shader::EyeReceiverListHeader) +
+                               sizeof(GLuint) * static_cast<size_t>(aw) * static_cast<size_t>(ah));
     // Padding texels must read as empty even before the first frame writes them.
     const float zero[4] = {0, 0, 0, 0};
     for (const gl::Texture* t : {&mGeoPosition, &mGeoNormal, &mGeoAlbedo, &mDepthInfo, &mNormalMin,
@@ -159,11 +174,23 @@ void EyeHierarchy::uploadUniforms(const ParamSet& params) {
 }
 
 void EyeHierarchy::beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& handles,
-                                         const FrameInputs& in, bool stencil) const {
+                                         const FrameInputs& in) const {
     pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight);
     bindInputs(pass, handles, in);
-    if (stencil) pass.stencilTest(false).stencilFunc(GL_EQUAL, 1);
     pass.blend(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
+}
+
+void EyeHierarchy::beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandles& handles,
+                                     const FrameInputs& in) const {
+    GIS_ASSERT(mOptions.receiverList);
+    bindInputs(pass, handles.inputs, in);
+    pass.buffer(handles.list, mReceiverList)
+        .image(handles.illumination, mIllumination, GL_READ_WRITE, GL_RGBA32F);
+}
+
+void EyeHierarchy::dispatchReceivers(gl::Pass& pass) const {
+    // The previous dispatch's image stores (and the stencil pass's list) before this one's loads.
+    pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT).dispatchIndirect(mReceiverList);
 }
 
 void EyeHierarchy::bindInputs(gl::Pass& pass, const EyeInputHandles& h, const FrameInputs& in) const {
@@ -233,6 +260,10 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     }
 
     gl::Pass pass(timer, "stencil_setup");
+    if (mOptions.receiverList) {
+        const shader::EyeReceiverListHeader empty{};
+        mReceiverList.upload(0, sizeof empty, &empty);
+    }
     pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight).clearColor(1).clearDepthStencil(1.0f, 0);
     pass.noColorWrites().stencilTest(true).stencilFunc(GL_ALWAYS, 1);
     // One draw per level, each counted: the padding between levels is never shaded.
@@ -241,10 +272,18 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
         if (l <= 1) {
             pass.use(r.program).texture(r.flags, mFlags);
             bindInputs(pass, r.inputs, in);
+            if (mOptions.receiverList) pass.buffer(r.list, mReceiverList);
         }
         pass.set(r.level, static_cast<int>(l))
             .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
             .drawFullscreenCounted(mEmptyVao, mReceiverQueries[l]);
+    }
+    if (mOptions.receiverList) {
+        pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT)
+            .use(mReceiverDispatch.program)
+            .buffer(mReceiverDispatch.list, mReceiverList)
+            .dispatch(1)
+            .barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     }
 }
 
@@ -267,6 +306,7 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
                                const gl::Framebuffer& indirectTarget, gl::PassTimer& timer) {
     bindUniforms();
     gl::Pass pass(timer, "upsample");
+    pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT); // a receiver pass's image stores before the fetches
     const UpsampleProgram& u = mUpsample;
     pass.target(mReconFbo, mAtlasWidth, mAtlasHeight).use(u.program).set(u.interpolate, irradiance ? 1 : 0);
     pass.texture(u.rendered, mIllumination)
@@ -294,6 +334,36 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     pass.textureBarrier().drawFullscreen(mEmptyVao);
 }
 
+namespace {
+// The (level, x within the level) of atlas texel (x, y), or level -1 for padding.
+std::array<int, 3> levelTexel(const std::vector<EyeLevel>& levels, int x, int y) {
+    for (size_t l = 0; l < levels.size(); ++l) {
+        const EyeLevel& e = levels[l];
+        if (x >= e.x && y >= e.y && x < e.x + e.width && y < e.y + e.height)
+            return {static_cast<int>(l), x - e.x, y - e.y};
+    }
+    return {-1, x, y};
+}
+} // namespace
+
+std::vector<std::array<int, 3>> EyeHierarchy::readReceiverList(shader::EyeReceiverListHeader* header) const {
+    GIS_ASSERT(mOptions.receiverList);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    shader::EyeReceiverListHeader h{};
+    glGetNamedBufferSubData(mReceiverList.id(), 0, sizeof h, &h);
+    if (header) *header = h;
+    const size_t capacity = (static_cast<size_t>(mReceiverList.size()) - sizeof h) / sizeof(GLuint);
+    std::vector<GLuint> items(std::min<size_t>(h.counts.x, capacity));
+    if (!items.empty())
+        glGetNamedBufferSubData(mReceiverList.id(), sizeof h,
+                                static_cast<GLsizeiptr>(items.size() * sizeof(GLuint)), items.data());
+    std::vector<std::array<int, 3>> list;
+    for (GLuint item : items)
+        list.push_back(levelTexel(mLevels, static_cast<int>(item & 0xFFFFu), static_cast<int>(item >> 16)));
+    std::sort(list.begin(), list.end());
+    return list;
+}
+
 std::vector<std::array<int, 3>> EyeHierarchy::readReceiverSet() const {
     std::vector<GLuint> packed(static_cast<size_t>(mAtlasWidth) * mAtlasHeight);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, mIllumFbo.id());
@@ -303,13 +373,8 @@ std::vector<std::array<int, 3>> EyeHierarchy::readReceiverSet() const {
     for (int y = 0; y < mAtlasHeight; ++y)
         for (int x = 0; x < mAtlasWidth; ++x) {
             if ((packed[static_cast<size_t>(y) * mAtlasWidth + x] & 0xFFu) == 0) continue;
-            for (size_t l = 0; l < mLevels.size(); ++l) {
-                const EyeLevel& e = mLevels[l];
-                if (x >= e.x && y >= e.y && x < e.x + e.width && y < e.y + e.height) {
-                    set.push_back({static_cast<int>(l), x - e.x, y - e.y});
-                    break;
-                }
-            }
+            const std::array<int, 3> texel = levelTexel(mLevels, x, y);
+            if (texel[0] >= 0) set.push_back(texel);
         }
     std::sort(set.begin(), set.end());
     return set;

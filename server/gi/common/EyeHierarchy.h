@@ -5,6 +5,8 @@
 // and the coarse-to-fine reconstruction to full resolution (000 §3.5).
 //
 // Per frame: build() -> [technique fills illumination() at receivers, alpha 1] -> reconstruct().
+// The gathers fill it with compute passes over the receiver list (receiverList: beginReceiverPass,
+// dispatchReceivers), one invocation per receiver; multires_splat splats into it with fragments.
 #pragma once
 
 #include <array>
@@ -49,16 +51,32 @@ struct EyeInputHandles {
     gl::TextureUnit atlasPosition{gl::kNoUnit}, atlasNormal{gl::kNoUnit}, atlasAlbedo{gl::kNoUnit};
 };
 
+/// What a receiver pass (a compute program including gi/common/eye_receiver_list.glsl with
+/// GIS_EYE_RECEIVER_PASS defined) binds: the hierarchy's inputs, the list and the illumination image.
+struct EyeReceiverPassHandles {
+    EyeReceiverPassHandles() = default;
+    explicit EyeReceiverPassHandles(const gl::Program& program);
+    EyeInputHandles inputs;
+    gl::BlockBinding list;
+    gl::ImageUnit illumination;
+};
+
+struct EyeHierarchyOptions {
+    /// The mipmap also averages the albedo (uAtlasAlbedo, eye_patch.glsl), which only multires_splat's
+    /// patches read; the others leave it out (GIS_EYE_ALBEDO in eye_mip_reduce.frag).
+    bool patchAlbedo = false;
+    /// The stencil pass also lists the receivers (eye_receiver_list.glsl) for receiver passes.
+    bool receiverList = false;
+};
+
 class EyeHierarchy {
 public:
-    /// `patchAlbedo`: the mipmap also averages the albedo (uAtlasAlbedo, eye_patch.glsl), which only
-    /// multires_splat's patches read; the others leave it out (GIS_EYE_ALBEDO in eye_mip_reduce.frag).
-    explicit EyeHierarchy(bool patchAlbedo = false);
+    explicit EyeHierarchy(EyeHierarchyOptions options = {});
     /// (Re)allocates the atlas when the size or coarsest level changes; may throw gis::Error.
     void ensureLayout(int width, int height, int coarsestSize);
 
     /// Builds the mipmaps and flags ("eye_mipmap"), marks the receivers in the stencil
-    /// ("stencil_setup") and clears the illumination atlas.
+    /// ("stencil_setup"), lists them (receiverList) and clears the illumination atlas.
     /// A later VPL part of the same image (FrameInputs::sameImageAsLastPart) keeps the mipmaps and
     /// flags of the part before.
     void build(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer);
@@ -79,12 +97,18 @@ public:
     const gl::Texture& geoNormal() const { return mGeoNormal; }
     const gl::Texture& geoAlbedo() const { return mGeoAlbedo; }
     const gl::Texture& flags() const { return mFlags; }
-    /// State every pass that lights receivers shares, set on `pass` (its program in use): the
+    /// State a fragment pass that lights receivers needs, set on `pass` (its program in use): the
     /// illumination atlas as target, the hierarchy's textures the program reads (bindInputs),
-    /// additive rgb with alpha marking data, and (`stencil`) the receiver stencil test. The pass
-    /// undoes it at its end.
-    void beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& handles, const FrameInputs& in,
-                               bool stencil) const;
+    /// additive rgb with alpha marking data (multires_splat's splats, whose list items are the
+    /// receivers). The pass undoes it at its end.
+    void beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& handles, const FrameInputs& in) const;
+    /// State a receiver pass needs, set on `pass` (its compute program in use; receiverList only): the
+    /// hierarchy's textures the program reads, the receiver list, the illumination atlas as image.
+    void beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandles& handles,
+                           const FrameInputs& in) const;
+    /// Runs the receiver program in use once per receiver (indirect, from the count the stencil pass
+    /// appended); each dispatch sees the illumination the ones before it added.
+    void dispatchReceivers(gl::Pass& pass) const;
     /// Binds the hierarchy's uniform block at GIS_UBO_EYE (every pass using eye_hierarchy.glsl).
     void bindUniforms() const;
     /// Binds the hierarchy's textures and the G-buffer (level 0) where `handles` name them.
@@ -94,6 +118,9 @@ public:
 
     /// Test hook: the receiver stencil read back as (level, x, y) triples, sorted.
     std::vector<std::array<int, 3>> readReceiverSet() const;
+    /// Test hook (receiverList): the receiver list read back like readReceiverSet(), duplicates kept,
+    /// and its header.
+    std::vector<std::array<int, 3>> readReceiverList(shader::EyeReceiverListHeader* header = nullptr) const;
 
 private:
     /// The geometry mipmaps and the refinement flags over the G-buffer ("eye_mipmap", "refine_flags").
@@ -117,6 +144,11 @@ private:
         gl::UniformLocation level;
         gl::TextureUnit flags;
         EyeInputHandles inputs;
+        gl::BlockBinding list; ///< receiverList only
+    };
+    struct ReceiverDispatchProgram {
+        gl::Program program;
+        gl::BlockBinding list;
     };
     struct UpsampleProgram {
         gl::Program program;
@@ -132,12 +164,13 @@ private:
     /// curvature: a program variant, see eye_mip_reduce.frag); the coarser levels.
     std::array<std::unique_ptr<ReduceProgram>, 2> mReduceFromPixels;
     std::unique_ptr<ReduceProgram> mReduce;
-    bool mPixelMetrics = false; ///< the depth or normal metric reads the pixels' neighbours
-    bool mPatchAlbedo = false;  ///< the mipmap writes mGeoAlbedo (its last attachment)
+    bool mPixelMetrics = false;   ///< the depth or normal metric reads the pixels' neighbours
+    EyeHierarchyOptions mOptions; ///< patchAlbedo: the mipmap writes mGeoAlbedo (its last attachment)
     FlagsProgram mFlagsProgram;
     /// The stencil's receiver test on level 0 (the G-buffer's pixels) and on the coarser levels
     /// (GIS_EYE_PIXEL_LEVEL in eye_receivers.frag).
     ReceiversProgram mPixelReceivers, mPatchReceivers;
+    ReceiverDispatchProgram mReceiverDispatch; ///< receiverList only
     UpsampleProgram mUpsample;
     ResolveProgram mResolve;
     gl::VertexArray mEmptyVao;
@@ -149,6 +182,7 @@ private:
     gl::Texture mGeoPosition, mGeoNormal, mGeoAlbedo, mDepthInfo, mNormalMin, mNormalMax, mFlags, mDiscFlags;
     gl::Texture mIllumination, mStencil, mReconstructed;
     gl::Framebuffer mGeoFbo, mFlagsFbo, mIllumFbo, mReconFbo;
+    gl::Buffer mReceiverList; ///< shader::EyeReceiverListHeader, then one item per atlas texel
     std::array<unsigned, GIS_MAX_EYE_LEVELS> mLastCounts{};
 };
 

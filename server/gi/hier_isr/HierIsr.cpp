@@ -71,15 +71,14 @@ std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
 
 HierIsr::HierIsr() {
     GatherProgram& g = mGather;
-    g.program = gl::Program::build(
-        {{GL_VERTEX_SHADER, "render/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "gi/hier_isr/gather.frag"}});
+    g.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/hier_isr/gather.comp"}});
     g.startLevel = g.program.location("uStartLevel");
     g.leafLevel = g.program.location("uLeafLevel");
     g.refineMode = g.program.location("uRefineMode");
     g.tau = g.program.location("uTau");
     g.stats = g.program.storageBlock("CutStats");
     g.transport = VplTransportHandles(g.program);
-    g.eye = EyeInputHandles(g.program);
+    g.eye = EyeReceiverPassHandles(g.program);
     mStats = gl::Buffer::create(6 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
 }
 
@@ -110,8 +109,8 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
                 .set(g.tau, s.tau);
             mTree.bind();
             pass.buffer(g.stats, mStats);
-            mEye.beginIlluminationPass(pass, g.eye, in, true);
-            pass.drawFullscreen(mEye.emptyVao());
+            mEye.beginReceiverPass(pass, g.eye, in);
+            mEye.dispatchReceivers(pass);
         }
     }
 

@@ -8,8 +8,8 @@
 // Pipeline:
 //   1. (renderer) RSM and G-buffer
 //   2. light_tree: the RSM's implicit mip pyramid with sums, means and min-max (LightTree.h)
-//   3. eye_mipmap, refine_flags, stencil_setup: the eye hierarchy (EyeHierarchy.h)
-//   4. vpl_gather: one stenciled full-screen pass over the eye atlas; each receiver starts from all
+//   3. eye_mipmap, refine_flags, stencil_setup: the eye hierarchy and its receiver list (EyeHierarchy.h)
+//   4. vpl_gather: one compute dispatch over the receiver list; each receiver starts from all
 //      nodes of the hier_coarsest level and descends with an explicit stack while Eq. 8 asks for
 //      refinement, down to the max_depth level; every node it stops at contributes with the disk
 //      kernel (001 Eq. 1) with the node's summed flux and area. The cut covers each valid texel once,
@@ -67,7 +67,7 @@
 
 namespace gis {
 
-enum class LightRefine { Test = 0, Always = 1, Never = 2 }; ///< values match uRefineMode in gather.frag
+enum class LightRefine { Test = 0, Always = 1, Never = 2 }; ///< values match uRefineMode in gather.comp
 
 struct LightCutSettings {
     int startLevel = 0; ///< level index of the roots (hier_coarsest)
@@ -80,7 +80,7 @@ struct LightCutSettings {
 /// CPU mirror below).
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
                                   int maxDepthResolution, double tau);
-/// CPU mirror of gather.frag's traversal for one receiver at `receiver`: the flat indices of the
+/// CPU mirror of gather.comp's traversal for one receiver at `receiver`: the flat indices of the
 /// nodes that contribute (its cut). `tanHalfFov` is gFrame.rsmInfo.y. For tests.
 std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
                              const std::vector<LightLevel>& levels, const LightCutSettings& settings,
@@ -99,14 +99,14 @@ public:
 
 private:
     LightTree mTree;
-    EyeHierarchy mEye;
+    EyeHierarchy mEye{{.receiverList = true}};
     BiasCompensation mSsbc;
     struct GatherProgram {
         gl::Program program;
         gl::UniformLocation startLevel, leafLevel, refineMode, tau;
         gl::BlockBinding stats;
         VplTransportHandles transport;
-        EyeInputHandles eye;
+        EyeReceiverPassHandles eye;
     } mGather;
     gl::Buffer mStats;
     IndirectTarget mIndirect;

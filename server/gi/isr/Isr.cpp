@@ -26,13 +26,12 @@ Isr::Isr() {
     s.vpls = s.program.storageBlock("IsrVpls");
     // The gather is multires_gather's, always with the disk kernel (001 Eq. 1).
     GatherProgram& g = mGather;
-    g.program = gl::Program::build({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
-                                    {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}},
+    g.program = gl::Program::build({{GL_COMPUTE_SHADER, "gi/multires_gather/gather.comp"}},
                                    kernelDefines(VplKernel::Disk, {}));
     g.vplCount = g.program.location("uVplCount");
     g.vplScale = g.program.location("uVplScale");
     g.transport = VplTransportHandles(g.program);
-    g.eye = EyeInputHandles(g.program);
+    g.eye = EyeReceiverPassHandles(g.program);
 }
 
 void Isr::resize(int width, int height) {
@@ -102,9 +101,9 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
             const GatherProgram& g = mGather;
             pass.use(g.program);
             g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
-            mEye.beginIlluminationPass(pass, g.eye, in, true);
+            mEye.beginReceiverPass(pass, g.eye, in);
             counters["vpl_batches"] = mBatches.forEach(mVpls, mVplCount, [&](int count, int) {
-                pass.set(g.vplCount, count).set(g.vplScale, 1.0f).drawFullscreen(mEye.emptyVao());
+                mEye.dispatchReceivers(pass.set(g.vplCount, count).set(g.vplScale, 1.0f));
             });
         }
     }

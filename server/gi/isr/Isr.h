@@ -1,7 +1,7 @@
 // Technique `isr`: image-space radiosity. Per frame, the light tree is cut into light patches that
 // are large where the lit surfaces are smooth in light space and small around light-space
 // discontinuities; each patch is one VPL, gathered with the disk kernel at the eye hierarchy's
-// stencil-selected receivers.
+// receivers (its receiver list).
 //
 // Paper: 001 (Nichols, Shopf & Wyman 2009) §3.4; digest S.3 preset isr (VPL set C, receivers R3,
 // kernel K2, reconstruction U1).
@@ -13,8 +13,8 @@
 //      is a VPL iff it is valid, continuous, and all its ancestors were discontinuous; the finest
 //      level takes what is left) and append them, in a deterministic order, to the VPL cache; each
 //      VPL carries its patch's summed flux and area, so the set conserves the RSM's flux
-//   4. eye_mipmap, refine_flags, stencil_setup: the eye hierarchy (EyeHierarchy.h)
-//   5. vpl_gather: multires_gather's stenciled gather (disk kernel) over the VPLs in UBO batches;
+//   4. eye_mipmap, refine_flags, stencil_setup: the eye hierarchy and its receiver list (EyeHierarchy.h)
+//   5. vpl_gather: multires_gather's gather over the receiver list (disk kernel), a dispatch per VPL batch;
 //      the VPL count is read back first (a small sync; it also feeds the counters)
 //   6. upsample: coarse-to-fine reconstruction, albedo / pi per pixel
 //
@@ -68,7 +68,7 @@ private:
     int select(const ParamSet& params, gl::PassTimer& timer, Counters& counters);
 
     LightTree mTree;
-    EyeHierarchy mEye;
+    EyeHierarchy mEye{{.receiverList = true}};
     BiasCompensation mSsbc;
     struct SelectProgram {
         gl::Program program;
@@ -80,7 +80,7 @@ private:
         gl::Program program;
         gl::UniformLocation vplCount, vplScale; ///< scale 1: isr renders no VPL parts
         VplTransportHandles transport;
-        EyeInputHandles eye;
+        EyeReceiverPassHandles eye;
     } mGather;
     gl::Buffer mVpls, mCounts;
     VplBatches mBatches;

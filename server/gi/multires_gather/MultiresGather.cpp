@@ -13,8 +13,7 @@ MultiresGather::GatherProgram::GatherProgram(gl::Program built)
       eye(program) {}
 
 MultiresGather::MultiresGather() {
-    mGather = KernelPrograms<GatherProgram>({{GL_VERTEX_SHADER, "render/fullscreen.vert"},
-                                             {GL_FRAGMENT_SHADER, "gi/multires_gather/gather.frag"}});
+    mGather = KernelPrograms<GatherProgram>({{GL_COMPUTE_SHADER, "gi/multires_gather/gather.comp"}});
 }
 
 void MultiresGather::resize(int width, int height) {
@@ -35,18 +34,18 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
             const GatherProgram& g = mGather.get(vplKernel(params));
             pass.use(g.program).set(g.minDistance, vplMinDistance(params, in.sceneSize));
             g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
-            mEye.beginIlluminationPass(pass, g.eye, in, true);
+            mEye.beginReceiverPass(pass, g.eye, in);
             // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.
             const int parts = std::max(1, in.vplParts);
             pass.set(g.vplScale, static_cast<float>(parts));
             if (parts > 1) {
                 counters["vpl_batches"] = mVpls.forEachPartBatch(
-                    [&](int count, int) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
+                    [&](int count, int) { mEye.dispatchReceivers(pass.set(g.vplCount, count)); });
                 counters["vpl_part"] = std::clamp(in.vplPart, 0, parts - 1);
                 counters["vpl_parts"] = parts;
             } else {
                 counters["vpl_batches"] = mVpls.forEachBatch(
-                    [&](int count, int) { pass.set(g.vplCount, count).drawFullscreen(mEye.emptyVao()); });
+                    [&](int count, int) { mEye.dispatchReceivers(pass.set(g.vplCount, count)); });
             }
         }
     }

@@ -10,13 +10,13 @@
 //   3. eye_mipmap: level 0 statistics from the G-buffer, min-max / derivative / curvature mips up
 //      to the coarsest level; refine_flags: the refinement flag of every texel (EyeHierarchy)
 //   4. stencil_setup: one full-screen draw per level of the flattened buffer sets stencil 1 at
-//      receivers, counted by occlusion queries
-//   5. vpl_gather: one full-screen pass per VPL batch with the stencil test; receivers sum the kernel
+//      receivers, counted by occlusion queries, and appends them to the receiver list
+//   5. vpl_gather: one compute dispatch per VPL batch over the receiver list; receivers sum the kernel
 //   6. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel
 //
 // Parameters: vpl_grid [1, 256] (16), kernel point|disk (disk), min_distance [0, 0.5] of the scene's
-// size (0.05, point only); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16, depth 0.1 relative,
-// normal 0.25, diagonal on, detail_alpha 0).
+// size (0.05, point only); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16, depth 0.1
+// relative, normal 0.25, diagonal on, detail_alpha 0).
 //
 // Limits: no indirect visibility; diffuse receivers; a coarse patch is lit at its mean position and
 // normal, so light varying inside a flat patch (near a VPL) is averaged: depth_threshold trades this.
@@ -41,13 +41,13 @@ public:
 
 private:
     VplGrid mVpls;
-    EyeHierarchy mEye;
+    EyeHierarchy mEye{{.receiverList = true}};
     struct GatherProgram {
         explicit GatherProgram(gl::Program built);
         gl::Program program;
         gl::UniformLocation minDistance, vplCount, vplScale;
         VplTransportHandles transport;
-        EyeInputHandles eye;
+        EyeReceiverPassHandles eye;
     };
     KernelPrograms<GatherProgram> mGather;
     BiasCompensation mSsbc;

@@ -252,7 +252,7 @@ void MultiresSplat::execute(const FrameInputs& in, const ParamSet& params, gl::P
             pass.use(splat.program).set(splat.atlasSize, glm::ivec2(mEye.atlasWidth(), mEye.atlasHeight()));
             setShading(pass, splat.shading, in, params, perVpl);
             pass.buffer(splat.shading.vpls, mVpls.buffer()).buffer(splat.splatList, mSplatList);
-            mEye.beginIlluminationPass(pass, splat.shading.eye, in, false); // every list item is a receiver
+            mEye.beginIlluminationPass(pass, splat.shading.eye, in); // every list item is a receiver
             if (feedback) {
                 glBindVertexArray(mItemVao.id());
                 splatFeedbackLists(vplCount);

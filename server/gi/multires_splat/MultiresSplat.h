@@ -114,7 +114,7 @@ private:
     void splatFeedbackLists(int vplCount);
 
     VplGrid mVpls;
-    EyeHierarchy mEye{true}; // the splats' patches read the mean albedo
+    EyeHierarchy mEye{{.patchAlbedo = true}}; // the splats' patches read the mean albedo
     BiasCompensation mSsbc;
     SeedProgram mSeed;
     std::unique_ptr<RefineProgram> mRefine;

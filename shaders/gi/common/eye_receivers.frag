@@ -5,7 +5,9 @@
 // so the gather's early stencil test skips it. Drawn once per level (the viewport covers level
 // uLevel only, so no fragment searches for its level); the host counts each level's receivers with
 // an occlusion query (discarded fragments do not count), which costs llvmpipe nothing per fragment
-// where a per-fragment atomic counter did.
+// where a per-fragment atomic counter did. With GIS_EYE_RECEIVER_LIST each receiver also appends its
+// texel to the receiver list (eye_receiver_list.glsl) for the gathers' compute passes: the atomic
+// runs for the receivers only, a few per cent of the fragments.
 #include "common.glsl"
 #include "gi/common/eye_hierarchy.glsl"
 #include "gi/common/eye_pixel.glsl"
@@ -19,6 +21,12 @@ uniform int uLevel;
 #ifndef GIS_EYE_PIXEL_LEVEL
 #define GIS_EYE_PIXEL_LEVEL 0
 #endif
+#ifndef GIS_EYE_RECEIVER_LIST
+#define GIS_EYE_RECEIVER_LIST 0
+#endif
+#if GIS_EYE_RECEIVER_LIST
+#include "gi/common/eye_receiver_list.glsl"
+#endif
 
 void main() {
 #if GIS_EYE_PIXEL_LEVEL
@@ -27,5 +35,8 @@ void main() {
 #else
     ivec2 t = ivec2(gl_FragCoord.xy) - gEye.level[uLevel].xy;
     if (!eyeIsReceiver(uFlags, uLevel, t, false)) discard;
+#endif
+#if GIS_EYE_RECEIVER_LIST
+    eyeAppendReceiver(ivec2(gl_FragCoord.xy));
 #endif
 }

@@ -1,15 +1,16 @@
 #version 450 core
-// Stenciled multiresolution gather (001 §3.2.2): one full-screen pass over the flattened
-// multiresolution buffer per batch of VPLs; the early stencil test leaves only receiver patches,
-// each of which sums the irradiance of every VPL in the batch (the VPL cache is the compact VPL
-// buffer, read as texels: gi/common/vpl_batch.glsl) at its mean position and normal. Irradiance only: the albedo is
-// applied per pixel after reconstruction. A VPL part (refinement, FrameInputs::vplPart) gathers the
-// batches of its own VPLs (vpl_interleave.comp), scaled by the number of parts uVplScale.
+// Multiresolution gather (001 §3.2.2) over the receiver list: one invocation per receiver of the
+// flattened multiresolution buffer (the one-pass stencil's receivers, eye_receiver_list.glsl), one
+// dispatch per batch of VPLs; each receiver sums the irradiance of every VPL in the batch (the VPL
+// cache is the compact VPL buffer, read as texels: gi/common/vpl_batch.glsl) at its mean position
+// and normal. Irradiance only: the albedo is applied per pixel after reconstruction. A VPL part
+// (refinement, FrameInputs::vplPart) gathers the batches of its own VPLs (vpl_interleave.comp),
+// scaled by the number of parts uVplScale.
+#define GIS_EYE_RECEIVER_PASS
 #include "common.glsl"
+#include "gi/common/eye_receiver_list.glsl"
 #include "gi/common/vpl_transport.glsl"
 #include "gi/common/vpl_batch.glsl"
-
-layout(early_fragment_tests) in;
 
 layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position, w covered pixels
 layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
@@ -20,15 +21,14 @@ uniform int uVplCount;
 uniform float uVplScale = 1.0; // the number of VPL parts (1 without parts, and when not set)
 uniform float uMinDistance; // m, point kernel only
 
-layout(location = 0) out vec4 outIrradiance; // rgb added by blending; alpha 1 marks data
-
 void main() {
-    ivec2 a = ivec2(gl_FragCoord.xy);
+    ivec2 a;
+    if (!eyeReceiver(a)) return;
     bool pixel = all(lessThan(vec2(a), gFrame.viewport.xy));
     vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
     vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
     vec3 e = vec3(0.0);
 #define GATHER_TERM(i) vplIrradianceSelected(pos, n, batchVpl(i), uMinDistance)
     GIS_SUM_OVER_BATCH(e, uVplCount, GATHER_TERM)
-    outIrradiance = vec4(max(sanitize(e * uVplScale), vec3(0.0)), 1.0);
+    eyeAddIllumination(a, max(sanitize(e * uVplScale), vec3(0.0)));
 }

@@ -1,6 +1,7 @@
 #version 450 core
 // Hierarchical image-space radiosity gather (001 §3.5, digest S.3 P4 D + P6 lightcut): every eye
-// receiver (early stencil test, as multires_gather) walks the light tree itself. It starts from all
+// receiver (one invocation per item of the receiver list, as multires_gather) walks the light tree
+// itself. It starts from all
 // nodes of level uStartLevel and descends, with an explicit stack, wherever 001 Eq. 8 asks for
 // refinement, down to uLeafLevel; a node that is not refined (or is a leaf) contributes with the
 // disk kernel (001 Eq. 1) at its flux-weighted mean position with its summed flux and area. The
@@ -10,11 +11,11 @@
 //   |V_ij|^2 <= T_l |V_j|max^2,   T_l = Omega (1 - tau) / (pi tau R_l^2),
 // Omega the light frustum's solid angle, |V_j|max the node's max light distance. uRefineMode
 // carries the degenerate taus: tau <= 0 always refines (T = +inf), tau >= 1 never (T <= 0).
+#define GIS_EYE_RECEIVER_PASS
 #include "common.glsl"
+#include "gi/common/eye_receiver_list.glsl"
 #include "gi/common/light_tree.glsl"
 #include "gi/common/vpl_transport.glsl"
-
-layout(early_fragment_tests) in;
 
 layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position
 layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
@@ -32,8 +33,6 @@ uniform int uLeafLevel;   // finest level visited (<= uStartLevel)
 uniform int uRefineMode;  // 0 Eq. 8 test, 1 always refine, 2 never refine
 uniform float uTau;       // in (0, 1) when uRefineMode == 0
 
-layout(location = 0) out vec4 outIrradiance; // rgb added by blending; alpha 1 marks data
-
 // Depth-first, at most 3 pending siblings per level below the root: 1 + 3 * 11 < 48.
 const int kStack = 48;
 
@@ -44,7 +43,8 @@ uint packNode(int level, ivec2 t) { return uint(level) | (uint(t.x) << 4) | (uin
     if (atomicAdd(lo, v) + (v) < (v)) atomicAdd(hi, 1u)
 
 void main() {
-    ivec2 a = ivec2(gl_FragCoord.xy);
+    ivec2 a;
+    if (!eyeReceiver(a)) return;
     bool pixel = all(lessThan(vec2(a), gFrame.viewport.xy));
     vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
     vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
@@ -97,5 +97,5 @@ void main() {
     atomicMax(gVisitedMax, visited);
     GIS_ADD64(gCutLo, gCutHi, cut);
     atomicMax(gCutMax, cut);
-    outIrradiance = vec4(max(sanitize(e), vec3(0.0)), 1.0);
+    eyeAddIllumination(a, max(sanitize(e), vec3(0.0)));
 }
