@@ -69,6 +69,7 @@ await page.evaluate(() => {
             const timing = window.giClient.lastDrawTiming;
             window.benchDraws.push({ t: performance.timeOrigin + performance.now(), quality: s.quality,
                 ms: (s.frame_ms ?? 0) + (s.encode_ms ?? 0), refine: s.refine ?? null, size: s.size,
+                vpls: s.counts?.vpl_count ?? null,
                 input: s.input ?? null, encode: s.encode_ms ?? 0, drawnAt: timing.drawnAt,
                 arrivedAt: timing.arrivedAt, decodeMs: timing.decodeMs });
         }
@@ -202,7 +203,9 @@ async function measureScene(requested, technique, params) {
         still_over_frame_ms: { p50: percentile(over, 0.5), p95: percentile(over, 0.95) },
         still_input_wait_ms: { p50: percentile(parts.inputWait, 0.5), p95: percentile(parts.inputWait, 0.95) },
         still_breakdown_ms_p50: breakdown, still_in_page: inPageSummary(results), presses: stillLat.length,
-        last_size: orbit.at(-1)?.size };
+        last_size: orbit.at(-1)?.size,
+        // The VPLs the frame budget left the orbit's frames (p50): with the size, what its time bought.
+        orbit_vpls_p50: percentile(orbit.map((d) => d.vpls).filter((v) => v !== null), 0.5) ?? null };
 }
 
 async function duringRefinement(scene, technique, params) {
@@ -239,15 +242,30 @@ async function duringRefinement(scene, technique, params) {
 }
 
 const report = { viewport, machine: process.env.GI_BENCH_MACHINE ?? null, server_nice: opts['server-nice'], scenes: [], refinement: [] };
-for (const scene of scenes) {
-    const r = await measureScene(scene, null);
-    report.scenes.push(r);
-    console.log(JSON.stringify(r));
-}
-for (const [technique, params] of [['rsm_gather', { vpl_grid: 256 }], ['hier_isr', { tau: 0 }]]) {
-    const r = await duringRefinement('builtin:cornell', technique, params);
-    report.refinement.push(r);
-    console.log(JSON.stringify(r));
+try {
+    for (const scene of scenes) {
+        const r = await measureScene(scene, null);
+        report.scenes.push(r);
+        console.log(JSON.stringify(r));
+    }
+    for (const [technique, params] of [['rsm_gather', { vpl_grid: 256 }], ['hier_isr', { tau: 0 }]]) {
+        const r = await duringRefinement('builtin:cornell', technique, params);
+        report.refinement.push(r);
+        console.log(JSON.stringify(r));
+    }
+} catch (e) {
+    // A press that got no frame is rare and not reproducible on demand: keep what explains it (the
+    // server's log, the page's last frames and the client's state) before giving up.
+    const last = await page.evaluate(() => ({ draws: (window.benchDraws ?? []).slice(-8),
+        connection: document.querySelector('#conn-text')?.textContent ?? null,
+        busy: document.querySelector('#busy')?.textContent ?? null,
+        lastStats: window.giClient?.lastStats ?? null })).catch(() => null);
+    console.error(`orbit: ${e.message}\n-- the page's last frames and state:\n${JSON.stringify(last, null, 1)}` +
+        `\n-- the server's log, last 60 lines:\n${serverLog().split('\n').slice(-60).join('\n')}`);
+    if (process.env.GI_SERVER_LOG) writeFileSync(process.env.GI_SERVER_LOG, serverLog());
+    await browser.close();
+    server.kill('SIGINT');
+    process.exit(1);
 }
 if (opts.out) writeFileSync(opts.out, JSON.stringify(report, null, 2));
 if (process.env.GI_SERVER_LOG) writeFileSync(process.env.GI_SERVER_LOG, serverLog());
