@@ -128,6 +128,34 @@ TEST(Multires, ReceiverListHoldsEachStencilReceiverOnce) {
     }
 }
 
+// A list of more than GIS_EYE_RECEIVER_MAX_GROUPS_X groups (4,194,240 receivers) is dispatched in rows
+// of groups: with every pixel a receiver (thresholds 0, the camera inside the box so that every pixel
+// sees a wall) at 2100 x 2048, the gather must still light each receiver once, as the full gather.
+TEST(Multires, ReceiverListsLongerThanOneRowOfGroupsRunIn2D) {
+    const int w = 2100, h = 2048;
+    static_assert(2100 * 2048 > GIS_EYE_RECEIVER_MAX_GROUPS_X * GIS_EYE_RECEIVER_GROUP);
+    const auto inside = [](FrameState& s) {
+        s.camera.position = {0.0f, 1.0f, 0.95f};
+        s.camera.target = {0.0f, 1.0f, -1.0f};
+    };
+    const nlohmann::json params = {
+        {"vpl_grid", 2}, {"kernel", "disk"}, {"depth_threshold", 0.0}, {"normal_threshold", 0.0}};
+    FrameOutput gather = renderScene("builtin:cornell", "multires_gather", w, h, params, inside);
+    auto* technique = dynamic_cast<MultiresGather*>(test::sharedRenderer().technique());
+    ASSERT_NE(technique, nullptr);
+    shader::EyeReceiverListHeader header{};
+    technique->hierarchy().readReceiverList(&header);
+    ASSERT_EQ(header.counts.x, static_cast<unsigned>(w * h)) << "every pixel must be a receiver";
+    EXPECT_EQ(header.dispatch.x, GIS_EYE_RECEIVER_MAX_GROUPS_X);
+    EXPECT_EQ(header.dispatch.y, 2u);
+    FrameOutput full =
+        renderScene("builtin:cornell", "rsm_gather", w, h, {{"vpl_grid", 2}, {"kernel", "disk"}}, inside);
+    EXPECT_LT(relativeRmseOf(gather, full), 1e-3);
+    EXPECT_EQ(badValues(gather), 0u);
+    // Back to a small frame: the shared renderer's next tests should not carry this atlas around.
+    renderScene("builtin:cornell", "multires_gather", 64, 64, {});
+}
+
 // 001 Fig. 9: thresholds of 0 refine every varying patch to single pixels, which is the
 // full-resolution gather with the same VPLs.
 TEST(Multires, ZeroThresholdsReproduceFullResolutionGather) {

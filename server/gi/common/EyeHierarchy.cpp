@@ -140,6 +140,8 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     mStencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, aw, ah);
     mIllumFbo = gl::Framebuffer::of("multiresolution illumination buffer", {&mIllumination}, &mStencil);
     mReconFbo = gl::Framebuffer::of("reconstructed illumination", {&mReconstructed});
+    // The list packs a texel as y << 16 | x; GL's texture size limits keep an atlas far below that.
+    GIS_ASSERT(aw < 65536 && ah < 65536);
     if (mOptions.receiverList)
         mReceiverList =
             gl::Buffer::create(sizeof(shader::EyeReceiverListHeader) +
