@@ -67,17 +67,37 @@ FrameState AdaptiveQuality::presetState(const FrameState& requested, const nlohm
     return requested;
 }
 
+namespace {
+
+// A technique's passes cost about vpls^e (TechniqueInfo::vplCostExponent): 1 for a sum over every VPL,
+// less for a traversal such as hier_isr's, whose cost grows far more slowly than its leaves.
+double vplCostExponent(const FrameState& state) {
+    const double e = findTechniqueInfo(state.technique).vplCostExponent;
+    return std::isfinite(e) ? std::clamp(e, 0.05, 1.0) : 1.0;
+}
+
+// The VPLs at which a cost of `costMs` at `vpls` falls to `targetMs`, under that power law.
+double vplsForCost(double vpls, double costMs, double targetMs, double exponent) {
+    if (!(costMs > 0.0) || !(targetMs > 0.0)) return vpls;
+    return vpls * std::pow(targetMs / costMs, 1.0 / exponent);
+}
+
+} // namespace
+
 double AdaptiveQuality::predictStepMs(const std::string& sceneName, const FrameState& state,
                                       QualityStep step) const {
     const double pixels = static_cast<double>(state.width) * state.height;
     const double vpls = static_cast<double>(std::max(1L, vplEstimate(state)));
     // Measured at the VPLs that step rendered with (perhaps capped): scaled to this state's. Not
-    // rendered yet: the nearest measured lower step, scaled by pixels and VPLs (gather cost grows with
-    // their product), so a final preset with 256 times the VPLs is predicted before it runs.
+    // rendered yet: the nearest measured lower step, scaled by pixels and by the VPLs' cost (gather
+    // cost grows with pixels x vpls^e), so a final preset with 256 times the VPLs is predicted before
+    // it runs.
+    const double exponent = vplCostExponent(state);
     for (int s = static_cast<int>(step); s >= 0; --s)
         if (auto c = mStepCost.find(stepKey(sceneName, state, static_cast<QualityStep>(s)));
             c != mStepCost.end())
-            return c->second.msPerPixel * pixels * vpls / static_cast<double>(c->second.vpls);
+            return c->second.msPerPixel * pixels *
+                   std::pow(vpls / static_cast<double>(c->second.vpls), exponent);
     return 0.0;
 }
 
@@ -88,13 +108,22 @@ void AdaptiveQuality::recordStepCost(const std::string& sceneName, const FrameSt
 }
 
 bool AdaptiveQuality::recordMinTileCost(const std::string& sceneName, const FrameState& state,
-                                        QualityStep step, double msPerVpl) {
-    if (!(msPerVpl > 0.0) || !std::isfinite(msPerVpl)) return false;
+                                        QualityStep step, double tileMs) {
+    if (!(tileMs > 0.0) || !std::isfinite(tileMs)) return false;
+    const TileCost measured{tileMs, std::max(1L, vplEstimate(state))};
     const std::string key = stepKey(sceneName, state, step);
-    auto known = mMinTileMsPerVpl.find(key);
-    const bool news = known == mMinTileMsPerVpl.end() || msPerVpl > 1.2 * known->second;
-    mMinTileMsPerVpl[key] = known == mMinTileMsPerVpl.end() ? msPerVpl : std::max(msPerVpl, known->second);
-    return news;
+    const auto known = mMinTileCost.find(key);
+    if (known == mMinTileCost.end()) {
+        mMinTileCost[key] = measured;
+        return true;
+    }
+    // Compared at equal VPLs: the known tile's cost scaled to the new one's VPLs.
+    const double knownAtMeasured = known->second.ms * std::pow(static_cast<double>(measured.vpls) /
+                                                                   static_cast<double>(known->second.vpls),
+                                                               vplCostExponent(state));
+    if (tileMs <= knownAtMeasured) return false;
+    known->second = measured;
+    return tileMs > 1.2 * knownAtMeasured;
 }
 
 AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const FrameState& requested,
@@ -165,30 +194,34 @@ void AdaptiveQuality::planRefinement(const std::string& sceneName, const FrameSt
     const double budgetMs = mLimits.refineBudgetMs;
     const double predictedMs = predictStepMs(sceneName, p.state, p.step);
     p.predictedMs = predictedMs;
-    // Fewer VPLs where the technique can take them (a step's cost is about proportional to them) when
+    // Fewer VPLs where the technique can take them (a step's cost grows as vpls^e with them) when
     // the whole step would overrun the budget, or, for a technique that cannot render its VPLs in
     // parts, when even the smallest tile would overrun a slice (input waits for at most one tile);
     // else a step over the budget is skipped. The client is told which.
     const TechniqueInfo& info = findTechniqueInfo(p.state.technique);
+    const double exponent = vplCostExponent(p.state);
     const long vpls = vplEstimate(p.state);
     double cap = static_cast<double>(vpls);
     std::string why;
     if (predictedMs > budgetMs) {
-        cap = 0.9 * static_cast<double>(vpls) * budgetMs / predictedMs;
+        cap = vplsForCost(static_cast<double>(vpls), predictedMs, 0.9 * budgetMs, exponent);
         why = "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
               " s, over the server's refinement budget of " + std::to_string(std::lround(budgetMs / 1000.0)) +
               " s (--refine-budget-ms)";
     }
-    // The smallest tile's measured cost per VPL where a step measured one, else the interactive
-    // frames' cost per pixel and VPL.
-    const auto minTile = mMinTileMsPerVpl.find(stepKey(sceneName, p.state, p.step));
-    const double minTileMsPerVpl =
-        minTile != mMinTileMsPerVpl.end()
+    // The smallest tile's measured cost where a step measured one, else the interactive frames'
+    // cost of the technique's passes over that tile at this step's VPLs.
+    const auto minTile = mMinTileCost.find(stepKey(sceneName, p.state, p.step));
+    const TileCost tile =
+        minTile != mMinTileCost.end()
             ? minTile->second
-            : mBudget.msPerPixelVpl(p.budgetKey) * double(kMinRefineTileSide) * kMinRefineTileSide;
+            : TileCost{
+                  mBudget.vplPassesMs(p.budgetKey, double(kMinRefineTileSide) * kMinRefineTileSide, vpls),
+                  std::max(1L, vpls)};
     const bool inParts = info.vplParts && info.vplParts(p.state.techniqueParams);
-    if (minTileMsPerVpl > 0.0 && !inParts) {
-        const double sliceCap = 0.8 * mLimits.sliceMs / minTileMsPerVpl;
+    if (tile.ms > 0.0 && !inParts) {
+        const double sliceCap =
+            vplsForCost(static_cast<double>(tile.vpls), tile.ms, 0.8 * mLimits.sliceMs, exponent);
         if (sliceCap < cap) {
             cap = sliceCap;
             why = "a " + std::to_string(kMinRefineTileSide) + " x " + std::to_string(kMinRefineTileSide) +

@@ -79,11 +79,11 @@ public:
     /// A finished step's cost per pixel (at the VPLs `state` rendered with).
     void recordStepCost(const std::string& sceneName, const FrameState& state, QualityStep step,
                         double msPerPixel);
-    /// A smallest tile of a technique that cannot split its VPLs overran its slice at `msPerVpl`; the
-    /// step's VPL cap follows it. True when this is news (first, or 20 % worse than known): the step
-    /// should start again with the cap.
+    /// A smallest tile of a technique that cannot split its VPLs overran its slice, taking `tileMs` at
+    /// the VPLs of `state`; the step's VPL cap follows it. True when this is news (first, or 20 % worse
+    /// than known at equal VPLs): the step should start again with the cap.
     bool recordMinTileCost(const std::string& sceneName, const FrameState& state, QualityStep step,
-                           double msPerVpl);
+                           double tileMs);
 
     /// The interactive frames' budget (their measured rates, and the costs refinement predicts from).
     FrameBudget& budget() { return mBudget; }
@@ -94,6 +94,10 @@ private:
         double msPerPixel = 0;
         long vpls = 1;
     };
+    struct TileCost {
+        double ms = 0; ///< the smallest tile's time
+        long vpls = 1; ///< at these VPLs
+    };
     static std::string stepKey(const std::string& sceneName, const FrameState& state, QualityStep step);
     void planRefinement(const std::string& sceneName, const FrameState& requested,
                         const nlohmann::json& explicitParams, Plan& plan) const;
@@ -102,8 +106,8 @@ private:
     SessionLimits mLimits;
     nlohmann::json mPresets;
     FrameBudget mBudget;
-    std::map<std::string, StepCost> mStepCost;      ///< scene/technique/step
-    std::map<std::string, double> mMinTileMsPerVpl; ///< scene/technique/step
+    std::map<std::string, StepCost> mStepCost;    ///< scene/technique/step
+    std::map<std::string, TileCost> mMinTileCost; ///< scene/technique/step
 };
 
 } // namespace gis

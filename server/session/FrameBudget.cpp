@@ -39,14 +39,11 @@ double FrameBudget::predictMs(const std::string& key, double pixels, long vpls) 
     return pixels * (r.base + r.encode) + technique;
 }
 
-double FrameBudget::msPerPixelVpl(const std::string& key) const {
+double FrameBudget::vplPassesMs(const std::string& key, double pixels, long vpls) const {
     const auto it = mRates.find(key);
-    if (it == mRates.end() || it->second.frames == 0) return 0.0;
+    if (it == mRates.end() || it->second.frames == 0 || !(pixels > 0.0)) return 0.0;
     const Rates& r = it->second;
-    // d/dv of v^e at the last count, v^(e-1) e, would understate a step's whole cost; the mean rate
-    // v^e / v is what a linear caller (the refinement's tile cap) scales by.
-    const double v = static_cast<double>(std::max(1L, r.lastVpls));
-    return r.vpl * std::pow(v, r.exponent) / v;
+    return r.vpl * pixels * std::pow(static_cast<double>(std::max(1L, vpls)), r.exponent);
 }
 
 void FrameBudget::record(const std::string& key, const FrameCost& cost) {

@@ -62,9 +62,9 @@ public:
     void record(const std::string& key, const FrameCost& cost);
     /// Predicted ms of a frame of `key` at `pixels` with `vpls`; 0 when nothing is measured.
     double predictMs(const std::string& key, double pixels, long vpls) const;
-    /// The measured ms per pixel and VPL of the technique's passes, at the last frame's VPL count (the
-    /// local rate where the cost is not linear in the VPLs); 0 when nothing is measured.
-    double msPerPixelVpl(const std::string& key) const;
+    /// Predicted ms of the technique's VPL passes alone over `pixels` with `vpls` (pixels x vpls^e at
+    /// the measured rate); 0 when nothing is measured or the technique's frames had no VPLs.
+    double vplPassesMs(const std::string& key, double pixels, long vpls) const;
 
 private:
     struct Rates {

@@ -1158,8 +1158,8 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         // batch of them is a draw), so the step starts again with the VPLs this measurement allows
         // (workerMain caps them).
         if (measureTile && !splittable && rect.width <= kMinTileSide && tileMs > 1.5 * sliceMs) {
-            const bool news = w.quality->recordMinTileCost(
-                w.scene->name, full, static_cast<QualityStep>(step), tileMs / static_cast<double>(vpls));
+            const bool news =
+                w.quality->recordMinTileCost(w.scene->name, full, static_cast<QualityStep>(step), tileMs);
             if (news && vpls > 16 && info.limitVpls && !plan.done()) {
                 progress("abandoned", shareDone, 0.0,
                          "a " + std::to_string(kMinTileSide) + " x " + std::to_string(kMinTileSide) +

@@ -1,6 +1,8 @@
 // Adaptive quality's decisions without GL or threads: presets under the client's parameters, the
 // snapshot's step, refinement capped or skipped to fit the budget and the slices, interactive frames
 // sized by the frame budget, and predictions from what earlier steps measured.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "frame/FrameState.h"
@@ -112,14 +114,62 @@ TEST(AdaptiveQuality, ASmallestTileOverItsSliceCapsTheStep) {
     const nlohmann::json none = {{"ssbc_iterations", 1}};
     const FrameState balanced = q.presetState(requested(), none, QualityStep::Balanced);
     ASSERT_EQ(balanced.techniqueParams.getInt("ssbc_iterations"), 1);
-    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 0.1)) << "first: news";
-    EXPECT_FALSE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 0.11)) << "within 20 %";
-    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 0.2)) << "much worse";
+    // Tiles of the balanced step (256 VPLs).
+    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 25.6)) << "first: news";
+    EXPECT_FALSE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 28.2)) << "within 20 %";
+    EXPECT_FALSE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 10.0)) << "cheaper";
+    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 51.2)) << "much worse";
     const AdaptiveQuality::Plan p = q.plan("cornell", requested(), none, QualityStep::Balanced, false, 80);
-    // 0.8 x 20 ms / 0.2 ms per VPL = 80 VPLs, of 256.
+    // 51.2 ms at 256 VPLs, linear: 0.8 x 20 ms fits 256 x 16 / 51.2 = 80 VPLs.
     EXPECT_FALSE(p.skip);
     EXPECT_LE(vplEstimate(p.state), 80);
     EXPECT_NE(p.why.find("slice (--slice-ms)"), std::string::npos) << p.why;
+}
+
+// hier_isr's traversal costs about leaves^0.4 (TechniqueInfo::vplCostExponent): predictions and caps
+// follow that law, not the leaves themselves, or its final step would be predicted at many times
+// its cost and capped for nothing.
+TEST(AdaptiveQuality, PredictionsAndCapsFollowTheTechniquesCostExponent) {
+    FrameState s = makeFrameState(cornell(), "hier_isr");
+    s.width = s.height = 256;
+    s.techniqueParams.set("hier_coarsest", 1);
+    const nlohmann::json hierPresets = {{"techniques",
+                                         {{"hier_isr",
+                                           {{"interactive", {{"max_depth", 16}}},
+                                            {"balanced", {{"max_depth", 64}}},
+                                            {"final", {{"max_depth", 256}}}}}}}};
+    SessionLimits l = limits();
+    l.refineBudgetMs = 1000;
+    AdaptiveQuality q(l, hierPresets);
+    const nlohmann::json none = nlohmann::json::object();
+    const FrameState interactive = q.presetState(s, none, QualityStep::Interactive);
+    const FrameState final = q.presetState(s, none, QualityStep::Final);
+    ASSERT_EQ(vplEstimate(interactive), 256);
+    ASSERT_EQ(vplEstimate(final), 65536);
+    q.recordStepCost("cornell", interactive, QualityStep::Interactive, 2e-3); // 131 ms at 256 leaves
+    // 256 times the leaves: 256^0.4 = 9.19 times the time, 1.2 s (linear: 33.6 s).
+    const double predicted = q.predictStepMs("cornell", final, QualityStep::Final);
+    EXPECT_NEAR(predicted, 131.072 * std::pow(256.0, 0.4), 1e-6);
+    // Over the 1 s budget: the cap is where the power law meets 0.9 s, 65536 x (900 / 1205)^(1 / 0.4)
+    // = 31,593 leaves, so max_depth 128 (16,384); a linear cap would give 1,759 leaves, max_depth 32.
+    const AdaptiveQuality::Plan plan = q.plan("cornell", s, none, QualityStep::Final, false, 80);
+    EXPECT_FALSE(plan.skip) << plan.why;
+    EXPECT_EQ(plan.state.techniqueParams.getInt("max_depth"), 128) << plan.why;
+    EXPECT_NE(plan.why.find("--refine-budget-ms"), std::string::npos) << plan.why;
+
+    // A smallest tile over its slice: 64 ms at the balanced step's 4,096 leaves; 0.8 x 20 ms is a
+    // quarter of that, (1/4)^(1 / 0.4) x 4,096 = 128 leaves fit (linear: 1,024), so max_depth 8.
+    const FrameState balanced = q.presetState(s, {{"ssbc_iterations", 1}}, QualityStep::Balanced);
+    ASSERT_EQ(vplEstimate(balanced), 4096);
+    EXPECT_TRUE(q.recordMinTileCost("cornell", balanced, QualityStep::Balanced, 64.0));
+    // Tiles are compared at equal leaves: 64 ms at 4,096 is 36.8 ms at 1,024, so 30 ms there is no news.
+    FrameState fewer = balanced;
+    fewer.techniqueParams.set("max_depth", 32);
+    EXPECT_FALSE(q.recordMinTileCost("cornell", fewer, QualityStep::Balanced, 30.0)) << "cheaper than 36.8";
+    const AdaptiveQuality::Plan tiled =
+        q.plan("cornell", s, {{"ssbc_iterations", 1}}, QualityStep::Balanced, false, 80);
+    EXPECT_EQ(tiled.state.techniqueParams.getInt("max_depth"), 8) << tiled.why;
+    EXPECT_NE(tiled.why.find("slice (--slice-ms)"), std::string::npos) << tiled.why;
 }
 
 TEST(AdaptiveQuality, SnapshotsTakeTheBestStepThatFits) {
