@@ -2,7 +2,8 @@
 // that asks for a 960x800 view of a scene, orbits the camera around its target (a camera message every
 // 30 ms, frames acknowledged as they arrive) and reports the interactive frames' rate against their own
 // render time (frame_ms): a rate below 1000 / frame_ms is time the server spends outside the frame.
-// Also the frame budget's last reason, size and VPLs. usage:
+// Also the frame budget's last reason, size and VPLs, and how often the size changed; with
+// WS_ORBIT_DUMP=1 the last frame's passes and timings as well. usage:
 //   node bench/interactive/ws_orbit.mjs [--server build/ci/bin/gi-server] [--scene builtin:cornell]
 //        [--seconds 10] [--server-args "--technique hier_isr"]
 import WebSocket from 'ws';
@@ -54,8 +55,11 @@ setTimeout(() => {
     const report = { scene: opts.scene, frames: frames.length, fps: +((frames.length - 1) / span).toFixed(2),
         cadence_ms: +(1000 * span / (frames.length - 1)).toFixed(1),
         frame_ms_p50: +percentile(frames.map((f) => f.ms), 0.5).toFixed(1),
-        size: last.size, vpls: last.counts?.vpl_count ?? null, budget: last.budget?.reason ?? null };
+        size: last.size, vpls: last.counts?.vpl_count ?? null, budget: last.budget?.reason ?? null,
+        // Frames whose size differs from the frame before: each resizes the technique's targets.
+        size_changes: frames.filter((f, i) => i > 0 && String(f.m.size) !== String(frames[i - 1].m.size)).length };
     console.log(JSON.stringify(report));
+    if (process.env.WS_ORBIT_DUMP) console.log(JSON.stringify({ passes: last.passes, timing: last.timing, input: last.input, readback: last.readback_ms, technique_ms: last.technique_ms }));
     server.kill();
     process.exit(0);
 }, (opts.seconds + 4) * 1000);
