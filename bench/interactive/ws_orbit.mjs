@@ -2,7 +2,8 @@
 // that asks for a 960x800 view of a scene, orbits the camera around its target (a camera message every
 // 30 ms, frames acknowledged as they arrive) and reports the interactive frames' rate against their own
 // render time (frame_ms): a rate below 1000 / frame_ms is time the server spends outside the frame.
-// Also the frame budget's last reason, size and VPLs, and how often the size changed; with
+// Also the frame budget's last reason, size and VPLs, how often the size changed and how many frames
+// of other qualities (refinement steps) came between; with
 // WS_ORBIT_DUMP=1 the last frame's passes and timings as well. usage:
 //   node bench/interactive/ws_orbit.mjs [--server build/ci/bin/gi-server] [--scene builtin:cornell]
 //        [--seconds 10] [--server-args "--technique hier_isr"]
@@ -17,6 +18,7 @@ const { server, port, log } = await startServer(opts.server,
 const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
 let camera = null, shown = false, angle = 0;
 const frames = [];
+const others = []; // frames of other qualities (refinement steps) while orbiting
 ws.on('open', () => {
     ws.send(JSON.stringify({ type: 'hello', protocol: 2, size: [960, 800], dpr: 1, max_in_flight: 2, codecs: ['jpeg'] }));
     ws.send(JSON.stringify({ type: 'scene', name: opts.scene }));
@@ -31,9 +33,10 @@ ws.on('message', (data, binary) => {
     if (m.type === 'error') console.error(`server: ${m.message}`);
     if (m.type !== 'stats' || m.scene !== opts.scene) return;
     // Two seconds of orbit before counting: the budget settles on its size and VPLs.
-    if (!shown) setTimeout(() => frames.splice(0), 2000);
+    if (!shown) setTimeout(() => { frames.splice(0); others.splice(0); }, 2000);
     shown = true;
     if (m.quality === 'interactive') frames.push({ t: Date.now(), ms: m.frame_ms, m });
+    else others.push(m.quality);
 });
 const orbit = setInterval(() => {
     if (!shown || !camera) return;
@@ -57,6 +60,7 @@ setTimeout(() => {
         frame_ms_p50: +percentile(frames.map((f) => f.ms), 0.5).toFixed(1),
         size: last.size, vpls: last.counts?.vpl_count ?? null, budget: last.budget?.reason ?? null,
         // Frames whose size differs from the frame before: each resizes the technique's targets.
+        other_frames: others.length,
         size_changes: frames.filter((f, i) => i > 0 && String(f.m.size) !== String(frames[i - 1].m.size)).length };
     console.log(JSON.stringify(report));
     if (process.env.WS_ORBIT_DUMP) console.log(JSON.stringify({ passes: last.passes, timing: last.timing, input: last.input, readback: last.readback_ms, technique_ms: last.technique_ms }));
