@@ -72,8 +72,7 @@ namespace {
 // A technique's passes cost about vpls^e (TechniqueInfo::vplCostExponent): 1 for a sum over every VPL,
 // less for a traversal such as hier_isr's, whose cost grows far more slowly than its leaves.
 double vplCostExponent(const FrameState& state) {
-    const double e = findTechniqueInfo(state.technique).vplCostExponent;
-    return std::isfinite(e) ? std::clamp(e, 0.05, 1.0) : 1.0;
+    return usableVplCostExponent(findTechniqueInfo(state.technique).vplCostExponent);
 }
 
 // The VPLs at which a cost of `costMs` at `vpls` falls to `targetMs`, under that power law.

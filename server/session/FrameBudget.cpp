@@ -21,6 +21,10 @@ struct Candidate {
 
 } // namespace
 
+double usableVplCostExponent(double exponent) {
+    return std::isfinite(exponent) ? std::clamp(exponent, 0.05, 1.0) : 1.0;
+}
+
 nlohmann::json BudgetChoice::toJson(double targetMs, long requestedVpls) const {
     return {{"target_ms", targetMs},
             {"scale", scale},
@@ -52,9 +56,7 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     const double technique = std::clamp(cost.techniqueMs, 0.0, cost.frameMs);
     const double base = (cost.frameMs - technique) / cost.pixels;
     const double encode = std::max(cost.encodeMs, 0.0) / cost.pixels;
-    // Exponents outside (0, 1] would model a technique whose VPLs cost more than linearly, or nothing.
-    const double exponent =
-        std::isfinite(cost.vplCostExponent) ? std::clamp(cost.vplCostExponent, 0.05, 1.0) : 1.0;
+    const double exponent = usableVplCostExponent(cost.vplCostExponent);
     if (exponent != r.exponent) r.frames = 0; // another model: start its means again
     r.exponent = exponent;
     const double vpl =
@@ -64,10 +66,7 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     const double a = r.frames == 0 ? 1.0 : 0.5;
     r.base += a * (base - r.base);
     r.encode += a * (encode - r.encode);
-    if (cost.vpls > 0) {
-        r.vpl += a * (vpl - r.vpl);
-        r.lastVpls = cost.vpls;
-    }
+    if (cost.vpls > 0) r.vpl += a * (vpl - r.vpl);
     r.tech += a * (tech - r.tech);
     ++r.frames;
 }

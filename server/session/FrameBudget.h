@@ -19,6 +19,10 @@
 
 namespace gis {
 
+/// A technique's vplCostExponent as the cost models use it: within [0.05, 1] (above 1 would model VPLs
+/// that cost more than linearly, 0 none at all); 1 when not finite.
+double usableVplCostExponent(double exponent);
+
 /// One measured interactive frame.
 struct FrameCost {
     double pixels = 0;      ///< rendered
@@ -70,8 +74,7 @@ private:
     struct Rates {
         double base = 0, encode = 0, vpl = 0; ///< ms per pixel, ms per pixel, ms per pixel per VPL^exponent
         double exponent = 1.0;                ///< FrameCost::vplCostExponent of the last frame
-        long lastVpls = 0;
-        double tech = 0; ///< ms per pixel of the technique when it has no VPLs
+        double tech = 0;                      ///< ms per pixel of the technique when it has no VPLs
         int frames = 0;
         int level = -1; ///< index of the last choice in the candidate ladder
     };
