@@ -1,9 +1,11 @@
 // What the node benchmarks that drive a gi-server share: their `--name value` options, starting the
-// server on a free loopback port, and percentiles.
+// server on a free loopback port, a WebSocket client without a browser, and percentiles.
 import { spawn } from 'node:child_process';
 import net from 'node:net';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+
+import WebSocket from 'ws';
 
 export const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 export const DEFAULT_SERVER = path.join(ROOT, 'build/ci/bin/gi-server');
@@ -55,6 +57,48 @@ export async function startServer(serverPath, args = [], { nice = 0 } = {}) {
     // the next measurement runs on).
     process.on('exit', () => server.kill('SIGKILL'));
     return { server, port, log: () => log };
+}
+
+/**
+ * A WebSocket client of the server on `port` (no browser): says hello (JPEG frames, dpr 1, two in
+ * flight, then the fields of `hello`) and acknowledges every frame. Resolves once open with a link:
+ * {ws, state (the latest welcome or state message's), stats (the latest), frames ({at, stats} per
+ * frame received), progress ({at, ...message}), onFrame (called with each frame's stats when set),
+ * send(message), until(what, test, timeoutMs) (waits until test() holds, or throws naming `what`)}.
+ */
+export function connectClient(port, hello = {}) {
+    const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
+    const link = { ws, stats: null, frames: [], progress: [], state: null, waiters: [] };
+    const wake = () => { for (const w of link.waiters.splice(0)) w(); };
+    ws.on('message', (data, isBinary) => {
+        if (isBinary) {
+            ws.send(JSON.stringify({ type: 'ack', frame: data.readUInt32LE(4) }));
+            if (link.stats) link.frames.push({ at: performance.now(), stats: link.stats });
+            link.onFrame?.(link.stats);
+        } else {
+            const m = JSON.parse(data.toString());
+            if (m.type === 'stats') link.stats = m;
+            else if (m.type === 'progress') link.progress.push({ at: performance.now(), ...m });
+            else if (m.type === 'welcome' || m.type === 'state') link.state = m.state;
+            else if (m.type === 'error') console.error(`server error: ${m.message}`);
+        }
+        wake();
+    });
+    link.until = async (what, test, timeoutMs = 60000) => {
+        const end = performance.now() + timeoutMs;
+        while (!test()) {
+            if (performance.now() > end) throw new Error(`timed out waiting for ${what}`);
+            await new Promise((resolve) => { link.waiters.push(resolve); setTimeout(resolve, 100); });
+        }
+    };
+    link.send = (m) => ws.send(JSON.stringify(m));
+    return new Promise((resolve, reject) => {
+        ws.on('open', () => {
+            link.send({ type: 'hello', protocol: 2, codecs: ['jpeg'], dpr: 1, max_in_flight: 2, ...hello });
+            resolve(link);
+        });
+        ws.on('error', reject);
+    });
 }
 
 /**

@@ -12,51 +12,12 @@
 //
 //   node bench/interactive/light_drag.mjs [--server build/ci/bin/gi-server] [--scene builtin:atrium]
 //       [--rounds 3] [--drag-s 4] [--press-ms 60] [--settings "--interactive-lod-px 1|--interactive-lod-px 0"]
-import WebSocket from 'ws';
-import { DEFAULT_SERVER, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
+import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:atrium', rounds: 3, 'drag-s': 4, 'press-ms': 60,
     settings: '--interactive-lod-px 1|--interactive-lod-px 0', size: '960x800' },
 'usage: node bench/interactive/light_drag.mjs [--server PATH] [--scene NAME] [--rounds N] [--drag-s S] [--press-ms MS] [--size WxH] [--settings "FLAGS|FLAGS"]');
 const [width, height] = opts.size.split('x').map(Number);
-
-// One connection's messages, with waits on what arrives.
-function connect(port) {
-    const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
-    const link = { ws, stats: null, frames: [], progress: [], state: null, waiters: [] };
-    const wake = () => { for (const w of link.waiters.splice(0)) w(); };
-    ws.on('message', (data, isBinary) => {
-        if (isBinary) {
-            const id = data.readUInt32LE(4);
-            ws.send(JSON.stringify({ type: 'ack', frame: id }));
-            if (link.stats) link.frames.push({ at: performance.now(), stats: link.stats });
-            link.onFrame?.(link.stats);
-        } else {
-            const m = JSON.parse(data.toString());
-            if (m.type === 'stats') link.stats = m;
-            else if (m.type === 'progress') link.progress.push({ at: performance.now(), ...m });
-            else if (m.type === 'welcome' || m.type === 'state') link.state = m.state;
-            else if (m.type === 'error') console.error(`server error: ${m.message}`);
-        }
-        wake();
-    });
-    link.until = async (what, test, timeoutMs = 60000) => {
-        const end = performance.now() + timeoutMs;
-        while (!test()) {
-            if (performance.now() > end) throw new Error(`timed out waiting for ${what}`);
-            await new Promise((resolve) => { link.waiters.push(resolve); setTimeout(resolve, 100); });
-        }
-    };
-    link.send = (m) => ws.send(JSON.stringify(m));
-    return new Promise((resolve, reject) => {
-        ws.on('open', () => {
-            link.send({ type: 'hello', protocol: 2, client: 'light_drag', codecs: ['jpeg'], adaptive: true,
-                size: [width, height], dpr: 1, max_in_flight: 2 });
-            resolve(link);
-        });
-        ws.on('error', reject);
-    });
-}
 
 // The light `angle` into the drag: a directional light's direction turned about the vertical, another
 // light moved sideways by up to a twentieth of the scene's extent (a light on the vertical axis
@@ -74,7 +35,7 @@ function turned(light, bounds, angle) {
 async function measure(flags) {
     const { server, port } = await startServer(opts.server, flags.split(' ').filter(Boolean));
     try {
-        const link = await connect(port);
+        const link = await connectClient(port, { client: 'light_drag', adaptive: true, size: [width, height] });
         await link.until('the welcome', () => link.state);
         link.send({ type: 'scene', name: opts.scene });
         await link.until(`frames of ${opts.scene}`, () => link.stats?.scene === opts.scene, 120000);
