@@ -1,7 +1,8 @@
 // The eye hierarchy's receiver list (shared/EyeHierarchy.h, EyeHierarchy::build): the stencil pass
 // appends every receiver (eyeAppendReceiver, eye_receivers.frag); a receiver pass is a compute program
-// that defines GIS_EYE_RECEIVER_PASS before including this file: one invocation per item
-// (eyeReceiver), each adding its light to the illumination atlas (eyeAddIllumination).
+// that defines GIS_EYE_RECEIVER_PASS before including this file (after common.glsl): one invocation
+// per item (eyeReceiver), lit where eyeReceiverGeometry says, adding its light to the illumination
+// atlas (eyeAddIllumination).
 #include "shared/EyeHierarchy.h"
 
 layout(std430, binding = GIS_SSBO_EYE_RECEIVERS) buffer EyeReceiverList {
@@ -34,6 +35,20 @@ bool eyeReceiver(out ivec2 atlasTexel) {
     uint item = gReceivers[i];
     atlasTexel = ivec2(int(item & 0xFFFFu), int(item >> 16));
     return true;
+}
+
+layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position, w covered pixels
+layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
+layout(binding = 8) uniform sampler2D gPosition;    // level 0 is the G-buffer itself
+layout(binding = 9) uniform sampler2D gNormal;
+
+// Where a receiver is lit: a level-0 texel is its G-buffer pixel, a coarser patch its mean position
+// and normal (EyeHierarchy::bindInputs binds both).
+void eyeReceiverGeometry(ivec2 atlasTexel, out vec3 position, out vec3 normal) {
+    bool pixel = all(lessThan(vec2(atlasTexel), gFrame.viewport.xy));
+    position = pixel ? texelFetch(gPosition, atlasTexel, 0).xyz
+                     : texelFetch(uGeoPosition, atlasTexel, 0).xyz;
+    normal = pixel ? texelFetch(gNormal, atlasTexel, 0).xyz : texelFetch(uGeoNormal, atlasTexel, 0).xyz;
 }
 
 // What a receiver pass adds, as the additive blend of a fragment pass did: rgb accumulates, alpha 1

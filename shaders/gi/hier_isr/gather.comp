@@ -17,11 +17,6 @@
 #include "gi/common/light_tree.glsl"
 #include "gi/common/vpl_transport.glsl"
 
-layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position
-layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
-layout(binding = 8) uniform sampler2D gPosition;    // level 0 is the G-buffer itself
-layout(binding = 9) uniform sampler2D gNormal;
-
 // Traversal statistics: 64-bit sums as (lo, hi) pairs (a full traversal at R = 256 visits 87k
 // nodes per receiver, which overflows 32 bits over a frame).
 layout(std430, binding = 3) buffer CutStats {
@@ -45,9 +40,8 @@ uint packNode(int level, ivec2 t) { return uint(level) | (uint(t.x) << 4) | (uin
 void main() {
     ivec2 a;
     if (!eyeReceiver(a)) return;
-    bool pixel = all(lessThan(vec2(a), gFrame.viewport.xy));
-    vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
-    vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
+    vec3 pos, n;
+    eyeReceiverGeometry(a, pos, n);
 
     // Omega (1 - tau) / (pi tau); tau is inside (0, 1) whenever the test runs.
     float t = gFrame.rsmInfo.y;

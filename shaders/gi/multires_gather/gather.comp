@@ -12,11 +12,6 @@
 #include "gi/common/vpl_transport.glsl"
 #include "gi/common/vpl_batch.glsl"
 
-layout(binding = 0) uniform sampler2D uGeoPosition; // atlas: xyz mean position, w covered pixels
-layout(binding = 1) uniform sampler2D uGeoNormal;   // atlas: xyz mean normal
-layout(binding = 8) uniform sampler2D gPosition;    // level 0 is the G-buffer itself
-layout(binding = 9) uniform sampler2D gNormal;
-
 uniform int uVplCount;
 uniform float uVplScale = 1.0; // the number of VPL parts (1 without parts, and when not set)
 uniform float uMinDistance; // m, point kernel only
@@ -24,9 +19,8 @@ uniform float uMinDistance; // m, point kernel only
 void main() {
     ivec2 a;
     if (!eyeReceiver(a)) return;
-    bool pixel = all(lessThan(vec2(a), gFrame.viewport.xy));
-    vec3 pos = pixel ? texelFetch(gPosition, a, 0).xyz : texelFetch(uGeoPosition, a, 0).xyz;
-    vec3 n = pixel ? texelFetch(gNormal, a, 0).xyz : texelFetch(uGeoNormal, a, 0).xyz;
+    vec3 pos, n;
+    eyeReceiverGeometry(a, pos, n);
     vec3 e = vec3(0.0);
 #define GATHER_TERM(i) vplIrradianceSelected(pos, n, batchVpl(i), uMinDistance)
     GIS_SUM_OVER_BATCH(e, uVplCount, GATHER_TERM)
