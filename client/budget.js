@@ -88,7 +88,12 @@ const ms0 = (v) => (Number.isFinite(v) ? `${Math.round(v)} ms` : '–');
 export function budgetLine(budget) {
     if (!budget || typeof budget !== 'object') return null;
     const parts = [`predicted ${ms0(budget.predicted_ms)}`];
-    if (Number.isFinite(budget.vpls)) {
+    // The receiver cap cut this frame's VPLs further, after the budget's own cap (the view had many
+    // more receivers than the frame before it).
+    const receiverCapped = Number.isFinite(budget.receiver_capped_vpls);
+    if (receiverCapped) {
+        parts.push(`VPLs ${budget.receiver_capped_vpls} of ${budget.vpls} (receiver cap)`);
+    } else if (Number.isFinite(budget.vpls)) {
         parts.push(Number.isFinite(budget.vpl_cap) && budget.vpl_cap < budget.vpls
             ? `VPLs ${budget.vpl_cap} of ${budget.vpls}` : `VPLs ${budget.vpls}`);
     }
@@ -104,6 +109,6 @@ export function budgetLine(budget) {
     return {
         text: `budget ${ms0(budget.target_ms)}: ${parts.join(' · ')}`,
         reason: typeof budget.reason === 'string' ? budget.reason : '',
-        capped: Number.isFinite(budget.vpl_cap) && budget.vpl_cap < budget.vpls,
+        capped: receiverCapped || (Number.isFinite(budget.vpl_cap) && budget.vpl_cap < budget.vpls),
     };
 }

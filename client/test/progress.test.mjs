@@ -204,6 +204,11 @@ test('a frame\'s budget reads as one line with its reason', () => {
         'budget 80 ms: predicted 12 ms · VPLs 64 · detail within 1 px, light views 1 texel', 'and in the light views');
     assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, light_lod_texels: 0.5 }).text,
         'budget 80 ms: predicted 12 ms · VPLs 64 · light views within 0.5 texels');
+    const receivers = budgetLine({ target_ms: 80, vpls: 4096, vpl_cap: null, receiver_share_cap: 0.04,
+        receiver_capped_vpls: 361, predicted_ms: 70, reason: 'fits; this view\'s receivers exceed the cap' });
+    assert.equal(receivers.text, 'budget 80 ms: predicted 70 ms · VPLs 361 of 4096 (receiver cap)',
+        'a frame the receiver cap cut says so');
+    assert.equal(receivers.capped, true);
     assert.equal(budgetLine(undefined), null);
     assert.equal(budgetLine('x'), null);
 });

@@ -28,6 +28,13 @@ struct TechniqueInfo {
     /// the session's frame budget (session/FrameBudget.h) makes an interactive frame cheaper. Empty:
     /// the count cannot be capped (hier_isr's cut adapts per receiver instead).
     std::function<void(ParamSet& technique, long vpls)> limitVpls;
+    /// Caps the gather's work per frame at `share` receivers per pixel (the techniques that gather over
+    /// the eye hierarchy's receiver list): a frame whose hierarchy selects more receivers than `share`
+    /// of its pixels gathers from proportionally fewer VPLs, so that receivers x VPLs stay at what
+    /// `share` would cost. The frame budget sets it from its last frame's share: the receivers, and
+    /// with them the gather's time, can grow tenfold between two frames of an orbit, which no cost
+    /// model fitted on the frames before predicts. Empty: no such cap.
+    std::function<void(ParamSet& technique, double share)> capReceiverShare;
     /// How the technique's passes' time grows with vplEstimate: about vpls^vplCostExponent (at a fixed
     /// size). 1 for the techniques that sum over every VPL; below 1 for a traversal whose cut grows
     /// much more slowly than its leaves (hier_isr). The frame budget models and caps with it.

@@ -175,7 +175,7 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
     if (p.step != QualityStep::Interactive && !snapshot && mLimits.refineBudgetMs > 0)
         planRefinement(sceneName, requested, explicitParams, p);
     if (p.step == QualityStep::Interactive && !snapshot) {
-        planInteractive(frameTargetMs, p);
+        planInteractive(frameTargetMs, explicitParams, p);
         if (budgetProbes) p.budget["env_budget_ms"] = envBudgetMs;
         // Interactive frames only: the steps that refine the view draw every triangle.
         if (mLimits.interactiveLodPixels > 0.0 && p.state.frameParams.has("lod_pixels") &&
@@ -246,7 +246,7 @@ void AdaptiveQuality::planRefinement(const std::string& sceneName, const FrameSt
     }
 }
 
-void AdaptiveQuality::planInteractive(int frameTargetMs, Plan& p) {
+void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& explicitParams, Plan& p) {
     const long requestedVpls = vplEstimate(p.state);
     if (frameTargetMs > 0) {
         mBudget.setTargetMs(frameTargetMs);
@@ -256,7 +256,12 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, Plan& p) {
                            static_cast<double>(p.state.width) * p.state.height);
         p.scale = choice.scale;
         if (choice.vplCap > 0 && info.limitVpls) info.limitVpls(p.state.techniqueParams, choice.vplCap);
+        // A cap the client set itself stays.
+        const bool capReceivers = choice.receiverShareCap > 0.0 && info.capReceiverShare &&
+                                  !explicitParams.contains("receiver_share_cap");
+        if (capReceivers) info.capReceiverShare(p.state.techniqueParams, choice.receiverShareCap);
         p.budget = choice.toJson(frameTargetMs, requestedVpls);
+        if (!capReceivers) p.budget["receiver_share_cap"] = nullptr;
     } else {
         p.scale = std::clamp(mLimits.interactiveScale, 0.05, 1.0);
         p.budget = {

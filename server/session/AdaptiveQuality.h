@@ -101,7 +101,7 @@ private:
     static std::string stepKey(const std::string& sceneName, const FrameState& state, QualityStep step);
     void planRefinement(const std::string& sceneName, const FrameState& requested,
                         const nlohmann::json& explicitParams, Plan& plan) const;
-    void planInteractive(int frameTargetMs, Plan& plan);
+    void planInteractive(int frameTargetMs, const nlohmann::json& explicitParams, Plan& plan);
 
     SessionLimits mLimits;
     nlohmann::json mPresets;

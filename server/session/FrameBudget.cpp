@@ -25,11 +25,56 @@ double usableVplCostExponent(double exponent) {
     return std::isfinite(exponent) ? std::clamp(exponent, 0.05, 1.0) : 1.0;
 }
 
+double receiverShareCapAfter(double lastShare) {
+    if (!std::isfinite(lastShare) || lastShare < 0.0) return 1.0;
+    return std::clamp(kReceiverShareGrowth * lastShare, kMinReceiverShareCap, 1.0);
+}
+
+FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
+                             double vplCostExponent) {
+    FrameCost cost;
+    cost.pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
+    cost.vpls = askedVpls;
+    cost.vplCostExponent = vplCostExponent;
+    cost.frameMs = stats.value("frame_ms", 0.0);
+    cost.techniqueMs = stats.value("technique_ms", 0.0);
+    const nlohmann::json counts = stats.value("counts", nlohmann::json::object());
+    const double cappedGrid = counts.value("receiver_share_capped_grid", 0.0);
+    if (cappedGrid >= 1.0) cost.vpls = std::min(askedVpls, static_cast<long>(cappedGrid * cappedGrid));
+    if (counts.contains("receivers_total") && cost.pixels > 0.0) {
+        const double gathered =
+            askedVpls > 0 ? static_cast<double>(cost.vpls) / static_cast<double>(askedVpls) : 1.0;
+        cost.receiverShare = counts.value("receivers_total", 0.0) / cost.pixels * gathered;
+    }
+    return cost;
+}
+
+void noteReceiverCap(nlohmann::json& budget, const nlohmann::json& frameStats, int width, int height) {
+    const nlohmann::json counts = frameStats.value("counts", nlohmann::json::object());
+    const double grid = counts.value("receiver_share_capped_grid", 0.0);
+    const double pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
+    if (!budget.is_object() || grid < 1.0 || !(pixels > 0.0)) return;
+    const long vpls = static_cast<long>(grid * grid);
+    budget["receiver_capped_vpls"] = vpls;
+    const double cap = budget.value("receiver_share_cap", 0.0);
+    const std::string asked = budget.contains("vpl_cap") && budget["vpl_cap"].is_number()
+                                  ? budget["vpl_cap"].dump()
+                                  : budget.value("vpls", nlohmann::json(0)).dump();
+    budget["reason"] =
+        budget.value("reason", std::string()) +
+        fmt("; this view's receivers (%.0f%% of the pixels) exceed the %.0f%% cap set from the "
+            "last frame: ",
+            100.0 * counts.value("receivers_total", 0.0) / pixels, 100.0 * cap) +
+        std::to_string(vpls) + " of " + asked + " VPLs gathered";
+}
+
 nlohmann::json BudgetChoice::toJson(double targetMs, long requestedVpls) const {
     return {{"target_ms", targetMs},
             {"scale", scale},
             {"vpls", requestedVpls},
             {"vpl_cap", vplCap > 0 ? nlohmann::json(vplCap) : nlohmann::json(nullptr)},
+            {"receiver_share_cap",
+             receiverShareCap > 0 ? nlohmann::json(receiverShareCap) : nlohmann::json(nullptr)},
             {"predicted_ms", predictedMs},
             {"reason", reason}};
 }
@@ -68,6 +113,9 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     r.encode += a * (encode - r.encode);
     if (cost.vpls > 0) r.vpl += a * (vpl - r.vpl);
     r.tech += a * (tech - r.tech);
+    // The last frame's, not a mean: the cap follows the view (its next frame sees nearly the same).
+    r.receiverShare =
+        std::isfinite(cost.receiverShare) && cost.receiverShare >= 0.0 ? cost.receiverShare : -1;
     ++r.frames;
 }
 
@@ -85,6 +133,7 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
         return out;
     }
     Rates& rates = it->second;
+    if (rates.receiverShare >= 0.0) out.receiverShareCap = receiverShareCapAfter(rates.receiverShare);
     // The ladder from the best frame to the cheapest: size down to the preferred minimum, then VPLs
     // down, then size down to the minimum.
     std::vector<Candidate> ladder;

@@ -10,6 +10,9 @@
 // where baseRate comes from the renderer's own stages (shadow maps, G-buffer, direct, composite,
 // reflections, overheads) and vplRate from the technique's passes. Counting all of the technique's
 // passes as VPL-bound over-predicts what more VPLs cost, so the budget climbs cautiously.
+// A technique that gathers over receivers (multires_gather) costs receivers x VPLs, and a view's
+// receivers are not a model's to predict: the next frame's gather is capped at twice the last
+// frame's receiver share instead (receiverShareCapAfter, TechniqueInfo::capReceiverShare).
 #pragma once
 
 #include <map>
@@ -32,6 +35,17 @@ struct FrameCost {
     double encodeMs = 0;
     /// The technique's passes cost about pixels x vpls^vplCostExponent (TechniqueInfo::vplCostExponent).
     double vplCostExponent = 1.0;
+    /// The gather's work per pixel and VPL asked for: receivers per pixel (counts receivers_total /
+    /// pixels) times the share of the asked VPLs a receiver cap left the gather. Below 0 when the
+    /// technique has no receiver list.
+    double receiverShare = -1;
+
+    /// A rendered frame's cost from its stats (frame_ms, technique_ms, counts) at width x height, whose
+    /// parameters asked for `askedVpls` (vplEstimate): a frame over its receiver cap
+    /// (counts.receiver_share_capped_grid) counts the VPLs it gathered, and its work share is the
+    /// receivers per pixel times the share of the asked VPLs it gathered. encodeMs stays 0.
+    static FrameCost ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
+                             double vplCostExponent);
 };
 
 /// What the next interactive frame renders with, and why.
@@ -39,9 +53,26 @@ struct BudgetChoice {
     double scale = 1.0;     ///< size factor (0, 1]
     long vplCap = 0;        ///< 0: the parameters' own count
     double predictedMs = 0; ///< 0: nothing measured yet
+    /// The gather's work cap for the next frame (TechniqueInfo::capReceiverShare), receivers per pixel;
+    /// 0: none (nothing measured, or the technique has no receivers).
+    double receiverShareCap = 0;
     std::string reason;
     nlohmann::json toJson(double targetMs, long requestedVpls) const;
 };
+
+/// The gather's work cap after a frame whose work was `lastShare` (FrameCost::receiverShare): twice
+/// that, and at least kMinReceiverShareCap. The usual frame-to-frame change in an orbit gathers every
+/// VPL, while a step to a view with ten times the receivers (from outside a building into it) costs at
+/// most twice the last gather's work per pixel and VPL, and the frames after it at most double again
+/// each, while the budget's size and VPL choice catch up with the new cost.
+inline constexpr double kReceiverShareGrowth = 2.0;
+inline constexpr double kMinReceiverShareCap = 0.02;
+double receiverShareCapAfter(double lastShare);
+
+/// What the receiver cap did to a rendered frame, into its stats.budget (BudgetChoice::toJson): when
+/// the frame gathered from a coarser grid (counts.receiver_share_capped_grid), receiver_capped_vpls
+/// (the VPLs it gathered) and a sentence on the reason. Nothing otherwise.
+void noteReceiverCap(nlohmann::json& budget, const nlohmann::json& frameStats, int width, int height);
 
 class FrameBudget {
 public:
@@ -75,6 +106,7 @@ private:
         double base = 0, encode = 0, vpl = 0; ///< ms per pixel, ms per pixel, ms per pixel per VPL^exponent
         double exponent = 1.0;                ///< FrameCost::vplCostExponent of the last frame
         double tech = 0;                      ///< ms per pixel of the technique when it has no VPLs
+        double receiverShare = -1;            ///< the last frame's (FrameCost::receiverShare)
         int frames = 0;
         int level = -1; ///< index of the last choice in the candidate ladder
     };

@@ -1395,7 +1395,10 @@ void Session::workerMain() {
         nlohmann::json stats = frame.stats;
         stats["scale"] = scale;
         stats["queue_ms"] = queueMs;
-        if (!budgetJson.is_null()) stats["budget"] = budgetJson;
+        if (!budgetJson.is_null()) {
+            stats["budget"] = budgetJson;
+            noteReceiverCap(stats["budget"], frame.stats, frame.width, frame.height);
+        }
         if (answersInputOf)
             // How long the input waited for the worker (a tile or an unacknowledged frame ahead of
             // it), and from its arrival to the frame about to be encoded.
@@ -1404,18 +1407,12 @@ void Session::workerMain() {
                 {"window_wait_ms", windowWaitMs},
                 {"rendered_ms",
                  std::chrono::duration<double, std::milli>(Clock::now() - *answersInputOf).count()}};
-        const double frameMs = frame.stats.value("frame_ms", 0.0);
-        const double techniqueMs = frame.stats.value("technique_ms", 0.0);
         if (!deliver(w, frame.rgba8, frame.width, frame.height, std::move(stats), stepName(step), stream,
                      snapshotFor, snapshotCodec))
             break;
         if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
-            FrameCost cost;
-            cost.pixels = static_cast<double>(frame.width) * frame.height;
-            cost.vpls = vplEstimate(state);
-            cost.vplCostExponent = findTechniqueInfo(state.technique).vplCostExponent;
-            cost.frameMs = frameMs;
-            cost.techniqueMs = techniqueMs;
+            FrameCost cost = FrameCost::ofFrame(frame.stats, frame.width, frame.height, vplEstimate(state),
+                                                findTechniqueInfo(state.technique).vplCostExponent);
             {
                 std::lock_guard lock(mMutex);
                 cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);

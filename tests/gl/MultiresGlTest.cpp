@@ -183,6 +183,45 @@ TEST(Multires, ZeroThresholdsReproduceFullResolutionGather) {
     EXPECT_LT(relativeRmseOf(gather, full), 1e-3);
 }
 
+// The live view's work cap: a frame whose hierarchy lists more receivers than receiver_share_cap of its
+// pixels gathers from the coarser grid the cap leaves (the side scaled by sqrt(cap / share)), and is
+// then exactly that grid's frame; a cap at or above the frame's share changes nothing.
+TEST(Multires, ReceiverShareCapGathersFromTheGridItLeaves) {
+    constexpr int kWidth = 96, kHeight = 80;
+    const nlohmann::json base = {{"vpl_grid", 24}};
+    const FrameOutput uncapped = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, base);
+    const double share = counter(uncapped, "receivers_total") / (kWidth * kHeight);
+    ASSERT_GT(share, 0.01);
+    ASSERT_EQ(counter(uncapped, "vpl_count"), 24 * 24);
+
+    nlohmann::json atShare = base;
+    atShare["receiver_share_cap"] = std::min(1.0, share * 1.001);
+    const FrameOutput same = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, atShare);
+    EXPECT_EQ(counter(same, "receiver_share_capped_grid"), 0);
+    EXPECT_EQ(counter(same, "vpl_count"), 24 * 24);
+    EXPECT_EQ(same.linear, uncapped.linear);
+
+    // A quarter of the share (and a hair more, against rounding): half the side.
+    nlohmann::json quarter = base;
+    quarter["receiver_share_cap"] = share / 4.0 * 1.001;
+    const FrameOutput capped = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, quarter);
+    EXPECT_EQ(counter(capped, "receiver_share_capped_grid"), 12);
+    EXPECT_EQ(counter(capped, "vpl_count"), 12 * 12);
+    EXPECT_EQ(counter(capped, "receivers_total"), counter(uncapped, "receivers_total"));
+    const FrameOutput grid12 =
+        renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, {{"vpl_grid", 12}});
+    EXPECT_EQ(capped.linear, grid12.linear);
+    EXPECT_GT(relativeRmseOf(capped, uncapped), 1e-4) << "a coarser grid must change the image";
+
+    // Far below any share: one VPL, never none.
+    nlohmann::json tiny = base;
+    tiny["receiver_share_cap"] = 0.001;
+    const FrameOutput one = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, tiny);
+    EXPECT_EQ(counter(one, "receiver_share_capped_grid"),
+              std::max(1.0, std::floor(24 * std::sqrt(0.001 / share))));
+    EXPECT_EQ(badValues(one), 0u);
+}
+
 // 001: "scattering and gathering give results of equal quality": same VPLs, same receivers, same
 // kernel, so the images agree up to the order of floating-point sums.
 TEST(Multires, SplatAndGatherAgree) {

@@ -348,6 +348,14 @@ std::array<int, 3> levelTexel(const std::vector<EyeLevel>& levels, int x, int y)
 }
 } // namespace
 
+long EyeHierarchy::listedReceivers() const {
+    GIS_ASSERT(mOptions.receiverList);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    shader::EyeReceiverListHeader h{};
+    glGetNamedBufferSubData(mReceiverList.id(), 0, sizeof h, &h);
+    return static_cast<long>(h.counts.x);
+}
+
 std::vector<std::array<int, 3>> EyeHierarchy::readReceiverList(shader::EyeReceiverListHeader* header) const {
     GIS_ASSERT(mOptions.receiverList);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);

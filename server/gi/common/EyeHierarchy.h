@@ -83,6 +83,9 @@ public:
     /// Reads back the receiver count per level (synchronises) and writes the counters
     /// receivers_total, receivers_l<k> and receiver_fraction (receivers / covered pixels).
     void countReceivers(Counters& counters, int coveredPixels = -1);
+    /// The receivers the last build() listed (receiverList only): reads the list's header back, which
+    /// waits for the stencil pass. What a frame's work cap needs before its gather is dispatched.
+    long listedReceivers() const;
     /// Reconstructs level 0 ("upsample") and writes the full-resolution indirect radiance.
     /// `irradiance`: one receiver list per frame holding irradiance (bilinear upsampling, albedo / pi
     /// applied per pixel); false: per-VPL lists holding radiance (parent replicated, see eyeCombine).

@@ -1,6 +1,7 @@
 #include "gi/multires_gather/MultiresGather.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "gi/common/ParamSpecs.h"
 
@@ -20,12 +21,29 @@ void MultiresGather::resize(int width, int height) {
     mIndirect.resize(width, height, "multires_gather indirect");
 }
 
+int MultiresGather::cappedVplGrid(const FrameInputs& in, const ParamSet& params, Counters& counters) const {
+    const int grid = params.getInt("vpl_grid");
+    const double shareCap = params.getFloat("receiver_share_cap");
+    // The parts of a refinement step must share one VPL set; they are sized by their own planner.
+    if (!(shareCap < 1.0) || in.vplParts > 1) return grid;
+    const double pixels = static_cast<double>(in.width) * in.height;
+    const double receivers = static_cast<double>(mEye.listedReceivers());
+    if (!(pixels > 0.0) || receivers <= shareCap * pixels) return grid;
+    // receivers x side^2 at most the cap's share x pixels x vpl_grid^2: the side shrinks by the root.
+    const int capped =
+        std::clamp(static_cast<int>(std::floor(grid * std::sqrt(shareCap * pixels / receivers))), 1, grid);
+    counters["receiver_share_capped_grid"] = capped;
+    return capped;
+}
+
 void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                              Counters& counters) {
-    const int vplCount = mVpls.extract(in, params.getInt("vpl_grid"), timer, counters);
+    // The hierarchy comes first: its receivers decide how many VPLs the work cap leaves this frame.
     mEye.build(in, params, timer);
     // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
     if (in.interrupted()) return;
+    const int grid = cappedVplGrid(in, params, counters);
+    const int vplCount = mVpls.extract(in, grid, timer, counters);
     if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
 
     {

@@ -6,17 +6,19 @@
 //
 // Pipeline:
 //   1. (renderer) RSM and G-buffer
-//   2. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid into the compact VPL buffer (the cache)
-//   3. eye_mipmap: level 0 statistics from the G-buffer, min-max / derivative / curvature mips up
+//   2. eye_mipmap: level 0 statistics from the G-buffer, min-max / derivative / curvature mips up
 //      to the coarsest level; refine_flags: the refinement flag of every texel (EyeHierarchy)
-//   4. stencil_setup: one full-screen draw per level of the flattened buffer sets stencil 1 at
+//   3. stencil_setup: one full-screen draw per level of the flattened buffer sets stencil 1 at
 //      receivers, counted by occlusion queries, and appends them to the receiver list
+//   4. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid into the compact VPL buffer (the cache);
+//      with receiver_share_cap below 1 and more receivers than that share, a coarser grid
 //   5. vpl_gather: one compute dispatch per VPL batch over the receiver list; receivers sum the kernel
 //   6. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel
 //
 // Parameters: vpl_grid [1, 256] (16), kernel point|disk (disk), min_distance [0, 0.5] of the scene's
-// size (0.05, point only); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16, depth 0.1
-// relative, normal 0.25, diagonal on, detail_alpha 0).
+// size (0.05, point only); receiver_share_cap [0.001, 1] receivers per pixel (1: none; the live view
+// sets it, docs/interactive.md); the eye hierarchy's thresholds (EyeHierarchy.h: coarsest_size 16,
+// depth 0.1 relative, normal 0.25, diagonal on, detail_alpha 0).
 //
 // Limits: no indirect visibility; diffuse receivers; a coarse patch is lit at its mean position and
 // normal, so light varying inside a flat patch (near a VPL) is averaged: depth_threshold trades this.
@@ -40,6 +42,11 @@ public:
     EyeHierarchy& hierarchy() { return mEye; }
 
 private:
+    /// vpl_grid, or the coarser grid receiver_share_cap leaves when the hierarchy lists more receivers
+    /// than the cap's share of the pixels (counter receiver_share_capped_grid). Reads the receiver count
+    /// back, so only a frame with a cap below 1 waits for the stencil pass here.
+    int cappedVplGrid(const FrameInputs& in, const ParamSet& params, Counters& counters) const;
+
     VplGrid mVpls;
     EyeHierarchy mEye{{.receiverList = true}};
     struct GatherProgram {

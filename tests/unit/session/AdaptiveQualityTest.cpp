@@ -312,3 +312,51 @@ TEST(AdaptiveQuality, EveryLiveStepDrawsTheLightViewsWithinATexelUnlessTheClient
 
 } // namespace
 } // namespace gis
+
+namespace gis {
+namespace {
+
+// The frame budget's receiver cap reaches the technique that has one (multires_gather), after the
+// first measured frame, unless the client set the parameter itself; other techniques are untouched.
+TEST(AdaptiveQuality, InteractiveFramesCapTheGatherAtTwiceTheLastReceiverShare) {
+    AdaptiveQuality q(limits(), nullptr);
+    const nlohmann::json none = nlohmann::json::object();
+    FrameState asked = makeFrameState(cornell(), "multires_gather");
+    asked.width = asked.height = 256;
+    const AdaptiveQuality::Plan first = q.plan("cornell", asked, none, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(first.state.techniqueParams.getFloat("receiver_share_cap"), 1.0) << "nothing measured";
+    EXPECT_TRUE(first.budget["receiver_share_cap"].is_null());
+
+    FrameCost cost;
+    cost.pixels = 100 * 100;
+    cost.vpls = 256;
+    cost.frameMs = 30;
+    cost.techniqueMs = 10;
+    cost.receiverShare = 0.1;
+    q.budget().record(first.budgetKey, cost);
+    const AdaptiveQuality::Plan next = q.plan("cornell", asked, none, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(next.state.techniqueParams.getFloat("receiver_share_cap"), 0.2);
+    EXPECT_DOUBLE_EQ(next.budget["receiver_share_cap"].get<double>(), 0.2);
+    for (QualityStep step : {QualityStep::Balanced, QualityStep::Final})
+        EXPECT_DOUBLE_EQ(q.plan("cornell", asked, none, step, false, 80)
+                             .state.techniqueParams.getFloat("receiver_share_cap"),
+                         1.0)
+            << qualityStepName(step) << " gathers every VPL";
+
+    FrameState own = asked;
+    own.techniqueParams.set("receiver_share_cap", 0.5);
+    const AdaptiveQuality::Plan kept =
+        q.plan("cornell", own, {{"receiver_share_cap", 0.5}}, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(kept.state.techniqueParams.getFloat("receiver_share_cap"), 0.5) << "the client's wins";
+    EXPECT_TRUE(kept.budget["receiver_share_cap"].is_null());
+
+    // rsm_gather has no receivers to cap, whatever the budget measured under its key.
+    q.budget().record("cornell/rsm_gather", cost);
+    const AdaptiveQuality::Plan plain =
+        q.plan("cornell", requested(), none, QualityStep::Interactive, false, 80);
+    EXPECT_FALSE(plain.state.techniqueParams.has("receiver_share_cap"));
+    EXPECT_TRUE(plain.budget["receiver_share_cap"].is_null());
+}
+
+} // namespace
+} // namespace gis

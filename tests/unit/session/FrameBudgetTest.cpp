@@ -151,3 +151,95 @@ TEST(FrameBudget, GarbageMeasurementsAreIgnored) {
 
 } // namespace
 } // namespace gis
+
+namespace gis {
+namespace {
+
+// The gather's work cap follows the last frame's work share (receivers per pixel, times the share of
+// the VPLs a cap left it): twice it, within [kMinReceiverShareCap, 1]; none before a frame with
+// receivers was measured.
+TEST(FrameBudget, TheReceiverCapIsTwiceTheLastFramesWorkShare) {
+    EXPECT_DOUBLE_EQ(receiverShareCapAfter(0.1), 0.2);
+    EXPECT_DOUBLE_EQ(receiverShareCapAfter(0.001), kMinReceiverShareCap);
+    EXPECT_DOUBLE_EQ(receiverShareCapAfter(0.7), 1.0);
+    EXPECT_DOUBLE_EQ(receiverShareCapAfter(-1.0), 1.0);
+    EXPECT_DOUBLE_EQ(receiverShareCapAfter(std::nan("")), 1.0);
+
+    FrameBudget budget(FrameBudget::Config{});
+    EXPECT_EQ(budget.choose("k", 4096, true, 960 * 800).receiverShareCap, 0.0) << "nothing measured";
+    FrameCost cost = synthetic(300 * 250, 4096, 2e-4, 1e-8);
+    budget.record("k", cost);
+    EXPECT_EQ(budget.choose("k", 4096, true, 960 * 800).receiverShareCap, 0.0) << "no receivers";
+    cost.receiverShare = 0.03;
+    budget.record("k", cost);
+    BudgetChoice choice = budget.choose("k", 4096, true, 960 * 800);
+    EXPECT_DOUBLE_EQ(choice.receiverShareCap, 0.06);
+    EXPECT_DOUBLE_EQ(choice.toJson(80, 4096)["receiver_share_cap"].get<double>(), 0.06);
+    // The last frame's, not a mean: a view with many receivers lifts the cap at once.
+    cost.receiverShare = 0.3;
+    budget.record("k", cost);
+    EXPECT_DOUBLE_EQ(budget.choose("k", 4096, true, 960 * 800).receiverShareCap, 0.6);
+    // Another key has its own.
+    EXPECT_EQ(budget.choose("other", 4096, true, 960 * 800).receiverShareCap, 0.0);
+    EXPECT_TRUE(BudgetChoice{}.toJson(80, 4096)["receiver_share_cap"].is_null());
+}
+
+} // namespace
+} // namespace gis
+
+namespace gis {
+namespace {
+
+TEST(FrameBudget, AFramesCostComesFromItsStats) {
+    const nlohmann::json plain = {
+        {"frame_ms", 40.0}, {"technique_ms", 25.0}, {"counts", {{"pixels", 20000}}}};
+    FrameCost c = FrameCost::ofFrame(plain, 200, 100, 4096, 1.0);
+    EXPECT_DOUBLE_EQ(c.pixels, 20000);
+    EXPECT_EQ(c.vpls, 4096);
+    EXPECT_DOUBLE_EQ(c.frameMs, 40.0);
+    EXPECT_DOUBLE_EQ(c.techniqueMs, 25.0);
+    EXPECT_LT(c.receiverShare, 0.0) << "no receivers";
+
+    const nlohmann::json listed = {
+        {"frame_ms", 40.0}, {"technique_ms", 25.0}, {"counts", {{"receivers_total", 2000}}}};
+    EXPECT_DOUBLE_EQ(FrameCost::ofFrame(listed, 200, 100, 4096, 1.0).receiverShare, 0.1);
+
+    // Capped to a 16 x 16 grid of the 64 x 64 asked for: 256 VPLs gathered, a sixteenth of the work.
+    const nlohmann::json capped = {
+        {"frame_ms", 40.0},
+        {"technique_ms", 25.0},
+        {"counts", {{"receivers_total", 16000}, {"receiver_share_capped_grid", 16}}}};
+    c = FrameCost::ofFrame(capped, 200, 100, 4096, 1.0);
+    EXPECT_EQ(c.vpls, 256);
+    EXPECT_DOUBLE_EQ(c.receiverShare, 0.8 / 16.0);
+    EXPECT_LT(FrameCost::ofFrame(nlohmann::json::object(), 0, 0, 0, 1.0).receiverShare, 0.0);
+}
+
+} // namespace
+} // namespace gis
+
+namespace gis {
+namespace {
+
+TEST(FrameBudget, AFrameOverItsReceiverCapSaysSoInItsBudget) {
+    BudgetChoice choice;
+    choice.receiverShareCap = 0.04;
+    choice.reason = "0.50 of the size meet the 80 ms target";
+    nlohmann::json budget = choice.toJson(80, 4096);
+    const nlohmann::json uncapped = {{"counts", {{"receivers_total", 500}}}};
+    nlohmann::json same = budget;
+    noteReceiverCap(same, uncapped, 100, 100);
+    EXPECT_EQ(same, budget) << "nothing to say";
+
+    const nlohmann::json capped = {
+        {"counts", {{"receivers_total", 4200}, {"receiver_share_capped_grid", 19}}}};
+    noteReceiverCap(budget, capped, 100, 100);
+    EXPECT_EQ(budget["receiver_capped_vpls"], 361);
+    EXPECT_EQ(
+        budget["reason"],
+        "0.50 of the size meet the 80 ms target; this view's receivers (42% of the pixels) exceed the 4% "
+        "cap set from the last frame: 361 of 4096 VPLs gathered");
+}
+
+} // namespace
+} // namespace gis
