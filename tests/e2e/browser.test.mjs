@@ -779,9 +779,11 @@ test('a late frame is said ("rendering… s") and the figures marked stale; inje
         await p.waitForFunction(() => window.giClient.busy === null && !window.giClient.stale, null,
             { timeout: WAIT_MS, polling: 50 });
         // The released frames are drawn before anything is injected: a fixed frame ends refinement.
+        // Settled means no new frame for 500 ms and no input waiting for its frame (on a loaded
+        // machine the drag's last frame can take longer than that, and its wait would show instead).
         for (let frames = -1; ;) {
-            const now = await p.evaluate(() => window.giClient.framesDrawn);
-            if (now === frames) break;
+            const now = await p.evaluate(() => (window.giClient.busy === null ? window.giClient.framesDrawn : -2));
+            if (now === frames && now >= 0) break;
             frames = now;
             await p.waitForTimeout(500);
         }
