@@ -25,9 +25,10 @@ double usableVplCostExponent(double exponent) {
     return std::isfinite(exponent) ? std::clamp(exponent, 0.05, 1.0) : 1.0;
 }
 
-double receiverShareCapAfter(double lastShare) {
+double receiverShareCapAfter(double lastShare, bool lastCut) {
     if (!std::isfinite(lastShare) || lastShare < 0.0) return 1.0;
-    return std::clamp(kReceiverShareGrowth * lastShare, kMinReceiverShareCap, 1.0);
+    return std::clamp((lastCut ? kCutReceiverShareGrowth : kReceiverShareGrowth) * lastShare,
+                      kMinReceiverShareCap, 1.0);
 }
 
 FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
@@ -39,12 +40,17 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
     cost.frameMs = stats.value("frame_ms", 0.0);
     cost.techniqueMs = stats.value("technique_ms", 0.0);
     const nlohmann::json counts = stats.value("counts", nlohmann::json::object());
-    const double cappedGrid = counts.value("receiver_share_capped_grid", 0.0);
-    if (cappedGrid >= 1.0) cost.vpls = std::min(askedVpls, static_cast<long>(cappedGrid * cappedGrid));
     if (counts.contains("receivers_total") && cost.pixels > 0.0) {
-        const double gathered =
-            askedVpls > 0 ? static_cast<double>(cost.vpls) / static_cast<double>(askedVpls) : 1.0;
-        cost.receiverShare = counts.value("receivers_total", 0.0) / cost.pixels * gathered;
+        cost.receiverShare = counts.value("receivers_total", 0.0) / cost.pixels;
+        // A frame the cap cut did the cap's work per pixel and asked VPL, whatever grid the rounding
+        // left it: recording the cap lets the next one double it (recording the rounded-down grid's
+        // work stalled a small grid at one VPL, which never reached the next square).
+        const nlohmann::json params = stats.value("params", nlohmann::json::object());
+        const double cap = params.value("receiver_share_cap", 1.0);
+        if (counts.value("receiver_share_capped_grid", 0.0) >= 1.0 && cap > 0.0) {
+            cost.receiverShare = std::min(cost.receiverShare, cap);
+            cost.receiverCut = true;
+        }
     }
     return cost;
 }
@@ -82,10 +88,13 @@ nlohmann::json BudgetChoice::toJson(double targetMs, long requestedVpls) const {
 double FrameBudget::predictMs(const std::string& key, double pixels, long vpls) const {
     const auto it = mRates.find(key);
     if (it == mRates.end() || it->second.frames == 0) return 0.0;
-    const Rates& r = it->second;
+    return predict(it->second, pixels, vpls, 1.0);
+}
+
+double FrameBudget::predict(const Rates& r, double pixels, long vpls, double techniqueFactor) {
     const double technique =
         vpls > 0 ? r.vpl * pixels * std::pow(static_cast<double>(vpls), r.exponent) : r.tech * pixels;
-    return pixels * (r.base + r.encode) + technique;
+    return pixels * (r.base + r.encode) + technique * techniqueFactor;
 }
 
 double FrameBudget::vplPassesMs(const std::string& key, double pixels, long vpls) const {
@@ -116,6 +125,7 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     // The last frame's, not a mean: the cap follows the view (its next frame sees nearly the same).
     r.receiverShare =
         std::isfinite(cost.receiverShare) && cost.receiverShare >= 0.0 ? cost.receiverShare : -1;
+    r.receiverCut = r.receiverShare >= 0.0 && cost.receiverCut;
     ++r.frames;
 }
 
@@ -133,7 +143,11 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
         return out;
     }
     Rates& rates = it->second;
-    if (rates.receiverShare >= 0.0) out.receiverShareCap = receiverShareCapAfter(rates.receiverShare);
+    if (rates.receiverShare >= 0.0)
+        out.receiverShareCap = receiverShareCapAfter(rates.receiverShare, rates.receiverCut);
+    // After a frame the cap cut, the next one may gather a quarter more per pixel and VPL (its cap
+    // grows so): the technique's passes, which the gather then dominates, are predicted so.
+    const double workGrowth = rates.receiverCut ? kCutReceiverShareGrowth : 1.0;
     // The ladder from the best frame to the cheapest: size down to the preferred minimum, then VPLs
     // down, then size down to the minimum.
     std::vector<Candidate> ladder;
@@ -155,7 +169,7 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     for (int i = 0; i < static_cast<int>(ladder.size()); ++i) {
         const Candidate& cand = ladder[static_cast<size_t>(i)];
         const long vpls = cand.vpls > 0 ? cand.vpls : requestedVpls;
-        const double ms = predictMs(key, fullPixels * cand.scale * cand.scale, vpls);
+        const double ms = predict(rates, fullPixels * cand.scale * cand.scale, vpls, workGrowth);
         // Climbing above the last choice needs 15 % headroom, so measurement noise does not make the
         // size flicker between two frames.
         const double allowed = previous >= 0 && i < previous ? target * 0.85 : target;

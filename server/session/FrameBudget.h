@@ -12,7 +12,9 @@
 // passes as VPL-bound over-predicts what more VPLs cost, so the budget climbs cautiously.
 // A technique that gathers over receivers (multires_gather) costs receivers x VPLs, and a view's
 // receivers are not a model's to predict: the next frame's gather is capped at twice the last
-// frame's receiver share instead (receiverShareCapAfter, TechniqueInfo::capReceiverShare).
+// frame's receiver share instead, or a quarter above the last cap after a frame it cut, which the
+// prediction then adds to the technique's passes (receiverShareCapAfter,
+// TechniqueInfo::capReceiverShare).
 #pragma once
 
 #include <map>
@@ -36,14 +38,15 @@ struct FrameCost {
     /// The technique's passes cost about pixels x vpls^vplCostExponent (TechniqueInfo::vplCostExponent).
     double vplCostExponent = 1.0;
     /// The gather's work per pixel and VPL asked for: receivers per pixel (counts receivers_total /
-    /// pixels) times the share of the asked VPLs a receiver cap left the gather. Below 0 when the
+    /// pixels), or the cap (params receiver_share_cap) for a frame the cap cut. Below 0 when the
     /// technique has no receiver list.
     double receiverShare = -1;
+    bool receiverCut = false; ///< the cap cut the frame's VPLs (receiverShare is then the cap)
 
-    /// A rendered frame's cost from its stats (frame_ms, technique_ms, counts) at width x height, whose
-    /// parameters asked for `askedVpls` (vplEstimate): a frame over its receiver cap
-    /// (counts.receiver_share_capped_grid) counts the VPLs it gathered, and its work share is the
-    /// receivers per pixel times the share of the asked VPLs it gathered. encodeMs stays 0.
+    /// A rendered frame's cost from its stats (frame_ms, technique_ms, counts, params) at width x
+    /// height, whose parameters asked for `askedVpls` (vplEstimate), which it counts whether or not the
+    /// receiver cap cut them (counts.receiver_share_capped_grid): its time is the time of a frame that
+    /// asks for them, under a cap. encodeMs stays 0.
     static FrameCost ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
                              double vplCostExponent);
 };
@@ -61,13 +64,16 @@ struct BudgetChoice {
 };
 
 /// The gather's work cap after a frame whose work was `lastShare` (FrameCost::receiverShare): twice
-/// that, and at least kMinReceiverShareCap. The usual frame-to-frame change in an orbit gathers every
-/// VPL, while a step to a view with ten times the receivers (from outside a building into it) costs at
-/// most twice the last gather's work per pixel and VPL, and the frames after it at most double again
-/// each, while the budget's size and VPL choice catch up with the new cost.
+/// that after a frame the cap left whole, so that the usual frame-to-frame change in an orbit gathers
+/// every VPL; a quarter more than the cap after a frame it cut, so that while a view with many more
+/// receivers than the last (from outside a building into it) is cut, each frame's gather grows by at
+/// most a quarter over the last and the budget's size and VPL choice, learning from each, keeps up
+/// (doubling it each frame gave frames three times the target on the way). At least
+/// kMinReceiverShareCap, at most 1.
 inline constexpr double kReceiverShareGrowth = 2.0;
+inline constexpr double kCutReceiverShareGrowth = 1.25;
 inline constexpr double kMinReceiverShareCap = 0.02;
-double receiverShareCapAfter(double lastShare);
+double receiverShareCapAfter(double lastShare, bool lastCut);
 
 /// What the receiver cap did to a rendered frame, into its stats.budget (BudgetChoice::toJson): when
 /// the frame gathered from a coarser grid (counts.receiver_share_capped_grid), receiver_capped_vpls
@@ -107,9 +113,13 @@ private:
         double exponent = 1.0;                ///< FrameCost::vplCostExponent of the last frame
         double tech = 0;                      ///< ms per pixel of the technique when it has no VPLs
         double receiverShare = -1;            ///< the last frame's (FrameCost::receiverShare)
+        bool receiverCut = false;             ///< FrameCost::receiverCut of the last frame
         int frames = 0;
         int level = -1; ///< index of the last choice in the candidate ladder
     };
+    /// ms at `pixels` and `vpls` from `rates`, the technique's passes times `techniqueFactor`.
+    static double predict(const Rates& rates, double pixels, long vpls, double techniqueFactor);
+
     Config mConfig;
     std::map<std::string, Rates> mRates;
 };

@@ -213,13 +213,18 @@ TEST(Multires, ReceiverShareCapGathersFromTheGridItLeaves) {
     EXPECT_EQ(capped.linear, grid12.linear);
     EXPECT_GT(relativeRmseOf(capped, uncapped), 1e-4) << "a coarser grid must change the image";
 
-    // Far below any share: one VPL, never none.
+    // Far below any share: the budget's floor of 16 VPLs, never fewer; a grid already below it stays.
     nlohmann::json tiny = base;
     tiny["receiver_share_cap"] = 0.001;
-    const FrameOutput one = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, tiny);
-    EXPECT_EQ(counter(one, "receiver_share_capped_grid"),
-              std::max(1.0, std::floor(24 * std::sqrt(0.001 / share))));
-    EXPECT_EQ(badValues(one), 0u);
+    const FrameOutput floor = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, tiny);
+    ASSERT_LT(24 * std::sqrt(0.001 / share), 4.0);
+    EXPECT_EQ(counter(floor, "receiver_share_capped_grid"), 4);
+    EXPECT_EQ(counter(floor, "vpl_count"), 16);
+    EXPECT_EQ(badValues(floor), 0u);
+    tiny["vpl_grid"] = 3;
+    const FrameOutput small = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, tiny);
+    EXPECT_EQ(counter(small, "receiver_share_capped_grid"), 0);
+    EXPECT_EQ(counter(small, "vpl_count"), 9);
 }
 
 // 001: "scattering and gathering give results of equal quality": same VPLs, same receivers, same

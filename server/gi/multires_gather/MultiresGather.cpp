@@ -29,9 +29,14 @@ int MultiresGather::cappedVplGrid(const FrameInputs& in, const ParamSet& params,
     const double pixels = static_cast<double>(in.width) * in.height;
     const double receivers = static_cast<double>(mEye.listedReceivers());
     if (!(pixels > 0.0) || receivers <= shareCap * pixels) return grid;
-    // receivers x side^2 at most the cap's share x pixels x vpl_grid^2: the side shrinks by the root.
+    // receivers x side^2 at most the cap's share x pixels x vpl_grid^2: the side shrinks by the root,
+    // to no fewer VPLs than the frame budget's own floor (16: below it the indirect light is a few
+    // point lights' blotches).
+    constexpr int kMinCappedGrid = 4;
     const int capped =
-        std::clamp(static_cast<int>(std::floor(grid * std::sqrt(shareCap * pixels / receivers))), 1, grid);
+        std::clamp(static_cast<int>(std::floor(grid * std::sqrt(shareCap * pixels / receivers))),
+                   std::min(grid, kMinCappedGrid), grid);
+    if (capped == grid) return grid;
     counters["receiver_share_capped_grid"] = capped;
     return capped;
 }
