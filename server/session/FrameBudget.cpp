@@ -43,8 +43,8 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
     if (counts.contains("receivers_total") && cost.pixels > 0.0) {
         cost.receiverShare = counts.value("receivers_total", 0.0) / cost.pixels;
         // A frame the cap cut did the cap's work per pixel and asked VPL, whatever grid the rounding
-        // left it: recording the cap lets the next one double it (recording the rounded-down grid's
-        // work stalled a small grid at one VPL, which never reached the next square).
+        // left it: the next cap grows from the cap (growing from the rounded-down grid's work stalled
+        // a small grid at one VPL, which never reached the next square).
         const nlohmann::json params = stats.value("params", nlohmann::json::object());
         const double cap = params.value("receiver_share_cap", 1.0);
         if (counts.value("receiver_share_capped_grid", 0.0) >= 1.0 && cap > 0.0) {
