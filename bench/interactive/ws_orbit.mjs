@@ -59,8 +59,8 @@ console.log(JSON.stringify({ scene: opts.scene, frames: frames.length, fps: +((f
     frame_ms_p50: +percentile(frames.map((f) => f.stats.frame_ms), 0.5).toFixed(1),
     frame_ms_p95: +percentile(frames.map((f) => f.stats.frame_ms), 0.95).toFixed(1),
     frame_ms_max: +Math.max(...frames.map((f) => f.stats.frame_ms)).toFixed(1),
-    // Frames the budget's receiver cap gave a coarser VPL grid (multires_gather).
-    receiver_capped: frames.filter((f) => f.stats.counts?.receiver_share_capped_grid).length,
+    // Frames the budget's receiver cap gave fewer VPLs.
+    receiver_capped: frames.filter((f) => f.stats.counts?.receiver_share_capped_vpls).length,
     size: last.size, vpls: last.counts?.vpl_count ?? null, budget: last.budget?.reason ?? null,
     // Where a frame's time goes besides rendering: encoding, the wait for the GL worker (queue), the
     // wait for input or for the client's acknowledgements (window); what remains of the cadence is
@@ -80,7 +80,7 @@ for (const f of opts['slow-ms'] > 0 ? frames.filter((f) => f.stats.frame_ms > op
     console.log(JSON.stringify({ slow_frame: f.stats.frame, frame_ms: +f.stats.frame_ms.toFixed(1), size: f.stats.size,
         passes: f.stats.passes.filter((p) => p.gpu_ms > 5).map((p) => [p.name, +p.gpu_ms.toFixed(1)]),
         receivers: c.receivers_total ?? null, vpls: c.vpl_count ?? null,
-        receiver_share_capped_grid: c.receiver_share_capped_grid ?? null,
+        receiver_share_capped_vpls: c.receiver_share_capped_vpls ?? null,
         camera: sent.filter((s) => s.at < f.at - f.stats.frame_ms).at(-1) ?? null }));
 }
 if (process.env.WS_ORBIT_DUMP)

@@ -26,6 +26,26 @@ const TechniqueInfo& findTechniqueInfo(const std::string& name, const std::strin
 
 namespace gis {
 
+double usableVplCostExponent(double exponent) {
+    return std::isfinite(exponent) ? std::clamp(exponent, 0.05, 1.0) : 1.0;
+}
+
+long capVplsForReceivers(const TechniqueInfo& info, ParamSet& technique, long estimate, double pixels,
+                         double receivers) {
+    if (!info.limitVpls || !technique.has("receiver_share_cap") || estimate <= 0) return 0;
+    const double shareCap = technique.getFloat("receiver_share_cap");
+    if (!(shareCap < 1.0) || !(pixels > 0.0) || !(receivers > shareCap * pixels)) return 0;
+    constexpr long kFloorVpls = 16;
+    const double exponent = usableVplCostExponent(info.vplCostExponent);
+    const double workShare = shareCap * pixels / receivers; // (0, 1)
+    const long allowed = std::max(
+        std::min(estimate, kFloorVpls),
+        static_cast<long>(std::floor(static_cast<double>(estimate) * std::pow(workShare, 1.0 / exponent))));
+    if (allowed >= estimate) return 0;
+    info.limitVpls(technique, allowed);
+    return allowed;
+}
+
 void limitGridVpls(ParamSet& technique, long vpls) {
     const long current = technique.getInt("vpl_grid");
     long side = static_cast<long>(std::floor(std::sqrt(static_cast<double>(std::max(vpls, 1L)))));

@@ -80,6 +80,20 @@ inline long gridVplEstimate(const ParamSet& technique, const ParamSet&) {
 /// limitVpls of the grid-VPL techniques: the largest vpl_grid with vpl_grid^2 <= vpls.
 void limitGridVpls(ParamSet& technique, long vpls);
 
+/// A technique's vplCostExponent as the cost models use it (the frame
+/// budget, refinement's planner, the receiver cap): within [0.05, 1] (above 1 would model VPLs
+/// that cost more than linearly, 0 none at all); 1 when not finite.
+double usableVplCostExponent(double exponent);
+
+/// The receiver work cap (capReceiverShare) of a frame whose eye hierarchy listed `receivers` over
+/// `pixels`, for a technique whose parameters ask for `estimate` VPLs (vplEstimate): where receivers
+/// exceed receiver_share_cap x pixels, lowers the VPL knob through info.limitVpls to at most
+/// estimate x (cap x pixels / receivers)^(1 / vplCostExponent), so that receivers x VPLs^exponent
+/// stay at the cap's, and never below 16 VPLs (the frame budget's floor; a smaller estimate stays).
+/// Returns the VPLs it allowed, or 0 when the frame is within the cap (the parameters unchanged).
+long capVplsForReceivers(const TechniqueInfo& info, ParamSet& technique, long estimate, double pixels,
+                         double receivers);
+
 // The entries, one per technique folder (gi/<name>/Info.cpp).
 TechniqueInfo noIndirectInfo();
 TechniqueInfo rsmGatherInfo();

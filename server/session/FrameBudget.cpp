@@ -21,10 +21,6 @@ struct Candidate {
 
 } // namespace
 
-double usableVplCostExponent(double exponent) {
-    return std::isfinite(exponent) ? std::clamp(exponent, 0.05, 1.0) : 1.0;
-}
-
 double receiverShareCapAfter(double lastShare, bool lastCut) {
     if (!std::isfinite(lastShare) || lastShare < 0.0) return 1.0;
     return std::clamp((lastCut ? kCutReceiverShareGrowth : kReceiverShareGrowth) * lastShare,
@@ -47,7 +43,7 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
         // a small grid at one VPL, which never reached the next square).
         const nlohmann::json params = stats.value("params", nlohmann::json::object());
         const double cap = params.value("receiver_share_cap", 1.0);
-        if (counts.value("receiver_share_capped_grid", 0.0) >= 1.0 && cap > 0.0) {
+        if (counts.value("receiver_share_capped_vpls", 0.0) >= 1.0 && cap > 0.0) {
             cost.receiverShare = std::min(cost.receiverShare, cap);
             cost.receiverCut = true;
         }
@@ -57,10 +53,9 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
 
 void noteReceiverCap(nlohmann::json& budget, const nlohmann::json& frameStats, int width, int height) {
     const nlohmann::json counts = frameStats.value("counts", nlohmann::json::object());
-    const double grid = counts.value("receiver_share_capped_grid", 0.0);
+    const auto vpls = static_cast<long>(counts.value("receiver_share_capped_vpls", 0.0));
     const double pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
-    if (!budget.is_object() || grid < 1.0 || !(pixels > 0.0)) return;
-    const long vpls = static_cast<long>(grid * grid);
+    if (!budget.is_object() || vpls < 1 || !(pixels > 0.0)) return;
     budget["receiver_capped_vpls"] = vpls;
     const double cap = budget.value("receiver_share_cap", 0.0);
     const std::string asked = budget.contains("vpl_cap") && budget["vpl_cap"].is_number()

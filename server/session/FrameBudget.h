@@ -22,11 +22,9 @@
 
 #include <nlohmann/json.hpp>
 
-namespace gis {
+#include "gi/Catalog.h" // usableVplCostExponent
 
-/// A technique's vplCostExponent as the cost models use it: within [0.05, 1] (above 1 would model VPLs
-/// that cost more than linearly, 0 none at all); 1 when not finite.
-double usableVplCostExponent(double exponent);
+namespace gis {
 
 /// One measured interactive frame.
 struct FrameCost {
@@ -45,7 +43,7 @@ struct FrameCost {
 
     /// A rendered frame's cost from its stats (frame_ms, technique_ms, counts, params) at width x
     /// height, whose parameters asked for `askedVpls` (vplEstimate), which it counts whether or not the
-    /// receiver cap cut them (counts.receiver_share_capped_grid): its time is the time of a frame that
+    /// receiver cap cut them (counts.receiver_share_capped_vpls): its time is the time of a frame that
     /// asks for them, under a cap. encodeMs stays 0.
     static FrameCost ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
                              double vplCostExponent);
@@ -76,8 +74,8 @@ inline constexpr double kMinReceiverShareCap = 0.02;
 double receiverShareCapAfter(double lastShare, bool lastCut);
 
 /// What the receiver cap did to a rendered frame, into its stats.budget (BudgetChoice::toJson): when
-/// the frame gathered from a coarser grid (counts.receiver_share_capped_grid), receiver_capped_vpls
-/// (the VPLs it gathered) and a sentence on the reason. Nothing otherwise.
+/// the frame gathered from fewer VPLs (counts.receiver_share_capped_vpls), receiver_capped_vpls
+/// (those VPLs) and a sentence on the reason. Nothing otherwise.
 void noteReceiverCap(nlohmann::json& budget, const nlohmann::json& frameStats, int width, int height);
 
 class FrameBudget {

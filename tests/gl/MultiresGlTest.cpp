@@ -197,7 +197,7 @@ TEST(Multires, ReceiverShareCapGathersFromTheGridItLeaves) {
     nlohmann::json atShare = base;
     atShare["receiver_share_cap"] = std::min(1.0, share * 1.001);
     const FrameOutput same = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, atShare);
-    EXPECT_EQ(counter(same, "receiver_share_capped_grid"), 0);
+    EXPECT_EQ(counter(same, "receiver_share_capped_vpls"), 0);
     EXPECT_EQ(counter(same, "vpl_count"), 24 * 24);
     EXPECT_EQ(same.linear, uncapped.linear);
 
@@ -205,7 +205,7 @@ TEST(Multires, ReceiverShareCapGathersFromTheGridItLeaves) {
     nlohmann::json quarter = base;
     quarter["receiver_share_cap"] = share / 4.0 * 1.001;
     const FrameOutput capped = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, quarter);
-    EXPECT_EQ(counter(capped, "receiver_share_capped_grid"), 12);
+    EXPECT_EQ(counter(capped, "receiver_share_capped_vpls"), 144);
     EXPECT_EQ(counter(capped, "vpl_count"), 12 * 12);
     EXPECT_EQ(counter(capped, "receivers_total"), counter(uncapped, "receivers_total"));
     const FrameOutput grid12 =
@@ -218,13 +218,48 @@ TEST(Multires, ReceiverShareCapGathersFromTheGridItLeaves) {
     tiny["receiver_share_cap"] = 0.001;
     const FrameOutput floor = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, tiny);
     ASSERT_LT(24 * std::sqrt(0.001 / share), 4.0);
-    EXPECT_EQ(counter(floor, "receiver_share_capped_grid"), 4);
+    EXPECT_EQ(counter(floor, "receiver_share_capped_vpls"), 16);
     EXPECT_EQ(counter(floor, "vpl_count"), 16);
     EXPECT_EQ(badValues(floor), 0u);
     tiny["vpl_grid"] = 3;
     const FrameOutput small = renderScene("builtin:cornell", "multires_gather", kWidth, kHeight, tiny);
-    EXPECT_EQ(counter(small, "receiver_share_capped_grid"), 0);
+    EXPECT_EQ(counter(small, "receiver_share_capped_vpls"), 0);
     EXPECT_EQ(counter(small, "vpl_count"), 9);
+}
+
+// The same cap on the light-tree techniques: a cap at half the frame's share lowers isr_finest (cost
+// linear in the light patches: 4,096 -> at most 2,048, so 32^2) and hier_isr's max_depth (cost as
+// leaves^0.4: 4,096 x 0.5^2.5 = 724 leaves at most, so 16^2), and the frame is then exactly that
+// setting's.
+TEST(Multires, ReceiverShareCapCutsTheLightTreeTechniquesToo) {
+    constexpr int kWidth = 96, kHeight = 80;
+    struct Case {
+        const char* technique;
+        nlohmann::json base, expected;
+        double cutVpls;
+    };
+    for (const Case& c : {Case{"isr", {{"isr_finest", 64}}, {{"isr_finest", 32}}, 1024},
+                          Case{"hier_isr",
+                               {{"max_depth", 64}, {"hier_coarsest", 4}, {"tau", 0.0}},
+                               {{"max_depth", 16}, {"hier_coarsest", 4}, {"tau", 0.0}},
+                               256}}) {
+        SCOPED_TRACE(c.technique);
+        const FrameOutput whole = renderScene("builtin:cornell", c.technique, kWidth, kHeight, c.base);
+        const double share = counter(whole, "receivers_total") / (kWidth * kHeight);
+        ASSERT_GT(share, 0.01);
+        nlohmann::json half = c.base;
+        half["receiver_share_cap"] = share / 2.0;
+        const FrameOutput cut = renderScene("builtin:cornell", c.technique, kWidth, kHeight, half);
+        EXPECT_EQ(counter(cut, "receiver_share_capped_vpls"), c.cutVpls);
+        const FrameOutput expected = renderScene("builtin:cornell", c.technique, kWidth, kHeight, c.expected);
+        EXPECT_EQ(cut.linear, expected.linear);
+        EXPECT_GT(relativeRmseOf(cut, whole), 1e-4) << "fewer lights must change the image";
+        nlohmann::json above = c.base;
+        above["receiver_share_cap"] = std::min(1.0, share * 1.001);
+        const FrameOutput same = renderScene("builtin:cornell", c.technique, kWidth, kHeight, above);
+        EXPECT_EQ(counter(same, "receiver_share_capped_vpls"), 0);
+        EXPECT_EQ(same.linear, whole.linear);
+    }
 }
 
 // 001: "scattering and gathering give results of equal quality": same VPLs, same receivers, same

@@ -138,6 +138,25 @@ float vplInverseClampB(const ParamSet& params, float sceneSize) {
     return std::isfinite(inv) ? static_cast<float>(inv) : 0.0f;
 }
 
+ParamSpec receiverShareCapSpec() {
+    return {.name = "receiver_share_cap",
+            .type = ParamType::Float,
+            .defaultValue = 1.0,
+            .min = 0.001,
+            .max = 1.0,
+            .unit = "receivers per pixel",
+            .help =
+                "work cap of one frame: where the eye hierarchy selects more receivers than this share of "
+                "the pixels, the gather uses fewer VPLs (the VPL knob lowered as the frame budget would), "
+                "so that receivers x VPLs stay at the cap's; 1 = never (receivers never outnumber pixels). "
+                "The live view sets it from its last frame's share",
+            .source = "eng"};
+}
+
+void setReceiverShareCap(ParamSet& technique, double share) {
+    technique.set("receiver_share_cap", std::clamp(share, 0.001, 1.0));
+}
+
 std::vector<ParamSpec> eyeHierarchyParamSpecs() {
     return {
         {.name = "coarsest_size",

@@ -23,6 +23,10 @@ std::vector<ParamSpec> biasCompensationParamSpecs(double defaultClampB = 0.0, in
 /// The multiresolution eye hierarchy's knobs: coarsest_size, the depth and normal metrics and
 /// thresholds, diagonal_refine (gi/common/EyeHierarchy.h).
 std::vector<ParamSpec> eyeHierarchyParamSpecs();
+/// receiver_share_cap, the per-frame work cap of a gather over the eye hierarchy's receivers
+/// (TechniqueInfo::capReceiverShare, capVplsForReceivers), and the capability that sets it.
+ParamSpec receiverShareCapSpec();
+void setReceiverShareCap(ParamSet& technique, double share);
 
 /// vpl_shadows, vpl_shadow_size, vpl_shadow_bias (gi/common/VplShadows.h).
 std::vector<ParamSpec> vplShadowParamSpecs();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gi/Catalog.h"
+
 namespace gis {
 
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
@@ -92,14 +94,27 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     mEye.build(in, params, timer);
     // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
     if (in.interrupted()) return;
+    // The receiver work cap (gi/Catalog.h): a view with more receivers than its share traverses to a
+    // shallower max_depth, its leaves cut by the cost exponent's root.
+    ParamSet traversal = params;
+    if (params.getFloat("receiver_share_cap") < 1.0 && mTree.valid()) {
+        const auto leaves = [&](const ParamSet& p) {
+            return squared(std::min<long>(in.rsmSize, p.getInt("max_depth")));
+        };
+        if (capVplsForReceivers(findTechniqueInfo("hier_isr"), traversal, leaves(params),
+                                static_cast<double>(in.width) * in.height,
+                                static_cast<double>(mEye.listedReceivers())) > 0)
+            counters["receiver_share_capped_vpls"] = leaves(traversal);
+    }
 
     const GLuint zero[6] = {};
     mStats.upload(0, sizeof zero, zero);
     {
         gl::Pass pass(timer, "vpl_gather");
         if (mTree.valid()) {
-            const LightCutSettings s = lightCutSettings(mTree.levels(), params.getInt("hier_coarsest"),
-                                                        params.getInt("max_depth"), params.getFloat("tau"));
+            const LightCutSettings s =
+                lightCutSettings(mTree.levels(), traversal.getInt("hier_coarsest"),
+                                 traversal.getInt("max_depth"), traversal.getFloat("tau"));
             const GatherProgram& g = mGather;
             pass.use(g.program);
             g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);

@@ -41,6 +41,9 @@
 //                  (001 §3.5 "16^2 coarsest light patches"); clamped to max_depth
 //   max_depth      finest level visited, patches per side, [1, 1024], default 256, clamped to rsm_size
 //                  (001's "maximal traversal depth"; 256 = the full RSM at the default rsm_size)
+//   receiver_share_cap  receivers per pixel, [0.001, 1], default 1 (none): above it, max_depth is
+//                  lowered, leaves by the cost exponent's root (capVplsForReceivers, gi/Catalog.h).
+//                  The live view sets it
 //   Eye hierarchy: coarsest_size, depth/normal metrics and thresholds, diagonal_refine, detail_alpha
 //   (EyeHierarchy.h).
 //

@@ -37,6 +37,7 @@ TechniqueInfo hierIsrInfo() {
          .source = "001 §3.5, Figs. 12-13"},
     };
     for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    specs.push_back(receiverShareCapSpec());
     for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
     TechniqueInfo info{"hier_isr",
                        "hierarchical image-space radiosity: per-receiver cuts through the light tree",
@@ -59,6 +60,7 @@ TechniqueInfo hierIsrInfo() {
     // 256, 31x over 4,096x the leaves, leaves^0.41 (docs/interactive.md). A linear model fitted on a
     // capped frame never let the frame budget lift the cap (max_depth 4 at 20 ms against 80).
     info.vplCostExponent = 0.4;
+    info.capReceiverShare = setReceiverShareCap;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     return info;

@@ -43,6 +43,7 @@ TechniqueInfo isrInfo() {
          .source = "001 §3.4 (no value given); 000 Figs. 11-12 eye-space quality setting"},
     };
     for (auto& s : eyeHierarchyParamSpecs()) specs.push_back(std::move(s));
+    specs.push_back(receiverShareCapSpec());
     for (auto& s : biasCompensationParamSpecs()) specs.push_back(std::move(s));
     TechniqueInfo info{"isr",
                        "image-space radiosity: per-frame light-space patches gathered at stencil receivers",
@@ -55,6 +56,7 @@ TechniqueInfo isrInfo() {
         p.set("isr_finest", std::max(1L, side));
         if (p.getInt("isr_coarsest") > side) p.set("isr_coarsest", side);
     };
+    info.capReceiverShare = setReceiverShareCap;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     return info;

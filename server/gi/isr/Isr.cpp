@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "gi/Catalog.h"
 #include "gi/common/BiasCompensation.h"
 #include "gi/common/VplGrid.h"
 
@@ -89,11 +90,20 @@ int Isr::select(const ParamSet& params, gl::PassTimer& timer, Counters& counters
 
 void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer, Counters& counters) {
     mTree.build(in, timer, counters);
-    mVplCount = mTree.valid() ? select(params, timer, counters) : 0;
-    if (!mTree.valid()) counters["vpl_count"] = 0;
+    // The hierarchy comes first: its receivers decide how fine a cut the work cap leaves this frame.
     mEye.build(in, params, timer);
     // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
     if (in.interrupted()) return;
+    // The receiver work cap (gi/Catalog.h): a view with more receivers than its share selects light
+    // patches no finer than a coarser isr_finest.
+    ParamSet cut = params;
+    if (params.getFloat("receiver_share_cap") < 1.0 && mTree.valid() &&
+        capVplsForReceivers(findTechniqueInfo("isr"), cut, squared(params.getInt("isr_finest")),
+                            static_cast<double>(in.width) * in.height,
+                            static_cast<double>(mEye.listedReceivers())) > 0)
+        counters["receiver_share_capped_vpls"] = squared(cut.getInt("isr_finest"));
+    mVplCount = mTree.valid() ? select(cut, timer, counters) : 0;
+    if (!mTree.valid()) counters["vpl_count"] = 0;
 
     {
         gl::Pass pass(timer, "vpl_gather");

@@ -30,6 +30,9 @@
 //                          and the eye hierarchy, so the cheaper setting is the default)
 //   light_normal_threshold refine where any normal component's range exceeds it, [0, 2], default 0.25
 //                          (the eye hierarchy's quality setting, 000 Figs. 11-12)
+//   receiver_share_cap     receivers per pixel, [0.001, 1], default 1 (none): above it, isr_finest is
+//                          lowered as the frame budget would (capVplsForReceivers, gi/Catalog.h); the
+//                          selection runs after the eye hierarchy for it. The live view sets it
 //   partial validity (a patch with empty texels) always refines.
 //   Eye hierarchy: coarsest_size, depth/normal metrics and thresholds, diagonal_refine, detail_alpha
 //   (EyeHierarchy.h).

@@ -1,8 +1,8 @@
 #include "gi/multires_gather/MultiresGather.h"
 
 #include <algorithm>
-#include <cmath>
 
+#include "gi/Catalog.h"
 #include "gi/common/ParamSpecs.h"
 
 namespace gis {
@@ -23,22 +23,16 @@ void MultiresGather::resize(int width, int height) {
 
 int MultiresGather::cappedVplGrid(const FrameInputs& in, const ParamSet& params, Counters& counters) const {
     const int grid = params.getInt("vpl_grid");
-    const double shareCap = params.getFloat("receiver_share_cap");
     // The parts of a refinement step must share one VPL set; they are sized by their own planner.
-    if (!(shareCap < 1.0) || in.vplParts > 1) return grid;
-    const double pixels = static_cast<double>(in.width) * in.height;
-    const double receivers = static_cast<double>(mEye.listedReceivers());
-    if (!(pixels > 0.0) || receivers <= shareCap * pixels) return grid;
-    // receivers x side^2 at most the cap's share x pixels x vpl_grid^2: the side shrinks by the root,
-    // to no fewer VPLs than the frame budget's own floor (16: below it the indirect light is a few
-    // point lights' blotches).
-    constexpr int kMinCappedGrid = 4;
-    const int capped =
-        std::clamp(static_cast<int>(std::floor(grid * std::sqrt(shareCap * pixels / receivers))),
-                   std::min(grid, kMinCappedGrid), grid);
-    if (capped == grid) return grid;
-    counters["receiver_share_capped_grid"] = capped;
-    return capped;
+    if (!(params.getFloat("receiver_share_cap") < 1.0) || in.vplParts > 1) return grid;
+    ParamSet capped = params;
+    const long allowed = capVplsForReceivers(findTechniqueInfo("multires_gather"), capped, squared(grid),
+                                             static_cast<double>(in.width) * in.height,
+                                             static_cast<double>(mEye.listedReceivers()));
+    if (allowed == 0) return grid;
+    const int cappedGrid = capped.getInt("vpl_grid");
+    counters["receiver_share_capped_vpls"] = squared(cappedGrid);
+    return cappedGrid;
 }
 
 void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,

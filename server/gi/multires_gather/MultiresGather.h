@@ -12,6 +12,7 @@
 //      receivers, counted by occlusion queries, and appends them to the receiver list
 //   4. vpl_extract: vpl_grid^2 VPLs on a regular RSM grid into the compact VPL buffer (the cache);
 //      with receiver_share_cap below 1 and more receivers than that share, a coarser grid
+//      (capVplsForReceivers, gi/Catalog.h)
 //   5. vpl_gather: one compute dispatch per VPL batch over the receiver list; receivers sum the kernel
 //   6. upsample: coarse-to-fine reconstruction (000 §3.5), then albedo / pi per pixel
 //
@@ -43,8 +44,8 @@ public:
 
 private:
     /// vpl_grid, or the coarser grid receiver_share_cap leaves when the hierarchy lists more receivers
-    /// than the cap's share of the pixels (counter receiver_share_capped_grid). Reads the receiver count
-    /// back, so only a frame with a cap below 1 waits for the stencil pass here.
+    /// than the cap's share of the pixels (capVplsForReceivers; counter receiver_share_capped_vpls). Reads
+    /// the receiver count back, so only a frame with a cap below 1 waits for the stencil pass here.
     int cappedVplGrid(const FrameInputs& in, const ParamSet& params, Counters& counters) const;
 
     VplGrid mVpls;

@@ -350,6 +350,16 @@ TEST(AdaptiveQuality, InteractiveFramesCapTheGatherAtTwiceTheLastReceiverShare) 
     EXPECT_DOUBLE_EQ(kept.state.techniqueParams.getFloat("receiver_share_cap"), 0.5) << "the client's wins";
     EXPECT_TRUE(kept.budget["receiver_share_cap"].is_null());
 
+    // The light-tree techniques gather over receivers too.
+    for (const char* technique : {"isr", "hier_isr"}) {
+        FrameState tree = makeFrameState(cornell(), technique);
+        q.budget().record(std::string("cornell/") + technique, cost);
+        EXPECT_DOUBLE_EQ(q.plan("cornell", tree, none, QualityStep::Interactive, false, 80)
+                             .state.techniqueParams.getFloat("receiver_share_cap"),
+                         0.2)
+            << technique;
+    }
+
     // rsm_gather has no receivers to cap, whatever the budget measured under its key.
     q.budget().record("cornell/rsm_gather", cost);
     const AdaptiveQuality::Plan plain =

@@ -213,13 +213,13 @@ TEST(FrameBudget, AFramesCostComesFromItsStats) {
         {"frame_ms", 40.0},
         {"technique_ms", 25.0},
         {"params", {{"receiver_share_cap", 0.1}}},
-        {"counts", {{"receivers_total", 16000}, {"receiver_share_capped_grid", 1}}}};
+        {"counts", {{"receivers_total", 16000}, {"receiver_share_capped_vpls", 1}}}};
     c = FrameCost::ofFrame(capped, 200, 100, 16, 1.0);
     EXPECT_EQ(c.vpls, 16);
     EXPECT_DOUBLE_EQ(c.receiverShare, 0.1);
     EXPECT_TRUE(c.receiverCut);
     nlohmann::json uncut = capped;
-    uncut["counts"].erase("receiver_share_capped_grid");
+    uncut["counts"].erase("receiver_share_capped_vpls");
     EXPECT_DOUBLE_EQ(FrameCost::ofFrame(uncut, 200, 100, 16, 1.0).receiverShare, 0.8)
         << "a cap it stayed under";
     EXPECT_LT(FrameCost::ofFrame(nlohmann::json::object(), 0, 0, 0, 1.0).receiverShare, 0.0);
@@ -242,7 +242,7 @@ TEST(FrameBudget, AFrameOverItsReceiverCapSaysSoInItsBudget) {
     EXPECT_EQ(same, budget) << "nothing to say";
 
     const nlohmann::json capped = {
-        {"counts", {{"receivers_total", 4200}, {"receiver_share_capped_grid", 19}}}};
+        {"counts", {{"receivers_total", 4200}, {"receiver_share_capped_vpls", 361}}}};
     noteReceiverCap(budget, capped, 100, 100);
     EXPECT_EQ(budget["receiver_capped_vpls"], 361);
     EXPECT_EQ(
@@ -281,7 +281,7 @@ TEST(FrameBudget, AJumpInReceiversIsAbsorbedWithoutAStallOrACollapse) {
         const double technique =
             pixels * kEyePerPixel + kPerPair * share * pixels * static_cast<double>(grid * grid);
         nlohmann::json counts = {{"receivers_total", share * pixels}};
-        if (grid < asked) counts["receiver_share_capped_grid"] = grid;
+        if (grid < asked) counts["receiver_share_capped_vpls"] = grid * grid;
         const nlohmann::json stats = {{"frame_ms", pixels * kFixedPerPixel + technique},
                                       {"technique_ms", technique},
                                       {"params", {{"receiver_share_cap", cap}}},
