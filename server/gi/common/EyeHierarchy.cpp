@@ -356,6 +356,17 @@ long EyeHierarchy::listedReceivers() const {
     return static_cast<long>(h.counts.x);
 }
 
+bool EyeHierarchy::capVplsToReceivers(const FrameInputs& in, const TechniqueInfo& info, ParamSet& params,
+                                      const std::function<long(const ParamSet&)>& vpls,
+                                      Counters& counters) const {
+    if (!params.has("receiver_share_cap") || !(params.getFloat("receiver_share_cap") < 1.0)) return false;
+    if (capVplsForReceivers(info, params, vpls(params), static_cast<double>(in.width) * in.height,
+                            static_cast<double>(listedReceivers())) == 0)
+        return false;
+    counters["receiver_share_capped_vpls"] = static_cast<double>(vpls(params));
+    return true;
+}
+
 std::vector<std::array<int, 3>> EyeHierarchy::readReceiverList(shader::EyeReceiverListHeader* header) const {
     GIS_ASSERT(mOptions.receiverList);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -86,6 +87,13 @@ public:
     /// The receivers the last build() listed (receiverList only): reads the list's header back, which
     /// waits for the stencil pass. What a frame's work cap needs before its gather is dispatched.
     long listedReceivers() const;
+    /// The receiver work cap (receiver_share_cap, capVplsForReceivers in gi/Catalog.h) on the frame
+    /// the last build() was for (receiverList only): with a cap below 1, reads the receivers back and,
+    /// over the cap's share of the frame's pixels, lowers `params`' VPL knob through info.limitVpls and
+    /// writes the counter receiver_share_capped_vpls = vpls(params). `vpls`: the technique's VPL count
+    /// under a parameter set. Returns whether it cut; a frame without a cap waits for nothing.
+    bool capVplsToReceivers(const FrameInputs& in, const TechniqueInfo& info, ParamSet& params,
+                            const std::function<long(const ParamSet&)>& vpls, Counters& counters) const;
     /// Reconstructs level 0 ("upsample") and writes the full-resolution indirect radiance.
     /// `irradiance`: one receiver list per frame holding irradiance (bilinear upsampling, albedo / pi
     /// applied per pixel); false: per-VPL lists holding radiance (parent replicated, see eyeCombine).

@@ -97,15 +97,11 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     // The receiver work cap (gi/Catalog.h): a view with more receivers than its share traverses to a
     // shallower max_depth, its leaves cut by the cost exponent's root.
     ParamSet traversal = params;
-    if (params.getFloat("receiver_share_cap") < 1.0 && mTree.valid()) {
-        const auto leaves = [&](const ParamSet& p) {
-            return squared(std::min<long>(in.rsmSize, p.getInt("max_depth")));
-        };
-        if (capVplsForReceivers(findTechniqueInfo("hier_isr"), traversal, leaves(params),
-                                static_cast<double>(in.width) * in.height,
-                                static_cast<double>(mEye.listedReceivers())) > 0)
-            counters["receiver_share_capped_vpls"] = leaves(traversal);
-    }
+    if (mTree.valid())
+        mEye.capVplsToReceivers(
+            in, findTechniqueInfo("hier_isr"), traversal,
+            [&](const ParamSet& p) { return squared(std::min<long>(in.rsmSize, p.getInt("max_depth"))); },
+            counters);
 
     const GLuint zero[6] = {};
     mStats.upload(0, sizeof zero, zero);

@@ -97,11 +97,10 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
     // The receiver work cap (gi/Catalog.h): a view with more receivers than its share selects light
     // patches no finer than a coarser isr_finest.
     ParamSet cut = params;
-    if (params.getFloat("receiver_share_cap") < 1.0 && mTree.valid() &&
-        capVplsForReceivers(findTechniqueInfo("isr"), cut, squared(params.getInt("isr_finest")),
-                            static_cast<double>(in.width) * in.height,
-                            static_cast<double>(mEye.listedReceivers())) > 0)
-        counters["receiver_share_capped_vpls"] = squared(cut.getInt("isr_finest"));
+    if (mTree.valid())
+        mEye.capVplsToReceivers(
+            in, findTechniqueInfo("isr"), cut,
+            [](const ParamSet& p) { return squared(p.getInt("isr_finest")); }, counters);
     mVplCount = mTree.valid() ? select(cut, timer, counters) : 0;
     if (!mTree.valid()) counters["vpl_count"] = 0;
 

@@ -21,28 +21,19 @@ void MultiresGather::resize(int width, int height) {
     mIndirect.resize(width, height, "multires_gather indirect");
 }
 
-int MultiresGather::cappedVplGrid(const FrameInputs& in, const ParamSet& params, Counters& counters) const {
-    const int grid = params.getInt("vpl_grid");
-    // The parts of a refinement step must share one VPL set; they are sized by their own planner.
-    if (!(params.getFloat("receiver_share_cap") < 1.0) || in.vplParts > 1) return grid;
-    ParamSet capped = params;
-    const long allowed = capVplsForReceivers(findTechniqueInfo("multires_gather"), capped, squared(grid),
-                                             static_cast<double>(in.width) * in.height,
-                                             static_cast<double>(mEye.listedReceivers()));
-    if (allowed == 0) return grid;
-    const int cappedGrid = capped.getInt("vpl_grid");
-    counters["receiver_share_capped_vpls"] = squared(cappedGrid);
-    return cappedGrid;
-}
-
 void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& timer,
                              Counters& counters) {
     // The hierarchy comes first: its receivers decide how many VPLs the work cap leaves this frame.
     mEye.build(in, params, timer);
     // The eye hierarchy is whole (a later part of the same image keeps it): input may stop the frame.
     if (in.interrupted()) return;
-    const int grid = cappedVplGrid(in, params, counters);
-    const int vplCount = mVpls.extract(in, grid, timer, counters);
+    // The parts of a refinement step share one VPL set, sized by their own planner: no work cap.
+    ParamSet capped = params;
+    if (in.vplParts <= 1)
+        mEye.capVplsToReceivers(
+            in, findTechniqueInfo("multires_gather"), capped,
+            [](const ParamSet& p) { return squared(p.getInt("vpl_grid")); }, counters);
+    const int vplCount = mVpls.extract(in, capped.getInt("vpl_grid"), timer, counters);
     if (in.vplParts > 1) mVpls.preparePart(in.vplPart, in.vplParts, timer);
 
     {

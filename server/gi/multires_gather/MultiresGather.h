@@ -43,11 +43,6 @@ public:
     EyeHierarchy& hierarchy() { return mEye; }
 
 private:
-    /// vpl_grid, or the coarser grid receiver_share_cap leaves when the hierarchy lists more receivers
-    /// than the cap's share of the pixels (capVplsForReceivers; counter receiver_share_capped_vpls). Reads
-    /// the receiver count back, so only a frame with a cap below 1 waits for the stencil pass here.
-    int cappedVplGrid(const FrameInputs& in, const ParamSet& params, Counters& counters) const;
-
     VplGrid mVpls;
     EyeHierarchy mEye{{.receiverList = true}};
     struct GatherProgram {
