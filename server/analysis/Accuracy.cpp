@@ -96,6 +96,12 @@ std::vector<float> differenceRgb(const ImageView& a, const ImageView& b) {
 nlohmann::json compareAccuracy(const AccuracyInputs& in) {
     // Background is black in the reference; leaving it out keeps the figures about the scene.
     const PixelMask mask = maskFromNonZero(in.reference);
+    // A view of unlit surfaces only (the outside of a box whose light is inside) has no relative
+    // error: the metrics below would refuse the empty mask with words about masks.
+    if (std::none_of(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; }))
+        throw InputError("/compare", "the reference is black in every pixel of this view: nothing a light "
+                                     "reaches is in sight, so there is no error to measure; turn the camera "
+                                     "toward a lit part of the scene");
     nlohmann::json out = toJson(compareImages(in.test, in.reference, mask, in.exposureEv));
     const bool wholeKnown = !in.referenceVariance.empty();
     out["reference_noise"] = noiseJson(relativeNoise(in.reference, in.referenceVariance, mask));

@@ -107,3 +107,18 @@ TEST(Accuracy, IndirectLightIsEachTotalLessItsOwnDirectPass) {
     in.testDirect = {};
     EXPECT_FALSE(compareAccuracy(in).contains("indirect"));
 }
+
+TEST(Accuracy, AViewTheLightsDoNotReachIsRefusedWithWhatToDo) {
+    const std::vector<float> black(kValues, 0.0f), lit = converged(0.5f);
+    AccuracyInputs in;
+    in.test = view(lit); // light leaking onto surfaces the reference leaves dark
+    in.reference = view(black);
+    try {
+        compareAccuracy(in);
+        FAIL() << "a black reference was compared";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.where(), "/compare");
+        EXPECT_NE(e.reason().find("black in every pixel"), std::string::npos) << e.what();
+        EXPECT_NE(e.reason().find("turn the camera"), std::string::npos) << e.what();
+    }
+}
