@@ -8,10 +8,39 @@ import { aimAt, containRect, dragToWorld, gizmoHandles, gizmoKinds, gizmoLabels,
 
 const SVG = 'http://www.w3.org/2000/svg';
 
+/** At most this long (ms) after a camera move without a frame drawn, the gizmo follows the camera. */
+export const CAMERA_FOLLOW_MS = 100;
+
 function svgElement(tag, attrs = {}) {
     const el = document.createElementNS(SVG, tag);
     for (const [k, v] of Object.entries(attrs)) el.setAttribute(k, String(v));
     return el;
+}
+
+// What render last wrote to each element (attributes, and style properties as "style.name"): a value
+// written again unchanged would still invalidate the layer's paint.
+const written = new WeakMap();
+
+function writeOnce(el, key, value, apply) {
+    const text = String(value);
+    const seen = written.get(el) ?? new Map();
+    written.set(el, seen);
+    if (seen.get(key) === text) return;
+    seen.set(key, text);
+    apply(text);
+}
+
+function setIfChanged(el, name, value) {
+    writeOnce(el, name, value, (text) => el.setAttribute(name, text));
+}
+
+/** A screen coordinate as written: a hundredth of a CSS pixel, so rounding noise writes nothing. */
+const px = (v) => v.toFixed(2);
+
+function setStyleIfChanged(el, property, value) {
+    writeOnce(el, `style.${property}`, value, (text) => {
+        el.style[property] = text;
+    });
 }
 
 function cssColor(rgb) {
@@ -29,6 +58,15 @@ export class LightGizmo {
         this.options = options;
         this.visible = true;
         this.enabled = true;
+        this.followTimer = 0;
+        // The layer's size, kept by a ResizeObserver: reading it from layout would force a layout in
+        // the middle of every frame's handler.
+        this.box = null;
+        if (typeof ResizeObserver === 'function') {
+            new ResizeObserver(([entry]) => {
+                this.box = { width: entry.contentRect.width, height: entry.contentRect.height };
+            }).observe(svg);
+        }
         this.line = svgElement('line', { class: 'gizmo-beam' });
         // Where a directional light's beam starts, which has no handle of its own.
         this.anchor = svgElement('circle', { class: 'gizmo-anchor', r: 3 });
@@ -42,7 +80,7 @@ export class LightGizmo {
     }
 
     rect() {
-        const box = this.svg.getBoundingClientRect();
+        const box = this.box ?? this.svg.getBoundingClientRect();
         const [w, h] = this.options.getFrameSize();
         return containRect(box.width, box.height, w, h);
     }
@@ -52,43 +90,58 @@ export class LightGizmo {
         return [rect.left + ((p.x + 1) / 2) * rect.width, rect.top + ((1 - p.y) / 2) * rect.height];
     }
 
+    /**
+     * The camera moved: redraw with the next frame drawn (whose handler calls render), or after
+     * CAMERA_FOLLOW_MS if no frame comes (a slow server, a lost connection).
+     */
+    followCamera() {
+        if (this.followTimer) return;
+        this.followTimer = setTimeout(() => {
+            this.followTimer = 0;
+            this.render();
+        }, CAMERA_FOLLOW_MS);
+    }
+
     render() {
+        clearTimeout(this.followTimer);
+        this.followTimer = 0;
         const camera = this.options.getCamera();
         const light = this.options.getLight();
         const kinds = gizmoKinds(light);
         const show = this.visible && this.enabled && camera && light
             && (!kinds.move || light.position) && (!kinds.aim || light.direction);
-        this.svg.classList.toggle('hidden', !show);
+        if (this.svg.classList.contains('hidden') === show) this.svg.classList.toggle('hidden', !show);
         if (!show) return;
-        this.svg.dataset.lightType = light.type ?? 'spot';
+        const type = light.type ?? 'spot';
+        if (this.svg.dataset.lightType !== type) this.svg.dataset.lightType = type;
         const labels = gizmoLabels(light);
-        this.origin.firstChild.textContent = labels.move;
-        this.tip.firstChild.textContent = labels.aim;
+        if (this.origin.firstChild.textContent !== labels.move) this.origin.firstChild.textContent = labels.move;
+        if (this.tip.firstChild.textContent !== labels.aim) this.tip.firstChild.textContent = labels.aim;
         const rect = this.rect();
         const { anchorPoint, origin, tip } = gizmoHandles(camera, rect.width / Math.max(1, rect.height), light);
         const place = (el, p) => {
-            el.style.display = p ? '' : 'none';
+            setStyleIfChanged(el, 'display', p ? '' : 'none');
             if (!p) return null;
             const [x, y] = LightGizmo.toScreen(p, rect);
-            el.setAttribute('cx', x);
-            el.setAttribute('cy', y);
+            setIfChanged(el, 'cx', px(x));
+            setIfChanged(el, 'cy', px(y));
             return [x, y];
         };
         const originAt = place(this.origin, origin);
         const anchorAt = place(this.anchor, kinds.move ? null : anchorPoint);
         const a = originAt ?? anchorAt;
         const b = place(this.tip, tip);
-        this.line.style.display = a && b ? '' : 'none';
+        setStyleIfChanged(this.line, 'display', a && b ? '' : 'none');
         if (a && b) {
-            this.line.setAttribute('x1', a[0]);
-            this.line.setAttribute('y1', a[1]);
-            this.line.setAttribute('x2', b[0]);
-            this.line.setAttribute('y2', b[1]);
+            setIfChanged(this.line, 'x1', px(a[0]));
+            setIfChanged(this.line, 'y1', px(a[1]));
+            setIfChanged(this.line, 'x2', px(b[0]));
+            setIfChanged(this.line, 'y2', px(b[1]));
         }
         const color = cssColor(light.color);
-        this.origin.style.fill = light.enabled === false ? 'transparent' : color;
-        this.anchor.style.fill = color;
-        this.line.style.stroke = color;
+        setStyleIfChanged(this.origin, 'fill', light.enabled === false ? 'transparent' : color);
+        setStyleIfChanged(this.anchor, 'fill', color);
+        setStyleIfChanged(this.line, 'stroke', color);
     }
 
     bindDrag(handle, kind) {

@@ -239,6 +239,7 @@ const {
 } = createOutbox({
     ui, state, settings, store, camera, connection, latency, watch, sentLog: hook.sent, showMessage,
     renderGizmo: () => gizmo.render(),
+    followCamera: () => gizmo.followCamera(),
     hello: { codecs: CODECS, maxInFlight: MAX_IN_FLIGHT, resumeKey: RESUME_KEY, page },
 });
 const frameView = createFrameView({ ui, state, connection, send, showMessage, onDrawn: recordDraw });

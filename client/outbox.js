@@ -13,11 +13,11 @@ import { DEFAULT_FRAME_TARGET_MS } from './progress.js';
 
 /**
  * `connection` sends; `sentLog` keeps the last messages for the console hook; `renderGizmo` redraws
- * the light gizmo; `hello` has the page's fixed hello fields ({codecs, maxInFlight, token, view,
+ * the light gizmo now and `followCamera` with the next frame (gizmo.js); `hello` has the page's fixed hello fields ({codecs, maxInFlight, token, view,
  * resumeKey}).
  */
 export function createOutbox({ ui, state, settings, store, camera, connection, latency, watch, sentLog, showMessage,
-    renderGizmo, hello }) {
+    renderGizmo, followCamera, hello }) {
     const { codecs: CODECS, maxInFlight: MAX_IN_FLIGHT, resumeKey: RESUME_KEY, page } = hello;
 
     /** Validates like the server would and sends; an invalid message is shown, never sent. */
@@ -106,7 +106,7 @@ export function createOutbox({ ui, state, settings, store, camera, connection, l
         if (state.viewer) return;
         outbox.camera = true;
         scheduleFlush();
-        renderGizmo();
+        followCamera();
         store.emit('camera');
     }
 
@@ -124,14 +124,14 @@ export function createOutbox({ ui, state, settings, store, camera, connection, l
         const key = state.lights[index].id ?? '';
         outbox.lights.set(key, { ...(outbox.lights.get(key) ?? {}), ...structuredClone(changes) });
         scheduleFlush();
-        renderGizmo();
+        followCamera();
         store.emit('lights');
     }
 
     function selectLight(id) {
         state.selectedLightId = id;
         store.emit('lights');
-        renderGizmo();
+        followCamera();
     }
 
     /** light_add for a light of `type` placed from the current view; the server's state answer selects it. */

@@ -4,7 +4,9 @@
 //   - input -> frame from a still view: from a key press (after refinement finished) to the first
 //     interactive frame drawn, p50 and p95, against that frame's own render + encode time,
 //   - input during refinement: the same, pressed while a slow configuration (rsm_gather with 65,536
-//     VPLs, hier_isr with tau 0) refines in tiles.
+//     VPLs, hier_isr with tau 0) refines in tiles (`--refinement 0` leaves these out),
+//   - the page's own work while orbiting: the share of one core its main thread was busy
+//     (`orbit_page_busy`, Chromium's TaskDuration), time the server's two cores did not get.
 // Each press is timed twice: from this script's key dispatch to the page's next animation frame after
 // the draw (`still_input_to_frame_ms`, `input_to_frame_ms`), and in the page, from the key event to the
 // frame drawn on the canvas (`still_in_page`, `in_page`, with where the time went).
@@ -12,14 +14,14 @@
 // the ones recorded. usage:
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
 //        [--orbit-s 6] [--still-s 3] [--chromium /usr/bin/chromium] [--out report.json]
-//        [--server-args "--slice-ms 20"] [--server-nice 10]
+//        [--server-args "--slice-ms 20"] [--server-nice 10] [--refinement 0]
 import { writeFileSync } from 'node:fs';
 
 import { DEFAULT_SERVER, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
-    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0, 'server-nice': 0 },
-'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"] [--server-nice 0..19]');
+    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0, 'server-nice': 0, refinement: 1 },
+'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"] [--server-nice 0..19] [--refinement 0|1]');
 
 const serverArgs = opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : [];
 // --server-nice N: the server below the browser's CPU priority (bench/lib.mjs, startServer).
@@ -85,6 +87,11 @@ await page.evaluate(() => {
             steerAt: window.giClient.lastDrawTiming.steerAt });
     });
 });
+// The renderer's main-thread time (script, style, layout, paint), cumulative seconds.
+const cdp = await page.context().newCDPSession(page);
+await cdp.send('Performance.enable');
+const pageTaskS = async () => (await cdp.send('Performance.getMetrics')).metrics
+    .find((m) => m.name === 'TaskDuration')?.value ?? null;
 const view = await page.$('canvas') ?? await page.$('#view');
 const box = await view.boundingBox();
 await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2); // focus for the keys
@@ -175,8 +182,13 @@ async function measureScene(requested, technique, params) {
     // Orbit: hold the left arrow.
     const orbitStart = Date.now();
     await page.keyboard.down('ArrowLeft');
-    await sleep(opts['orbit-s'] * 1000);
+    await sleep(1000);
+    const busyFrom = { task: await pageTaskS(), at: Date.now() };
+    await sleep(opts['orbit-s'] * 1000 - 1000);
+    const busyTo = { task: await pageTaskS(), at: Date.now() };
     await page.keyboard.up('ArrowLeft');
+    const pageBusy = busyFrom.task !== null && busyTo.task !== null && busyTo.at > busyFrom.at
+        ? (busyTo.task - busyFrom.task) / ((busyTo.at - busyFrom.at) / 1000) : null;
     const orbit = (await draws(orbitStart + 1000)).filter((d) => d.t <= orbitStart + opts['orbit-s'] * 1000);
     const fps = orbit.length > 1 ? (orbit.length - 1) / ((orbit.at(-1).t - orbit[0].t) / 1000) : 0;
     const frameMs = orbit.map((d) => d.ms);
@@ -204,6 +216,7 @@ async function measureScene(requested, technique, params) {
         still_input_wait_ms: { p50: percentile(parts.inputWait, 0.5), p95: percentile(parts.inputWait, 0.95) },
         still_breakdown_ms_p50: breakdown, still_in_page: inPageSummary(results), presses: stillLat.length,
         last_size: orbit.at(-1)?.size,
+        orbit_page_busy: pageBusy === null ? null : +pageBusy.toFixed(3),
         // The VPLs the frame budget left the orbit's frames (p50): with the size, what its time bought.
         orbit_vpls_p50: percentile(orbit.map((d) => d.vpls).filter((v) => v !== null), 0.5) ?? null };
 }
@@ -248,7 +261,7 @@ try {
         report.scenes.push(r);
         console.log(JSON.stringify(r));
     }
-    for (const [technique, params] of [['rsm_gather', { vpl_grid: 256 }], ['hier_isr', { tau: 0 }]]) {
+    for (const [technique, params] of opts.refinement ? [['rsm_gather', { vpl_grid: 256 }], ['hier_isr', { tau: 0 }]] : []) {
         const r = await duringRefinement('builtin:cornell', technique, params);
         report.refinement.push(r);
         console.log(JSON.stringify(r));

@@ -370,10 +370,49 @@ test('the stats overlay shows fps, latency, times, bytes and per-pass timings', 
     assert.match(await page.locator('#ov-bytes').textContent(), /KB\/frame · \d+×\d+ (webp|jpeg) · fixed/);
 });
 
-test('the light gizmo and Ctrl-drag move and aim the spotlight', async () => {
+test('the light gizmo and Ctrl-drag move and aim the spotlight', async (t) => {
     const start = await page.evaluate(() => window.giClient.light);
+    assert.ok(await page.locator('.gizmo-origin').boundingBox(), 'the gizmo is drawn');
+
+    // An orbit moves the gizmo with the frames drawn, not at every animation frame (gizmo.js): its
+    // redraws had kept the page laying out and painting at 60 Hz on the cores the server renders on.
+    // The spotlight hangs over the orbit's vertical axis, aimed down it: the orbit goes up.
+    await page.evaluate(() => {
+        const origin = document.querySelector('.gizmo-origin');
+        window.gizmoMoves = { moves: 0, animationFrames: 0, drawn: window.giClient.framesDrawn, at: origin.getAttribute('cy') };
+        // One callback per task that moved it: a redraw writes its attributes together.
+        window.gizmoObserver = new MutationObserver(() => { window.gizmoMoves.moves += 1; });
+        window.gizmoObserver.observe(origin, { attributes: true, attributeFilter: ['cx', 'cy'] });
+        const count = () => {
+            if (!window.gizmoObserver) return;
+            window.gizmoMoves.animationFrames += 1;
+            requestAnimationFrame(count);
+        };
+        requestAnimationFrame(count);
+    });
+    await page.locator('#view').focus(); // for the keys
+    await page.keyboard.down('ArrowUp');
+    await page.waitForTimeout(1000);
+    await page.keyboard.up('ArrowUp');
+    const orbit = await page.evaluate(() => {
+        window.gizmoObserver.disconnect();
+        window.gizmoObserver = null;
+        const m = window.gizmoMoves;
+        return { ...m, drawn: window.giClient.framesDrawn - m.drawn,
+            moved: document.querySelector('.gizmo-origin').getAttribute('cy') !== m.at };
+    });
+    t.diagnostic(`orbit: ${orbit.moves} gizmo moves, ${orbit.drawn} frames drawn, ${orbit.animationFrames} animation frames`);
+    assert.ok(orbit.moved, 'the gizmo follows the orbit');
+    // Besides the frames, a move 100 ms after a camera change that no frame answered.
+    assert.ok(orbit.moves <= orbit.drawn + 11, `gizmo moves ${orbit.moves} against ${orbit.drawn} frames drawn`);
+    assert.ok(orbit.moves < orbit.animationFrames * 0.75,
+        `gizmo moves ${orbit.moves} against ${orbit.animationFrames} animation frames`);
+    // Back to the scene's camera, as the rest of the test and the next ones expect it.
+    const beforeHome = await page.evaluate(() => window.giClient.lastFrame);
+    await page.keyboard.press('Home');
+    await until('a frame from the scene camera', (f) => window.giClient.lastFrame > f, beforeHome);
+
     const origin = await page.locator('.gizmo-origin').boundingBox();
-    assert.ok(origin, 'the gizmo is drawn');
     const frame = await page.evaluate(() => window.giClient.lastFrame);
     await page.mouse.move(origin.x + origin.width / 2, origin.y + origin.height / 2);
     await page.mouse.down();
@@ -764,11 +803,14 @@ test('a late frame is said ("rendering… s") and the figures marked stale; inje
         await p.locator('[data-control="adaptive"] input').uncheck();
         await p.waitForFunction(() => window.giClient.lastStats?.quality === 'fixed', null, { timeout: WAIT_MS });
         assert.equal(await p.evaluate(() => window.giClient.busy), null, 'not busy while frames keep up');
+        const gizmoAt = () => p.locator('.gizmo-tip').evaluate((e) => `${e.getAttribute('cx')},${e.getAttribute('cy')}`);
+        const gizmoBefore = await gizmoAt();
         hold = true;
         await drag(p);
         const busy = await p.waitForFunction(() => /^rendering… \d+\.\d s$/.test(window.giClient.busy ?? '')
             && window.giClient.stale && window.giClient.busy, null, { timeout: WAIT_MS, polling: 50 });
         assert.match(await busy.jsonValue(), /rendering…/);
+        assert.notEqual(await gizmoAt(), gizmoBefore, 'the gizmo follows the camera when no frame comes');
         assert.match(await p.locator('#ov-stale').textContent(), /^stale: figures from before your input \d+\.\d s ago$/);
         assert.ok(await p.locator('#busy').isVisible());
         const first = await p.locator('#busy').textContent();
