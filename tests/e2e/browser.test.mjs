@@ -823,9 +823,14 @@ test('a late frame is said ("rendering… s") and the figures marked stale; inje
         // The released frames are drawn before anything is injected: a fixed frame ends refinement.
         // Settled means no new frame for 500 ms and no input waiting for its frame (on a loaded
         // machine the drag's last frame can take longer than that, and its wait would show instead).
-        for (let frames = -1; ;) {
+        for (let frames = -1, deadline = Date.now() + WAIT_MS; ;) {
             const now = await p.evaluate(() => (window.giClient.busy === null ? window.giClient.framesDrawn : -2));
             if (now === frames && now >= 0) break;
+            if (Date.now() > deadline) {
+                const state = await p.evaluate(() => ({ busy: window.giClient.busy, stale: window.giClient.stale,
+                    frames: window.giClient.framesDrawn, rttMs: window.giClient.rttMs, quality: window.giClient.lastStats?.quality }));
+                assert.fail(`the page did not settle within ${WAIT_MS} ms after the held frames: ${JSON.stringify(state)}`);
+            }
             frames = now;
             await p.waitForTimeout(500);
         }
