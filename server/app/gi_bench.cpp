@@ -67,7 +67,9 @@ Renders every configuration --frames times, interleaved (frame k of each configu
 k+1 of any), and prints the median ms of each pass per configuration, the total, the ratio of each
 total to the first configuration's, the receivers per eye level against the covered pixels
 (fill-rate saving) and, with --baseline, the relative RMSE of each configuration against that GL
-configuration.)";
+configuration. With --size-before, every timed frame follows an untimed one of that size: the same
+command with and without it gives what a change of size costs a frame (the live view's frame
+budget changes the size as the view's cost moves).)";
 
 int compare(const std::vector<std::string>& args) {
     if (args.size() != 2) throw UsageError("compare needs two files: TEST.exr REFERENCE.exr");
@@ -96,6 +98,13 @@ int passes(const std::vector<std::string>& args) {
     options.value("--baseline", "SPEC",
                   "GL configuration the errors are measured against (rendered once, untimed)",
                   [&](const std::string& v) { baseline = {parseConfig(v)}; });
+    int beforeWidth = 0, beforeHeight = 0;
+    options.value("--size-before", "WxH",
+                  "an untimed frame of this size before each timed one, so that each timed frame "
+                  "changes size (default: none)",
+                  [&](const std::string& v) {
+                      gis::cli::parseSize("--size-before", v, 4096, beforeWidth, beforeHeight);
+                  });
     if (printedHelp(args, kPassesHelp, options)) return 0;
     options.parse(args);
     auto& [sceneName, width, height, frames, configs, jsonPath, gl, timerQueries] = o;
@@ -117,10 +126,16 @@ int passes(const std::vector<std::string>& args) {
     std::vector<gis::FrameOutput> last(configs.size());
     std::vector<std::vector<nlohmann::json>> stats(configs.size());
     for (size_t i = 0; i < configs.size(); ++i) last[i] = renderers[i]->render(states[i], true); // warm-up
+    std::vector<gis::FrameState> before = states;
+    for (gis::FrameState& b : before) {
+        b.width = beforeWidth;
+        b.height = beforeHeight;
+    }
     for (int k = 0; k < frames; ++k) {
         for (size_t i = 0; i < configs.size(); ++i) {
             gis::logInfo("gi-bench: frame " + std::to_string(k + 1) + "/" + std::to_string(frames) + " of " +
                          configs[i].label);
+            if (beforeWidth > 0) renderers[i]->render(before[i], false);
             last[i] = renderers[i]->render(states[i], true);
             stats[i].push_back(last[i].stats);
         }
@@ -157,10 +172,14 @@ int passes(const std::vector<std::string>& args) {
         rows.push_back(row);
     }
 
-    std::printf("scene %s, %dx%d, GL %s (%s), timing %s, median of %d interleaved frames\n\n",
-                sceneName.c_str(), width, height, context->info().backend.c_str(),
-                context->info().renderer.c_str(), timerQueries ? "timer queries" : "glFinish per pass",
-                frames);
+    std::printf(
+        "scene %s, %dx%d, GL %s (%s), timing %s, median of %d interleaved frames%s\n\n", sceneName.c_str(),
+        width, height, context->info().backend.c_str(), context->info().renderer.c_str(),
+        timerQueries ? "timer queries" : "glFinish per pass", frames,
+        beforeWidth > 0
+            ? (", each after a frame of " + std::to_string(beforeWidth) + "x" + std::to_string(beforeHeight))
+                  .c_str()
+            : "");
     std::printf("| pass (ms) |");
     for (const auto& c : configs) std::printf(" %s |", c.label.c_str());
     std::printf("\n|---|");

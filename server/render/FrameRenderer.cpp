@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -284,22 +285,33 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
         mLightPassesValid = false;
     }
     if (width != mWidth || height != mHeight) {
-        mGPosition = gl::Texture::create2D(GL_RGBA32F, width, height);
-        mGNormal = gl::Texture::create2D(GL_RGBA16F, width, height);
-        mGAlbedo = gl::Texture::create2D(GL_RGBA8, width, height);
-        mGEmissive = gl::Texture::create2D(GL_RGBA16F, width, height);
-        mGSpecular = gl::Texture::create2D(GL_RGBA8, width, height);
-        mGDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, width, height);
-        mGBufferFbo = gl::Framebuffer::of(
-            "G-buffer", {&mGPosition, &mGNormal, &mGAlbedo, &mGEmissive, &mGSpecular}, &mGDepth);
-        mDirect = gl::Texture::create2D(GL_RGBA32F, width, height);
-        mDirectFbo = gl::Framebuffer::of("direct light", {&mDirect});
-        mDisplay = gl::Texture::create2D(GL_RGBA8, width, height);
-        mLinear = gl::Texture::create2D(GL_RGBA32F, width, height);
-        mCompositeFbo = gl::Framebuffer::of("composite", {&mDisplay, &mLinear});
+        // A size used before takes its targets back (the budget's sizes recur): no allocation and
+        // no first touch of fresh memory on the frame.
+        std::optional<ScreenTargets> kept = mRecentScreens.take({width, height});
+        if (mWidth > 0)
+            mRecentScreens.keep({mWidth, mHeight}, std::move(mScreen), static_cast<double>(mWidth) * mHeight);
+        mScreen = kept ? std::move(*kept) : ScreenTargets::create(width, height);
         mWidth = width;
         mHeight = height;
     }
+}
+
+FrameRenderer::ScreenTargets FrameRenderer::ScreenTargets::create(int width, int height) {
+    ScreenTargets t;
+    t.gPosition = gl::Texture::create2D(GL_RGBA32F, width, height);
+    t.gNormal = gl::Texture::create2D(GL_RGBA16F, width, height);
+    t.gAlbedo = gl::Texture::create2D(GL_RGBA8, width, height);
+    t.gEmissive = gl::Texture::create2D(GL_RGBA16F, width, height);
+    t.gSpecular = gl::Texture::create2D(GL_RGBA8, width, height);
+    t.gDepth = gl::Texture::create2D(GL_DEPTH_COMPONENT32F, width, height);
+    t.gBufferFbo = gl::Framebuffer::of(
+        "G-buffer", {&t.gPosition, &t.gNormal, &t.gAlbedo, &t.gEmissive, &t.gSpecular}, &t.gDepth);
+    t.direct = gl::Texture::create2D(GL_RGBA32F, width, height);
+    t.directFbo = gl::Framebuffer::of("direct light", {&t.direct});
+    t.display = gl::Texture::create2D(GL_RGBA8, width, height);
+    t.linear = gl::Texture::create2D(GL_RGBA32F, width, height);
+    t.compositeFbo = gl::Framebuffer::of("composite", {&t.display, &t.linear});
+    return t;
 }
 
 void FrameRenderer::ensureTechnique(const std::string& name, int width, int height) {
@@ -382,7 +394,7 @@ std::vector<double> FrameRenderer::readViewFlux(int views) const {
 
 DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& viewProj, const LodView& lod) {
     gl::Pass pass(mTimer, "gbuffer");
-    pass.target(mGBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
+    pass.target(mScreen.gBufferFbo, width, height).depthTest(GL_LESS).clearColor(5).clearDepth();
     const MeshPass& gbuffer = gbufferPass();
     pass.use(gbuffer.program).set(gbuffer.view, -1);
     const DrawCount count =
@@ -392,18 +404,18 @@ DrawCount FrameRenderer::renderGBuffer(int width, int height, const glm::mat4& v
 }
 
 void FrameRenderer::publishGBuffer() {
-    mResources.publish("gbuffer.position", "gbuffer", mGPosition);
-    mResources.publish("gbuffer.normal", "gbuffer", mGNormal);
-    mResources.publish("gbuffer.albedo", "gbuffer", mGAlbedo);
-    mResources.publish("gbuffer.emissive", "gbuffer", mGEmissive);
-    mResources.publish("gbuffer.specular", "gbuffer", mGSpecular);
-    mResources.publish("gbuffer.depth", "gbuffer", mGDepth);
+    mResources.publish("gbuffer.position", "gbuffer", mScreen.gPosition);
+    mResources.publish("gbuffer.normal", "gbuffer", mScreen.gNormal);
+    mResources.publish("gbuffer.albedo", "gbuffer", mScreen.gAlbedo);
+    mResources.publish("gbuffer.emissive", "gbuffer", mScreen.gEmissive);
+    mResources.publish("gbuffer.specular", "gbuffer", mScreen.gSpecular);
+    mResources.publish("gbuffer.depth", "gbuffer", mScreen.gDepth);
 }
 
 void FrameRenderer::renderDirect() {
     // The viewport is the G-buffer's, set by the pass before.
     gl::Pass pass(mTimer, "direct");
-    glBindFramebuffer(GL_FRAMEBUFFER, mDirectFbo.id());
+    glBindFramebuffer(GL_FRAMEBUFFER, mScreen.directFbo.id());
     const DirectPass& d = mDirectPasses[mDirectCase];
     pass.use(d.program)
         .texture(d.position, mResources.get("gbuffer.position"))
@@ -413,7 +425,7 @@ void FrameRenderer::renderDirect() {
         .texture(d.shadow, mResources.get("lights.shadow"))
         .texture(d.specular, mResources.get("gbuffer.specular"));
     pass.drawFullscreen(mEmptyVao);
-    mResources.publish("direct", "direct", mDirect);
+    mResources.publish("direct", "direct", mScreen.direct);
 }
 
 void FrameRenderer::composite(int width, int height, const gl::Texture* indirect,
@@ -421,15 +433,15 @@ void FrameRenderer::composite(int width, int height, const gl::Texture* indirect
     gl::Pass pass(mTimer, "composite");
     const CompositePass& c = mCompositePasses[reflection ? 1 : 0];
     const gl::Texture& direct = mResources.get("direct");
-    pass.target(mCompositeFbo, width, height).use(c.program);
+    pass.target(mScreen.compositeFbo, width, height).use(c.program);
     pass.set(c.hasIndirect, indirect ? 1 : 0).set(c.applyOcclusion, indirect && applyOcclusion ? 1 : 0);
     pass.texture(c.direct, direct)
         .texture(c.indirect, indirect ? *indirect : direct)
         .texture(c.reflection, reflection ? *reflection : direct)
         .texture(c.albedo, mResources.get("gbuffer.albedo"));
     pass.drawFullscreen(mEmptyVao);
-    mResources.publish("display", "composite", mDisplay);
-    mResources.publish("linear", "composite", mLinear);
+    mResources.publish("display", "composite", mScreen.display);
+    mResources.publish("linear", "composite", mScreen.linear);
 }
 
 std::array<int, 7> FrameRenderer::partKey(const FrameState& state) {
@@ -621,7 +633,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     DrawCount eyeDraws;
     if (keepEyePasses) {
         publishGBuffer();
-        mResources.publish("direct", "direct", mDirect);
+        mResources.publish("direct", "direct", mScreen.direct);
     } else {
         eyeDraws = renderGBuffer(state.width, state.height, u.viewProj, lod);
         renderDirect();
@@ -719,9 +731,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     out.width = state.width;
     out.height = state.height;
     Stopwatch readClock;
-    out.rgba8 = readRgba8(mCompositeFbo, 0, state.width, state.height);
-    if (wantLinear) out.linear = readRgba32f(mCompositeFbo, 1, state.width, state.height);
-    if (wantDirect) out.linearDirect = readRgba32f(mDirectFbo, 0, state.width, state.height);
+    out.rgba8 = readRgba8(mScreen.compositeFbo, 0, state.width, state.height);
+    if (wantLinear) out.linear = readRgba32f(mScreen.compositeFbo, 1, state.width, state.height);
+    if (wantDirect) out.linearDirect = readRgba32f(mScreen.directFbo, 0, state.width, state.height);
     const double readbackMs = readClock.elapsedMs();
     if (readsRsm && views == 1 && !reuseLights) viewFlux = readViewFlux(views);
     if (mReuseLightPasses && !reuseLights) {

@@ -22,6 +22,7 @@
 #include "gi/Technique.h"
 #include "gl/FrameResources.h"
 #include "gl/Objects.h"
+#include "gl/RecentTargets.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
 #include "gl/ShaderShared.h"
@@ -200,12 +201,19 @@ private:
     std::vector<gl::Framebuffer> mShadowFbos;
     gl::Texture mRsmPosition, mRsmNormal, mRsmFlux, mRsmSpecular, mRsmDepth;
     std::vector<gl::Framebuffer> mRsmFbos;
-    gl::Texture mGPosition, mGNormal, mGAlbedo, mGEmissive, mGSpecular, mGDepth;
-    gl::Framebuffer mGBufferFbo;
-    gl::Texture mDirect;
-    gl::Framebuffer mDirectFbo;
-    gl::Texture mDisplay, mLinear;
-    gl::Framebuffer mCompositeFbo;
+    /// What is sized to the frame: G-buffer, direct light, composite.
+    struct ScreenTargets {
+        gl::Texture gPosition, gNormal, gAlbedo, gEmissive, gSpecular, gDepth;
+        gl::Framebuffer gBufferFbo;
+        gl::Texture direct;
+        gl::Framebuffer directFbo;
+        gl::Texture display, linear;
+        gl::Framebuffer compositeFbo;
+        static ScreenTargets create(int width, int height);
+    };
+    ScreenTargets mScreen;
+    /// The targets of the last few other sizes (gl/RecentTargets.h): at most 4, 512k pixels together.
+    gl::RecentTargets<std::pair<int, int>, ScreenTargets> mRecentScreens{4, 512.0 * 1024.0};
 
     /// The mean of the VPL parts of one image so far, allocated by the first part.
     struct PartAverage {

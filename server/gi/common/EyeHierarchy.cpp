@@ -1,6 +1,7 @@
 #include "gi/common/EyeHierarchy.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "core/Error.h"
 
@@ -117,46 +118,62 @@ EyeHierarchy::EyeHierarchy(EyeHierarchyOptions options) : mOptions(options) {
 
 void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     if (width == mWidth && height == mHeight && coarsestSize == mCoarsest) return;
-    mLevels = eyeLevelLayout(width, height, coarsestSize, &mAtlasWidth, &mAtlasHeight);
-    const int aw = mAtlasWidth, ah = mAtlasHeight;
-    mGeoPosition = gl::Texture::create2D(GL_RGBA32F, aw, ah);
-    mGeoNormal = gl::Texture::create2D(GL_RGBA16F, aw, ah); // as precise as the G-buffer's normals
-    mGeoAlbedo = gl::Texture::create2D(GL_RGBA16F, aw, ah);
-    mDepthInfo = gl::Texture::create2D(GL_RGBA32F, aw, ah);
-    mNormalMin = gl::Texture::create2D(GL_RGBA16F, aw, ah);
-    mNormalMax = gl::Texture::create2D(GL_RGBA16F, aw, ah);
-    mFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
-    mDiscFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
-    // The albedo last, so that a hierarchy without it attaches one target fewer.
-    mGeoFbo = mOptions.patchAlbedo
-                  ? gl::Framebuffer::of("eye hierarchy mipmaps",
-                                        {&mGeoPosition, &mGeoNormal, &mDepthInfo, &mNormalMin, &mNormalMax,
-                                         &mDiscFlags, &mGeoAlbedo})
-                  : gl::Framebuffer::of("eye hierarchy mipmaps", {&mGeoPosition, &mGeoNormal, &mDepthInfo,
-                                                                  &mNormalMin, &mNormalMax, &mDiscFlags});
-    mFlagsFbo = gl::Framebuffer::of("eye refinement flags", {&mFlags});
-    mIllumination = gl::Texture::create2D(GL_RGBA32F, aw, ah);
-    mReconstructed = gl::Texture::create2D(GL_RGBA32F, aw, ah);
-    mStencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, aw, ah);
-    mIllumFbo = gl::Framebuffer::of("multiresolution illumination buffer", {&mIllumination}, &mStencil);
-    mReconFbo = gl::Framebuffer::of("reconstructed illumination", {&mReconstructed});
-    // The list packs a texel as y << 16 | x; GL's texture size limits keep an atlas far below that.
-    GIS_ASSERT(aw < 65536 && ah < 65536);
-    if (mOptions.receiverList)
-        mReceiverList =
-            gl::Buffer::create(sizeof(shader::EyeReceiverListHeader) +
-                               sizeof(GLuint) * static_cast<size_t>(aw) * static_cast<size_t>(ah));
-    // Padding texels must read as empty even before the first frame writes them.
-    const float zero[4] = {0, 0, 0, 0};
-    for (const gl::Texture* t : {&mGeoPosition, &mGeoNormal, &mGeoAlbedo, &mDepthInfo, &mNormalMin,
-                                 &mNormalMax, &mIllumination, &mReconstructed})
-        glClearTexImage(t->id(), 0, GL_RGBA, GL_FLOAT, zero);
-    const GLuint zeroU = 0;
-    glClearTexImage(mFlags.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zeroU);
-    glClearTexImage(mDiscFlags.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zeroU);
+    int atlasWidth = 0, atlasHeight = 0;
+    std::vector<EyeLevel> levels = eyeLevelLayout(width, height, coarsestSize, &atlasWidth, &atlasHeight);
+    // A layout used before takes its targets back: the frame budget's sizes recur, and allocating and
+    // clearing eleven atlas textures cost a frame of a new size several milliseconds.
+    std::optional<LayoutTargets> kept = mRecentLayouts.take({width, height, coarsestSize});
+    if (mWidth > 0)
+        mRecentLayouts.keep({mWidth, mHeight, mCoarsest}, std::move(mTargets),
+                            static_cast<double>(mAtlasWidth) * mAtlasHeight);
+    mTargets = kept ? std::move(*kept) : createTargets(atlasWidth, atlasHeight);
+    mLevels = std::move(levels);
+    mAtlasWidth = atlasWidth;
+    mAtlasHeight = atlasHeight;
     mWidth = width;
     mHeight = height;
     mCoarsest = coarsestSize;
+}
+
+EyeHierarchy::LayoutTargets EyeHierarchy::createTargets(int aw, int ah) const {
+    LayoutTargets t;
+    t.geoPosition = gl::Texture::create2D(GL_RGBA32F, aw, ah);
+    t.geoNormal = gl::Texture::create2D(GL_RGBA16F, aw, ah); // as precise as the G-buffer's normals
+    t.geoAlbedo = gl::Texture::create2D(GL_RGBA16F, aw, ah);
+    t.depthInfo = gl::Texture::create2D(GL_RGBA32F, aw, ah);
+    t.normalMin = gl::Texture::create2D(GL_RGBA16F, aw, ah);
+    t.normalMax = gl::Texture::create2D(GL_RGBA16F, aw, ah);
+    t.flags = gl::Texture::create2D(GL_R8UI, aw, ah);
+    t.discFlags = gl::Texture::create2D(GL_R8UI, aw, ah);
+    // The albedo last, so that a hierarchy without it attaches one target fewer.
+    t.geoFbo = mOptions.patchAlbedo
+                   ? gl::Framebuffer::of("eye hierarchy mipmaps",
+                                         {&t.geoPosition, &t.geoNormal, &t.depthInfo, &t.normalMin,
+                                          &t.normalMax, &t.discFlags, &t.geoAlbedo})
+                   : gl::Framebuffer::of("eye hierarchy mipmaps", {&t.geoPosition, &t.geoNormal, &t.depthInfo,
+                                                                   &t.normalMin, &t.normalMax, &t.discFlags});
+    t.flagsFbo = gl::Framebuffer::of("eye refinement flags", {&t.flags});
+    t.illumination = gl::Texture::create2D(GL_RGBA32F, aw, ah);
+    t.reconstructed = gl::Texture::create2D(GL_RGBA32F, aw, ah);
+    t.stencil = gl::Texture::create2D(GL_DEPTH24_STENCIL8, aw, ah);
+    t.illumFbo = gl::Framebuffer::of("multiresolution illumination buffer", {&t.illumination}, &t.stencil);
+    t.reconFbo = gl::Framebuffer::of("reconstructed illumination", {&t.reconstructed});
+    // The list packs a texel as y << 16 | x; GL's texture size limits keep an atlas far below that.
+    GIS_ASSERT(aw < 65536 && ah < 65536);
+    if (mOptions.receiverList)
+        t.receiverList =
+            gl::Buffer::create(sizeof(shader::EyeReceiverListHeader) +
+                               sizeof(GLuint) * static_cast<size_t>(aw) * static_cast<size_t>(ah));
+    // Padding texels must read as empty even before the first frame writes them (no pass writes
+    // them, so targets taken back still hold the zeros).
+    const float zero[4] = {0, 0, 0, 0};
+    for (const gl::Texture* tex : {&t.geoPosition, &t.geoNormal, &t.geoAlbedo, &t.depthInfo, &t.normalMin,
+                                   &t.normalMax, &t.illumination, &t.reconstructed})
+        glClearTexImage(tex->id(), 0, GL_RGBA, GL_FLOAT, zero);
+    const GLuint zeroU = 0;
+    glClearTexImage(t.flags.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zeroU);
+    glClearTexImage(t.discFlags.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zeroU);
+    return t;
 }
 
 void EyeHierarchy::uploadUniforms(const ParamSet& params) {
@@ -177,7 +194,7 @@ void EyeHierarchy::uploadUniforms(const ParamSet& params) {
 
 void EyeHierarchy::beginIlluminationPass(gl::Pass& pass, const EyeInputHandles& handles,
                                          const FrameInputs& in) const {
-    pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight);
+    pass.target(mTargets.illumFbo, mAtlasWidth, mAtlasHeight);
     bindInputs(pass, handles, in);
     pass.blend(GL_ONE, GL_ONE, GL_ONE, GL_ZERO); // rgb accumulates, alpha marks data
 }
@@ -186,21 +203,21 @@ void EyeHierarchy::beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandle
                                      const FrameInputs& in) const {
     GIS_ASSERT(mOptions.receiverList);
     bindInputs(pass, handles.inputs, in);
-    pass.buffer(handles.list, mReceiverList)
-        .image(handles.illumination, mIllumination, GL_READ_WRITE, GL_RGBA32F);
+    pass.buffer(handles.list, mTargets.receiverList)
+        .image(handles.illumination, mTargets.illumination, GL_READ_WRITE, GL_RGBA32F);
 }
 
 void EyeHierarchy::dispatchReceivers(gl::Pass& pass) const {
     // The previous dispatch's image stores (and the stencil pass's list) before this one's loads.
-    pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT).dispatchIndirect(mReceiverList);
+    pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT).dispatchIndirect(mTargets.receiverList);
 }
 
 void EyeHierarchy::bindInputs(gl::Pass& pass, const EyeInputHandles& h, const FrameInputs& in) const {
-    pass.texture(h.geoPosition, mGeoPosition)
-        .texture(h.geoNormal, mGeoNormal)
-        .texture(h.atlasPosition, mGeoPosition)
-        .texture(h.atlasNormal, mGeoNormal)
-        .texture(h.atlasAlbedo, mGeoAlbedo)
+    pass.texture(h.geoPosition, mTargets.geoPosition)
+        .texture(h.geoNormal, mTargets.geoNormal)
+        .texture(h.atlasPosition, mTargets.geoPosition)
+        .texture(h.atlasNormal, mTargets.geoNormal)
+        .texture(h.atlasAlbedo, mTargets.geoAlbedo)
         .texture(h.pixelPosition, in.get("gbuffer.position"))
         .texture(h.pixelNormal, in.get("gbuffer.normal"))
         .texture(h.pixelAlbedo, in.get("gbuffer.albedo"));
@@ -213,9 +230,9 @@ void EyeHierarchy::bindUniforms() const {
 void EyeHierarchy::buildGeometryLevels(const FrameInputs& in, gl::PassTimer& timer) {
     {
         gl::Pass pass(timer, "eye_mipmap");
-        pass.target(mGeoFbo, mAtlasWidth, mAtlasHeight);
-        const gl::Texture* geo[6] = {&mGeoPosition, &mGeoNormal, &mGeoAlbedo,
-                                     &mDepthInfo,   &mNormalMin, &mNormalMax};
+        pass.target(mTargets.geoFbo, mAtlasWidth, mAtlasHeight);
+        const gl::Texture* geo[6] = {&mTargets.geoPosition, &mTargets.geoNormal, &mTargets.geoAlbedo,
+                                     &mTargets.depthInfo,   &mTargets.normalMin, &mTargets.normalMax};
         for (int i = 0; i < 6; ++i) pass.texture(mReduce->geo[static_cast<size_t>(i)], *geo[i]);
         const ReduceProgram& fromPixels = *mReduceFromPixels[mPixelMetrics ? 1 : 0];
         bindInputs(pass, fromPixels.inputs, in);
@@ -232,10 +249,10 @@ void EyeHierarchy::buildGeometryLevels(const FrameInputs& in, gl::PassTimer& tim
     {
         gl::Pass pass(timer, "refine_flags");
         if (mLevels.size() > 1) {
-            pass.target(mFlagsFbo, mAtlasWidth, mAtlasHeight)
+            pass.target(mTargets.flagsFbo, mAtlasWidth, mAtlasHeight)
                 .use(mFlagsProgram.program)
-                .texture(mFlagsProgram.discFlags, mDiscFlags)
-                .texture(mFlagsProgram.flags, mFlags);
+                .texture(mFlagsProgram.discFlags, mTargets.discFlags)
+                .texture(mFlagsProgram.flags, mTargets.flags);
             // Coarsest first: each level reads its parents' finished flags. Padding keeps the cleared 0.
             for (size_t l = mLevels.size() - 1; l >= 1; --l) {
                 pass.textureBarrier()
@@ -264,17 +281,17 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     gl::Pass pass(timer, "stencil_setup");
     if (mOptions.receiverList) {
         const shader::EyeReceiverListHeader empty{};
-        mReceiverList.upload(0, sizeof empty, &empty);
+        mTargets.receiverList.upload(0, sizeof empty, &empty);
     }
-    pass.target(mIllumFbo, mAtlasWidth, mAtlasHeight).clearColor(1).clearDepthStencil(1.0f, 0);
+    pass.target(mTargets.illumFbo, mAtlasWidth, mAtlasHeight).clearColor(1).clearDepthStencil(1.0f, 0);
     pass.noColorWrites().stencilTest(true).stencilFunc(GL_ALWAYS, 1);
     // One draw per level, each counted: the padding between levels is never shaded.
     for (size_t l = 0; l < mLevels.size(); ++l) {
         const ReceiversProgram& r = l == 0 ? mPixelReceivers : mPatchReceivers;
         if (l <= 1) {
-            pass.use(r.program).texture(r.flags, mFlags);
+            pass.use(r.program).texture(r.flags, mTargets.flags);
             bindInputs(pass, r.inputs, in);
-            if (mOptions.receiverList) pass.buffer(r.list, mReceiverList);
+            if (mOptions.receiverList) pass.buffer(r.list, mTargets.receiverList);
         }
         pass.set(r.level, static_cast<int>(l))
             .viewport(mLevels[l].x, mLevels[l].y, mLevels[l].width, mLevels[l].height)
@@ -283,7 +300,7 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     if (mOptions.receiverList) {
         pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT)
             .use(mReceiverDispatch.program)
-            .buffer(mReceiverDispatch.list, mReceiverList)
+            .buffer(mReceiverDispatch.list, mTargets.receiverList)
             .dispatch(1)
             .barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     }
@@ -310,11 +327,13 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     gl::Pass pass(timer, "upsample");
     pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT); // a receiver pass's image stores before the fetches
     const UpsampleProgram& u = mUpsample;
-    pass.target(mReconFbo, mAtlasWidth, mAtlasHeight).use(u.program).set(u.interpolate, irradiance ? 1 : 0);
-    pass.texture(u.rendered, mIllumination)
-        .texture(u.reconstructed, mReconstructed)
-        .texture(u.atlasPosition, mGeoPosition) // receiver geometry for the upsampling's edge weights
-        .texture(u.atlasNormal, mGeoNormal);
+    pass.target(mTargets.reconFbo, mAtlasWidth, mAtlasHeight)
+        .use(u.program)
+        .set(u.interpolate, irradiance ? 1 : 0);
+    pass.texture(u.rendered, mTargets.illumination)
+        .texture(u.reconstructed, mTargets.reconstructed)
+        .texture(u.atlasPosition, mTargets.geoPosition) // receiver geometry for the upsampling's edge weights
+        .texture(u.atlasNormal, mTargets.geoNormal);
     for (int l = static_cast<int>(mLevels.size()) - 1; l >= 1; --l) {
         pass.textureBarrier(); // level l + 1 is complete before level l reads it
         pass.set(u.level, l)
@@ -329,10 +348,10 @@ void EyeHierarchy::reconstruct(const FrameInputs& in, const ParamSet& params, bo
     pass.texture(v.position, in.get("gbuffer.position"))
         .texture(v.normal, in.get("gbuffer.normal"))
         .texture(v.albedo, in.get("gbuffer.albedo"))
-        .texture(v.reconstructed, mReconstructed)
-        .texture(v.rendered, mIllumination)
-        .texture(v.atlasPosition, mGeoPosition)
-        .texture(v.atlasNormal, mGeoNormal);
+        .texture(v.reconstructed, mTargets.reconstructed)
+        .texture(v.rendered, mTargets.illumination)
+        .texture(v.atlasPosition, mTargets.geoPosition)
+        .texture(v.atlasNormal, mTargets.geoNormal);
     pass.textureBarrier().drawFullscreen(mEmptyVao);
 }
 
@@ -352,7 +371,7 @@ long EyeHierarchy::listedReceivers() const {
     GIS_ASSERT(mOptions.receiverList);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     shader::EyeReceiverListHeader h{};
-    glGetNamedBufferSubData(mReceiverList.id(), 0, sizeof h, &h);
+    glGetNamedBufferSubData(mTargets.receiverList.id(), 0, sizeof h, &h);
     return static_cast<long>(h.counts.x);
 }
 
@@ -371,12 +390,12 @@ std::vector<std::array<int, 3>> EyeHierarchy::readReceiverList(shader::EyeReceiv
     GIS_ASSERT(mOptions.receiverList);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     shader::EyeReceiverListHeader h{};
-    glGetNamedBufferSubData(mReceiverList.id(), 0, sizeof h, &h);
+    glGetNamedBufferSubData(mTargets.receiverList.id(), 0, sizeof h, &h);
     if (header) *header = h;
-    const size_t capacity = (static_cast<size_t>(mReceiverList.size()) - sizeof h) / sizeof(GLuint);
+    const size_t capacity = (static_cast<size_t>(mTargets.receiverList.size()) - sizeof h) / sizeof(GLuint);
     std::vector<GLuint> items(std::min<size_t>(h.counts.x, capacity));
     if (!items.empty())
-        glGetNamedBufferSubData(mReceiverList.id(), sizeof h,
+        glGetNamedBufferSubData(mTargets.receiverList.id(), sizeof h,
                                 static_cast<GLsizeiptr>(items.size() * sizeof(GLuint)), items.data());
     std::vector<std::array<int, 3>> list;
     for (GLuint item : items)
@@ -387,7 +406,7 @@ std::vector<std::array<int, 3>> EyeHierarchy::readReceiverList(shader::EyeReceiv
 
 std::vector<std::array<int, 3>> EyeHierarchy::readReceiverSet() const {
     std::vector<GLuint> packed(static_cast<size_t>(mAtlasWidth) * mAtlasHeight);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, mIllumFbo.id());
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, mTargets.illumFbo.id());
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, mAtlasWidth, mAtlasHeight, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, packed.data());
     std::vector<std::array<int, 3>> set;

@@ -12,6 +12,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "gl/Objects.h"
 #include "gl/Pass.h"
 #include "gl/PassTimer.h"
+#include "gl/RecentTargets.h"
 #include "gl/Shader.h"
 #include "gl/ShaderShared.h"
 
@@ -103,11 +105,11 @@ public:
     const std::vector<EyeLevel>& levels() const { return mLevels; }
     int atlasWidth() const { return mAtlasWidth; }
     int atlasHeight() const { return mAtlasHeight; }
-    const gl::Texture& illumination() const { return mIllumination; }
-    const gl::Texture& geoPosition() const { return mGeoPosition; }
-    const gl::Texture& geoNormal() const { return mGeoNormal; }
-    const gl::Texture& geoAlbedo() const { return mGeoAlbedo; }
-    const gl::Texture& flags() const { return mFlags; }
+    const gl::Texture& illumination() const { return mTargets.illumination; }
+    const gl::Texture& geoPosition() const { return mTargets.geoPosition; }
+    const gl::Texture& geoNormal() const { return mTargets.geoNormal; }
+    const gl::Texture& geoAlbedo() const { return mTargets.geoAlbedo; }
+    const gl::Texture& flags() const { return mTargets.flags; }
     /// State a fragment pass that lights receivers needs, set on `pass` (its program in use): the
     /// illumination atlas as target, the hierarchy's textures the program reads (bindInputs),
     /// additive rgb with alpha marking data (multires_splat's splats, whose list items are the
@@ -176,7 +178,7 @@ private:
     std::array<std::unique_ptr<ReduceProgram>, 2> mReduceFromPixels;
     std::unique_ptr<ReduceProgram> mReduce;
     bool mPixelMetrics = false;   ///< the depth or normal metric reads the pixels' neighbours
-    EyeHierarchyOptions mOptions; ///< patchAlbedo: the mipmap writes mGeoAlbedo (its last attachment)
+    EyeHierarchyOptions mOptions; ///< patchAlbedo: the mipmap writes mTargets.geoAlbedo (its last attachment)
     FlagsProgram mFlagsProgram;
     /// The stencil's receiver test on level 0 (the G-buffer's pixels) and on the coarser levels
     /// (GIS_EYE_PIXEL_LEVEL in eye_receivers.frag).
@@ -190,10 +192,17 @@ private:
     std::vector<EyeLevel> mLevels;
     int mWidth = 0, mHeight = 0, mCoarsest = 0, mAtlasWidth = 0, mAtlasHeight = 0;
     bool mBuilt = false; ///< the mipmaps and flags were built for the current layout
-    gl::Texture mGeoPosition, mGeoNormal, mGeoAlbedo, mDepthInfo, mNormalMin, mNormalMax, mFlags, mDiscFlags;
-    gl::Texture mIllumination, mStencil, mReconstructed;
-    gl::Framebuffer mGeoFbo, mFlagsFbo, mIllumFbo, mReconFbo;
-    gl::Buffer mReceiverList; ///< shader::EyeReceiverListHeader, then one item per atlas texel
+    /// What is sized to the atlas of one layout (width, height, coarsest level).
+    struct LayoutTargets {
+        gl::Texture geoPosition, geoNormal, geoAlbedo, depthInfo, normalMin, normalMax, flags, discFlags;
+        gl::Texture illumination, stencil, reconstructed;
+        gl::Framebuffer geoFbo, flagsFbo, illumFbo, reconFbo;
+        gl::Buffer receiverList; ///< shader::EyeReceiverListHeader, then one item per atlas texel
+    };
+    LayoutTargets createTargets(int atlasWidth, int atlasHeight) const;
+    LayoutTargets mTargets;
+    /// The targets of the last few other layouts (gl/RecentTargets.h): at most 4, 768k atlas texels.
+    gl::RecentTargets<std::array<int, 3>, LayoutTargets> mRecentLayouts{4, 768.0 * 1024.0};
     std::array<unsigned, GIS_MAX_EYE_LEVELS> mLastCounts{};
 };
 
