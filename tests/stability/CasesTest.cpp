@@ -829,8 +829,8 @@ TEST_P(S4, C20_WorstCaseRefinement) {
     // multires_splat seeds 256 coarsest texels x 16384 VPLs = 4M items, 65536 work groups of 64: a
     // 2D dispatch (65535 is GL's guaranteed limit per dimension; one dimension failed with
     // GL_INVALID_VALUE and no light before).
-    // The splat frame draws 4M points: bounded (no runaway), but by a minute rather than 20 s, so a
-    // loaded sanitizer run does not fail it (21.5 s measured there).
+    // The splat frame draws 4M points: bounded (no runaway), but by a minute rather than 20 s (three
+    // in the sanitizer build, where it took 54-65 s: FrameBounds::maxFrameMs).
     Frame f = render(spec(bumpy, p), {.maxFrameMs = t == "multires_splat" ? 60000.0 : kMaxFrameMs});
     note("frame ms", f.wallMs);
     if (usesEyeHierarchy(t)) {

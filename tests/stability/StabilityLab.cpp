@@ -446,7 +446,8 @@ Frame render(const RenderSpec& spec, const FrameBounds& bounds) {
             EXPECT_EQ(below, 0u) << "second_order indirect below -direct in " << name;
         }
     }
-    EXPECT_LE(f.wallMs, bounds.maxFrameMs) << "frame time " << f.wallMs << " ms in " << name;
+    EXPECT_LE(f.wallMs, bounds.maxFrameMs * kSanitizerSlowdown)
+        << "frame time " << f.wallMs << " ms in " << name;
     if (bounds.energy > 0 && !f.indirect.empty()) {
         const double flux = std::max({f.rsmFluxSum[0], f.rsmFluxSum[1], f.rsmFluxSum[2]});
         if (flux > 0) {
