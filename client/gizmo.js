@@ -60,11 +60,14 @@ export class LightGizmo {
         this.enabled = true;
         this.followTimer = 0;
         // The layer's size, kept by a ResizeObserver: reading it from layout would force a layout in
-        // the middle of every frame's handler.
+        // the middle of every frame's handler. Hidden (display: none) it has none, and is measured
+        // once more when shown; a new size redraws the handles.
         this.box = null;
         if (typeof ResizeObserver === 'function') {
             new ResizeObserver(([entry]) => {
-                this.box = { width: entry.contentRect.width, height: entry.contentRect.height };
+                const { width, height } = entry.contentRect;
+                this.box = width > 0 && height > 0 ? { width, height } : null;
+                if (this.box) this.render();
             }).observe(svg);
         }
         this.line = svgElement('line', { class: 'gizmo-beam' });
@@ -108,8 +111,8 @@ export class LightGizmo {
         const camera = this.options.getCamera();
         const light = this.options.getLight();
         const kinds = gizmoKinds(light);
-        const show = this.visible && this.enabled && camera && light
-            && (!kinds.move || light.position) && (!kinds.aim || light.direction);
+        const show = Boolean(this.visible && this.enabled && camera && light
+            && (!kinds.move || light.position) && (!kinds.aim || light.direction));
         if (this.svg.classList.contains('hidden') === show) this.svg.classList.toggle('hidden', !show);
         if (!show) return;
         const type = light.type ?? 'spot';

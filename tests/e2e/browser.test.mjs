@@ -373,6 +373,14 @@ test('the stats overlay shows fps, latency, times, bytes and per-pass timings', 
 test('the light gizmo and Ctrl-drag move and aim the spotlight', async (t) => {
     const start = await page.evaluate(() => window.giClient.light);
     assert.ok(await page.locator('.gizmo-origin').boundingBox(), 'the gizmo is drawn');
+    // Hidden and shown again from the Light panel, it is where it was.
+    const originAt = () => page.locator('.gizmo-origin').evaluate((e) => [e.getAttribute('cx'), e.getAttribute('cy')]);
+    const shownAt = await originAt();
+    await control('light-gizmo', 'input').uncheck();
+    assert.ok(!(await page.locator('.gizmo-origin').isVisible()), 'hidden');
+    await control('light-gizmo', 'input').check();
+    assert.ok(await page.locator('.gizmo-origin').isVisible(), 'shown again');
+    assert.deepEqual(await originAt(), shownAt);
 
     // An orbit moves the gizmo with the frames drawn, not at every animation frame (gizmo.js): its
     // redraws had kept the page laying out and painting at 60 Hz on the cores the server renders on.
