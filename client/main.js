@@ -15,7 +15,7 @@ import { applyLightChanges, lightsOfState, pickSelection } from './lights.js';
 import { StreamConnection, formatCountdown, pageOptions, shareLink, streamUrl } from './connection.js';
 import { block } from './controls.js';
 import { resetPlan, schemaDefaults } from './params.js';
-import { LatencyTracker, PassHistory, RateCounter, networkMs } from './stats.js';
+import { LatencyTracker, PassHistory, RateCounter, RoundTrip, networkMs } from './stats.js';
 import { InputWatch, RefineTracker } from './progress.js';
 import { DEFAULT_PIXEL_BUDGET, frameTargetSupported, normalizeFrameTarget, normalizePixelBudget } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
@@ -174,6 +174,7 @@ const state = store.state;
 const camera = new OrbitCamera();
 const rate = new RateCounter(1000);
 const latency = new LatencyTracker();
+const roundTrip = new RoundTrip(); // state.rttMs: the least of the last pings' round trips
 const passes = new PassHistory(CHART_WINDOW_S);
 const refine = new RefineTracker();
 const watch = new InputWatch();
@@ -254,6 +255,8 @@ function handleOpen() {
     latency.reset();
     watch.reset();
     refine.reset();
+    roundTrip.reset(); // another connection, perhaps another way
+    state.rttMs = null;
     send(buildHello());
     sendPing();
 }
@@ -300,7 +303,7 @@ function handleText(text) {
             + 'client will reconnect to a new one.', 'info');
         break;
     case 'pong':
-        if (Number.isFinite(msg.t)) state.rttMs = performance.now() - msg.t;
+        if (Number.isFinite(msg.t)) state.rttMs = roundTrip.add(performance.now() - msg.t);
         break;
     case 'progress':
         refine.message(msg, performance.now());

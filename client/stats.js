@@ -85,6 +85,38 @@ export function networkMs(rttMs, statsArrivedAt, binaryArrivedAt) {
     return (Number.isFinite(rttMs) ? rttMs / 2 : 0) + transfer;
 }
 
+/**
+ * The connection's round trip as frames' timing needs it: the least of the last few pings' round
+ * trips. A ping whose answer waited behind a stall (a frozen network, a proxy holding messages)
+ * measures the stall, not the way; taken as the round trip, it put every frame drawn after the
+ * stall's end before the input it answered, and the page then said "rendering…" for input no
+ * later frame would ever be counted as answering.
+ */
+export class RoundTrip {
+    constructor(samples = 8) {
+        this.samples = samples;
+        this.recent = [];
+    }
+
+    /** Adds a ping's round trip (ms); returns the estimate. Not finite or negative: ignored. */
+    add(ms) {
+        if (Number.isFinite(ms) && ms >= 0) {
+            this.recent.push(ms);
+            if (this.recent.length > this.samples) this.recent.shift();
+        }
+        return this.ms;
+    }
+
+    reset() {
+        this.recent = [];
+    }
+
+    /** The estimate (ms), or null before any ping came back. */
+    get ms() {
+        return this.recent.length ? Math.min(...this.recent) : null;
+    }
+}
+
 /** A pass's time: its GPU time where measured, else its CPU time. */
 export function passMs(pass) {
     if (Number.isFinite(pass?.gpu_ms)) return pass.gpu_ms;

@@ -18,7 +18,8 @@ import {
     newLightFor, pickSelection, requestLight,
 } from '../lights.js';
 import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
-import { LatencyTracker, PassHistory, RateCounter, formatBytes, networkMs, passMs, stackSeries, trianglesText } from '../stats.js';
+import { InputWatch } from '../progress.js';
+import { LatencyTracker, PassHistory, RateCounter, RoundTrip, formatBytes, networkMs, passMs, stackSeries, trianglesText } from '../stats.js';
 import {
     DEFAULT_COMPARE, buildCompareRequest, canCompare, compareSettings, compareSize, diffImage, formatCompare, percent,
     referenceLabel, validateCompareRequest, viewKey,
@@ -590,4 +591,34 @@ test('the triangle count says what instancing holds back', () => {
     assert.equal(trianglesText({ triangles: 1164 }), '1164');
     assert.equal(trianglesText({ triangles: 1106, triangles_stored: 94, instances: 12 }),
         '1106 (94 held, 12 instances)');
+});
+
+test('the round trip is the least of the last pings\', so a stalled pong does not unanswer input', () => {
+    const rtt = new RoundTrip(4);
+    assert.equal(rtt.ms, null, 'nothing before a pong');
+    assert.equal(rtt.add(15), 15);
+    assert.equal(rtt.add(12), 12);
+    // A pong that waited 2.6 s behind a stall (a proxy holding messages, a frozen network).
+    assert.equal(rtt.add(2600), 12);
+    rtt.add(Number.NaN);
+    rtt.add(-3);
+    assert.equal(rtt.ms, 12, 'not finite or negative: ignored');
+    for (const ms of [30, 31, 32, 33]) rtt.add(ms);
+    assert.equal(rtt.ms, 30, 'only the last four count');
+    rtt.reset();
+    assert.equal(rtt.ms, null);
+
+    // Input at 1000 ms; frames and the pong held back until 3500 ms; the frame (50 ms to render)
+    // arrives at 3510. With the stalled pong as the round trip its render "began" before the input.
+    const renderStart = (roundTripMs) => 3510 - roundTripMs - 50;
+    const answered = (roundTripMs) => {
+        const watch = new InputWatch();
+        watch.input(1000);
+        watch.frameDrawn(renderStart(roundTripMs), 3515);
+        return !watch.pending;
+    };
+    assert.equal(answered(2600), false, 'the last pong\'s round trip leaves the input waiting for ever');
+    const estimate = new RoundTrip();
+    [15, 12, 2600].forEach((ms) => estimate.add(ms));
+    assert.equal(answered(estimate.ms), true);
 });
