@@ -13,7 +13,8 @@ import { DEFAULT_FRAME_TARGET_MS } from './progress.js';
 
 /**
  * `connection` sends; `sentLog` keeps the last messages for the console hook; `renderGizmo` redraws
- * the light gizmo now and `followCamera` with the next frame (gizmo.js); `hello` has the page's fixed hello fields ({codecs, maxInFlight, token, view,
+ * the light gizmo now (a light change) and `followCamera` with the next frame (a camera move,
+ * gizmo.js); `hello` has the page's fixed hello fields ({codecs, maxInFlight, token, view,
  * resumeKey}).
  */
 export function createOutbox({ ui, state, settings, store, camera, connection, latency, watch, sentLog, showMessage,
@@ -124,14 +125,14 @@ export function createOutbox({ ui, state, settings, store, camera, connection, l
         const key = state.lights[index].id ?? '';
         outbox.lights.set(key, { ...(outbox.lights.get(key) ?? {}), ...structuredClone(changes) });
         scheduleFlush();
-        followCamera();
+        renderGizmo();
         store.emit('lights');
     }
 
     function selectLight(id) {
         state.selectedLightId = id;
         store.emit('lights');
-        followCamera();
+        renderGizmo();
     }
 
     /** light_add for a light of `type` placed from the current view; the server's state answer selects it. */

@@ -422,12 +422,24 @@ test('the light gizmo and Ctrl-drag move and aim the spotlight', async (t) => {
 
     const origin = await page.locator('.gizmo-origin').boundingBox();
     const frame = await page.evaluate(() => window.giClient.lastFrame);
+    // Where the disc is at the end of each pointer move's own task: a dragged handle follows the
+    // pointer at once, not with a later frame.
+    await page.evaluate(() => {
+        window.discDuringDrag = [];
+        window.addEventListener('pointermove', () => window.discDuringDrag.push(
+            Number(document.querySelector('.gizmo-origin').getAttribute('cx'))));
+    });
+    const discBefore = Number(await page.locator('.gizmo-origin').getAttribute('cx'));
     await page.mouse.move(origin.x + origin.width / 2, origin.y + origin.height / 2);
     await page.mouse.down();
     await page.mouse.move(origin.x + origin.width / 2 - 40, origin.y + origin.height / 2 + 10, { steps: 4 });
     await page.mouse.up();
     const moved = await page.evaluate(() => window.giClient.light);
     assert.ok(moved.position[0] < start.position[0] - 0.05, `dragging the disc left moves the light left (${moved.position})`);
+    const discDuringDrag = await page.evaluate(() => window.discDuringDrag);
+    // The disc is moved parallel to the image: it stays under the pointer, 40 px to the left.
+    assert.ok(Math.abs(discDuringDrag.at(-1) - (discBefore - 40)) < 2,
+        `the disc is under the pointer at its last move, in that move's task (${discBefore} -> ${discDuringDrag})`);
     await until('a frame with the moved light', (f) => window.giClient.lastFrame > f, frame);
     const box = await page.locator('#view').boundingBox();
     await page.keyboard.down('Control');
