@@ -20,6 +20,18 @@ export class PassChart {
         this.colors = new Map(); // pass name -> colour, kept while the page lives
         this.names = [];
         this.plot = null;
+        this.drawn = null; // {end, version} of the last redraw; null after a resize
+        this.legendText = null; // the legend's names and times as last shown
+        this.redraws = 0;
+    }
+
+    /**
+     * Whether a redraw would show what the chart shows: the same window end (the chart stops scrolling
+     * 10 s after the last frame) over the same samples (PassHistory.version), at the size resize() set.
+     */
+    isCurrent(end, version) {
+        const d = this.drawn;
+        return d !== null && d.end === end && d.version === version;
     }
 
     colorOf(name) {
@@ -63,9 +75,11 @@ export class PassChart {
         this.plot.root.setAttribute('aria-label', 'per-pass render time, stacked, milliseconds over the last seconds');
     }
 
-    /** Draws PassHistory.series() with the window ending at `nowS` seconds. */
-    update({ names, times, values, stacked }, nowS) {
+    /** Draws PassHistory.series() with the window ending at `nowS` seconds; `version`: the history's. */
+    update({ names, times, values, stacked }, nowS, version = null) {
         this.now = nowS;
+        this.drawn = { end: nowS, version };
+        this.redraws += 1;
         if (!this.plot || names.length !== this.names.length || names.some((n, i) => n !== this.names[i])) {
             this.build(names);
         }
@@ -77,6 +91,11 @@ export class PassChart {
 
     showLegend(names, values) {
         if (!this.legend) return;
+        const times = values.map((v) => v.at(-1));
+        const text = names.map((name, k) => `${name} ${Number.isFinite(times[k]) ? times[k].toFixed(1) : '–'}`).join('\n');
+        // New elements each tick restyle and lay out the overlay for nothing when no time changed.
+        if (text === this.legendText) return;
+        this.legendText = text;
         this.legend.replaceChildren(...names.map((name, k) => {
             const li = document.createElement('li');
             li.dataset.pass = name;
@@ -91,5 +110,6 @@ export class PassChart {
 
     resize() {
         this.plot?.setSize({ width: this.width(), height: this.height });
+        this.drawn = null;
     }
 }

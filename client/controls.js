@@ -17,6 +17,35 @@ export function block(tag, className, text) {
     return el;
 }
 
+/**
+ * A list of label: value rows in `container` that show(rows) keeps up to date ([label, value] pairs):
+ * only the values that changed are written, and the rows are built again only when the labels do. A
+ * panel shown beside a live view is told about every frame: new elements each time would restyle and
+ * lay out the sidebar for nothing.
+ */
+export function keyValueRows(container) {
+    let labels = null;
+    let values = [];
+    return {
+        show(rows) {
+            const key = rows.map(([label]) => label).join('\n');
+            if (key !== labels) {
+                labels = key;
+                values = rows.map(() => block('span', 'v'));
+                container.replaceChildren(...rows.map(([label], i) => {
+                    const div = block('div', 'kv');
+                    div.append(block('span', 'k', label), values[i]);
+                    return div;
+                }));
+            }
+            rows.forEach(([, value], i) => {
+                const text = String(value);
+                if (values[i].textContent !== text) values[i].textContent = text;
+            });
+        },
+    };
+}
+
 export function makeSection(container, title, { id, closed = false } = {}) {
     const gui = new GUI({ container, title, closeFolders: false });
     gui.domElement.classList.add('section');

@@ -15,7 +15,7 @@ import { applyLightChanges, lightsOfState, pickSelection } from './lights.js';
 import { StreamConnection, formatCountdown, pageOptions, shareLink, streamUrl } from './connection.js';
 import { block } from './controls.js';
 import { resetPlan, schemaDefaults } from './params.js';
-import { LatencyTracker, PassHistory, RateCounter, RoundTrip, networkMs } from './stats.js';
+import { ChartSchedule, LatencyTracker, PassHistory, RateCounter, RoundTrip, networkMs } from './stats.js';
 import { InputWatch, RefineTracker } from './progress.js';
 import { DEFAULT_PIXEL_BUDGET, frameTargetSupported, normalizeFrameTarget, normalizePixelBudget } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
@@ -42,6 +42,7 @@ const RESIZE_DEBOUNCE_MS = 200;
 const MESSAGE_HIDE_MS = 8000;
 const PING_INTERVAL_MS = 2000;
 const CHART_WINDOW_S = 10;
+const OVERLAY_TICK_MS = 250; // the overlay's figures, and the chart's redraw at most this often
 // WebP first: about a third smaller than JPEG at the same quality; JPEG for browsers without it.
 const CODECS = ['webp', 'jpeg'];
 // Two frames in flight: the next frame travels while this one decodes, without building a queue.
@@ -180,8 +181,9 @@ const refine = new RefineTracker();
 const watch = new InputWatch();
 const toasts = new MessageStack({ max: 4, ttlMs: MESSAGE_HIDE_MS });
 const chart = new PassChart(ui.ovChart, ui.ovLegend, { windowS: CHART_WINDOW_S });
+const chartSchedule = new ChartSchedule({ periodMs: OVERLAY_TICK_MS });
 const overlay = createOverlay({ ui, state, settings, store },
-    { rate, latency, passes, chart, refine, watch, toasts, frameTargetMs: () => frameTargetMs() });
+    { rate, latency, passes, chart, chartSchedule, refine, watch, toasts, frameTargetMs: () => frameTargetMs() });
 const { showRate, showProgress, showFrameStats } = overlay;
 const connection = new StreamConnection(streamUrl(window.location), {
     onOpen: handleOpen,
@@ -226,6 +228,8 @@ const hook = {
     get bounds() { return state.bounds ? structuredClone(state.bounds) : null; },
     get welcome() { return state.welcome ? structuredClone(state.welcome) : null; },
     get frameTargetMs() { return state.frameTargetMs; },
+    get chartRedraws() { return chart.redraws; },
+    get inputPending() { return watch.pending; }, // an input no drawn frame can contain yet
     get explicit() { return [...state.explicit]; },
     // Benchmarks and tests steer through the page's own connection, exactly as the panels do.
     send: (msg) => send(msg),
@@ -547,6 +551,7 @@ function recordDraw(frame, decodeMs, frameBytes) {
     store.emit('frame', stats);
     gizmo.render();
     showProgress();
+    overlay.frameDrawn(now);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -876,7 +881,7 @@ function start() {
         chart.resize();
         gizmo.render();
     }, RESIZE_DEBOUNCE_MS)).observe(ui.viewport);
-    setInterval(showRate, 250);
+    setInterval(showRate, OVERLAY_TICK_MS);
     setInterval(sendPing, PING_INTERVAL_MS);
     connection.connect();
 }

@@ -7,7 +7,7 @@ import { formatCountdown } from './connection.js';
 import { busyText, formatSeconds } from './progress.js';
 import { formatBytes, formatMs } from './stats.js';
 
-export function createOverlay({ ui, state, settings, store }, { rate, latency, passes, chart, refine, watch, toasts, frameTargetMs }) {
+export function createOverlay({ ui, state, settings, store }, { rate, latency, passes, chart, chartSchedule, refine, watch, toasts, frameTargetMs }) {
     /** The 4-per-second tick: rate, busy badge, stale figures, chart, countdown and fading toasts. */
     function showRate() {
         const now = performance.now();
@@ -16,23 +16,42 @@ export function createOverlay({ ui, state, settings, store }, { rate, latency, p
         ui.ovRate.textContent = `${fps.toFixed(0)} fps · input→frame ${lat === null ? '–' : formatMs(lat, 0)}`
             + ` · decode ${formatMs(state.decodeMs)}`;
         showProgress(now);
-        if (settings.chart && settings.overlay) {
-            const nowS = now / 1000;
-            passes.prune(nowS);
-            const end = passes.windowEnd(nowS);
-            chart.update(passes.series(), end);
-            const age = passes.ageS(nowS);
-            // A chart that stops scrolling says why instead of looking like a live one.
-            ui.ovChartNote.hidden = end === nowS && age !== null;
-            const why = state.connState !== 'open' ? ' (not connected)'
-                : watch.pending ? ' (waiting for the server)' : ' (the view is still)';
-            ui.ovChartNote.textContent = age === null ? 'no frame timings yet'
-                : `last frame ${formatSeconds(age * 1000)} ago${why}`;
-        }
+        if (chartSchedule.onTick(now, watch.pending)) showChart(now);
         if (state.connState === 'waiting' && state.retryAt !== null) {
             ui.connText.textContent = `disconnected, retrying in ${formatCountdown(state.retryAt - now)}`;
         }
         for (const entry of toasts.expire(now)) document.querySelector(`.message[data-id="${entry.id}"]`)?.remove();
+    }
+
+    /** The pass chart and, when it stopped scrolling, why (ChartSchedule says when). */
+    function showChart(now = performance.now()) {
+        chartSchedule.drawn(now);
+        if (!settings.chart || !settings.overlay) return;
+        const nowS = now / 1000;
+        passes.prune(nowS);
+        const end = passes.windowEnd(nowS);
+        if (!chart.isCurrent(end, passes.version)) chart.update(passes.series(), end, passes.version);
+        const age = passes.ageS(nowS);
+        // A chart that stops scrolling says why instead of looking like a live one.
+        ui.ovChartNote.hidden = end === nowS && age !== null;
+        const why = state.connState !== 'open' ? ' (not connected)'
+            : watch.pending ? ' (waiting for the server)' : ' (the view is still)';
+        ui.ovChartNote.textContent = age === null ? 'no frame timings yet'
+            : `last frame ${formatSeconds(age * 1000)} ago${why}`;
+    }
+
+    let chartAfterShown = false;
+    /**
+     * After a frame is drawn: a chart redraw that input put off runs once that frame is on screen
+     * (the task after its animation frame), not before it.
+     */
+    function frameDrawn(now = performance.now()) {
+        if (chartAfterShown || !chartSchedule.onFrameDrawn(now)) return;
+        chartAfterShown = true;
+        requestAnimationFrame(() => setTimeout(() => {
+            chartAfterShown = false;
+            showChart();
+        }, 0));
     }
 
     /**
@@ -81,5 +100,5 @@ export function createOverlay({ ui, state, settings, store }, { rate, latency, p
         store.emit('rate');
     }
 
-    return { showRate, showProgress, showFrameStats };
+    return { showRate, showProgress, showFrameStats, frameDrawn };
 }

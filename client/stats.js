@@ -132,16 +132,20 @@ export class PassHistory {
     constructor(windowS = 10) {
         this.windowS = windowS;
         this.samples = []; // {t, values: Map name -> ms}
+        this.version = 0; // changes whenever the samples do: a chart drawn at this version is current
     }
 
     push(t, passes) {
         this.samples.push({ t, values: new Map((passes ?? []).map((p) => [p.name, passMs(p)])) });
+        this.version += 1;
         this.prune(t);
     }
 
     prune(now) {
         const end = this.windowEnd(now);
+        const before = this.samples.length;
         while (this.samples.length && this.samples[0].t < end - this.windowS) this.samples.shift();
+        if (this.samples.length !== before) this.version += 1;
     }
 
     /**
@@ -161,6 +165,7 @@ export class PassHistory {
 
     clear() {
         this.samples.length = 0;
+        this.version += 1;
     }
 
     /** Pass names in pipeline order: the newest frame's order, then names only older frames had. */
@@ -181,6 +186,38 @@ export class PassHistory {
         const times = this.samples.map((s) => s.t);
         const values = names.map((n) => this.samples.map((s) => s.values.get(n) ?? 0));
         return { names, times, values, stacked: stackSeries(values) };
+    }
+}
+
+/**
+ * When the overlay's pass chart redraws. Every `periodMs` while no input waits for its frame; while one
+ * waits, not before that frame is drawn (and then just after it is shown: `onFrameDrawn`), so that a
+ * redraw of the chart, several ms of the page's main thread on a busy machine, never holds up the
+ * key's handling or the frame's decode and draw; at most `maxDeferMs` after the last redraw all the same
+ * (a server that stalls leaves input waiting, and the chart then says so).
+ */
+export class ChartSchedule {
+    constructor({ periodMs = 250, maxDeferMs = 1000 } = {}) {
+        this.periodMs = periodMs;
+        this.maxDeferMs = maxDeferMs;
+        this.drawnAt = -Infinity;
+    }
+
+    /** On the overlay's tick at `now` (ms): whether to redraw now; `pending`: an input awaits its frame. */
+    onTick(now, pending) {
+        const since = now - this.drawnAt;
+        // A tick a little early on its timer is still the next tick, not one to skip.
+        if (since < this.periodMs * 0.8) return false;
+        return !pending || since >= this.maxDeferMs;
+    }
+
+    /** After a frame is drawn at `now`: whether a redraw is due, to be run once the frame is shown. */
+    onFrameDrawn(now) {
+        return now - this.drawnAt >= this.periodMs;
+    }
+
+    drawn(now) {
+        this.drawnAt = now;
     }
 }
 

@@ -1,7 +1,7 @@
 // The Stats section: the overlay and chart toggles, and the details of the frame on screen (quality,
 // budget, refinement, queue, VPLs, triangles, what differs from the panel). Hears: frame.
 import { budgetLine } from '../budget.js';
-import { addBlock, block, describe, makeSection } from '../controls.js';
+import { addBlock, block, describe, keyValueRows, makeSection } from '../controls.js';
 import { presetChanges } from '../params.js';
 import { formatMs, trianglesText } from '../stats.js';
 
@@ -29,12 +29,8 @@ export function createStatsSection({ ui, state, settings, saveSettings, store, c
         });
     const details = addBlock(gui, block('div', 'stats-details block'));
     details.dataset.block = 'stats-details';
+    const rows = keyValueRows(details);
     applyOverlay();
-    const row = (label, value) => {
-        const div = block('div', 'kv');
-        div.append(block('span', 'k', label), block('span', 'v', value));
-        return div;
-    };
     const section = {
         gui,
         showDetails(stats) {
@@ -42,26 +38,26 @@ export function createStatsSection({ ui, state, settings, saveSettings, store, c
             const changed = presetChanges(stats.params, state.params);
             const budget = budgetLine(stats.budget);
             const r = stats.refine;
-            details.replaceChildren(
-                row('quality', `${stats.quality ?? '–'}${stats.refined ? ' (refined)' : ''}`
-                    + `${stats.scale !== undefined ? `, scale ${stats.scale}` : ''}`),
-                ...(budget ? [row('frame budget', budget.text), row('why', budget.reason || '–')] : []),
-                ...(r ? [row('refinement', `${r.step ?? stats.quality}: ${r.tiles_done ?? '?'} tiles, `
+            rows.show([
+                ['quality', `${stats.quality ?? '–'}${stats.refined ? ' (refined)' : ''}`
+                    + `${stats.scale !== undefined ? `, scale ${stats.scale}` : ''}`],
+                ...(budget ? [['frame budget', budget.text], ['why', budget.reason || '–']] : []),
+                ...(r ? [['refinement', `${r.step ?? stats.quality}: ${r.tiles_done ?? '?'} tiles, `
                     + `${Math.round(100 * (r.share ?? 0))} %, ${formatMs(r.elapsed_ms, 0)}`
                     + `${r.vpl_parts > 1 ? `, tile at ${r.vpl_parts_done} of ${r.vpl_parts} VPL parts` : ''}`
-                    + `${r.complete ? ', complete' : `, ${formatMs(r.eta_ms, 0)} left`}`)] : []),
-                row('queue', formatMs(stats.queue_ms)),
-                row('readback', formatMs(stats.readback_ms)),
-                row('timing', stats.timing ?? '–'),
-                row('VPLs', String(stats.counts?.vpl_count ?? '–')),
-                row('triangles', trianglesText(stats.counts)),
-                row('dropped', String(stats.dropped_frames ?? 0)),
-                row('viewers', String(stats.viewers ?? 0)),
-                row('round trip', formatMs(state.rttMs)),
-                row('this frame differs', changed.length
+                    + `${r.complete ? ', complete' : `, ${formatMs(r.eta_ms, 0)} left`}`]] : []),
+                ['queue', formatMs(stats.queue_ms)],
+                ['readback', formatMs(stats.readback_ms)],
+                ['timing', stats.timing ?? '–'],
+                ['VPLs', stats.counts?.vpl_count ?? '–'],
+                ['triangles', trianglesText(stats.counts)],
+                ['dropped', stats.dropped_frames ?? 0],
+                ['viewers', stats.viewers ?? 0],
+                ['round trip', formatMs(state.rttMs)],
+                ['this frame differs', changed.length
                     ? changed.map(([k, v]) => `${k}=${typeof v === 'number' ? Number(v.toPrecision(4)) : v}`).join(', ')
-                    : 'no (the panel\'s values)'),
-            );
+                    : 'no (the panel\'s values)'],
+            ]);
         },
     };
     store.on('frame', (stats) => section.showDetails(stats));

@@ -19,7 +19,7 @@ import {
 } from '../lights.js';
 import { controlSpec, paramHelp, paramLabel, presetChanges, schemaDefaults } from '../params.js';
 import { InputWatch } from '../progress.js';
-import { LatencyTracker, PassHistory, RateCounter, RoundTrip, formatBytes, networkMs, passMs, stackSeries, trianglesText } from '../stats.js';
+import { ChartSchedule, LatencyTracker, PassHistory, RateCounter, RoundTrip, formatBytes, networkMs, passMs, stackSeries, trianglesText } from '../stats.js';
 import {
     DEFAULT_COMPARE, buildCompareRequest, canCompare, compareSettings, compareSize, diffImage, formatCompare, percent,
     referenceLabel, validateCompareRequest, viewKey,
@@ -364,6 +364,41 @@ test('pass history keeps the window, orders passes and stacks them', () => {
     assert.deepEqual(stackSeries([[1, NaN], [2, 2]]), [[1, 0], [3, 2]]);
     h.clear();
     assert.deepEqual(h.series().names, []);
+});
+
+test('the pass history\'s version changes with its samples only, so a still chart need not redraw', () => {
+    const h = new PassHistory(10);
+    const v0 = h.version;
+    h.push(1, [{ name: 'gather', gpu_ms: 5 }]);
+    const v1 = h.version;
+    assert.notEqual(v1, v0, 'a frame');
+    h.prune(5);
+    assert.equal(h.version, v1, 'a prune that removes nothing');
+    assert.equal(h.windowEnd(30), 1, 'the window stops at the newest frame 10 s after it');
+    h.prune(30);
+    assert.equal(h.version, v1, 'nor does a window that stopped');
+    h.push(40, [{ name: 'gather', gpu_ms: 5 }]);
+    assert.notEqual(h.version, v1, 'a frame that pushes the old one out');
+    assert.deepEqual(h.series().times, [40]);
+    const v2 = h.version;
+    h.clear();
+    assert.notEqual(h.version, v2, 'a clear');
+});
+
+test('the chart redraws each tick while nothing waits, and after the awaited frame while input does', () => {
+    const s = new ChartSchedule({ periodMs: 250, maxDeferMs: 1000 });
+    assert.equal(s.onTick(0, false), true, 'the first tick');
+    s.drawn(0);
+    assert.equal(s.onTick(240, false), true, 'the next tick, a little early on its timer');
+    s.drawn(240);
+    assert.equal(s.onTick(300, false), false, 'not twice within a period');
+    assert.equal(s.onTick(500, true), false, 'an input awaits its frame: the tick leaves the chart');
+    assert.equal(s.onTick(750, true), false);
+    assert.equal(s.onFrameDrawn(760), true, 'the awaited frame is drawn: the chart after it');
+    s.drawn(770);
+    assert.equal(s.onFrameDrawn(800), false, 'the next frame, within a period: not again');
+    assert.equal(s.onTick(1000, true), false);
+    assert.equal(s.onTick(1770, true), true, 'input waiting for a second holds it back no longer');
 });
 
 // ---- accuracy -----------------------------------------------------------------------------------

@@ -330,6 +330,14 @@ test('refinement fills the image in tile by tile and the overlay shows step, sha
 });
 
 test('the stats overlay shows fps, latency, times, bytes and per-pass timings', async (t) => {
+    // The Stats section's details of the frame on screen are kept, not built again, from frame to frame:
+    // a mark on a value's element survives the frames below.
+    const detail = (label) => [...document.querySelectorAll('[data-block="stats-details"] .kv')]
+        .find((row) => row.querySelector('.k')?.textContent === label)?.querySelector('.v');
+    const marked = await page.evaluate(`(() => { const v = (${detail})('round trip'); if (!v) return 'no row';
+        v.dataset.kept = '1'; return 'marked'; })()`);
+    assert.notEqual(marked, 'no row', 'the details have a round trip row');
+    const framesBefore = await page.evaluate(() => window.giClient.framesDrawn);
     // A few frames with camera input so that the chart and the latency have samples.
     const box = await page.locator('#view').boundingBox();
     for (let i = 0; i < 3; ++i) {
@@ -368,6 +376,13 @@ test('the stats overlay shows fps, latency, times, bytes and per-pass timings', 
     assert.match(await page.locator('#ov-times').textContent(),
         /render \d+\.\d · encode \d+\.\d · net \d+\.\d ms/);
     assert.match(await page.locator('#ov-bytes').textContent(), /KB\/frame · \d+×\d+ (webp|jpeg) · fixed/);
+    const details = await page.evaluate(`({ kept: (${detail})('round trip')?.dataset.kept ?? null,
+        quality: (${detail})('quality')?.textContent, vpls: (${detail})('VPLs')?.textContent,
+        frames: window.giClient.framesDrawn })`);
+    assert.ok(details.frames > framesBefore, 'frames were drawn');
+    assert.equal(details.kept, '1', `the details' rows were built again: ${JSON.stringify(details)}`);
+    assert.match(details.quality, /^fixed/);
+    assert.match(details.vpls, /^\d+$/);
 });
 
 test('the light gizmo and Ctrl-drag move and aim the spotlight', async (t) => {
@@ -418,7 +433,10 @@ test('the light gizmo and Ctrl-drag move and aim the spotlight', async (t) => {
     // Back to the scene's camera, as the rest of the test and the next ones expect it.
     const beforeHome = await page.evaluate(() => window.giClient.lastFrame);
     await page.keyboard.press('Home');
-    await until('a frame from the scene camera', (f) => window.giClient.lastFrame > f, beforeHome);
+    // A frame of the orbit still on its way is not one from the scene camera: the gizmo would move
+    // again after the disc's place is read.
+    await until('a frame from the scene camera', (f) => window.giClient.lastFrame > f && !window.giClient.inputPending,
+        beforeHome);
 
     const origin = await page.locator('.gizmo-origin').boundingBox();
     const frame = await page.evaluate(() => window.giClient.lastFrame);
@@ -834,12 +852,19 @@ test('a late frame is said ("rendering… s") and the figures marked stale; inje
         assert.match(await p.locator('#ov-stale').textContent(), /^stale: figures from before your input \d+\.\d s ago$/);
         assert.ok(await p.locator('#busy').isVisible());
         const first = await p.locator('#busy').textContent();
-        await p.waitForTimeout(600);
+        // The pass chart waits for the frame input awaits (a redraw a second at most, against four
+        // while nothing waits), so that it never holds up that frame's draw.
+        const redrawsBefore = await p.evaluate(() => window.giClient.chartRedraws);
+        await p.waitForTimeout(1300);
         assert.notEqual(await p.locator('#busy').textContent(), first, 'the time counts up');
+        const redrawsHeld = await p.evaluate(() => window.giClient.chartRedraws) - redrawsBefore;
+        assert.ok(redrawsHeld <= 2, `the chart redrew ${redrawsHeld} times in 1.3 s while input waited`);
         hold = false;
         for (const m of held.splice(0)) toPage(m);
         await p.waitForFunction(() => window.giClient.busy === null && !window.giClient.stale, null,
             { timeout: WAIT_MS, polling: 50 });
+        const redrawsAfter = await p.evaluate(() => window.giClient.chartRedraws);
+        await p.waitForFunction((n) => window.giClient.chartRedraws >= n + 2, redrawsAfter, { timeout: 5000, polling: 50 });
         // The released frames are drawn before anything is injected: a fixed frame ends refinement.
         // Settled means no new frame for 500 ms and no input waiting for its frame (on a loaded
         // machine the drag's last frame can take longer than that, and its wait would show instead).
