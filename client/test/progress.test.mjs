@@ -31,6 +31,10 @@ test('refinement tiles and progress messages show the step, the share done and t
     assert.equal(r.view(9000).text, 'refining balanced · 41 % · 0.0 s left', 'never below zero');
     assert.equal(r.view(2000).share, 0.41);
     assert.ok(r.refining);
+    // A step with nothing measured before it: the server does not know the time left yet.
+    r.stats({ quality: 'balanced', refine: { step: 'balanced', share: 0.02, eta_ms: null, complete: false } }, 2100);
+    assert.equal(r.view(2200).text, 'refining balanced · 2 %', 'no time left when none is known');
+    r.stats({ quality: 'balanced', refine: { step: 'balanced', share: 0.41, eta_ms: 1300, complete: false } }, 2000);
     r.stats({ quality: 'balanced', refine: { step: 'balanced', share: 1, eta_ms: 0, complete: true } }, 2600);
     assert.equal(r.view(2600), null, 'between steps nothing runs');
     r.message({ state: 'skipped', step: 'final', reason: 'over budget' }, 2700);

@@ -39,6 +39,12 @@ struct TechniqueInfo {
     /// size). 1 for the techniques that sum over every VPL; below 1 for a traversal whose cut grows
     /// much more slowly than its leaves (hier_isr). The frame budget models and caps with it.
     double vplCostExponent = 1.0;
+    /// The passes (gl::Pass names) whose time grows with vplEstimate, as vpls^vplCostExponent: the
+    /// gathers and splats over the VPLs and what is built over them. The rest of a frame (shadow maps,
+    /// G-buffer, eye hierarchy, upsampling) costs about the same at any VPL count, so a refinement
+    /// step predicted from a frame with far fewer VPLs scales only these (AdaptiveQuality). Empty: the
+    /// whole frame is taken to scale. tests/gl/TechniquesGlTest.cpp checks that a frame has each.
+    std::vector<std::string> vplPasses;
     /// Effect knobs the effect plan may set (docs/effects.md): the multiresolution eye hierarchy
     /// (coarsest_size and the discontinuity thresholds of gi/common/ParamSpecs.h), VPL visibility
     /// (vpl_shadows) and bias compensation (clamp_b, ssbc_iterations).

@@ -83,27 +83,84 @@ double vplsForCost(double vpls, double costMs, double targetMs, double exponent)
 
 } // namespace
 
+double vplPassesMs(const std::string& technique, const nlohmann::json& stats) {
+    const TechniqueInfo* info = nullptr;
+    for (const TechniqueInfo& t : techniqueCatalog())
+        if (t.name == technique) info = &t;
+    if (!info || info->vplPasses.empty()) return -1.0;
+    double ms = 0.0;
+    const nlohmann::json passes = stats.value("passes", nlohmann::json::array());
+    for (const nlohmann::json& pass : passes) {
+        if (!pass.is_object()) continue;
+        const std::string name = pass.value("name", std::string());
+        if (std::find(info->vplPasses.begin(), info->vplPasses.end(), name) == info->vplPasses.end())
+            continue;
+        const nlohmann::json& gpu = pass.contains("gpu_ms") ? pass["gpu_ms"] : nlohmann::json();
+        const double t = gpu.is_number() ? gpu.get<double>() : pass.value("cpu_ms", 0.0);
+        if (std::isfinite(t) && t > 0.0) ms += t;
+    }
+    return ms;
+}
+
+double stepEtaMs(double elapsedMs, double share, double paceFromMs, double paceFromShare,
+                 double predictedMs) {
+    share = std::clamp(std::isfinite(share) ? share : 0.0, 0.0, 1.0);
+    if (share >= 1.0) return 0.0;
+    const bool predicted = std::isfinite(predictedMs) && predictedMs > 0.0;
+    const double predictedLeft = predicted ? std::max(0.0, predictedMs - elapsedMs) : 0.0;
+    const double paced = share - paceFromShare;
+    if (!(paced > 0.0) || !(elapsedMs > paceFromMs)) return predicted ? predictedLeft : -1.0;
+    const double paceLeft = (elapsedMs - paceFromMs) * (1.0 - share) / paced;
+    if (!predicted) return paceLeft;
+    const double weight = std::min(1.0, share / 0.1);
+    return weight * paceLeft + (1.0 - weight) * predictedLeft;
+}
+
 double AdaptiveQuality::predictStepMs(const std::string& sceneName, const FrameState& state,
                                       QualityStep step) const {
     const double pixels = static_cast<double>(state.width) * state.height;
     const double vpls = static_cast<double>(std::max(1L, vplEstimate(state)));
     // Measured at the VPLs that step rendered with (perhaps capped): scaled to this state's. Not
-    // rendered yet: the nearest measured lower step, scaled by pixels and by the VPLs' cost (gather
-    // cost grows with pixels x vpls^e), so a final preset with 256 times the VPLs is predicted before
-    // it runs.
+    // rendered yet: the nearest measured lower step, scaled by pixels and its VPL passes by the VPLs'
+    // cost (a gather grows with pixels x vpls^e), so a final preset with 256 times the VPLs is
+    // predicted before it runs.
     const double exponent = vplCostExponent(state);
     for (int s = static_cast<int>(step); s >= 0; --s)
         if (auto c = mStepCost.find(stepKey(sceneName, state, static_cast<QualityStep>(s)));
-            c != mStepCost.end())
-            return c->second.msPerPixel * pixels *
-                   std::pow(vpls / static_cast<double>(c->second.vpls), exponent);
+            c != mStepCost.end()) {
+            const StepCost& cost = c->second;
+            const double vplScale = std::pow(vpls / static_cast<double>(cost.vpls), exponent);
+            return pixels * ((cost.msPerPixel - cost.vplMsPerPixel) + cost.vplMsPerPixel * vplScale);
+        }
     return 0.0;
 }
 
+double AdaptiveQuality::vplsForStepMs(const std::string& sceneName, const FrameState& state, QualityStep step,
+                                      double targetMs) const {
+    const double pixels = static_cast<double>(state.width) * state.height;
+    const double vpls = static_cast<double>(std::max(1L, vplEstimate(state)));
+    for (int s = static_cast<int>(step); s >= 0; --s)
+        if (auto c = mStepCost.find(stepKey(sceneName, state, static_cast<QualityStep>(s)));
+            c != mStepCost.end()) {
+            const StepCost& cost = c->second;
+            // The VPL passes get what the rest of the frame leaves of the target: none, no count fits.
+            const double vplTargetMs = targetMs - pixels * (cost.msPerPixel - cost.vplMsPerPixel);
+            const double vplMsAtMeasured = pixels * cost.vplMsPerPixel;
+            if (!(vplTargetMs > 0.0) || !(vplMsAtMeasured > 0.0)) return 0.0;
+            return static_cast<double>(cost.vpls) *
+                   std::pow(vplTargetMs / vplMsAtMeasured, 1.0 / vplCostExponent(state));
+        }
+    return vpls;
+}
+
 void AdaptiveQuality::recordStepCost(const std::string& sceneName, const FrameState& state, QualityStep step,
-                                     double msPerPixel) {
+                                     double msPerPixel, double vplMsPerPixel) {
     if (!(msPerPixel > 0.0) || !std::isfinite(msPerPixel)) return;
-    mStepCost[stepKey(sceneName, state, step)] = {msPerPixel, std::max(1L, vplEstimate(state))};
+    // Not known (or not a number): the whole cost is taken to scale, as a frame of VPL passes alone.
+    const double vplPart = std::isfinite(vplMsPerPixel) && vplMsPerPixel >= 0.0
+                               ? std::min(vplMsPerPixel, msPerPixel)
+                               : msPerPixel;
+    mStepCost[stepKey(sceneName, state, step)] = {msPerPixel, vplPart, std::max(1L, vplEstimate(state))};
 }
 
 bool AdaptiveQuality::recordMinTileCost(const std::string& sceneName, const FrameState& state,
@@ -203,7 +260,7 @@ void AdaptiveQuality::planRefinement(const std::string& sceneName, const FrameSt
     double cap = static_cast<double>(vpls);
     std::string why;
     if (predictedMs > budgetMs) {
-        cap = vplsForCost(static_cast<double>(vpls), predictedMs, 0.9 * budgetMs, exponent);
+        cap = vplsForStepMs(sceneName, p.state, p.step, 0.9 * budgetMs);
         why = "predicted at " + std::to_string(std::lround(predictedMs / 1000.0)) +
               " s, over the server's refinement budget of " + std::to_string(std::lround(budgetMs / 1000.0)) +
               " s (--refine-budget-ms)";

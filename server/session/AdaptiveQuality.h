@@ -45,6 +45,17 @@ constexpr double kSnapshotBudgetMs = 5000.0;
 /// (--interactive-lod-px above 0) and the client did not set it: the frame parameter's maximum.
 constexpr double kLiveLightLodTexels = 1.0;
 
+/// The ms of a rendered frame's passes that grow with the VPLs (TechniqueInfo::vplPasses of
+/// `technique`, from stats.passes: gpu_ms, else cpu_ms); below 0 when the technique names none.
+double vplPassesMs(const std::string& technique, const nlohmann::json& stats);
+
+/// The time left of a refinement step `elapsedMs` into it with `share` (0..1) of its image done: the
+/// step's own pace since `paceFrom` (elapsed ms and share once the one-time work of its first tile,
+/// the light views, was done), blended with what is left of `predictedMs` (predictStepMs; 0: none)
+/// until a tenth of the image is done, since its first tiles are the smallest and the dearest per
+/// pixel. Below 0 when neither is known (protocol: eta_ms null).
+double stepEtaMs(double elapsedMs, double share, double paceFromMs, double paceFromShare, double predictedMs);
+
 class AdaptiveQuality {
 public:
     /// `presets`: presets/presets.json's document, null for none (every step renders as requested).
@@ -74,11 +85,19 @@ public:
                            QualityStep step) const;
 
     /// The total ms a step of `state` is predicted to take: its own last measurement, else the nearest
-    /// lower step's, scaled by pixels and VPLs; 0 when neither was measured.
+    /// lower step's, scaled by pixels and, its VPL passes alone, by VPLs; 0 when neither was measured.
     double predictStepMs(const std::string& sceneName, const FrameState& state, QualityStep step) const;
-    /// A finished step's cost per pixel (at the VPLs `state` rendered with).
+    /// The VPLs at which that prediction for `state` is `targetMs` (only the VPL passes shrink with
+    /// them): 0 when the rest of the frame alone takes longer; the state's own VPLs when nothing is
+    /// measured.
+    double vplsForStepMs(const std::string& sceneName, const FrameState& state, QualityStep step,
+                         double targetMs) const;
+    /// A finished step's cost per pixel (at the VPLs `state` rendered with), of which `vplMsPerPixel`
+    /// in the technique's VPL passes (vplPassesMs; below 0: not known, the whole cost scales with the
+    /// VPLs). Only that part grows with more VPLs: scaling the whole of a frame with 16 VPLs to a step
+    /// with 4,096 predicted 300 s for a step of 3 s, and capped or skipped it.
     void recordStepCost(const std::string& sceneName, const FrameState& state, QualityStep step,
-                        double msPerPixel);
+                        double msPerPixel, double vplMsPerPixel = -1.0);
     /// A smallest tile of a technique that cannot split its VPLs overran its slice, taking `tileMs` at
     /// the VPLs of `state`; the step's VPL cap follows it. True when this is news (first, or 20 % worse
     /// than known at equal VPLs): the step should start again with the cap.
@@ -92,6 +111,7 @@ public:
 private:
     struct StepCost {
         double msPerPixel = 0;
+        double vplMsPerPixel = 0; ///< the part that scales with the VPLs, at most msPerPixel
         long vpls = 1;
     };
     struct TileCost {

@@ -959,7 +959,7 @@ void Session::broadcastProgress(const char* state, const std::string& step, doub
                    {"state", state},
                    {"step", step},
                    {"share", share},
-                   {"eta_ms", etaMs},
+                   {"eta_ms", etaMs >= 0.0 ? nlohmann::json(etaMs) : nlohmann::json(nullptr)},
                    {"reason", reason}});
 }
 
@@ -995,6 +995,7 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     bool sentOnce = false;
     TileRect unsent; // the canvas's pixels pasted since the last send
     double renderedMs = 0.0;
+    double vplRenderedMs = 0.0; // of that in the technique's VPL passes; below 0: it names none
     // VPL parts: tiles of partSide^2 inner pixels (smaller when a part's fixed work alone would fill
     // most of a slice), in as many parts as the parts measured so far say fit 70 % of a slice. The
     // planner counts rendered pixels, the guard band included.
@@ -1037,7 +1038,13 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
         const bool envCubes = c.value("env_probes", 0.0) > 0.0 && c.value("env_cubes_reused", 1.0) == 0.0;
         return lightViews || envCubes;
     };
-    progress("refining", 0.0, rate > 0.0 ? rate * fullPixels : 0.0,
+    // The step's predicted time from a measured step alone (the interactive frames' model mispredicts
+    // a whole step several-fold); not known: the client shows no time left until tiles measured it.
+    const double stepPredictedMs =
+        w.quality->predictStepMs(w.scene->name, full, static_cast<QualityStep>(step));
+    // The step's pace is measured from the end of its one-time work (or of its first part).
+    std::optional<std::pair<double, double>> paceFrom; // (elapsed ms, share)
+    progress("refining", 0.0, stepPredictedMs > 0.0 ? stepPredictedMs : -1.0,
              "the view is still: rendering the " + stepLabel + " step in tiles of about " +
                  std::to_string(sliceMs) + " ms" + (note.empty() ? std::string() : "; " + note));
     double shareDone = 0.0; // tiles and parts rendered (plan.shareDone() counts a tile once it starts)
@@ -1095,6 +1102,10 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
             }
             if (planned && !oneTime) partPlanner.record(tilePixels, parts, rendered.renderMs);
             renderedMs += rendered.renderMs;
+            if (vplRenderedMs >= 0.0) {
+                const double vplMs = vplPassesMs(full.technique, frame.stats);
+                vplRenderedMs = vplMs >= 0.0 ? vplRenderedMs + vplMs : -1.0;
+            }
             pasteTile(canvas, full.width, full.height, frame.rgba8, frame.width, frame.height, rect, guard);
             unsent = unite(unsent, clipToImage(rect, full.width, full.height));
 
@@ -1103,9 +1114,9 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
             shareDone = share;
             if (inputPending()) return abandoned();
             const bool last = plan.done() && part + 1 == parts;
-            const double tileRate = rate > 0.0 ? rate : tileMs * parts / ((part + 1) * tilePixels);
-            const double etaMs =
-                tileRate * fullPixels * (1.0 - share) * (tilePixels / std::max(1.0, inner * inner));
+            const double nowMs = stepClock.elapsedMs();
+            if (oneTime || !paceFrom) paceFrom = {nowMs, share};
+            const double etaMs = stepEtaMs(nowMs, share, paceFrom->first, paceFrom->second, stepPredictedMs);
             // Send when the controller's window has room, at most every 150 ms, and always the last
             // tile (waiting for room, unless input comes first).
             bool send = false;
@@ -1136,7 +1147,9 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
                                {"share", share},
                                {"elapsed_ms", stepClock.elapsedMs()},
                                {"render_ms", renderedMs},
-                               {"eta_ms", last ? 0.0 : etaMs},
+                               {"eta_ms", last           ? nlohmann::json(0.0)
+                                          : etaMs >= 0.0 ? nlohmann::json(etaMs)
+                                                         : nlohmann::json(nullptr)},
                                {"complete", last},
                                {"vpl_parts", parts},
                                {"vpl_parts_done", part + 1}};
@@ -1171,7 +1184,8 @@ Session::RefineResult Session::refineInTiles(Worker& w, const FrameState& full, 
     }
     // The whole step's cost per pixel, which predicts the next one (and its refinement-budget check);
     // single tiles would over-predict it, their fixed costs and the slowest regions included.
-    w.quality->recordStepCost(w.scene->name, full, static_cast<QualityStep>(step), renderedMs / fullPixels);
+    w.quality->recordStepCost(w.scene->name, full, static_cast<QualityStep>(step), renderedMs / fullPixels,
+                              vplRenderedMs >= 0.0 ? vplRenderedMs / fullPixels : -1.0);
     if (step == static_cast<int>(Step::Final)) {
         std::string done =
             "converged: the final step took " + std::to_string(std::lround(stepClock.elapsedMs())) + " ms";
@@ -1389,9 +1403,12 @@ void Session::workerMain() {
         if (renderAdmitted(w, state, rendered) != RenderStatus::Ok) break;
         const FrameOutput& frame = rendered.frame;
         const double queueMs = rendered.queueMs;
-        if (step >= 0 && frame.width > 0 && frame.height > 0)
+        if (step >= 0 && frame.width > 0 && frame.height > 0) {
+            const double pixels = static_cast<double>(frame.width) * frame.height;
+            const double vplMs = vplPassesMs(state.technique, frame.stats);
             w.quality->recordStepCost(scene->name, state, static_cast<QualityStep>(step),
-                                      rendered.renderMs / (static_cast<double>(frame.width) * frame.height));
+                                      rendered.renderMs / pixels, vplMs >= 0.0 ? vplMs / pixels : -1.0);
+        }
         nlohmann::json stats = frame.stats;
         stats["scale"] = scale;
         stats["queue_ms"] = queueMs;

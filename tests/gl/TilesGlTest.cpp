@@ -145,6 +145,24 @@ bool hasPass(const FrameOutput& f, const std::string& name) {
 
 // VPL parts (FrameState::VplPart): the running mean of the parts of one image ends at the image of
 // every VPL, its first parts differ from it, and parts of another image or out of order start again.
+// Refinement predicts a step's VPL passes apart from the rest of its frame (AdaptiveQuality): the
+// names a technique declares must be passes its frames run.
+TEST(TilesGl, EveryTechniquesVplPassesAreRunByItsFrames) {
+    sharedContext();
+    const Scene scene = loadScene("builtin:cornell");
+    FrameRenderer renderer;
+    renderer.setScene(std::make_shared<const Scene>(scene));
+    int named = 0;
+    for (const TechniqueInfo& info : techniqueCatalog()) {
+        if (info.vplPasses.empty()) continue;
+        ++named;
+        const FrameOutput out = renderer.render(stateFor(scene, info.name, 64, 48));
+        for (const std::string& pass : info.vplPasses)
+            EXPECT_TRUE(hasPass(out, pass)) << info.name << ": " << pass;
+    }
+    EXPECT_GE(named, 6) << "every technique with VPLs names its VPL passes";
+}
+
 TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
     sharedContext();
     const Scene scene = loadScene("builtin:cornell");

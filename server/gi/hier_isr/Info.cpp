@@ -63,6 +63,7 @@ TechniqueInfo hierIsrInfo() {
     info.capReceiverShare = setReceiverShareCap;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
+    info.vplPasses = {"light_tree", "vpl_gather"};
     return info;
 }
 

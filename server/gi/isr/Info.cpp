@@ -59,6 +59,7 @@ TechniqueInfo isrInfo() {
     info.capReceiverShare = setReceiverShareCap;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
+    info.vplPasses = {"light_tree", "vpl_gather"};
     return info;
 }
 

@@ -20,6 +20,7 @@ TechniqueInfo multiresGatherInfo() {
     // The gather's irradiance is linear in the VPLs up to the reconstruction; bias compensation
     // filters the sum in screen space.
     info.vplParts = [](const ParamSet& technique) { return technique.getInt("ssbc_iterations") == 0; };
+    info.vplPasses = {"vpl_gather"};
     return info;
 }
 

@@ -69,6 +69,7 @@ TechniqueInfo multiresSplatInfo() {
     info.limitVpls = limitGridVpls;
     info.eyeHierarchy = true;
     info.biasCompensation = true;
+    info.vplPasses = {"subsplat_splat"};
     return info;
 }
 

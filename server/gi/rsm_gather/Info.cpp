@@ -31,6 +31,7 @@ TechniqueInfo rsmGatherInfo() {
     info.indirectShadows = vplShadowsOn;
     info.biasCompensation = true;
     info.vplParts = gatherVplParts;
+    info.vplPasses = {"vpl_gather"};
     return info;
 }
 
@@ -51,6 +52,7 @@ TechniqueInfo ssbcInfo() {
     info.indirectShadows = vplShadowsOn;
     info.biasCompensation = true;
     info.vplParts = gatherVplParts;
+    info.vplPasses = {"vpl_gather"};
     return info;
 }
 

@@ -81,6 +81,7 @@ TechniqueInfo secondOrderInfo() {
     info.biasCompensation = true;
     info.viewSampled = true;
     info.indirectShadows = [](const ParamSet& p) { return p.getInt("negative_count") > 0; };
+    info.vplPasses = {"lowres_gather", "fixup_gather"};
     return info;
 }
 

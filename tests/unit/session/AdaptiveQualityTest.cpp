@@ -79,6 +79,51 @@ TEST(AdaptiveQuality, PredictionsScaleTheNearestMeasuredStep) {
     EXPECT_NEAR(q.predictStepMs("cornell", bigger, QualityStep::Final), 131.072, 1e-9) << "NaN is not kept";
 }
 
+TEST(AdaptiveQuality, OnlyTheVplPassesOfAMeasuredStepScaleWithTheVpls) {
+    AdaptiveQuality q(limits(), presets());
+    FrameState s = requested(); // 64 VPLs, 65,536 px
+    // 65.5 ms at 64 VPLs, of which a tenth in the gather: the shadow maps, G-buffer and the rest cost
+    // the same with 64 times the VPLs.
+    q.recordStepCost("cornell", s, QualityStep::Interactive, 1e-3, 1e-4);
+    FrameState many = s;
+    many.techniqueParams.set("vpl_grid", 64); // 4,096 VPLs
+    EXPECT_NEAR(q.predictStepMs("cornell", many, QualityStep::Balanced), 65.536 * (0.9 + 0.1 * 64), 1e-9);
+    EXPECT_NEAR(q.predictStepMs("cornell", s, QualityStep::Balanced), 65.536, 1e-9) << "at the same VPLs";
+    // A VPL part larger than the whole is the whole; one not known (or not a number) scales it all.
+    q.recordStepCost("cornell", s, QualityStep::Interactive, 1e-3, 5e-3);
+    EXPECT_NEAR(q.predictStepMs("cornell", many, QualityStep::Balanced), 64 * 65.536, 1e-9);
+    q.recordStepCost("cornell", s, QualityStep::Interactive, 1e-3, std::nan(""));
+    EXPECT_NEAR(q.predictStepMs("cornell", many, QualityStep::Balanced), 64 * 65.536, 1e-9);
+}
+
+TEST(AdaptiveQuality, TheVplPassesAreTheTechniquesOwn) {
+    const nlohmann::json stats = {{"passes",
+                                   {{{"name", "shadow_map"}, {"cpu_ms", 5.0}},
+                                    {{"name", "vpl_gather"}, {"cpu_ms", 7.0}, {"gpu_ms", 6.0}},
+                                    {{"name", "light_tree"}, {"cpu_ms", 2.0}},
+                                    {{"name", "vpl_gather"}, {"cpu_ms", 1.5}},
+                                    {{"name", "upsample"}, {"cpu_ms", 3.0}}}}};
+    EXPECT_DOUBLE_EQ(vplPassesMs("multires_gather", stats), 7.5) << "gpu_ms first, every run of the pass";
+    EXPECT_DOUBLE_EQ(vplPassesMs("hier_isr", stats), 9.5) << "the tree over the VPLs too";
+    EXPECT_DOUBLE_EQ(vplPassesMs("multires_splat", stats), 0.0) << "its splat did not run";
+    EXPECT_LT(vplPassesMs("none", stats), 0.0) << "no VPLs: none named";
+    EXPECT_DOUBLE_EQ(vplPassesMs("rsm_gather", nlohmann::json::object()), 0.0) << "no passes";
+}
+
+TEST(AdaptiveQuality, TheTimeLeftFollowsTheStepsPaceOnceATenthIsDone) {
+    EXPECT_LT(stepEtaMs(0, 0, 0, 0, 0), 0.0) << "nothing known";
+    EXPECT_DOUBLE_EQ(stepEtaMs(1000, 0, 0, 0, 5000), 4000) << "the prediction before any pace";
+    EXPECT_DOUBLE_EQ(stepEtaMs(6000, 0, 0, 0, 5000), 0) << "a prediction overrun leaves nothing, not less";
+    EXPECT_DOUBLE_EQ(stepEtaMs(3000, 0.5, 0, 0, 0), 3000) << "the pace alone";
+    // The one-time work took 1 s and 1 % of the image; the next 2 s did 19 % more.
+    EXPECT_DOUBLE_EQ(stepEtaMs(3000, 0.2, 1000, 0.01, 100000), 2000.0 * 0.8 / 0.19)
+        << "a tenth done: the pace";
+    // Half-way to a tenth: half the pace, half what is left of the prediction.
+    EXPECT_DOUBLE_EQ(stepEtaMs(1000, 0.05, 0, 0, 9000), 0.5 * (1000 * 0.95 / 0.05) + 0.5 * 8000);
+    EXPECT_DOUBLE_EQ(stepEtaMs(5000, 1.0, 0, 0, 9000), 0.0) << "done";
+    EXPECT_DOUBLE_EQ(stepEtaMs(1000, std::nan(""), 0, 0, 3000), 2000) << "a share not a number counts as 0";
+}
+
 TEST(AdaptiveQuality, RefinementOverTheBudgetIsCappedOrSkipped) {
     SessionLimits l = limits();
     l.refineBudgetMs = 1000;
@@ -106,6 +151,32 @@ TEST(AdaptiveQuality, RefinementOverTheBudgetIsCappedOrSkipped) {
         tight.plan("cornell", requested(), none, QualityStep::Final, false, 80);
     EXPECT_TRUE(skipped.skip);
     EXPECT_NE(skipped.why.find("no more than the step before"), std::string::npos) << skipped.why;
+}
+
+TEST(AdaptiveQuality, TheBudgetsVplCapLeavesTheRestOfTheFrameItsTime) {
+    SessionLimits l = limits();
+    l.refineBudgetMs = 1000;
+    AdaptiveQuality q(l, presets());
+    const nlohmann::json none = nlohmann::json::object();
+    // The interactive step (16 VPLs, 65,536 px): 16.4 ms, 1.6 ms of it in the gather. The final
+    // preset (4,096 VPLs): 14.7 + 1.6 x 256 = 434 ms, within the budget: not capped.
+    const FrameState interactive = q.presetState(requested(), none, QualityStep::Interactive);
+    q.recordStepCost("cornell", interactive, QualityStep::Interactive, 2.5e-4, 2.5e-5);
+    const AdaptiveQuality::Plan fits = q.plan("cornell", requested(), none, QualityStep::Final, false, 80);
+    EXPECT_NEAR(fits.predictedMs, 65536 * (2.25e-4 + 2.5e-5 * 256), 1e-6);
+    EXPECT_EQ(vplEstimate(fits.state), 4096) << fits.why;
+    // 65.5 ms, a quarter of it in the gather: 49.2 + 16.4 x 256 ms = 4.2 s. The VPLs that fit 0.9 of
+    // the 1 s leave the rest its 49.2 ms: 16 x (900 - 49.2) / 16.4 = 831, a 28 x 28 grid, where
+    // scaling the whole frame gave 0.9 x 4096 / 4.2 = 869, 29 x 29, and a step over its budget.
+    q.recordStepCost("cornell", interactive, QualityStep::Interactive, 1e-3, 2.5e-4);
+    const AdaptiveQuality::Plan capped = q.plan("cornell", requested(), none, QualityStep::Final, false, 80);
+    EXPECT_EQ(grid(capped.state), 28) << capped.why;
+    EXPECT_LE(q.predictStepMs("cornell", capped.state, QualityStep::Final), 900.0);
+    // The rest of the frame alone over the budget: no VPL count fits, the step is skipped.
+    q.recordStepCost("cornell", interactive, QualityStep::Interactive, 0.02, 1e-4);
+    const AdaptiveQuality::Plan skipped = q.plan("cornell", requested(), none, QualityStep::Final, false, 80);
+    EXPECT_TRUE(skipped.skip) << skipped.why;
+    EXPECT_DOUBLE_EQ(q.vplsForStepMs("cornell", requested(), QualityStep::Final, 900.0), 0.0);
 }
 
 TEST(AdaptiveQuality, ASmallestTileOverItsSliceCapsTheStep) {
