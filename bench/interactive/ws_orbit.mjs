@@ -5,13 +5,14 @@
 // Also the frame budget's last reason, size and VPLs, how often the size changed and how many frames
 // of other qualities (refinement steps) came between, the frames' p95 and slowest render time, how many
 // the receiver cap gave fewer VPLs, and frames rendered but never received; with WS_ORBIT_DUMP=1 the
-// last frame's passes and timings as well, with --slow-ms each frame slower than that. usage:
+// last frame's passes and timings as well, with --slow-ms each frame slower than that, with --first N
+// the session's first N interactive frames (how the budget starts). usage:
 //   node bench/interactive/ws_orbit.mjs [--server build/ci/bin/gi-server] [--scene builtin:cornell]
-//        [--seconds 10] [--server-args "--technique hier_isr"] [--slow-ms 150]
+//        [--seconds 10] [--server-args "--technique hier_isr"] [--slow-ms 150] [--first 12]
 import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
-const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:cornell', seconds: 10, 'server-args': '', 'slow-ms': 0 },
-    'usage: node bench/interactive/ws_orbit.mjs [--server PATH] [--scene NAME] [--seconds S] [--server-args "FLAGS"] [--slow-ms MS]');
+const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:cornell', seconds: 10, 'server-args': '', 'slow-ms': 0, first: 0 },
+    'usage: node bench/interactive/ws_orbit.mjs [--server PATH] [--scene NAME] [--seconds S] [--server-args "FLAGS"] [--slow-ms MS] [--first N]');
 const { server, port, log } = await startServer(opts.server,
     opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : []);
 const link = await connectClient(port, { client: 'ws_orbit', size: [960, 800] });
@@ -87,5 +88,11 @@ if (process.env.WS_ORBIT_DUMP)
     console.log(JSON.stringify({ passes: last.passes, timing: last.timing, input: last.input,
         readback: last.readback_ms, technique_ms: last.technique_ms }));
 link.ws.close();
+// The session's first interactive frames, from the connection on: what the budget chose before it had
+// measured much.
+for (const f of link.frames.filter((x) => x.stats.quality === 'interactive').slice(0, opts.first)) {
+    console.log(JSON.stringify({ first_frame: f.stats.frame, technique: f.stats.technique, size: f.stats.size,
+        vpls: f.stats.counts?.vpl_count ?? null, frame_ms: +f.stats.frame_ms.toFixed(1), budget: f.stats.budget?.reason ?? null }));
+}
 server.kill();
 process.exit(0);

@@ -111,8 +111,10 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     const double vpl =
         cost.vpls > 0 ? technique / (cost.pixels * std::pow(static_cast<double>(cost.vpls), exponent)) : 0.0;
     const double tech = technique / cost.pixels;
-    // Half the weight on the newest frame: one noisy frame moves the choice, two confirm it.
-    const double a = r.frames == 0 ? 1.0 : 0.5;
+    // Half the weight on the newest frame: one noisy frame moves the choice, two confirm it. The
+    // second frame replaces the first, whose time included compiling the technique's shaders
+    // (FrameBudget::choose).
+    const double a = r.frames <= 1 ? 1.0 : 0.5;
     r.base += a * (base - r.base);
     r.encode += a * (encode - r.encode);
     if (cost.vpls > 0) r.vpl += a * (vpl - r.vpl);
@@ -138,6 +140,20 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
         return out;
     }
     Rates& rates = it->second;
+    if (rates.frames == 1) {
+        // The first frame of a scene and technique compiles the technique's shaders and uploads what
+        // the scene's first draw needs (471 ms for cornell's first multires_gather frame, against about
+        // 60 ms for the next at that size): its rates would take the next frames down to 16 VPLs and a
+        // fifth of the size, from which the budget climbs for a second. One more small frame instead,
+        // whose time replaces the first's.
+        out.scale = std::clamp(c.firstScale, c.minScale, c.maxScale);
+        if (cappable && requestedVpls > c.firstVplCap) out.vplCap = c.firstVplCap;
+        out.reason = "second frame of this scene and technique: the first one's time included compiling "
+                     "its shaders, so another small one (" +
+                     fmt("%.2f", out.scale) + " of the size" +
+                     (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) + ")";
+        return out;
+    }
     if (rates.receiverShare >= 0.0)
         out.receiverShareCap = receiverShareCapAfter(rates.receiverShare, rates.receiverCut);
     // After a frame the cap cut, the next one may gather a quarter more per pixel and VPL (its cap

@@ -86,8 +86,9 @@ public:
         double preferredMinScale = 0.3; ///< below this, VPLs go first
         double minScale = 0.1;
         long minVpls = 16;
-        /// A frame with nothing measured for its scene and technique: this size factor, at most
-        /// firstVplCap VPLs (a guess kept small, so that the one unmeasured frame stays short).
+        /// The first two frames of a scene and technique (nothing measured, then only a frame that
+        /// compiled the technique's shaders): this size factor, at most firstVplCap VPLs (a guess
+        /// kept small, so that those frames stay short).
         double firstScale = 0.35;
         long firstVplCap = 1024;
     };

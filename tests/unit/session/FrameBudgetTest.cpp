@@ -41,6 +41,28 @@ TEST(FrameBudget, FirstFrameIsSmallAndSaysWhy) {
     EXPECT_NE(c.reason.find("nothing measured"), std::string::npos);
 }
 
+TEST(FrameBudget, TheFirstFramesTimeIsNotTrusted) {
+    FrameBudget budget(FrameBudget::Config{});
+    const double full = 960 * 800;
+    const BudgetChoice first = budget.choose("k", 4096, true, full);
+    const double pixels = full * first.scale * first.scale;
+    // The first frame compiled its shaders: eight times what the same frame costs after.
+    FrameCost compiled = synthetic(pixels, first.vplCap, 1e-4, 1e-8);
+    const FrameCost warm = compiled;
+    compiled.frameMs *= 8;
+    compiled.techniqueMs *= 8;
+    budget.record("k", compiled);
+    const BudgetChoice second = budget.choose("k", 4096, true, full);
+    EXPECT_DOUBLE_EQ(second.scale, first.scale) << "another small frame, not a fifth of the size";
+    EXPECT_EQ(second.vplCap, first.vplCap);
+    EXPECT_NE(second.reason.find("second frame"), std::string::npos) << second.reason;
+    budget.record("k", warm);
+    EXPECT_DOUBLE_EQ(budget.predictMs("k", pixels, first.vplCap), warm.frameMs)
+        << "the second replaces the first";
+    const BudgetChoice third = budget.choose("k", 4096, true, full);
+    EXPECT_GT(third.scale, first.scale) << third.reason;
+}
+
 TEST(FrameBudget, CheapFramesGetFullQuality) {
     FrameBudget budget(FrameBudget::Config{});
     double ms = 0;
