@@ -48,6 +48,17 @@ public:
         }
     }
 
+    /// A change of shape: the targets of `next`, those kept for it or else `create()`, while the
+    /// owner's `current` targets (of `previous`, costing `cost`; none when `previous` is empty) are
+    /// kept in their place.
+    template <class Create>
+    Targets exchange(const Key& next, const std::optional<Key>& previous, Targets current, double cost,
+                     Create&& create) {
+        std::optional<Targets> kept = take(next);
+        if (previous) keep(*previous, std::move(current), cost);
+        return kept ? std::move(*kept) : create();
+    }
+
     std::size_t size() const { return mEntries.size(); }
     void clear() { mEntries.clear(); }
 

@@ -287,10 +287,11 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
     if (width != mWidth || height != mHeight) {
         // A size used before takes its targets back (the budget's sizes recur): no allocation and
         // no first touch of fresh memory on the frame.
-        std::optional<ScreenTargets> kept = mRecentScreens.take({width, height});
-        if (mWidth > 0)
-            mRecentScreens.keep({mWidth, mHeight}, std::move(mScreen), static_cast<double>(mWidth) * mHeight);
-        mScreen = kept ? std::move(*kept) : ScreenTargets::create(width, height);
+        mScreen = mRecentScreens.exchange({width, height},
+                                          mWidth > 0 ? std::optional<std::pair<int, int>>({mWidth, mHeight})
+                                                     : std::nullopt,
+                                          std::move(mScreen), static_cast<double>(mWidth) * mHeight,
+                                          [&] { return ScreenTargets::create(width, height); });
         mWidth = width;
         mHeight = height;
     }

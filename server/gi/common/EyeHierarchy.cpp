@@ -122,11 +122,11 @@ void EyeHierarchy::ensureLayout(int width, int height, int coarsestSize) {
     std::vector<EyeLevel> levels = eyeLevelLayout(width, height, coarsestSize, &atlasWidth, &atlasHeight);
     // A layout used before takes its targets back: the frame budget's sizes recur, and allocating and
     // clearing eleven atlas textures cost a frame of a new size several milliseconds.
-    std::optional<LayoutTargets> kept = mRecentLayouts.take({width, height, coarsestSize});
-    if (mWidth > 0)
-        mRecentLayouts.keep({mWidth, mHeight, mCoarsest}, std::move(mTargets),
-                            static_cast<double>(mAtlasWidth) * mAtlasHeight);
-    mTargets = kept ? std::move(*kept) : createTargets(atlasWidth, atlasHeight);
+    mTargets = mRecentLayouts.exchange(
+        {width, height, coarsestSize},
+        mWidth > 0 ? std::optional<std::array<int, 3>>({mWidth, mHeight, mCoarsest}) : std::nullopt,
+        std::move(mTargets), static_cast<double>(mAtlasWidth) * mAtlasHeight,
+        [&] { return createTargets(atlasWidth, atlasHeight); });
     mLevels = std::move(levels);
     mAtlasWidth = atlasWidth;
     mAtlasHeight = atlasHeight;

@@ -48,6 +48,26 @@ TEST(RecentTargets, ASizeUsedBeforeGetsItsOwnTargetsBack) {
     EXPECT_EQ(alive, 0) << "every target was freed once";
 }
 
+TEST(RecentTargets, AnExchangeKeepsTheCurrentTargetsAndTakesOrCreatesTheNext) {
+    int alive = 0, created = 0;
+    {
+        gl::RecentTargets<Size, Counted> recent(4, 1e9);
+        const auto create = [&] { return Counted(&alive, 100 + created++); };
+        // The first shape: nothing current to keep.
+        Counted current = recent.exchange({282, 240}, std::nullopt, Counted(&alive, 0), 0.0, create);
+        EXPECT_EQ(current.id, 100);
+        EXPECT_EQ(recent.size(), 0u);
+        current = recent.exchange({254, 216}, Size{282, 240}, std::move(current), 282.0 * 240.0, create);
+        EXPECT_EQ(current.id, 101) << "a new shape is created";
+        current = recent.exchange({282, 240}, Size{254, 216}, std::move(current), 254.0 * 216.0, create);
+        EXPECT_EQ(current.id, 100) << "a shape used before takes its targets back";
+        EXPECT_EQ(created, 2);
+        EXPECT_EQ(recent.size(), 1u);
+        EXPECT_EQ(alive, 2);
+    }
+    EXPECT_EQ(alive, 0) << "every target was freed once";
+}
+
 TEST(RecentTargets, TheOldestGoBeyondTheCountOrTheCost) {
     int alive = 0;
     {
