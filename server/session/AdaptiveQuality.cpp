@@ -84,17 +84,14 @@ double vplsForCost(double vpls, double costMs, double targetMs, double exponent)
 } // namespace
 
 double vplPassesMs(const std::string& technique, const nlohmann::json& stats) {
-    const TechniqueInfo* info = nullptr;
-    for (const TechniqueInfo& t : techniqueCatalog())
-        if (t.name == technique) info = &t;
-    if (!info || info->vplPasses.empty()) return -1.0;
+    const TechniqueInfo& info = findTechniqueInfo(technique);
+    if (info.vplPasses.empty()) return -1.0;
     double ms = 0.0;
     const nlohmann::json passes = stats.value("passes", nlohmann::json::array());
     for (const nlohmann::json& pass : passes) {
         if (!pass.is_object()) continue;
         const std::string name = pass.value("name", std::string());
-        if (std::find(info->vplPasses.begin(), info->vplPasses.end(), name) == info->vplPasses.end())
-            continue;
+        if (std::find(info.vplPasses.begin(), info.vplPasses.end(), name) == info.vplPasses.end()) continue;
         const nlohmann::json& gpu = pass.contains("gpu_ms") ? pass["gpu_ms"] : nlohmann::json();
         const double t = gpu.is_number() ? gpu.get<double>() : pass.value("cpu_ms", 0.0);
         if (std::isfinite(t) && t > 0.0) ms += t;
@@ -124,33 +121,33 @@ double AdaptiveQuality::predictStepMs(const std::string& sceneName, const FrameS
     // rendered yet: the nearest measured lower step, scaled by pixels and its VPL passes by the VPLs'
     // cost (a gather grows with pixels x vpls^e), so a final preset with 256 times the VPLs is
     // predicted before it runs.
-    const double exponent = vplCostExponent(state);
+    const StepCost* cost = nearestStepCost(sceneName, state, step);
+    if (!cost) return 0.0;
+    const double vplScale = std::pow(vpls / static_cast<double>(cost->vpls), vplCostExponent(state));
+    return pixels * ((cost->msPerPixel - cost->vplMsPerPixel) + cost->vplMsPerPixel * vplScale);
+}
+
+const AdaptiveQuality::StepCost* AdaptiveQuality::nearestStepCost(const std::string& sceneName,
+                                                                  const FrameState& state,
+                                                                  QualityStep step) const {
     for (int s = static_cast<int>(step); s >= 0; --s)
         if (auto c = mStepCost.find(stepKey(sceneName, state, static_cast<QualityStep>(s)));
-            c != mStepCost.end()) {
-            const StepCost& cost = c->second;
-            const double vplScale = std::pow(vpls / static_cast<double>(cost.vpls), exponent);
-            return pixels * ((cost.msPerPixel - cost.vplMsPerPixel) + cost.vplMsPerPixel * vplScale);
-        }
-    return 0.0;
+            c != mStepCost.end())
+            return &c->second;
+    return nullptr;
 }
 
 double AdaptiveQuality::vplsForStepMs(const std::string& sceneName, const FrameState& state, QualityStep step,
                                       double targetMs) const {
+    const StepCost* cost = nearestStepCost(sceneName, state, step);
+    if (!cost) return static_cast<double>(std::max(1L, vplEstimate(state)));
     const double pixels = static_cast<double>(state.width) * state.height;
-    const double vpls = static_cast<double>(std::max(1L, vplEstimate(state)));
-    for (int s = static_cast<int>(step); s >= 0; --s)
-        if (auto c = mStepCost.find(stepKey(sceneName, state, static_cast<QualityStep>(s)));
-            c != mStepCost.end()) {
-            const StepCost& cost = c->second;
-            // The VPL passes get what the rest of the frame leaves of the target: none, no count fits.
-            const double vplTargetMs = targetMs - pixels * (cost.msPerPixel - cost.vplMsPerPixel);
-            const double vplMsAtMeasured = pixels * cost.vplMsPerPixel;
-            if (!(vplTargetMs > 0.0) || !(vplMsAtMeasured > 0.0)) return 0.0;
-            return static_cast<double>(cost.vpls) *
-                   std::pow(vplTargetMs / vplMsAtMeasured, 1.0 / vplCostExponent(state));
-        }
-    return vpls;
+    // The VPL passes get what the rest of the frame leaves of the target: none, no count fits.
+    const double vplTargetMs = targetMs - pixels * (cost->msPerPixel - cost->vplMsPerPixel);
+    const double vplMsAtMeasured = pixels * cost->vplMsPerPixel;
+    if (!(vplTargetMs > 0.0) || !(vplMsAtMeasured > 0.0)) return 0.0;
+    return static_cast<double>(cost->vpls) *
+           std::pow(vplTargetMs / vplMsAtMeasured, 1.0 / vplCostExponent(state));
 }
 
 void AdaptiveQuality::recordStepCost(const std::string& sceneName, const FrameState& state, QualityStep step,

@@ -119,6 +119,9 @@ private:
         long vpls = 1; ///< at these VPLs
     };
     static std::string stepKey(const std::string& sceneName, const FrameState& state, QualityStep step);
+    /// The cost of `step` of `state`'s scene and technique, else of the nearest lower step measured.
+    const StepCost* nearestStepCost(const std::string& sceneName, const FrameState& state,
+                                    QualityStep step) const;
     void planRefinement(const std::string& sceneName, const FrameState& requested,
                         const nlohmann::json& explicitParams, Plan& plan) const;
     void planInteractive(int frameTargetMs, const nlohmann::json& explicitParams, Plan& plan);

@@ -131,29 +131,24 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     const Config& c = mConfig;
     BudgetChoice out;
     auto it = mRates.find(key);
-    if (it == mRates.end() || it->second.frames == 0) {
+    // The first two frames of a scene and technique are small ones. The first has nothing measured;
+    // the first's time included compiling the technique's shaders and uploading what the scene's first
+    // draw needs (471 ms for cornell's first multires_gather frame, against about 60 ms for the next
+    // at that size), and its rates would take the next frames down to 16 VPLs and a fifth of the size,
+    // from which the budget climbs for a second. The second's time replaces the first's (record).
+    const int measured = it == mRates.end() ? 0 : it->second.frames;
+    if (measured < 2) {
         out.scale = std::clamp(c.firstScale, c.minScale, c.maxScale);
         if (cappable && requestedVpls > c.firstVplCap) out.vplCap = c.firstVplCap;
-        out.reason = "first frame of this scene and technique: nothing measured yet, so a small one (" +
-                     fmt("%.2f", out.scale) + " of the size" +
-                     (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) + ")";
+        out.reason =
+            std::string(measured == 0 ? "first frame of this scene and technique: nothing measured yet"
+                                      : "second frame of this scene and technique: the first one's time "
+                                        "included compiling its shaders") +
+            ", so a small one (" + fmt("%.2f", out.scale) + " of the size" +
+            (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) + ")";
         return out;
     }
     Rates& rates = it->second;
-    if (rates.frames == 1) {
-        // The first frame of a scene and technique compiles the technique's shaders and uploads what
-        // the scene's first draw needs (471 ms for cornell's first multires_gather frame, against about
-        // 60 ms for the next at that size): its rates would take the next frames down to 16 VPLs and a
-        // fifth of the size, from which the budget climbs for a second. One more small frame instead,
-        // whose time replaces the first's.
-        out.scale = std::clamp(c.firstScale, c.minScale, c.maxScale);
-        if (cappable && requestedVpls > c.firstVplCap) out.vplCap = c.firstVplCap;
-        out.reason = "second frame of this scene and technique: the first one's time included compiling "
-                     "its shaders, so another small one (" +
-                     fmt("%.2f", out.scale) + " of the size" +
-                     (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) + ")";
-        return out;
-    }
     if (rates.receiverShare >= 0.0)
         out.receiverShareCap = receiverShareCapAfter(rates.receiverShare, rates.receiverCut);
     // After a frame the cap cut, the next one may gather a quarter more per pixel and VPL (its cap
