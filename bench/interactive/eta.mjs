@@ -5,13 +5,14 @@
 // left, at a quarter, half and three quarters of its image. usage:
 //   node bench/interactive/eta.mjs [--server build/ci/bin/gi-server] [--scene builtin:cornell]
 //        [--technique T] [--params '{"vpl_grid": 64}'] [--seconds 60] [--verbose 1]
+//        [--server-args "--scene-dir tests/data/corpus"] (then --scene file:colonnade.glb)
 import WebSocket from 'ws';
 
 import { DEFAULT_SERVER, parseOptions, sleep, startServer } from '../lib.mjs';
 
-const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:cornell', technique: '', params: '', seconds: 60, verbose: 0 },
-    'usage: node bench/interactive/eta.mjs [--server PATH] [--scene NAME] [--technique T] [--params JSON] [--seconds S] [--verbose 1]');
-const { server, port } = await startServer(opts.server);
+const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:cornell', technique: '', params: '', seconds: 60, verbose: 0, 'server-args': '' },
+    'usage: node bench/interactive/eta.mjs [--server PATH] [--scene NAME] [--technique T] [--params JSON] [--seconds S] [--verbose 1] [--server-args "FLAGS"]');
+const { server, port } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 const ws = new WebSocket(`ws://127.0.0.1:${port}/ws`, 'gi-stream');
 const steps = new Map(); // step -> {announced, vpls, parts, sends: [{t, share, eta}], end}
 const stepOf = (name) => {

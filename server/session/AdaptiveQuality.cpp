@@ -109,7 +109,7 @@ double stepEtaMs(double elapsedMs, double share, double paceFromMs, double paceF
     if (!(paced > 0.0) || !(elapsedMs > paceFromMs)) return predicted ? predictedLeft : -1.0;
     const double paceLeft = (elapsedMs - paceFromMs) * (1.0 - share) / paced;
     if (!predicted) return paceLeft;
-    const double weight = std::min(1.0, share / 0.1);
+    const double weight = std::min(1.0, share / kStepPaceTrustedShare);
     return weight * paceLeft + (1.0 - weight) * predictedLeft;
 }
 

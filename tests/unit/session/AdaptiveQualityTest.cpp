@@ -110,16 +110,15 @@ TEST(AdaptiveQuality, TheVplPassesAreTheTechniquesOwn) {
     EXPECT_DOUBLE_EQ(vplPassesMs("rsm_gather", nlohmann::json::object()), 0.0) << "no passes";
 }
 
-TEST(AdaptiveQuality, TheTimeLeftFollowsTheStepsPaceOnceATenthIsDone) {
+TEST(AdaptiveQuality, TheTimeLeftFollowsTheStepsPaceOnceHalfIsDone) {
     EXPECT_LT(stepEtaMs(0, 0, 0, 0, 0), 0.0) << "nothing known";
     EXPECT_DOUBLE_EQ(stepEtaMs(1000, 0, 0, 0, 5000), 4000) << "the prediction before any pace";
     EXPECT_DOUBLE_EQ(stepEtaMs(6000, 0, 0, 0, 5000), 0) << "a prediction overrun leaves nothing, not less";
     EXPECT_DOUBLE_EQ(stepEtaMs(3000, 0.5, 0, 0, 0), 3000) << "the pace alone";
-    // The one-time work took 1 s and 1 % of the image; the next 2 s did 19 % more.
-    EXPECT_DOUBLE_EQ(stepEtaMs(3000, 0.2, 1000, 0.01, 100000), 2000.0 * 0.8 / 0.19)
-        << "a tenth done: the pace";
-    // Half-way to a tenth: half the pace, half what is left of the prediction.
-    EXPECT_DOUBLE_EQ(stepEtaMs(1000, 0.05, 0, 0, 9000), 0.5 * (1000 * 0.95 / 0.05) + 0.5 * 8000);
+    // The one-time work took 1 s and 1 % of the image; the next 2 s did 59 % more.
+    EXPECT_DOUBLE_EQ(stepEtaMs(3000, 0.6, 1000, 0.01, 100000), 2000.0 * 0.4 / 0.59) << "half done: the pace";
+    // Half-way to half: half the pace, half what is left of the prediction.
+    EXPECT_DOUBLE_EQ(stepEtaMs(1000, 0.25, 0, 0, 9000), 0.5 * (1000 * 0.75 / 0.25) + 0.5 * 8000);
     EXPECT_DOUBLE_EQ(stepEtaMs(5000, 1.0, 0, 0, 9000), 0.0) << "done";
     EXPECT_DOUBLE_EQ(stepEtaMs(1000, std::nan(""), 0, 0, 3000), 2000) << "a share not a number counts as 0";
 }
