@@ -2,11 +2,14 @@
 // replaces those waiting, patches queue in order: frames.js), decoded off the main thread and drawn
 // whole or as a patch of a refining image, every frame acknowledged on the connection that brought it,
 // and a requested snapshot saved as it arrives. `onDrawn(frame, decodeMs, bytes)` follows each draw.
+import { createFrameDecoder } from './decode.js';
 import { enqueueFrame, patchPlacement } from './frames.js';
 import { ackMsg, CODEC_MIME, parseFrameHeader } from './protocol.js';
 
 export function createFrameView({ ui, state, connection, send, showMessage, onDrawn }) {
     const ctx = ui.canvas.getContext('2d');
+    const decoder = createFrameDecoder();
+    let lastWay = null; // how the last frame was decoded (decode.js)
 
     function handleBinary(buffer) {
         const arrivedAt = performance.now();
@@ -39,11 +42,14 @@ export function createFrameView({ ui, state, connection, send, showMessage, onDr
     async function decodeAndDraw(frame) {
         state.decoding = true;
         const { header, buffer } = frame;
+        let decoded = null;
         try {
             const started = performance.now();
             const payload = new Uint8Array(buffer, header.payloadOffset);
-            // createImageBitmap decodes off the main thread; the draw below is a copy.
-            const bitmap = await createImageBitmap(new Blob([payload], { type: CODEC_MIME[header.codec] }));
+            // Decoded off the main thread (decode.js); the draw below is a copy.
+            decoded = await decoder.decode(payload, CODEC_MIME[header.codec]);
+            lastWay = decoded.way;
+            const { image } = decoded;
             const decodeMs = performance.now() - started;
             if (frame.socket === connection.socket) {
                 const patch = patchPlacement(frame.entry?.stats, header);
@@ -60,20 +66,20 @@ export function createFrameView({ ui, state, connection, send, showMessage, onDr
                         ctx.drawImage(before, 0, 0, patch.width, patch.height);
                         before.close();
                     }
-                    ctx.drawImage(bitmap, patch.x, patch.y);
+                    ctx.drawImage(image, patch.x, patch.y);
                 } else {
                     if (ui.canvas.width !== header.width || ui.canvas.height !== header.height) {
                         ui.canvas.width = header.width;
                         ui.canvas.height = header.height;
                     }
-                    ctx.drawImage(bitmap, 0, 0, header.width, header.height);
+                    ctx.drawImage(image, 0, 0, header.width, header.height);
                 }
                 onDrawn(frame, decodeMs, buffer.byteLength);
             }
-            bitmap.close();
         } catch (e) {
             showMessage(`Frame ${header.frame} could not be decoded: ${e.message}`);
         } finally {
+            decoded?.close();
             // Acknowledge even a frame that failed to decode, else the server would wait forever.
             acknowledge(frame);
             state.decoding = false;
@@ -102,5 +108,5 @@ export function createFrameView({ ui, state, connection, send, showMessage, onDr
         setTimeout(() => URL.revokeObjectURL(link.href), 1000);
     }
 
-    return { handleBinary };
+    return { handleBinary, get decodedBy() { return lastWay; } };
 }

@@ -205,6 +205,8 @@ const hook = {
         return { arrivedAt: epoch(state.lastDrawn?.arrivedAt), drawnAt: epoch(state.lastDrawn?.drawnAt),
             decodeMs: state.lastDrawn?.decodeMs ?? null, steerAt: epoch(state.lastSteerAt) };
     },
+    // How the last frame was decoded: 'ImageDecoder' (a secure context) or 'createImageBitmap'.
+    get decodedBy() { return frameView.decodedBy; },
     get connection() { return state.connState; },
     get role() { return state.viewer ? 'viewer' : 'controller'; },
     get session() { return state.welcome?.session ?? null; },

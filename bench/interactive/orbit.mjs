@@ -9,7 +9,8 @@
 //     (`orbit_page_busy`, Chromium's TaskDuration), time the server's two cores did not get.
 // Each press is timed twice: from this script's key dispatch to the page's next animation frame after
 // the draw (`still_input_to_frame_ms`, `input_to_frame_ms`), and in the page, from the key event to the
-// frame drawn on the canvas (`still_in_page`, `in_page`, with where the time went).
+// frame drawn on the canvas (`still_in_page`, `in_page`, with where the time went: `decodeDraw` from the
+// frame's arrival to its draw, `decode` the decode alone).
 // Figures are measured side by side in one run on whatever machine runs it; docs/interactive.md has
 // the ones recorded. usage:
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
@@ -124,6 +125,8 @@ async function pressLatency(key) {
         client: keyEvent.steerAt !== null && keyEvent.steerAt >= keyEvent.at - 1 ? keyEvent.steerAt - keyEvent.at : null,
         server: keyEvent.steerAt !== null && d.arrivedAt ? d.arrivedAt - keyEvent.steerAt : null,
         decodeDraw: d.arrivedAt ? d.drawnAt - d.arrivedAt : null,
+        // Of that, the decode itself (createImageBitmap); the rest waited for a decode ahead of it.
+        decode: d.decodeMs ?? null,
         dispatch: keyEvent.at - t0, toAnimationFrame: d.t - d.drawnAt,
         // The camera message's way to the server and the frame's way back (both sockets, the server's
         // network thread and the page's message handling): the server part less the server's own time
@@ -142,7 +145,7 @@ function inPageSummary(results) {
     if (!pressed.length) return null;
     const pcts = (v) => ({ p50: percentile(v, 0.5), p95: percentile(v, 0.95) });
     const parts = {};
-    for (const k of ['dispatch', 'client', 'server', 'sockets', 'decodeDraw', 'toAnimationFrame']) {
+    for (const k of ['dispatch', 'client', 'server', 'sockets', 'decodeDraw', 'decode', 'toAnimationFrame']) {
         const v = pressed.map((r) => r.inPage[k]).filter((x) => x !== null && x !== undefined);
         if (v.length) parts[k] = pcts(v);
     }

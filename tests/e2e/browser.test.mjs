@@ -157,6 +157,31 @@ test('the page connects and shows frames', async () => {
     }
 });
 
+test('frames are decoded by ImageDecoder on a secure page, and drawn without it elsewhere', async () => {
+    assert.equal(await page.evaluate(() => window.giClient.decodedBy), 'ImageDecoder',
+        'the page on 127.0.0.1 is a secure context');
+    // A browser without WebCodecs, or the page served over plain http from another host.
+    const plain = await browser.newContext({ viewport: { width: 800, height: 600 } });
+    try {
+        await plain.addInitScript(() => { delete window.ImageDecoder; });
+        const p = await plain.newPage();
+        p.on('pageerror', (e) => pageErrors.push(`without ImageDecoder: ${e.message}`));
+        await p.goto(url());
+        await p.waitForFunction(() => window.giClient?.framesDrawn > 1, null, { timeout: WAIT_MS, polling: 100 });
+        assert.equal(await p.evaluate(() => window.giClient.decodedBy), 'createImageBitmap');
+        const mean = await p.evaluate(() => {
+            const c = document.querySelector('canvas');
+            const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+            let sum = 0;
+            for (let i = 0; i < d.length; i += 4) sum += d[i] + d[i + 1] + d[i + 2];
+            return sum / (d.length * 0.75);
+        });
+        assert.ok(mean > 10, `the frame is drawn, not black (mean ${mean.toFixed(1)})`);
+    } finally {
+        await plain.close();
+    }
+});
+
 test('changing the technique changes the image', async (t) => {
     // Fixed quality: each frame is exactly what was asked for (no half-size interactive frames).
     await control('adaptive', 'input').uncheck();
