@@ -69,6 +69,10 @@ Pass& Pass::target(const Framebuffer& fbo, int width, int height) {
     mFbo = fbo.id();
     glBindFramebuffer(GL_FRAMEBUFFER, mFbo);
     glViewport(0, 0, width, height);
+    mViewport[0] = 0;
+    mViewport[1] = 0;
+    mViewport[2] = width;
+    mViewport[3] = height;
     return *this;
 }
 
@@ -104,6 +108,10 @@ Pass& Pass::polygonOffset(float factor, float units) {
 
 Pass& Pass::viewport(int x, int y, int width, int height) {
     glViewport(x, y, width, height);
+    mViewport[0] = x;
+    mViewport[1] = y;
+    mViewport[2] = width;
+    mViewport[3] = height;
     return *this;
 }
 
@@ -281,6 +289,34 @@ Pass& Pass::set(UniformLocation u, float value) {
 void Pass::drawFullscreen(const VertexArray& emptyVao) {
     glBindVertexArray(emptyVao.id());
     glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+bool Pass::drawFullscreenInBands(const VertexArray& emptyVao, const std::function<bool()>& stop, int bands) {
+    const auto [x, y, width, height] = mViewport;
+    // Rows per band: llvmpipe rasterizes the target in 64 x 64 bins, one per thread at a time, so
+    // bands of whole bin rows keep its threads as busy as one draw would; a target of a single bin
+    // row (a small refinement tile, one thread's work either way) goes in multiples of 16 rows.
+    constexpr int kBinRows = 64, kSmallBandRows = 16;
+    const int step = height > kBinRows ? kBinRows : kSmallBandRows;
+    const int wanted = (height + std::max(bands, 1) - 1) / std::max(bands, 1);
+    const int rows = (wanted + step - 1) / step * step;
+    if (!stop || height <= rows) {
+        drawFullscreen(emptyVao);
+        return true;
+    }
+    glEnable(GL_SCISSOR_TEST);
+    bool goOn = true;
+    for (int top = 0; top < height && goOn; top += rows) {
+        glScissor(x, y + top, width, std::min(rows, height - top));
+        drawFullscreen(emptyVao);
+        if (top + rows >= height) break;
+        // The band is done before `stop` is asked: GL work once queued runs to its end, so asking
+        // earlier would only leave it to delay the frame that answers the input.
+        glFinish();
+        goOn = !stop();
+    }
+    glDisable(GL_SCISSOR_TEST);
+    return goOn;
 }
 
 bool Pass::drawFullscreenAnySamples(const VertexArray& emptyVao, const Query& anySamples) {

@@ -18,6 +18,8 @@
 
 #include <glm/glm.hpp>
 
+#include <functional>
+
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -91,6 +93,12 @@ public:
     Pass& set(UniformLocation u, std::span<const glm::vec3> values);
     /// A fullscreen triangle (shaders/render/fullscreen.vert) with `emptyVao` bound.
     void drawFullscreen(const VertexArray& emptyVao);
+    /// drawFullscreen() in about `bands` horizontal bands of the viewport, `stop` asked after each
+    /// band but the last once that band is done: at its first true the bands not yet drawn are left
+    /// and false is returned. Refinement's long gathers use it so that input waits for one band
+    /// rather than the whole pass; each pixel is shaded exactly as by one draw. Without `stop`, or for
+    /// one band, it is drawFullscreen() (and true).
+    bool drawFullscreenInBands(const VertexArray& emptyVao, const std::function<bool()>& stop, int bands);
     /// drawFullscreen() counted by `anySamples` (a GL_ANY_SAMPLES_PASSED query): waits for the result
     /// and returns whether any sample passed the tests.
     bool drawFullscreenAnySamples(const VertexArray& emptyVao, const Query& anySamples);
@@ -109,6 +117,7 @@ private:
     PassTimer* mTimer;
     std::string mName;
     GLuint mFbo = 0;
+    int mViewport[4] = {0, 0, 0, 0}; ///< the last target() or viewport(): x, y, width, height
     bool mDepthTest = false;
     bool mPolygonOffset = false;
     bool mBlend = false;

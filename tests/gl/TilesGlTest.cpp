@@ -8,6 +8,7 @@
 #include "frame/FrameState.h"
 #include "frame/Tiles.h"
 #include "gi/Catalog.h"
+#include "gi/common/VplGrid.h"
 
 namespace gis::test {
 namespace {
@@ -272,6 +273,31 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
 // Refinement's interruption (FrameRenderer::setInterruptCheck): a frame stops at the first check that
 // says true, and keeps nothing half done: the frame after it is the one an uninterrupted renderer draws,
 // at whichever stage it stopped.
+// Refinement's gathers in about eight pieces: whole batches of 1,024 VPLs where there are eight or
+// more (25,921 VPLs: 26 batches, a check after every 3rd rather than a wait after each), else each
+// batch cut.
+TEST(TilesGl, AGatherGoesInAboutEightPieces) {
+    auto pieces = [](int batches) {
+        const GatherCut cut = gatherCut(batches);
+        EXPECT_GE(cut.cutsPerBatch, 1);
+        EXPECT_GE(cut.batchesPerPiece, 1);
+        EXPECT_TRUE(cut.cutsPerBatch == 1 || cut.batchesPerPiece == 1)
+            << "cut batches or group them, not both";
+        return cut.cutsPerBatch > 1 ? batches * cut.cutsPerBatch
+                                    : (batches + cut.batchesPerPiece - 1) / cut.batchesPerPiece;
+    };
+    EXPECT_EQ(gatherCut(1).cutsPerBatch, 8);
+    EXPECT_EQ(gatherCut(3).cutsPerBatch, 3);
+    EXPECT_EQ(gatherCut(5).cutsPerBatch, 2);
+    EXPECT_EQ(gatherCut(7).cutsPerBatch, 1);
+    EXPECT_EQ(gatherCut(26).batchesPerPiece, 3);
+    EXPECT_EQ(gatherCut(0).cutsPerBatch, 8) << "no batch: nothing to cut, and no division by zero";
+    for (int batches = 1; batches <= 64; ++batches) {
+        EXPECT_GE(pieces(batches), 6) << batches;
+        EXPECT_LE(pieces(batches), 11) << batches;
+    }
+}
+
 TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
     sharedContext();
     const auto shared = std::make_shared<const Scene>(loadScene("builtin:cornell"));
@@ -297,6 +323,7 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
 
         // An uninterrupted frame that draws its light views: how many checks it passes.
         int checks = 0;
+        int gatherPieces = 0;
         {
             auto counting = reusingRenderer(scene);
             counting->setInterruptCheck([&] {
@@ -306,10 +333,18 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
             const FrameOutput out = counting->render(lit);
             EXPECT_FALSE(out.interrupted);
             EXPECT_EQ(out.rgba8, expected.rgba8) << scene->name << " " << technique;
+            // One batch of VPLs, cut in eight: rsm_gather's 80 rows in bands of whole bin rows (64,
+            // then 16); the receiver gathers' list in chunks of ceil(groups / 8) groups.
+            const GatherCut cut = gatherCut(1);
+            EXPECT_EQ(cut.cutsPerBatch, 8);
+            const int groups = static_cast<int>(std::ceil(counter(out, "receivers_total") / 64.0));
+            const int perChunk = (groups + cut.cutsPerBatch - 1) / cut.cutsPerBatch;
+            gatherPieces = technique == "rsm_gather" ? 2 : (groups + perChunk - 1) / perChunk;
+            EXPECT_GE(gatherPieces, 2) << scene->name << " " << technique << ": the gather is cut";
         }
         // Shadow maps, RSMs, eye passes, after the technique; the hierarchical ones and rsm_gather
-        // once more inside it.
-        EXPECT_EQ(checks, 5) << scene->name << " " << technique;
+        // once more inside it; and between the pieces of the gather.
+        EXPECT_EQ(checks, 5 + gatherPieces - 1) << scene->name << " " << technique;
 
         for (int stopAt = 1; stopAt <= checks; ++stopAt) {
             auto renderer = reusingRenderer(scene);
@@ -355,10 +390,13 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
             });
             EXPECT_EQ(counting.render(resized).rgba8, expected.rgba8);
         }
-        // Eye passes, the technique (2), the room probe's faces, before each local probe and after its
-        // faces (2 x 2), after the reflections; the light views are kept.
-        EXPECT_EQ(checks, 9);
-        for (int stopAt = 4; stopAt <= checks; ++stopAt) {
+        // Eye passes, the technique (2, and between the chunks of its receivers), the room probe's
+        // faces, before each local probe and after its faces (2 x 2), after the reflections; the light
+        // views are kept. The last six are the probes'.
+        const int groups = static_cast<int>(std::ceil(counter(expected, "receivers_total") / 64.0));
+        const int perChunk = (groups + 7) / 8;
+        EXPECT_EQ(checks, 9 + (groups + perChunk - 1) / perChunk - 1);
+        for (int stopAt = checks - 5; stopAt <= checks; ++stopAt) {
             FrameRenderer renderer;
             renderer.setReuseLightPasses(true);
             renderer.setScene(gallery);

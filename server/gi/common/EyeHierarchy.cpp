@@ -40,7 +40,8 @@ EyeInputHandles::EyeInputHandles(const gl::Program& p) {
 }
 
 EyeReceiverPassHandles::EyeReceiverPassHandles(const gl::Program& p)
-    : inputs(p), list(p.storageBlock("EyeReceiverList")), illumination(p.imageUnit("uEyeIllumination")) {}
+    : inputs(p), list(p.storageBlock("EyeReceiverList")), illumination(p.imageUnit("uEyeIllumination")),
+      groupBase(p.location("uEyeReceiverGroupBase")) {}
 
 EyeHierarchy::ReduceProgram::ReduceProgram(gl::Program built)
     : program(std::move(built)), level(program.location("uLevel")),
@@ -207,9 +208,35 @@ void EyeHierarchy::beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandle
         .image(handles.illumination, mTargets.illumination, GL_READ_WRITE, GL_RGBA32F);
 }
 
-void EyeHierarchy::dispatchReceivers(gl::Pass& pass) const {
+bool EyeHierarchy::dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandles& handles,
+                                     const std::function<bool()>& stop, int chunks) const {
     // The previous dispatch's image stores (and the stencil pass's list) before this one's loads.
-    pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT).dispatchIndirect(mTargets.receiverList);
+    pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    if (!stop || chunks <= 1) {
+        pass.set(handles.groupBase, 0u).dispatchIndirect(mTargets.receiverList);
+        return true;
+    }
+    // Refinement: the count read back (this waits for the stencil pass), then the list in chunks,
+    // each done before `stop` is asked, as GL work once queued runs to its end.
+    shader::EyeReceiverListHeader header{};
+    glGetNamedBufferSubData(mTargets.receiverList.id(), 0, sizeof header, &header);
+    const unsigned capacity = static_cast<unsigned>(
+        (mTargets.receiverList.size() - static_cast<GLsizeiptr>(sizeof header)) / sizeof(unsigned));
+    const unsigned receivers = std::min(header.counts.x, capacity);
+    const unsigned groups = (receivers + GIS_EYE_RECEIVER_GROUP - 1) / GIS_EYE_RECEIVER_GROUP;
+    // One row of groups per chunk: a second row would run past the chunk into the next one.
+    const auto parts = static_cast<unsigned>(chunks);
+    const unsigned chunkGroups =
+        std::clamp((groups + parts - 1) / parts, 1u, static_cast<unsigned>(GIS_EYE_RECEIVER_MAX_GROUPS_X));
+    for (unsigned first = 0; first < groups; first += chunkGroups) {
+        const unsigned count = std::min(chunkGroups, groups - first);
+        if (first > 0) pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        pass.set(handles.groupBase, first).dispatch(static_cast<int>(count));
+        if (first + count >= groups) break;
+        glFinish();
+        if (stop()) return false;
+    }
+    return true;
 }
 
 void EyeHierarchy::bindInputs(gl::Pass& pass, const EyeInputHandles& h, const FrameInputs& in) const {

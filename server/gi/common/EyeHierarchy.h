@@ -62,6 +62,7 @@ struct EyeReceiverPassHandles {
     EyeInputHandles inputs;
     gl::BlockBinding list;
     gl::ImageUnit illumination;
+    gl::UniformLocation groupBase; ///< uEyeReceiverGroupBase
 };
 
 struct EyeHierarchyOptions {
@@ -120,8 +121,13 @@ public:
     void beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandles& handles,
                            const FrameInputs& in) const;
     /// Runs the receiver program in use once per receiver (indirect, from the count the stencil pass
-    /// appended); each dispatch sees the illumination the ones before it added.
-    void dispatchReceivers(gl::Pass& pass) const;
+    /// appended); each dispatch sees the illumination the ones before it added. With `stop` and more
+    /// than one `chunks` (refinement: gatherCut) it reads the count back and runs the list in that
+    /// many chunks instead, `stop` asked after each but the last once it is done: at its first true
+    /// the rest is left and false is returned, so that input waits for one chunk rather than the whole
+    /// pass. Each receiver is lit exactly as by one dispatch.
+    bool dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandles& handles,
+                           const std::function<bool()>& stop = {}, int chunks = 1) const;
     /// Binds the hierarchy's uniform block at GIS_UBO_EYE (every pass using eye_hierarchy.glsl).
     void bindUniforms() const;
     /// Binds the hierarchy's textures and the G-buffer (level 0) where `handles` name them.

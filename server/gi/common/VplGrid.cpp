@@ -143,6 +143,37 @@ int VplBatches::forEach(const gl::Buffer& vpls, int count,
     return batches;
 }
 
+GatherCut gatherCut(int batches) {
+    // Rounded to the nearest, so that the pieces stay within about 3/4 to 3/2 of kGatherPieces.
+    GatherCut cut;
+    const int n = std::max(batches, 1);
+    if (n >= kGatherPieces)
+        cut.batchesPerPiece = (n + kGatherPieces / 2) / kGatherPieces;
+    else
+        cut.cutsPerBatch = std::max(1, (kGatherPieces + n / 2) / n);
+    return cut;
+}
+
+bool VplBatches::forEachPiece(const gl::Buffer& vpls, int count, const std::function<bool()>& stop,
+                              const std::function<bool(int batchCount, int first, int cuts)>& draw,
+                              int& batches) {
+    const int total = (std::max(count, 0) + GIS_MAX_VPLS_PER_BATCH - 1) / GIS_MAX_VPLS_PER_BATCH;
+    const GatherCut cut = stop ? gatherCut(total) : GatherCut{};
+    bool goOn = true;
+    batches = 0;
+    forEach(vpls, count, [&](int n, int first) {
+        if (!goOn) return;
+        ++batches;
+        goOn = draw(n, first, cut.cutsPerBatch);
+        if (goOn && stop && batches < total && batches % cut.batchesPerPiece == 0) {
+            // The piece is done before `stop` is asked: GL work once queued runs to its end.
+            glFinish();
+            goOn = !stop();
+        }
+    });
+    return goOn;
+}
+
 int VplGrid::forEachBatch(const std::function<void(int batchCount, int first)>& draw) {
     return mBatches.forEach(mVpls, mCount, draw);
 }
@@ -168,6 +199,13 @@ int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
 
 int VplGrid::forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) {
     return mBatches.forEach(mPartVpls, mPartCount, draw);
+}
+
+bool VplGrid::forEachPiece(bool part, const std::function<bool()>& stop,
+                           const std::function<bool(int batchCount, int first, int cuts)>& draw,
+                           int& batches) {
+    return part ? mBatches.forEachPiece(mPartVpls, mPartCount, stop, draw, batches)
+                : mBatches.forEachPiece(mVpls, mCount, stop, draw, batches);
 }
 
 } // namespace gis

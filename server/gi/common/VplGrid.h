@@ -59,6 +59,17 @@ struct VplTransportHandles {
 /// measure no flux share evenly. Pure (unit-tested).
 std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int views, int rsmSide);
 
+/// Refinement's gathers go in about kGatherPieces pieces that input can stop between (the interrupt
+/// check asked after each, once its work is done): whole batches where there are at least that many,
+/// else each batch cut in bands or receiver-list chunks. A fixed cut rather than one by time keeps a
+/// frame's checks the same from run to run. Pure (unit-tested).
+constexpr int kGatherPieces = 8;
+struct GatherCut {
+    int cutsPerBatch = 1;    ///< pieces each batch's draw is cut in
+    int batchesPerPiece = 1; ///< whole batches drawn before the check is asked
+};
+GatherCut gatherCut(int batches);
+
 /// The gathers' VPLs, batch by batch (gi/common/vpl_batch.glsl): each batch of up to
 /// GIS_MAX_VPLS_PER_BATCH VPLs of a buffer is viewed as RGBA32F texels, three per shader::Vpl, at
 /// texture unit GIS_TEXTURE_VPLS. A buffer texture rather than a uniform block: llvmpipe reads a
@@ -70,6 +81,12 @@ public:
     /// each, `first` being the index in `vpls` of the batch's first VPL. Returns the number of batches.
     int forEach(const gl::Buffer& vpls, int count,
                 const std::function<void(int batchCount, int first)>& draw);
+    /// forEach() in refinement's pieces (gatherCut) when `stop` is set: `draw(batchCount, first,
+    /// cuts)` draws its batch in `cuts` pieces and returns false once `stop` said true inside it;
+    /// after a piece of whole batches the work is waited for and `stop` asked. Returns false once
+    /// stopped (the rest is not drawn); `batches` counts the batches drawn.
+    bool forEachPiece(const gl::Buffer& vpls, int count, const std::function<bool()>& stop,
+                      const std::function<bool(int batchCount, int first, int cuts)>& draw, int& batches);
 
 private:
     gl::BufferTexture mView;
@@ -97,6 +114,10 @@ public:
     /// Like forEachBatch() over the prepared part's VPLs; `draw(batchCount, first)` gets the index in
     /// the part of the batch's first VPL.
     int forEachPartBatch(const std::function<void(int batchCount, int first)>& draw);
+    /// forEachBatch(), or forEachPartBatch() for a prepared `part`, in refinement's pieces
+    /// (VplBatches::forEachPiece).
+    bool forEachPiece(bool part, const std::function<bool()>& stop,
+                      const std::function<bool(int batchCount, int first, int cuts)>& draw, int& batches);
 
 private:
     struct ExtractProgram {

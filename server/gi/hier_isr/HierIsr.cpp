@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "gi/Catalog.h"
+#include "gi/common/VplGrid.h"
 
 namespace gis {
 
@@ -121,7 +122,9 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
             mTree.bind();
             pass.buffer(g.stats, mStats);
             mEye.beginReceiverPass(pass, g.eye, in);
-            mEye.dispatchReceivers(pass);
+            // In refinement the receivers go in chunks that input can stop between (one dispatch:
+            // gatherCut of one batch).
+            if (!mEye.dispatchReceivers(pass, g.eye, in.interruptCheck, gatherCut(1).cutsPerBatch)) return;
         }
     }
 

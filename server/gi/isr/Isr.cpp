@@ -111,9 +111,18 @@ void Isr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTimer& 
             pass.use(g.program);
             g.transport.set(pass, params, in.sceneSize, false, in.glossyMinRoughness, nullptr);
             mEye.beginReceiverPass(pass, g.eye, in);
-            counters["vpl_batches"] = mBatches.forEach(mVpls, mVplCount, [&](int count, int) {
-                mEye.dispatchReceivers(pass.set(g.vplCount, count).set(g.vplScale, 1.0f));
-            });
+            // In refinement the gather goes in pieces that input can stop between: batches, or
+            // chunks of the receiver list (gatherCut).
+            int batches = 0;
+            const bool whole = mBatches.forEachPiece(
+                mVpls, mVplCount, in.interruptCheck,
+                [&](int count, int, int cuts) {
+                    return mEye.dispatchReceivers(pass.set(g.vplCount, count).set(g.vplScale, 1.0f), g.eye,
+                                                  in.interruptCheck, cuts);
+                },
+                batches);
+            counters["vpl_batches"] = batches;
+            if (!whole) return;
         }
     }
 

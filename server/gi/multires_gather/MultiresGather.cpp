@@ -46,15 +46,22 @@ void MultiresGather::execute(const FrameInputs& in, const ParamSet& params, gl::
             // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.
             const int parts = std::max(1, in.vplParts);
             pass.set(g.vplScale, static_cast<float>(parts));
+            // In refinement the gather goes in pieces that input can stop between (a VPL part's
+            // gather is a whole slice): batches, or chunks of the receiver list (gatherCut).
+            int batches = 0;
+            const bool whole = mVpls.forEachPiece(
+                parts > 1, in.interruptCheck,
+                [&](int count, int, int cuts) {
+                    return mEye.dispatchReceivers(pass.set(g.vplCount, count), g.eye, in.interruptCheck,
+                                                  cuts);
+                },
+                batches);
+            counters["vpl_batches"] = batches;
             if (parts > 1) {
-                counters["vpl_batches"] = mVpls.forEachPartBatch(
-                    [&](int count, int) { mEye.dispatchReceivers(pass.set(g.vplCount, count)); });
                 counters["vpl_part"] = std::clamp(in.vplPart, 0, parts - 1);
                 counters["vpl_parts"] = parts;
-            } else {
-                counters["vpl_batches"] = mVpls.forEachBatch(
-                    [&](int count, int) { mEye.dispatchReceivers(pass.set(g.vplCount, count)); });
             }
+            if (!whole) return;
         }
     }
 

@@ -53,20 +53,25 @@ void RsmGather::execute(const FrameInputs& in, const ParamSet& params, gl::PassT
             // A VPL part (refinement) gathers every vplParts-th VPL, laid out contiguously.
             const int parts = std::max(1, in.vplParts);
             const int part = std::clamp(in.vplPart, 0, parts - 1);
-            auto drawBatch = [&](int count, int first) {
-                pass.set(g.vplCount, count)
-                    .set(g.vplFirst, first)
-                    .set(g.vplPhase, part)
-                    .set(g.vplStride, parts)
-                    .drawFullscreen(mEmptyVao);
-            };
+            // In refinement the gather goes in pieces that input can stop between (a VPL part's
+            // gather is a whole slice): batches, or bands of each batch (gatherCut).
+            int batches = 0;
+            const bool whole = mVpls.forEachPiece(
+                parts > 1, in.interruptCheck,
+                [&](int count, int first, int cuts) {
+                    pass.set(g.vplCount, count)
+                        .set(g.vplFirst, first)
+                        .set(g.vplPhase, part)
+                        .set(g.vplStride, parts);
+                    return pass.drawFullscreenInBands(mEmptyVao, in.interruptCheck, cuts);
+                },
+                batches);
+            counters["vpl_batches"] = batches;
             if (parts > 1) {
-                counters["vpl_batches"] = mVpls.forEachPartBatch(drawBatch);
                 counters["vpl_part"] = part;
                 counters["vpl_parts"] = parts;
-            } else {
-                counters["vpl_batches"] = mVpls.forEachBatch(drawBatch);
             }
+            if (!whole) return;
         }
     }
     mSsbc.apply(in, params, mIndirect.texture, timer, counters);

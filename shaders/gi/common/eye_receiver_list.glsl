@@ -25,10 +25,14 @@ layout(local_size_x = GIS_EYE_RECEIVER_GROUP) in;
 // dispatches (EyeHierarchy::dispatchReceivers), so successive dispatches add in order.
 layout(rgba32f, binding = GIS_IMAGE_EYE_ILLUMINATION) uniform image2D uEyeIllumination;
 
+// The first group of this dispatch: 0 for the whole list at once, else the chunk's first
+// (EyeHierarchy::dispatchReceivers with a stop check).
+uniform uint uEyeReceiverGroupBase;
+
 // This invocation's receiver, false past the list's end (the last group's spare lanes). Groups are
 // laid out in rows of gl_NumWorkGroups.x (2D once a list outgrows one dimension).
 bool eyeReceiver(out ivec2 atlasTexel) {
-    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    uint group = uEyeReceiverGroupBase + gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
     uint i = group * uint(GIS_EYE_RECEIVER_GROUP) + gl_LocalInvocationID.x;
     atlasTexel = ivec2(0);
     if (i >= min(gReceiverHeader.counts.x, uint(gReceivers.length()))) return false;
