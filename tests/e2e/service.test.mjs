@@ -86,6 +86,13 @@ async function settle(client, last = null, quietMs = 400) {
 }
 
 /** A first frame, then quiet: the state every effect test starts from. */
+// Whether the server logged `text` within `timeoutMs`: a line written before a frame was sent can
+// reach this process after the frame, its stderr and the socket being read apart.
+async function logged(server, text, timeoutMs = 5000) {
+    for (const until = Date.now() + timeoutMs; !server.log.includes(text) && Date.now() < until;) await sleep(50);
+    return server.log.includes(text);
+}
+
 async function quietFrame(client) {
     return settle(client, await client.frame('a frame'));
 }
@@ -769,7 +776,7 @@ check('interactive frames of a big scene draw its levels of detail once built, s
     assert.ok(simplified, 'an interactive frame drew simplified triangles');
     assert.ok(simplified.stats.counts.triangles_gbuffer < 0.5 * simplified.stats.counts.triangles,
         `far fewer triangles drawn: ${simplified.stats.counts.triangles_gbuffer} of ${simplified.stats.counts.triangles}`);
-    assert.ok(servers.main.log.includes(`session ${client.welcome.session}: levels of detail for builtin:atrium built in`),
+    assert.ok(await logged(servers.main, `session ${client.welcome.session}: levels of detail for builtin:atrium built in`),
         'the build is logged');
     const refined = await client.frame('a refinement frame', (s) => s.quality === 'balanced' || s.quality === 'final', 60000);
     assert.equal(refined.stats.params?.lod_pixels, 0, 'refinement draws every triangle');
@@ -785,9 +792,10 @@ check('interactive frames of a big scene draw its levels of detail once built, s
     const moved = await second.frame('a moved frame', (s) => s.scene === 'builtin:atrium' && s.quality === 'interactive' &&
         s.counts?.triangles_gbuffer_simplified > 0, 15000);
     assert.ok(moved.stats.counts.triangles_gbuffer_simplified > 0);
+    assert.ok(await logged(servers.main,
+        `session ${second.welcome.session}: the levels of detail for builtin:atrium are shared with another session`),
+    'the second session says it shares the levels');
     const lines = servers.main.log.split('\n').filter((l) => l.includes(`session ${second.welcome.session}: `));
-    assert.ok(lines.some((l) => l.includes('levels of detail for builtin:atrium are shared with another session')),
-        'the second session says it shares the levels');
     assert.ok(!lines.some((l) => l.includes('levels of detail for builtin:atrium built in')), 'and builds none');
 
     // A client that wants every triangle in its own view still gets the light views within a texel,
