@@ -1,9 +1,10 @@
 // A frame's encoded bytes to an image the canvas can draw. Where the page may use WebCodecs'
-// ImageDecoder (a secure context: https, or the server on localhost) it decodes straight from the bytes:
-// in headless Chromium on two busy cores a 282 x 240 JPEG took 1.7-2.3 ms at the median and 2.8-5.3 ms
-// at p95, decoded and drawn, against 2.8-3.6 and 4.1-11.5 ms through createImageBitmap on a Blob (the
-// Blob is read back through the browser's blob registry before it is decoded). Elsewhere, and for a
-// type ImageDecoder does not take, createImageBitmap. Pure apart from the decoders it is given.
+// ImageDecoder (a secure context: https, or the server on localhost) it decodes straight from the bytes,
+// where createImageBitmap needs them in a Blob, which the browser reads back through its blob registry
+// before it decodes: 1.2-1.6 ms at the median against 3.4-4.4 ms for cornell's 282 x 240 JPEGs
+// (`node bench/interactive/orbit.mjs --scenes cornell --refinement 0`, `decode`; docs/interactive.md).
+// Elsewhere, and for a type ImageDecoder does not take, createImageBitmap. Pure apart from the decoders
+// it is given.
 
 /**
  * The decoder for a page: `decode(bytes, mime)` resolves to `{ image, close(), way }`, where `image`

@@ -67,9 +67,11 @@ Renders every configuration --frames times, interleaved (frame k of each configu
 k+1 of any), and prints the median ms of each pass per configuration, the total, the ratio of each
 total to the first configuration's, the receivers per eye level against the covered pixels
 (fill-rate saving) and, with --baseline, the relative RMSE of each configuration against that GL
-configuration. With --size-before, every timed frame follows an untimed one of that size: the same
-command with and without it gives what a change of size costs a frame (the live view's frame
-budget changes the size as the view's cost moves).)";
+configuration. With --in-pieces, every configuration is rendered a second time as refinement renders
+it, its gather in pieces that input could stop between: what the pieces cost. With --size-before,
+every timed frame follows an untimed one of that size: the same command with and without it gives
+what a change of size costs a frame (the live view's frame budget changes the size as the view's
+cost moves).)";
 
 int compare(const std::vector<std::string>& args) {
     if (args.size() != 2) throw UsageError("compare needs two files: TEST.exr REFERENCE.exr");
@@ -105,10 +107,24 @@ int passes(const std::vector<std::string>& args) {
                   [&](const std::string& v) {
                       gis::cli::parseSize("--size-before", v, 4096, beforeWidth, beforeHeight);
                   });
+    bool inPieces = false;
+    options.flag("--in-pieces",
+                 "each configuration also as refinement renders it: with an interrupt check that never "
+                 "stops, so that its gather goes in pieces (a second column, \"CONFIG in pieces\")",
+                 [&] { inPieces = true; });
     if (printedHelp(args, kPassesHelp, options)) return 0;
     options.parse(args);
     auto& [sceneName, width, height, frames, configs, jsonPath, gl, timerQueries] = o;
     if (configs.empty()) configs = {parseConfig("multires_splat"), parseConfig("multires_gather")};
+    // Configurations rendered with the never-stopping check: the second half with --in-pieces.
+    const size_t checkedFrom = configs.size();
+    if (inPieces) {
+        for (size_t i = 0; i < checkedFrom; ++i) {
+            Config checked = configs[i];
+            checked.label += " in pieces";
+            configs.push_back(std::move(checked));
+        }
+    }
 
     auto scene = std::make_shared<gis::Scene>(gis::loadScene(sceneName));
     std::vector<gis::FrameState> states = makeStates(*scene, configs, width, height);
@@ -121,6 +137,7 @@ int passes(const std::vector<std::string>& args) {
     for (size_t i = 0; i < configs.size() + 1; ++i) {
         renderers.push_back(std::make_unique<gis::FrameRenderer>(timerQueries));
         renderers.back()->setScene(scene);
+        if (i >= checkedFrom && i < configs.size()) renderers.back()->setInterruptCheck([] { return false; });
     }
 
     std::vector<gis::FrameOutput> last(configs.size());
