@@ -16,13 +16,23 @@
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
 //        [--orbit-s 6] [--still-s 3] [--chromium /usr/bin/chromium] [--out report.json]
 //        [--server-args "--slice-ms 20"] [--server-nice 10] [--refinement 0]
+//        [--refine-cases rsm_gather,hier_isr] (which slow configurations; --scenes none: only those)
 import { writeFileSync } from 'node:fs';
 
 import { DEFAULT_SERVER, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scenes: '', presses: 10, 'orbit-s': 6, 'still-s': 3,
-    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0, 'server-nice': 0, refinement: 1 },
-'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"] [--server-nice 0..19] [--refinement 0|1]');
+    chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium', out: '', 'server-args': '', verbose: 0, 'server-nice': 0, refinement: 1,
+    'refine-cases': 'rsm_gather,hier_isr' },
+'usage: node bench/interactive/orbit.mjs [--server PATH] [--scenes a,b] [--presses N] [--orbit-s S] [--still-s S] [--chromium PATH] [--out FILE] [--server-args "FLAGS"] [--server-nice 0..19] [--refinement 0|1] [--refine-cases rsm_gather,hier_isr]');
+// The slow configurations pressed during refinement: the slowest each parameter table allows.
+const refineCases = { rsm_gather: { vpl_grid: 256 }, hier_isr: { tau: 0 } };
+const chosenCases = opts['refine-cases'].split(',').filter(Boolean);
+for (const name of chosenCases)
+    if (!refineCases[name]) {
+        console.error(`orbit: unknown --refine-cases entry '${name}' (known: ${Object.keys(refineCases).join(', ')})`);
+        process.exit(2);
+    }
 
 const serverArgs = opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : [];
 // --server-nice N: the server below the browser's CPU priority (bench/lib.mjs, startServer).
@@ -96,7 +106,7 @@ const pageTaskS = async () => (await cdp.send('Performance.getMetrics')).metrics
 const view = await page.$('canvas') ?? await page.$('#view');
 const box = await view.boundingBox();
 await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2); // focus for the keys
-const scenes = opts.scenes ? opts.scenes.split(',') : (await page.evaluate(() => window.giClient.welcome.scenes))
+const scenes = opts.scenes === 'none' ? [] : opts.scenes ? opts.scenes.split(',') : (await page.evaluate(() => window.giClient.welcome.scenes))
     .filter((s) => s.startsWith('builtin:'));
 const viewport = await page.evaluate(() => window.giClient.viewport);
 const draws = (since) => page.evaluate((t) => window.benchDraws.filter((d) => d.t >= t), since);
@@ -264,7 +274,7 @@ try {
         report.scenes.push(r);
         console.log(JSON.stringify(r));
     }
-    for (const [technique, params] of opts.refinement ? [['rsm_gather', { vpl_grid: 256 }], ['hier_isr', { tau: 0 }]] : []) {
+    for (const [technique, params] of opts.refinement ? chosenCases.map((name) => [name, refineCases[name]]) : []) {
         const r = await duringRefinement('builtin:cornell', technique, params);
         report.refinement.push(r);
         console.log(JSON.stringify(r));

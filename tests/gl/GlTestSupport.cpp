@@ -98,6 +98,12 @@ double counter(const FrameOutput& f, const std::string& name) {
     return c.contains(name) ? c.at(name).get<double>() : 0.0;
 }
 
+bool hasPass(const FrameOutput& f, const std::string& name) {
+    for (const auto& p : f.stats.at("passes"))
+        if (p.at("name") == name) return true;
+    return false;
+}
+
 bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>& rgb) {
     auto in = OIIO::ImageInput::open(path);
     if (!in) return false;

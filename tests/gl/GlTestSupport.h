@@ -53,6 +53,8 @@ double relativeRmseOf(const FrameOutput& test, const FrameOutput& reference);
 std::size_t badValues(const FrameOutput& f);
 /// A frame's stats counter (stats.counts.NAME), 0 when absent.
 double counter(const FrameOutput& f, const std::string& name);
+/// Whether the frame's stats list a pass of that name.
+bool hasPass(const FrameOutput& f, const std::string& name);
 
 bool readPng(const std::string& path, int& w, int& h, std::vector<std::uint8_t>& rgb);
 bool writePng(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);

@@ -12,6 +12,7 @@
 using namespace gis;
 using test::badValues;
 using test::counter;
+using test::hasPass;
 using test::relativeRmseOf;
 
 namespace {
@@ -95,13 +96,6 @@ const float* pixel(const FrameOutput& f, int x, int y) {
 
 double count(const FrameOutput& f, const char* name) {
     return f.stats["counts"].value(name, -1.0);
-}
-
-
-bool hasPass(const FrameOutput& f, const std::string& name) {
-    for (const auto& p : f.stats["passes"])
-        if (p["name"] == name) return true;
-    return false;
 }
 
 // The mirror's screen rectangle (pixels, top-left origin) from its mesh's corners.

@@ -79,11 +79,12 @@ TEST(TilesGl, TiledFramesMatchWholeFramesForEveryTechnique) {
 
 // Two renderers of one scene, one reusing light views; the reusing one has rendered the state once.
 struct ReusePair {
-    explicit ReusePair(const std::string& name) : scene(std::make_shared<const Scene>(loadScene(name))) {
+    explicit ReusePair(const std::string& name, const std::string& technique = "rsm_gather")
+        : scene(std::make_shared<const Scene>(loadScene(name))) {
         fresh.setScene(scene);
         reusing.setScene(scene);
         reusing.setReuseLightPasses(true);
-        state = stateFor(*scene, "rsm_gather", 96, 80);
+        state = stateFor(*scene, technique, 96, 80);
         (void)reusing.render(state);
     }
     gl::Context& context = sharedContext(); // first: the renderers below need it
@@ -109,6 +110,39 @@ TEST(TilesGl, ReusedLightViewsRenderTheSameFrame) {
     EXPECT_EQ(counter(c, "light_views_reused"), 0.0);
     EXPECT_EQ(counter(c, "vpls_reused"), 0.0);
     EXPECT_EQ(c.rgba8, d.rgba8);
+}
+
+// isr's and hier_isr's light tree depends on the RSMs alone: frames that reuse the light views (an
+// orbit, the tiles of a refinement step) keep it instead of building it again.
+TEST(TilesGl, ReusedLightViewsKeepTheLightTree) {
+    for (const char* technique : {"hier_isr", "isr"}) {
+        SCOPED_TRACE(technique);
+        ReusePair pair("builtin:cornell-point", technique); // six views in one tree
+        FrameRenderer &fresh = pair.fresh, &reusing = pair.reusing;
+        FrameState s = pair.state;
+        s.camera.position += glm::vec3(0.3f, 0.0f, 0.0f);
+        const FrameOutput a = fresh.render(s), b = reusing.render(s);
+        ASSERT_EQ(counter(b, "light_views_reused"), 6.0);
+        EXPECT_EQ(counter(b, "vpl_tree_reused"), 1.0);
+        EXPECT_FALSE(hasPass(b, "light_tree"));
+        EXPECT_EQ(counter(a, "vpl_tree_reused"), 0.0);
+        EXPECT_TRUE(hasPass(a, "light_tree"));
+        EXPECT_EQ(counter(b, "vpl_tree_nodes"), counter(a, "vpl_tree_nodes"));
+        EXPECT_EQ(a.rgba8, b.rgba8);
+        // A dimmer light renders its views again, and builds the tree again from them.
+        s.lights[0].light.intensity *= 0.5f;
+        const FrameOutput c = reusing.render(s), d = fresh.render(s);
+        EXPECT_EQ(counter(c, "vpl_tree_reused"), 0.0);
+        EXPECT_TRUE(hasPass(c, "light_tree"));
+        EXPECT_EQ(c.rgba8, d.rgba8);
+        // Switched off and on again: no stale tree serves the frame after.
+        s.lights[0].enabled = false;
+        (void)reusing.render(s);
+        s.lights[0].enabled = true;
+        const FrameOutput e = reusing.render(s), f = fresh.render(s);
+        EXPECT_TRUE(hasPass(e, "light_tree"));
+        EXPECT_EQ(e.rgba8, f.rgba8);
+    }
 }
 
 TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {

@@ -71,11 +71,22 @@ int lightTreeTiles(int views) {
 }
 
 void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters) {
+    const int tiles = lightTreeTiles(std::max(in.lightViews, 1));
+    // The nodes depend on the RSMs alone: unchanged light views (an orbit, the tiles and VPL parts
+    // of a refinement step) keep the last build, which was whole (GL finishes queued work).
+    if (mValid && in.lightViewsReused && in.lightEnabled && in.lightViews > 0 && tiles == mTiles &&
+        tiles * in.rsmSize == mRsmSize && in.find("lights.rsm.position")) {
+        mLastInputs = in;
+        mLastInputs.lights = nullptr;
+        counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
+        counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);
+        counters["vpl_tree_reused"] = 1;
+        return;
+    }
     mLastInputs = in;
     mLastInputs.lights = nullptr; // the renderer's per-frame copy: gone after the frame
     mValid = false;
     if (in.rsmSize <= 0 || !in.find("lights.rsm.position")) return;
-    const int tiles = lightTreeTiles(std::max(in.lightViews, 1));
     ensureLayout(tiles * in.rsmSize);
     mTiles = tiles;
     counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());

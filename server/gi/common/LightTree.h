@@ -49,7 +49,9 @@ class LightTree {
 public:
     LightTree();
     /// Builds every level from the RSM (pass "light_tree"); nothing when the light is off (valid()
-    /// then reports false). Writes the counters vpl_tree_levels and vpl_tree_nodes.
+    /// then reports false). Writes the counters vpl_tree_levels and vpl_tree_nodes. Light views the
+    /// frame reuses (FrameInputs::lightViewsReused) keep the last build: no pass, and the counter
+    /// vpl_tree_reused.
     void build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters);
     bool valid() const { return mValid; }
     const std::vector<LightLevel>& levels() const { return mLevels; }
