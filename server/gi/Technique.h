@@ -82,7 +82,8 @@ struct FrameInputs {
     bool sameImageAsLastPart = false;
     /// Refinement's interruption (FrameRenderer::setInterruptCheck): says true once input waits and
     /// the frame will be dropped. A technique asks between its stages, where returning at once leaves
-    /// whole what it keeps for later frames; empty: frames run to the end.
+    /// whole what it keeps for later frames; the renderer's check finishes the GL work queued before it
+    /// asks, so the work between two checks is one stage. Empty: frames run to the end.
     std::function<bool()> interruptCheck;
 
     /// Whether the frame should stop here (interruptCheck, when set).

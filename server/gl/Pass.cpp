@@ -310,9 +310,6 @@ bool Pass::drawFullscreenInBands(const VertexArray& emptyVao, const std::functio
         glScissor(x, y + top, width, std::min(rows, height - top));
         drawFullscreen(emptyVao);
         if (top + rows >= height) break;
-        // The band is done before `stop` is asked: GL work once queued runs to its end, so asking
-        // earlier would only leave it to delay the frame that answers the input.
-        glFinish();
         goOn = !stop();
     }
     glDisable(GL_SCISSOR_TEST);

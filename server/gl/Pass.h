@@ -94,7 +94,8 @@ public:
     /// A fullscreen triangle (shaders/render/fullscreen.vert) with `emptyVao` bound.
     void drawFullscreen(const VertexArray& emptyVao);
     /// drawFullscreen() in about `bands` horizontal bands of the viewport, `stop` asked after each
-    /// band but the last once that band is done: at its first true the bands not yet drawn are left
+    /// band but the last (a `stop` that waits for the work queued, as the renderer's interrupt check
+    /// does, makes each band a stage): at its first true the bands not yet drawn are left
     /// and false is returned. Refinement's long gathers use it so that input waits for one band
     /// rather than the whole pass; each pixel is shaded exactly as by one draw. Without `stop`, or for
     /// one band, it is drawFullscreen() (and true).

@@ -555,10 +555,16 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
 
     // Refinement's interruption (setInterruptCheck): latched, so that the technique's checks and the
-    // renderer's agree once it said stop.
+    // renderer's agree once it said stop. The work queued so far is finished before the check is
+    // asked: GL work once queued runs to its end (llvmpipe rasterises a pass when a later one reads
+    // its target), so a check asked before it would stop the frame one stage later than it seems
+    // and leave that stage to delay the frame that answers the input.
     bool stopAsked = false;
     auto interrupted = [&] {
-        if (!stopAsked && mInterruptCheck) stopAsked = mInterruptCheck();
+        if (!stopAsked && mInterruptCheck) {
+            glFinish();
+            stopAsked = mInterruptCheck();
+        }
         return stopAsked;
     };
     // What an interrupted frame drew is not kept: redrawn light views and environment cubes are marked

@@ -79,8 +79,9 @@ public:
     void setReuseLightPasses(bool reuse) { mReuseLightPasses = reuse; }
     /// Refinement's interruption: while `check` is set, render() asks it between its stages (after the
     /// shadow maps, the RSMs, the eye passes, the technique and the reflections, and inside a technique
-    /// or the environment probes where they ask, FrameInputs::interrupted, ReflectionInputs::interrupted)
-    /// and stops at the first true, returning an `interrupted` output. What the frame began is not kept
+    /// or the environment probes where they ask, FrameInputs::interrupted, ReflectionInputs::interrupted),
+    /// each time once the GL work queued so far is done (glFinish), and stops at the first true,
+    /// returning an `interrupted` output. What the frame began is not kept
     /// for the next (redrawn light views, environment cubes; the VPL parts' mean is not added to); GL
     /// work already issued still runs. Empty (the default): every frame runs to the end.
     void setInterruptCheck(std::function<bool()> check) { mInterruptCheck = std::move(check); }

@@ -304,9 +304,6 @@ TEST(TilesGl, VplPartsAverageToTheWholeVplSet) {
     EXPECT_EQ(ssbcPart.rgba8, ssbcWhole.rgba8);
 }
 
-// Refinement's interruption (FrameRenderer::setInterruptCheck): a frame stops at the first check that
-// says true, and keeps nothing half done: the frame after it is the one an uninterrupted renderer draws,
-// at whichever stage it stopped.
 // Refinement's gathers in about eight pieces: whole batches of 1,024 VPLs where there are eight or
 // more (25,921 VPLs: 26 batches, a check after every 3rd rather than a wait after each), else each
 // batch cut.
@@ -332,6 +329,9 @@ TEST(TilesGl, AGatherGoesInAboutEightPieces) {
     }
 }
 
+// Refinement's interruption (FrameRenderer::setInterruptCheck): a frame stops at the first check that
+// says true, and keeps nothing half done: the frame after it is the one an uninterrupted renderer draws,
+// at whichever stage it stopped.
 TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
     sharedContext();
     const auto shared = std::make_shared<const Scene>(loadScene("builtin:cornell"));
@@ -376,9 +376,11 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
             gatherPieces = technique == "rsm_gather" ? 2 : (groups + perChunk - 1) / perChunk;
             EXPECT_GE(gatherPieces, 2) << scene->name << " " << technique << ": the gather is cut";
         }
-        // Shadow maps, RSMs, eye passes, after the technique; the hierarchical ones and rsm_gather
-        // once more inside it; and between the pieces of the gather.
-        EXPECT_EQ(checks, 5 + gatherPieces - 1) << scene->name << " " << technique;
+        // Shadow maps, RSMs, eye passes, after the technique; inside it rsm_gather after its VPL
+        // shadow maps, the hierarchical ones after their geometry levels and after the receivers'
+        // stencil; and between the pieces of the gather.
+        const int insideTechnique = technique == "rsm_gather" ? 1 : 2;
+        EXPECT_EQ(checks, 4 + insideTechnique + gatherPieces - 1) << scene->name << " " << technique;
 
         for (int stopAt = 1; stopAt <= checks; ++stopAt) {
             auto renderer = reusingRenderer(scene);
@@ -424,12 +426,13 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
             });
             EXPECT_EQ(counting.render(resized).rgba8, expected.rgba8);
         }
-        // Eye passes, the technique (2, and between the chunks of its receivers), the room probe's
-        // faces, before each local probe and after its faces (2 x 2), after the reflections; the light
-        // views are kept. The last six are the probes'.
+        // Eye passes, the technique (3: after its geometry levels, after the receivers' stencil and
+        // after it, and between the chunks of its receivers), the room probe's faces, before each
+        // local probe and after its faces (2 x 2), after the reflections; the light views are kept.
+        // The last six are the probes'.
         const int groups = static_cast<int>(std::ceil(counter(expected, "receivers_total") / 64.0));
         const int perChunk = (groups + 7) / 8;
-        EXPECT_EQ(checks, 9 + (groups + perChunk - 1) / perChunk - 1);
+        EXPECT_EQ(checks, 10 + (groups + perChunk - 1) / perChunk - 1);
         for (int stopAt = checks - 5; stopAt <= checks; ++stopAt) {
             FrameRenderer renderer;
             renderer.setReuseLightPasses(true);

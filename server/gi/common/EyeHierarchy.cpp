@@ -233,7 +233,6 @@ bool EyeHierarchy::dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandle
         if (first > 0) pass.barrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         pass.set(handles.groupBase, first).dispatch(static_cast<int>(count));
         if (first + count >= groups) break;
-        glFinish();
         if (stop()) return false;
     }
     return true;
@@ -303,6 +302,9 @@ void EyeHierarchy::build(const FrameInputs& in, const ParamSet& params, gl::Pass
     if (!(in.sameImageAsLastPart && sameLayout && mBuilt)) {
         buildGeometryLevels(in, timer);
         mBuilt = true;
+        // Input may stop the frame here: the levels are whole (queued GL work runs to its end), and
+        // the technique's own check after build() sees the same answer.
+        if (in.interrupted()) return;
     }
 
     gl::Pass pass(timer, "stencil_setup");

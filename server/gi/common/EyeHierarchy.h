@@ -123,7 +123,7 @@ public:
     /// Runs the receiver program in use once per receiver (indirect, from the count the stencil pass
     /// appended); each dispatch sees the illumination the ones before it added. With `stop` and more
     /// than one `chunks` (refinement: gatherCut) it reads the count back and runs the list in that
-    /// many chunks instead, `stop` asked after each but the last once it is done: at its first true
+    /// many chunks instead, `stop` asked after each but the last: at its first true
     /// the rest is left and false is returned, so that input waits for one chunk rather than the whole
     /// pass. Each receiver is lit exactly as by one dispatch.
     bool dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandles& handles,

@@ -165,11 +165,7 @@ bool VplBatches::forEachPiece(const gl::Buffer& vpls, int count, const std::func
         if (!goOn) return;
         ++batches;
         goOn = draw(n, first, cut.cutsPerBatch);
-        if (goOn && stop && batches < total && batches % cut.batchesPerPiece == 0) {
-            // The piece is done before `stop` is asked: GL work once queued runs to its end.
-            glFinish();
-            goOn = !stop();
-        }
+        if (goOn && stop && batches < total && batches % cut.batchesPerPiece == 0) goOn = !stop();
     });
     return goOn;
 }

@@ -60,8 +60,8 @@ struct VplTransportHandles {
 std::vector<int> splitVplGrid(int grid, const std::vector<double>& viewFlux, int views, int rsmSide);
 
 /// Refinement's gathers go in about kGatherPieces pieces that input can stop between (the interrupt
-/// check asked after each, once its work is done): whole batches where there are at least that many,
-/// else each batch cut in bands or receiver-list chunks. A fixed cut rather than one by time keeps a
+/// check asked after each; it waits for the work queued first): whole batches where there are at least that
+/// many, else each batch cut in bands or receiver-list chunks. A fixed cut rather than one by time keeps a
 /// frame's checks the same from run to run. Pure (unit-tested).
 constexpr int kGatherPieces = 8;
 struct GatherCut {
@@ -83,7 +83,7 @@ public:
                 const std::function<void(int batchCount, int first)>& draw);
     /// forEach() in refinement's pieces (gatherCut) when `stop` is set: `draw(batchCount, first,
     /// cuts)` draws its batch in `cuts` pieces and returns false once `stop` said true inside it;
-    /// after a piece of whole batches the work is waited for and `stop` asked. Returns false once
+    /// after a piece of whole batches `stop` is asked. Returns false once
     /// stopped (the rest is not drawn); `batches` counts the batches drawn.
     bool forEachPiece(const gl::Buffer& vpls, int count, const std::function<bool()>& stop,
                       const std::function<bool(int batchCount, int first, int cuts)>& draw, int& batches);
