@@ -48,7 +48,8 @@
 //   (EyeHierarchy.h).
 //
 // Counters: nodes_visited_mean / _max and cut_size_mean / _max (per receiver), vpl_tree_levels,
-// vpl_tree_nodes, and the eye hierarchy's receiver counts.
+// vpl_tree_nodes (and vpl_tree_reused when the last frame's tree served: its light views were
+// reused), and the eye hierarchy's receiver counts.
 //
 // Limits: no indirect visibility; diffuse only; the bound ignores the node's actual flux (001's
 // choice), so dark patches refine as much as bright ones; cost per receiver grows as the receiver
