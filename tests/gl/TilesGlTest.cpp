@@ -9,6 +9,7 @@
 #include "frame/Tiles.h"
 #include "gi/Catalog.h"
 #include "gi/common/VplGrid.h"
+#include "gi/hier_isr/HierIsr.h"
 
 namespace gis::test {
 namespace {
@@ -327,6 +328,64 @@ TEST(TilesGl, AGatherGoesInAboutEightPieces) {
         EXPECT_GE(pieces(batches), 6) << batches;
         EXPECT_LE(pieces(batches), 11) << batches;
     }
+}
+
+// A full traversal (hier_isr, tau 0) goes in ranges of the light tree's roots, each a dispatch over
+// every receiver: enough that no invocation passes llvmpipe's loop limit (which cut the traversal
+// short, silently), and in refinement about a million receiver-leaf pairs each, 8 to 64 of them.
+TEST(TilesGl, AFullTraversalGoesInRootRanges) {
+    EXPECT_EQ(fullTraversalRanges(256, 4), 2) << "256 roots x (341 nodes + 1) over the budget";
+    EXPECT_EQ(fullTraversalRanges(256, 0), 1);
+    EXPECT_EQ(fullTraversalRanges(1, 7), 1);
+    EXPECT_EQ(fullTraversalRanges(4096, 7), 1492) << "4,096 x (21,845 + 1) iterations";
+    EXPECT_EQ(fullTraversalRanges(4096, 8), 4096) << "at most one root a range";
+    // A full traversal starts at most kFullTraversalMaxDepth levels above its leaves (the same
+    // leaves); a traversal by the test keeps hier_coarsest.
+    const std::vector<LightLevel> levels = lightTreeLayout(256);
+    EXPECT_EQ(lightCutSettings(levels, 1, 256, 0.0).startLevel, kFullTraversalMaxDepth);
+    EXPECT_EQ(lightCutSettings(levels, 1, 256, 0.5).startLevel, 8);
+
+    EXPECT_EQ(traversalRanges(1576, 65536.0, 256), kMaxTraversalRanges) << "a 48 x 48 tile, 65,536 leaves";
+    EXPECT_EQ(traversalRanges(3000, 1024.0, 256), 8) << "little work: the usual eight pieces";
+    EXPECT_EQ(traversalRanges(6000, 4096.0, 256), 24);
+    EXPECT_EQ(traversalRanges(1e9, 1e9, 4), 4) << "at most one root a range";
+    EXPECT_EQ(traversalRanges(100, 16.0, 1), 1);
+    EXPECT_EQ(traversalRanges(100, std::nan(""), 256), 8) << "unknown work: the usual eight";
+
+    sharedContext();
+    const auto scene = std::make_shared<const Scene>(loadScene("builtin:cornell"));
+    FrameState s = stateFor(*scene, "hier_isr", 96, 80);
+    s.techniqueParams.set("tau", 0.0);
+    FrameRenderer plain;
+    plain.setScene(scene);
+    const FrameOutput expected = plain.render(s);
+    int checks = 0;
+    FrameRenderer counting;
+    counting.setScene(scene);
+    counting.setInterruptCheck([&] {
+        ++checks;
+        return false;
+    });
+    const FrameOutput ranged = counting.render(s);
+    const double ranges = counter(ranged, "traversal_ranges");
+    EXPECT_GE(ranges, 8.0);
+    EXPECT_EQ(counter(expected, "traversal_ranges"), 2.0) << "without a check: the loop budget's ranges";
+    // Shadow maps, RSMs, eye passes, the geometry levels, the stencil, between the ranges, after it.
+    EXPECT_EQ(checks, 5 + static_cast<int>(ranges) - 1 + 1);
+    // Each range adds its share of every receiver's sum: the same light, up to float rounding.
+    const Difference d = compare(expected.rgba8, ranged.rgba8);
+    EXPECT_LE(d.mean, 0.02);
+    EXPECT_EQ(d.over8, 0.0);
+    // Every node, whichever the ranges (one dispatch visited 65,117 of cornell's 67,848 nodes here).
+    EXPECT_EQ(counter(ranged, "nodes_visited_mean"), counter(expected, "nodes_visited_mean"));
+    EXPECT_EQ(counter(ranged, "cut_size_mean"), counter(expected, "cut_size_mean"));
+    EXPECT_GT(counter(expected, "nodes_visited_mean"), 65535.0);
+    // Stopped between two ranges, the next frame is the whole one.
+    int asked = 0;
+    counting.setInterruptCheck([&] { return ++asked >= checks - 2; });
+    EXPECT_TRUE(counting.render(s).interrupted);
+    counting.setInterruptCheck({});
+    EXPECT_EQ(counting.render(s).rgba8, expected.rgba8);
 }
 
 // Refinement's interruption (FrameRenderer::setInterruptCheck): a frame stops at the first check that

@@ -208,6 +208,15 @@ void EyeHierarchy::beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandle
         .image(handles.illumination, mTargets.illumination, GL_READ_WRITE, GL_RGBA32F);
 }
 
+unsigned EyeHierarchy::readReceiverCount() const {
+    GIS_ASSERT(mOptions.receiverList);
+    shader::EyeReceiverListHeader header{};
+    glGetNamedBufferSubData(mTargets.receiverList.id(), 0, sizeof header, &header);
+    const unsigned capacity = static_cast<unsigned>(
+        (mTargets.receiverList.size() - static_cast<GLsizeiptr>(sizeof header)) / sizeof(unsigned));
+    return std::min(header.counts.x, capacity);
+}
+
 bool EyeHierarchy::dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandles& handles,
                                      const std::function<bool()>& stop, int chunks) const {
     // The previous dispatch's image stores (and the stencil pass's list) before this one's loads.
@@ -216,13 +225,8 @@ bool EyeHierarchy::dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandle
         pass.set(handles.groupBase, 0u).dispatchIndirect(mTargets.receiverList);
         return true;
     }
-    // Refinement: the count read back (this waits for the stencil pass), then the list in chunks,
-    // each done before `stop` is asked, as GL work once queued runs to its end.
-    shader::EyeReceiverListHeader header{};
-    glGetNamedBufferSubData(mTargets.receiverList.id(), 0, sizeof header, &header);
-    const unsigned capacity = static_cast<unsigned>(
-        (mTargets.receiverList.size() - static_cast<GLsizeiptr>(sizeof header)) / sizeof(unsigned));
-    const unsigned receivers = std::min(header.counts.x, capacity);
+    // Refinement: the count read back, then the list in chunks, `stop` asked between them.
+    const unsigned receivers = readReceiverCount();
     const unsigned groups = (receivers + GIS_EYE_RECEIVER_GROUP - 1) / GIS_EYE_RECEIVER_GROUP;
     // One row of groups per chunk: a second row would run past the chunk into the next one.
     const auto parts = static_cast<unsigned>(chunks);

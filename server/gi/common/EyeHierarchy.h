@@ -120,6 +120,9 @@ public:
     /// hierarchy's textures the program reads, the receiver list, the illumination atlas as image.
     void beginReceiverPass(gl::Pass& pass, const EyeReceiverPassHandles& handles,
                            const FrameInputs& in) const;
+    /// The receivers the stencil pass listed (at most the list's capacity), read back: this waits
+    /// for the stencil pass.
+    unsigned readReceiverCount() const;
     /// Runs the receiver program in use once per receiver (indirect, from the count the stencil pass
     /// appended); each dispatch sees the illumination the ones before it added. With `stop` and more
     /// than one `chunks` (refinement: gatherCut) it reads the count back and runs the list in that

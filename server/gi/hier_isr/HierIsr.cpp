@@ -19,7 +19,31 @@ LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coa
         s.mode = LightRefine::Always;
     else if (s.tau >= 1.0f)
         s.mode = LightRefine::Never;
+    // A full traversal reaches the same leaves from any start level: start no coarser than a root
+    // whose subtree fits one invocation's loop budget (kFullTraversalMaxDepth).
+    if (s.mode == LightRefine::Always)
+        s.startLevel = std::min(s.startLevel, s.leafLevel + kFullTraversalMaxDepth);
     return s;
+}
+
+int fullTraversalRanges(int roots, int depth) {
+    if (roots <= 1) return 1;
+    // Nodes of a root's subtree down `depth` levels (each node 4 children at most), plus the root
+    // loop's own iteration.
+    double perRoot = 1.0;
+    for (int d = 0, level = 1; d < std::max(depth, 0); ++d) perRoot += (level *= 4);
+    const double iterations = static_cast<double>(roots) * (perRoot + 1.0);
+    return std::clamp(static_cast<int>(std::ceil(iterations / kTraversalLoopBudget)), 1, roots);
+}
+
+int traversalRanges(double receivers, double leavesPerReceiver, int roots) {
+    if (roots <= 1) return 1;
+    double ranges = kGatherPieces;
+    const double pairs = receivers * leavesPerReceiver;
+    if (std::isfinite(pairs) && pairs > 0.0)
+        ranges = std::max(ranges, std::ceil(pairs / kTraversalPairsPerRange));
+    ranges = std::min({ranges, static_cast<double>(kMaxTraversalRanges), static_cast<double>(roots)});
+    return static_cast<int>(ranges);
 }
 
 std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
@@ -79,6 +103,8 @@ HierIsr::HierIsr() {
     g.leafLevel = g.program.location("uLeafLevel");
     g.refineMode = g.program.location("uRefineMode");
     g.tau = g.program.location("uTau");
+    g.rootFirst = g.program.location("uRootFirst");
+    g.rootEnd = g.program.location("uRootEnd");
     g.stats = g.program.storageBlock("CutStats");
     g.transport = VplTransportHandles(g.program);
     g.eye = EyeReceiverPassHandles(g.program);
@@ -122,9 +148,35 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
             mTree.bind();
             pass.buffer(g.stats, mStats);
             mEye.beginReceiverPass(pass, g.eye, in);
-            // In refinement the receivers go in chunks that input can stop between (one dispatch:
-            // gatherCut of one batch).
-            if (!mEye.dispatchReceivers(pass, g.eye, in.interruptCheck, gatherCut(1).cutsPerBatch)) return;
+            const int rootSide = mTree.levels()[static_cast<size_t>(s.startLevel)].side;
+            const int roots = rootSide * rootSide;
+            // A full traversal: the roots in ranges within llvmpipe's loop budget and, in refinement,
+            // small enough for input to stop between (traversalRanges); every receiver in each.
+            int ranges = 1;
+            if (s.mode == LightRefine::Always) {
+                ranges = fullTraversalRanges(roots, s.startLevel - s.leafLevel);
+                if (in.interruptCheck) {
+                    const int leafSide = mTree.levels()[static_cast<size_t>(s.leafLevel)].side;
+                    ranges =
+                        std::max(ranges, traversalRanges(static_cast<double>(mEye.readReceiverCount()),
+                                                         static_cast<double>(leafSide) * leafSide, roots));
+                }
+            }
+            if (ranges > 1) {
+                const int perRange = (roots + ranges - 1) / ranges;
+                counters["traversal_ranges"] = (roots + perRange - 1) / perRange;
+                for (int first = 0; first < roots; first += perRange) {
+                    pass.set(g.rootFirst, first).set(g.rootEnd, std::min(first + perRange, roots));
+                    mEye.dispatchReceivers(pass, g.eye);
+                    if (first + perRange < roots && in.interrupted()) return;
+                }
+            } else {
+                // In refinement the receivers go in chunks that input can stop between (one
+                // dispatch: gatherCut of one batch).
+                pass.set(g.rootFirst, 0).set(g.rootEnd, roots);
+                if (!mEye.dispatchReceivers(pass, g.eye, in.interruptCheck, gatherCut(1).cutsPerBatch))
+                    return;
+            }
         }
     }
 

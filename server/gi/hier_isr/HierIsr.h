@@ -47,7 +47,8 @@
 //   Eye hierarchy: coarsest_size, depth/normal metrics and thresholds, diagonal_refine, detail_alpha
 //   (EyeHierarchy.h).
 //
-// Counters: nodes_visited_mean / _max and cut_size_mean / _max (per receiver), vpl_tree_levels,
+// Counters: nodes_visited_mean / _max and cut_size_mean / _max (per receiver; the maxima per range
+// when refinement cuts a full traversal in traversal_ranges ranges of roots), vpl_tree_levels,
 // vpl_tree_nodes (and vpl_tree_reused when the last frame's tree served: its light views were
 // reused), and the eye hierarchy's receiver counts.
 //
@@ -84,6 +85,28 @@ struct LightCutSettings {
 /// CPU mirror below).
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
                                   int maxDepthResolution, double tau);
+/// llvmpipe stops a shader invocation's loops after 65,535 iterations in all (gallivm's loop
+/// limiter, counted over every loop of the invocation), silently: a full traversal (tau 0) of 256
+/// roots four levels deep visits 67,848 nodes of cornell's tree, and a single dispatch left out
+/// the last 4 % (its last roots' light). A full traversal therefore goes in ranges of roots of at
+/// most kTraversalLoopBudget iterations an invocation, each range a dispatch over every receiver,
+/// starting at most kFullTraversalMaxDepth levels above the leaves (21,845 nodes a root). A
+/// traversal that refines by the test (0 < tau < 1) visits far fewer nodes and is not split; its
+/// receivers past the budget are cut short (nodes_visited_max near 65,535 shows it).
+constexpr double kTraversalLoopBudget = 60000.0;
+constexpr int kFullTraversalMaxDepth = 7;
+/// Ranges of roots a full traversal of `roots` roots, each `depth` levels above the leaves, needs
+/// to stay within kTraversalLoopBudget iterations an invocation (at most one root a range). Pure.
+int fullTraversalRanges(int roots, int depth);
+/// Refinement's cut of a full traversal (tau 0: every receiver visits every node down to the leaf
+/// level). Receiver chunks cannot shorten it: one group of 64 receivers over 65,536 leaves is about
+/// 44 ms of one of llvmpipe's threads. So the roots go in ranges instead, each range a dispatch over
+/// every receiver (both threads busy), input's check asked between them: about
+/// kTraversalPairsPerRange receiver-leaf pairs a range (about 5 ms on two cores: 0.19 million pairs
+/// a ms), at least kGatherPieces ranges, at most kMaxTraversalRanges and one root a range. Pure.
+constexpr double kTraversalPairsPerRange = 1048576.0;
+constexpr int kMaxTraversalRanges = 64;
+int traversalRanges(double receivers, double leavesPerReceiver, int roots);
 /// CPU mirror of gather.comp's traversal for one receiver at `receiver`: the flat indices of the
 /// nodes that contribute (its cut). `tanHalfFov` is gFrame.rsmInfo.y. For tests.
 std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
@@ -107,7 +130,7 @@ private:
     BiasCompensation mSsbc;
     struct GatherProgram {
         gl::Program program;
-        gl::UniformLocation startLevel, leafLevel, refineMode, tau;
+        gl::UniformLocation startLevel, leafLevel, refineMode, tau, rootFirst, rootEnd;
         gl::BlockBinding stats;
         VplTransportHandles transport;
         EyeReceiverPassHandles eye;

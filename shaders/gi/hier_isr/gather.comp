@@ -27,6 +27,10 @@ uniform int uStartLevel;  // level index of the roots
 uniform int uLeafLevel;   // finest level visited (<= uStartLevel)
 uniform int uRefineMode;  // 0 Eq. 8 test, 1 always refine, 2 never refine
 uniform float uTau;       // in (0, 1) when uRefineMode == 0
+// The roots this dispatch traverses, [uRootFirst, uRootEnd) in row-major order: all of them, or
+// refinement's range of them (HierIsr.h, traversalRanges), each dispatch adding its share.
+uniform int uRootFirst;
+uniform int uRootEnd;
 
 // Depth-first, at most 3 pending siblings per level below the root: 1 + 3 * 11 < 48.
 const int kStack = 48;
@@ -52,7 +56,8 @@ void main() {
     vec3 e = vec3(0.0);
     uint visited = 0u, cut = 0u;
     int rootSide = lightLevelSide(uStartLevel);
-    for (int r = 0; r < rootSide * rootSide; ++r) {
+    int rootEnd = min(uRootEnd, rootSide * rootSide);
+    for (int r = max(uRootFirst, 0); r < rootEnd; ++r) {
         stack[0] = packNode(uStartLevel, ivec2(r % rootSide, r / rootSide));
         int sp = 1;
         while (sp > 0) {
