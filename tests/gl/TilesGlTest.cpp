@@ -339,6 +339,7 @@ TEST(TilesGl, AFullTraversalGoesInRootRanges) {
     EXPECT_EQ(fullTraversalRanges(1, 7), 1);
     EXPECT_EQ(fullTraversalRanges(4096, 7), 1492) << "4,096 x (21,845 + 1) iterations";
     EXPECT_EQ(fullTraversalRanges(4096, 8), 4096) << "at most one root a range";
+    EXPECT_EQ(fullTraversalRanges(16, 40), 16) << "a depth past any tree: no overflow";
     // A full traversal starts at most kFullTraversalMaxDepth levels above its leaves (the same
     // leaves); a traversal by the test keeps hier_coarsest.
     const std::vector<LightLevel> levels = lightTreeLayout(256);

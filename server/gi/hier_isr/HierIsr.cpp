@@ -31,9 +31,12 @@ int fullTraversalRanges(int roots, int depth) {
     // Nodes of a root's subtree down `depth` levels (each node 4 children at most), plus the root
     // loop's own iteration.
     double perRoot = 1.0;
-    for (int d = 0, level = 1; d < std::max(depth, 0); ++d) perRoot += (level *= 4);
+    double level = 1.0; // nodes of one level of the subtree: 4^d (a double: no overflow at any depth)
+    for (int d = 0; d < std::max(depth, 0); ++d) perRoot += (level *= 4.0);
     const double iterations = static_cast<double>(roots) * (perRoot + 1.0);
-    return std::clamp(static_cast<int>(std::ceil(iterations / kTraversalLoopBudget)), 1, roots);
+    // Clamped as a double: a deep subtree's count is past any int.
+    return static_cast<int>(
+        std::clamp(std::ceil(iterations / kTraversalLoopBudget), 1.0, static_cast<double>(roots)));
 }
 
 int traversalRanges(double receivers, double leavesPerReceiver, int roots) {
