@@ -170,10 +170,6 @@ bool VplBatches::forEachPiece(const gl::Buffer& vpls, int count, const std::func
     return goOn;
 }
 
-int VplGrid::forEachBatch(const std::function<void(int batchCount, int first)>& draw) {
-    return mBatches.forEach(mVpls, mCount, draw);
-}
-
 int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
     parts = std::max(parts, 1);
     part = std::clamp(part, 0, parts - 1);
@@ -191,10 +187,6 @@ int VplGrid::preparePart(int part, int parts, gl::PassTimer& timer) {
     pass.dispatch((mPartCount + 63) / 64);
     pass.barrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     return mPartCount;
-}
-
-int VplGrid::forEachPartBatch(const std::function<void(int batchCount, int first)>& draw) {
-    return mBatches.forEach(mPartVpls, mPartCount, draw);
 }
 
 bool VplGrid::forEachPiece(bool part, const std::function<bool()>& stop,

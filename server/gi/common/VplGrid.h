@@ -103,19 +103,14 @@ public:
     /// The VPLs' glossy data (shader::VplGlossy), indexed like buffer().
     const gl::Buffer& glossyBuffer() const { return mGlossy; }
     int count() const { return mCount; }
-    /// Binds the VPLs batch by batch (VplBatches) and calls `draw(batchCount, first)` for each batch.
-    /// Returns the number of batches.
-    int forEachBatch(const std::function<void(int batchCount, int first)>& draw);
     /// Refinement's VPL parts (FrameInputs::vplPart): copies the VPLs part, part + parts, ... of the
     /// extracted set into one run (pass "vpl_interleave", gi/common/vpl_interleave.comp) for
-    /// forEachPartBatch(); returns how many there are. The set's index of the part's k-th VPL is
+    /// forEachPiece(true, ...); returns how many there are. The set's index of the part's k-th VPL is
     /// part + k * parts (its glossy data and shadow maps).
     int preparePart(int part, int parts, gl::PassTimer& timer);
-    /// Like forEachBatch() over the prepared part's VPLs; `draw(batchCount, first)` gets the index in
-    /// the part of the batch's first VPL.
-    int forEachPartBatch(const std::function<void(int batchCount, int first)>& draw);
-    /// forEachBatch(), or forEachPartBatch() for a prepared `part`, in refinement's pieces
-    /// (VplBatches::forEachPiece).
+    /// Binds the VPLs batch by batch (VplBatches), or the prepared part's VPLs when `part` (then
+    /// `draw`'s `first` is the index in the part of the batch's first VPL), and draws them, in
+    /// refinement's pieces when `stop` is set (VplBatches::forEachPiece).
     bool forEachPiece(bool part, const std::function<bool()>& stop,
                       const std::function<bool(int batchCount, int first, int cuts)>& draw, int& batches);
 
