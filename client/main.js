@@ -17,6 +17,7 @@ import { block } from './controls.js';
 import { resetPlan, schemaDefaults } from './params.js';
 import { ChartSchedule, LatencyTracker, PassHistory, RateCounter, RoundTrip, networkMs } from './stats.js';
 import { InputWatch, RefineTracker } from './progress.js';
+import { estimatedRenderStart } from './inputs.js';
 import { DEFAULT_PIXEL_BUDGET, frameTargetSupported, normalizeFrameTarget, normalizePixelBudget } from './budget.js';
 import { lightRestoreMessages, restoreMessages, restorePlan, sessionSnapshot } from './restore.js';
 
@@ -231,7 +232,8 @@ const hook = {
     get welcome() { return state.welcome ? structuredClone(state.welcome) : null; },
     get frameTargetMs() { return state.frameTargetMs; },
     get chartRedraws() { return chart.redraws; },
-    get inputPending() { return watch.pending; }, // an input no drawn frame can contain yet
+    get inputPending() { return watch.pending; }, // an input no drawn frame shows yet
+    get steerSeq() { return lastSteerSeq(); }, // the number of the last steering message sent
     get explicit() { return [...state.explicit]; },
     // Benchmarks and tests steer through the page's own connection, exactly as the panels do.
     send: (msg) => send(msg),
@@ -242,7 +244,7 @@ window.giClient = hook;
 // Sending (outbox.js)
 
 const {
-    send, steer, currentViewport, sendResize, flushOutbox, scheduleFlush, scheduleCamera, selectedLight, changeLight, selectLight, addLight, removeSelectedLight, queueParams, sendParamsNow, buildHello, frameTargetMs, sendQuality, pendingLight,
+    send, steer, currentViewport, sendResize, flushOutbox, scheduleFlush, scheduleCamera, selectedLight, changeLight, selectLight, addLight, removeSelectedLight, queueParams, sendParamsNow, buildHello, frameTargetMs, sendQuality, pendingLight, lastSteerSeq,
 } = createOutbox({
     ui, state, settings, store, camera, connection, latency, watch, sentLog: hook.sent, showMessage,
     renderGizmo: () => gizmo.render(),
@@ -533,9 +535,7 @@ function recordDraw(frame, decodeMs, frameBytes) {
         passes.push(now / 1000, stats.passes);
         refine.stats(stats, now);
     }
-    // When the frame's render began on this clock, as the latency estimates it.
-    const renderStart = frame.arrivedAt - (state.rttMs ?? 0) - (stats?.frame_ms ?? 0) - (stats?.encode_ms ?? 0);
-    watch.frameDrawn(renderStart, now);
+    watch.frameDrawn(estimatedRenderStart(frame.arrivedAt, stats, state.rttMs ?? 0), now, stats?.input_seq);
     // A viewer follows what the controller does; a controller's own choice is already shown (and
     // frames of the previous choice may still be on their way).
     if (state.viewer && stats?.technique && stats.technique !== state.technique && state.techniques.has(stats.technique)) {

@@ -36,14 +36,20 @@ export function createOutbox({ ui, state, settings, store, camera, connection, l
         return sent;
     }
 
-    /** A steering message: sent, and counted as input for the latency. */
+    // Steering messages are numbered (`seq`); each frame echoes the last number its state includes
+    // (stats.input_seq), which tells the page which inputs a frame shows. The numbers rise for the
+    // page's lifetime: the server starts afresh with each connection, so any rising count will do.
+    let steerSeq = 0;
+
+    /** A steering message: numbered, sent, and counted as input for the latency. */
     function steer(msg) {
         if (state.viewer) return false;
-        const sent = send(msg);
+        const sent = send({ ...msg, seq: steerSeq + 1 });
         if (sent) {
+            steerSeq += 1;
             const now = performance.now();
-            latency.input(now);
-            watch.input(now);
+            latency.input(now, steerSeq);
+            watch.input(now, steerSeq);
             state.lastSteerAt = now;
         }
         return sent;
@@ -208,5 +214,6 @@ export function createOutbox({ ui, state, settings, store, camera, connection, l
 
     return {
         send, steer, currentViewport, sendResize, flushOutbox, scheduleFlush, scheduleCamera, selectedLight, changeLight, selectLight, addLight, removeSelectedLight, queueParams, sendParamsNow, buildHello, frameTargetMs, sendQuality, pendingLight,
+        lastSteerSeq: () => steerSeq,
     };
 }

@@ -2,6 +2,7 @@
 // and `progress` messages), a frame that is late after input ("rendering… 1.2 s"), and whether
 // the overlay's figures still describe what is on screen. Pure (times in ms of one clock such as
 // performance.now()), so node's test runner checks it.
+import { PendingInputs } from './inputs.js';
 
 /** How long "done", "abandoned" and "skipped" stay up. */
 // A load's line stays until the load ends (`loaded` or `load_failed` replaces it), up to two minutes.
@@ -142,33 +143,36 @@ export class RefineTracker {
  */
 export class InputWatch {
     constructor() {
-        this.pendingSince = null; // the oldest input no drawn frame can contain yet
+        this.inputs = new PendingInputs();
         this.lastInputAt = null;
         this.lastDrawnAt = null;
     }
 
     reset() {
-        this.pendingSince = null;
+        this.inputs.clear();
         this.lastInputAt = null;
         this.lastDrawnAt = null;
     }
 
-    input(now) {
-        this.pendingSince ??= now;
+    /** A steering input sent at `now`, numbered `seq` (its message's `seq`). */
+    input(now, seq = null) {
+        this.inputs.add(now, seq);
         this.lastInputAt = now;
     }
 
     /**
-     * A frame was drawn at `now`; its render started at `renderStart` (estimated like the
-     * latency: arrival minus round trip and server time). Input before that is in it.
+     * A frame was drawn at `now`: the inputs it shows no longer wait. `inputSeq` is its
+     * `stats.input_seq`; `renderStart`, its estimated render start, decides where the server does
+     * not echo one (client/inputs.js).
      */
-    frameDrawn(renderStart, now) {
+    frameDrawn(renderStart, now, inputSeq = undefined) {
         this.lastDrawnAt = now;
-        if (this.lastInputAt !== null && renderStart >= this.lastInputAt) this.pendingSince = null;
-        else if (this.pendingSince !== null && renderStart >= this.pendingSince) {
-            // Part of the input is in; what still waits arrived after this frame's render began.
-            this.pendingSince = renderStart;
-        }
+        this.inputs.takeShown({ inputSeq, renderStart });
+    }
+
+    /** When the oldest input no drawn frame shows was sent; null when none waits. */
+    get pendingSince() {
+        return this.inputs.oldestAt;
     }
 
     get pending() {

@@ -1,6 +1,7 @@
 // Client-side frame statistics: frame rate, input-to-frame latency, network time and the rolling
 // per-pass history behind the stacked timing chart. Pure (times are passed in, in milliseconds
 // of one clock such as performance.now()), so node's test runner checks it.
+import { estimatedRenderStart, PendingInputs } from './inputs.js';
 
 /** Frames drawn within the last `windowMs`. */
 export class RateCounter {
@@ -29,33 +30,26 @@ function median(values) {
 
 /**
  * Input-to-frame latency: the time from a steering input (camera, light, parameters...) to the
- * first drawn frame that can contain it. The server does not say which input a frame reflects, so
- * the tracker estimates when the frame's render started on the client's clock: its arrival minus
- * the round trip and the server's render and encode times. Inputs sent before that are in the
- * frame; the latency is measured from the oldest of them (what a user feels when a drag starts).
+ * first drawn frame that shows it, by the input number the frame echoes (`stats.input_seq`), else
+ * by its estimated render start (client/inputs.js). The latency is measured from the oldest input
+ * the frame shows (what a user feels when a drag starts).
  */
 export class LatencyTracker {
     constructor(keep = 15) {
         this.keep = keep;
-        this.inputs = [];
+        this.inputs = new PendingInputs();
         this.samples = [];
         this.last = null;
     }
 
-    input(now) {
-        this.inputs.push(now);
-        if (this.inputs.length > 1000) this.inputs.shift();
+    input(now, seq = null) {
+        this.inputs.add(now, seq);
     }
 
     /** A frame that arrived at `arrivedAt` was drawn at `drawnAt`; returns its latency or null. */
     frameDrawn(arrivedAt, drawnAt, stats, rttMs = 0) {
-        const serverMs = (stats?.frame_ms ?? 0) + (stats?.encode_ms ?? 0);
-        const renderStart = arrivedAt - (rttMs ?? 0) - serverMs;
-        let oldest = null;
-        while (this.inputs.length && this.inputs[0] <= renderStart) {
-            oldest ??= this.inputs[0];
-            this.inputs.shift();
-        }
+        const oldest = this.inputs.takeShown({ inputSeq: stats?.input_seq,
+            renderStart: estimatedRenderStart(arrivedAt, stats, rttMs) });
         if (oldest === null) return null;
         this.last = drawnAt - oldest;
         this.samples.push(this.last);
@@ -69,7 +63,7 @@ export class LatencyTracker {
     }
 
     reset() {
-        this.inputs.length = 0;
+        this.inputs.clear();
         this.samples.length = 0;
         this.last = null;
     }

@@ -339,6 +339,18 @@ test('input-to-frame latency counts from the oldest input a frame can contain', 
     assert.equal(l.typical, null);
 });
 
+test('input-to-frame latency follows the input number a frame echoes', () => {
+    const l = new LatencyTracker();
+    l.input(1000, 1);
+    l.input(1010, 2);
+    // Estimated to begin rendering at 1250 - 40 - 20 = 1190, after both inputs, but it echoes 1:
+    // the second input is not in it.
+    assert.equal(l.frameDrawn(1250, 1252, { frame_ms: 30, encode_ms: 10, input_seq: 1 }, 20), 252);
+    // Estimated to begin before the input (a long round trip), yet it shows it.
+    assert.equal(l.frameDrawn(1300, 1302, { frame_ms: 30, encode_ms: 10, input_seq: 2 }, 500), 292);
+    assert.equal(l.frameDrawn(1400, 1402, { frame_ms: 30, encode_ms: 10, input_seq: 2 }, 20), null, 'nothing new');
+});
+
 test('network time, pass times and byte formatting', () => {
     assert.equal(networkMs(20, 100, 103), 13);
     assert.equal(networkMs(null, 100, 101), 1);

@@ -276,3 +276,34 @@ test('a long load shows how far it got and the time left, counting down between 
     r.message({ type: 'progress', state: 'loaded', step: 'scene', share: 1, reason: 'loaded upload:city.glb' }, 9100);
     assert.deepEqual(r.view(9200), { kind: 'loaded', text: 'loaded upload:city.glb', share: null });
 });
+
+test('the echoed input number decides which inputs a frame shows, whatever the clocks say', () => {
+    const w = new InputWatch();
+    w.input(1000, 1);
+    w.input(1010, 2);
+    // A frame estimated to have begun before both inputs (a round trip measured too long) that
+    // echoes number 2 shows both: nothing waits, in a still view where no later frame would come.
+    w.frameDrawn(900, 1200, 2);
+    assert.equal(w.pending, false);
+    w.input(1300, 3);
+    // A refinement tile of the step input abandoned: its estimated start follows the input, but
+    // it echoes 2, so input 3 still waits for a frame.
+    w.frameDrawn(1350, 1400, 2);
+    assert.equal(w.pending, true);
+    assert.equal(w.pendingSince, 1300);
+    w.input(1450, 4);
+    w.frameDrawn(1460, 1500, 3); // shows 3, not 4
+    assert.equal(w.pendingSince, 1450);
+    // Once the server has echoed a number, a frame without one predates every numbered input of
+    // the connection (the server numbers afresh on each): it shows none.
+    w.frameDrawn(2000, 2100, undefined);
+    assert.equal(w.pendingSince, 1450);
+    w.frameDrawn(0, 2200, 4);
+    assert.equal(w.pending, false);
+    w.reset();
+    w.input(3000, 5);
+    w.frameDrawn(3100, 3200, undefined);
+    assert.equal(w.pending, true, 'a new connection: frames before its first number show nothing');
+    w.frameDrawn(2900, 3300, 5);
+    assert.equal(w.pending, false);
+});

@@ -192,6 +192,7 @@ void Session::attach(const std::shared_ptr<ClientLink>& link, const StreamOption
         if (link->role() == ClientRole::Controller) {
             if (mController && mController != link) mController->close();
             mController = link;
+            mInputSeq = 0; // a new connection numbers its messages afresh
             if (options) mStream = *options;
             // A new or resumed controller has seen nothing yet: render the current state for it.
             markInput();
@@ -305,6 +306,10 @@ void Session::apply(const nlohmann::json& msg, const std::shared_ptr<ClientLink>
     if (handler == messageHandlers().end())
         throw ProtocolError{"unknown_type", "'" + type + "' does not steer a session", "/type", type};
     std::unique_lock lock(mMutex);
+    // The controller numbers its steering messages (`seq`); frames echo the last one their state
+    // includes (stats.input_seq), so the client knows which of its inputs a frame shows. A refused
+    // message counts too: every frame after it is as it asked, unchanged.
+    if (from == mController && msg.contains("seq")) mInputSeq = msg["seq"].get<std::uint64_t>();
     Applied applied = Applied::Nothing;
     try {
         applied = (this->*handler->second)(msg, from);
@@ -467,6 +472,8 @@ struct Session::Worker {
     /// The last image sent to the controller (RGBA8): the canvas a tiled step starts from.
     std::vector<std::uint8_t> lastImage;
     int lastWidth = 0, lastHeight = 0;
+    /// The controller's last steering `seq` included in the state being rendered (0: none).
+    std::uint64_t stateSeq = 0;
     /// Its stats and step: what a whole image sent again (Session::mWholeFrameWanted) carries.
     nlohmann::json lastStats;
     std::string lastQuality;
@@ -886,6 +893,8 @@ bool Session::deliver(Worker& w, const std::vector<std::uint8_t>& rgba, int widt
     }
     ++w.frameId;
     ++mFramesRendered;
+    // An image sent again keeps the number of the state it shows.
+    if (w.stateSeq > 0 && !stats.contains("input_seq")) stats["input_seq"] = w.stateSeq;
     addPublishingStats(stats, frame, quality, snapshotFor != nullptr,
                        mSceneName.empty() ? w.scene->name : mSceneName, width, height);
     FrameReport report = reportOf(stats, frame, quality, snapshotFor != nullptr);
@@ -1322,6 +1331,7 @@ void Session::workerMain() {
         {
             std::lock_guard lock(mMutex);
             state = mDesired;
+            w.stateSeq = mInputSeq;
         }
         // Adaptive steps: the step's preset under the client's explicit parameters; interactive
         // frames sized (and their VPLs capped) by the frame budget (protocol/PROTOCOL.md, "Adaptive

@@ -250,6 +250,8 @@ private:
     /// when the worker is idle it sends the last image again.
     bool mWholeFrameWanted = false;
     std::shared_ptr<ClientLink> mController;
+    /// The `seq` of the controller's last steering message (0: none since it attached).
+    std::uint64_t mInputSeq = 0;
     std::vector<std::shared_ptr<ClientLink>> mViewers;
     /// Refinement's VPL-part fits by scene, technique and tile limits (session/VplPartPlanner.h): a
     /// step starts from the last one's instead of a prediction (worker thread only).

@@ -462,6 +462,9 @@ test('the light gizmo and Ctrl-drag move and aim the spotlight', async (t) => {
     // again after the disc's place is read.
     await until('a frame from the scene camera', (f) => window.giClient.lastFrame > f && !window.giClient.inputPending,
         beforeHome);
+    // The frame on screen says it shows the page's last steering message (Home's camera).
+    const shown = await page.evaluate(() => [window.giClient.lastStats.input_seq, window.giClient.steerSeq]);
+    assert.ok(shown[1] > 0 && shown[0] === shown[1], `the frame echoes input ${shown[0]}, the page sent ${shown[1]}`);
 
     const origin = await page.locator('.gizmo-origin').boundingBox();
     const frame = await page.evaluate(() => window.giClient.lastFrame);

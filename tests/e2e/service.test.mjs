@@ -301,6 +301,26 @@ check('every client message type has its effect', async (t) => {
     assert.deepEqual(client.inbox.unclaimed().filter((type) => type === 'error'), [], 'no unexpected errors');
 });
 
+check('frames echo the seq of the last steering message their state includes', async () => {
+    const client = await open(servers.main);
+    let last = await quietFrame(client);
+    assert.equal(last.stats.input_seq, undefined, 'none before the controller sends one');
+    const after = async (msg, what) => {
+        const before = last.stats.frame;
+        client.send(msg);
+        last = await client.frame(what, (s) => s.frame > before);
+        return last.stats.input_seq;
+    };
+    assert.equal(await after({ type: 'camera', position: [0.2, 1, 3.6], target: [0, 1, 0], seq: 5 }, 'camera seq 5'), 5);
+    assert.equal(await after({ type: 'params', values: { exposure: 0.5 }, seq: 6 }, 'params seq 6'), 6);
+    // A refused message counts: the frames after it are as it asked, unchanged.
+    await client.expectError({ type: 'technique', name: 'no_such_technique', seq: 7 }, 'unknown_technique');
+    assert.equal(await after({ type: 'camera', position: [0.3, 1, 3.6], target: [0, 1, 0] }, 'camera without seq'), 7,
+        'a message without seq leaves the number');
+    await client.expectError({ type: 'camera', position: [0, 1, 3], target: [0, 1, 0], seq: 0 }, 'invalid_message',
+        'seq 0');
+});
+
 check('bad messages get an error and the connection stays open', async () => {
     const client = await open(servers.main);
     const maxBytes = client.welcome.limits?.max_message_bytes;
@@ -333,8 +353,9 @@ check('a lost connection resumes with the resume token, state intact; after a cl
     assert.equal(typeof token, 'string');
     const camera = { position: [1.25, 1.5, 3.0], target: [0, 0.9, 0] };
     const before = (await quietFrame(first)).stats.frame;
-    first.send({ type: 'camera', ...camera });
-    await first.frame('frame with the new camera', (s) => s.frame > before);
+    first.send({ type: 'camera', ...camera, seq: 9 });
+    const moved = await first.frame('frame with the new camera', (s) => s.frame > before);
+    assert.equal(moved.stats.input_seq, 9, 'the frame echoes the camera message\'s seq');
     await first.terminate();
     await sleep(300); // let the server see the dropped connection
 
@@ -346,6 +367,7 @@ check('a lost connection resumes with the resume token, state intact; after a cl
     assertClose(second.welcome.state?.camera?.target, camera.target, 'resumed camera target');
     const frame = await second.frame('a frame after resuming');
     assert.deepEqual(frame.stats.size, SIZE);
+    assert.equal(frame.stats.input_seq, undefined, 'a new connection numbers its messages afresh');
 
     await second.close(); // status 1000: the session ends now
     const latest = second.welcome.resume_token ?? token;
@@ -505,18 +527,25 @@ check('the frame budget sizes interactive frames from what they measured, and sa
 check('input during a slow refinement is answered at the next tile or VPL part', async () => {
     // 65,536 VPLs: seconds per refinement step on a CPU, rendered in tiles that input interrupts.
     const client = await open(servers.main, { adaptive: true });
-    client.send({ type: 'technique', name: 'rsm_gather' });
-    client.send({ type: 'params', values: { vpl_grid: 256 } });
+    client.send({ type: 'technique', name: 'rsm_gather', seq: 1 });
+    client.send({ type: 'params', values: { vpl_grid: 256 }, seq: 2 });
     // A 64 x 64 tile of them takes seconds: it renders in VPL parts, each sent as they add up.
     const refining = await client.frame('a refinement tile in VPL parts',
         (s) => s.refined && s.refine && !s.refine.complete && s.refine.vpl_parts > 1, 60000);
+    assert.equal(refining.stats.input_seq, 2, 'the step renders the state after both messages');
     assert.ok(refining.stats.refine.share < 1);
     assert.ok(refining.stats.refine.vpl_parts_done >= 1 && refining.stats.refine.vpl_parts_done <= refining.stats.refine.vpl_parts);
     assert.equal(refining.stats.counts.vpl_parts, refining.stats.refine.vpl_parts, 'the renderer rendered that part');
     const sent = Date.now();
-    client.send({ type: 'camera', position: [0.5, 1.1, 3.7], target: [0, 1, 0] });
-    const answer = await client.frame('the answer to input', (s) => s.quality === 'interactive' && s.frame > refining.stats.frame, 10000);
+    client.send({ type: 'camera', position: [0.5, 1.1, 3.7], target: [0, 1, 0], seq: 3 });
+    const seqs = [];
+    const answer = await client.frame('the answer to input', (s) => {
+        seqs.push(`${s.quality}:${s.input_seq}`);
+        return s.quality === 'interactive' && s.frame > refining.stats.frame;
+    }, 10000);
     const waited = Date.now() - sent;
+    assert.equal(answer.stats.input_seq, 3, 'the answer shows the camera message');
+    assert.ok(seqs.slice(0, -1).every((q) => q.endsWith(':2')), `the abandoned step's frames do not: ${seqs}`);
     const abandoned = await client.inbox.next((m) => m.type === 'progress' && m.state === 'abandoned', 'progress abandoned', 5000);
     assert.ok(abandoned.share < 1);
     // One tile (about --slice-ms) plus one interactive frame; generous for a loaded CI machine.
