@@ -251,7 +251,7 @@ TEST(LightTree, FullTraversalEqualsThePerTexelGather) {
     // kernel; eye thresholds 0 make every covered pixel a level-0 receiver. That is rsm_gather with
     // one VPL per texel and the disk kernel, up to float summation order. At the default rsm_size
     // (256) the traversal visits more nodes than llvmpipe lets one invocation's loops run (65,535):
-    // its roots go in ranges (fullTraversalRanges), else the last ones' light went missing.
+    // its roots go in ranges (traversalSplit), else the last ones' light went missing.
     for (const auto& [rsm, side] : {std::pair{32, 64}, {256, 24}}) {
         SCOPED_TRACE(rsm);
         const nlohmann::json eye = {{"rsm_size", rsm}, {"depth_threshold", 0.0}, {"normal_threshold", 0.0}};

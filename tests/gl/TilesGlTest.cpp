@@ -1,6 +1,7 @@
 // Tiled refinement (frame/Tiles.h): a frame assembled from tiles must be the frame rendered whole, for
 // every technique (exactly for per-pixel ones; the screen-space hierarchy and bias compensation within
 // the bounds measured here), and reusing the light views across frames must change nothing.
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -334,16 +335,24 @@ TEST(TilesGl, AGatherGoesInAboutEightPieces) {
 // every receiver: enough that no invocation passes llvmpipe's loop limit (which cut the traversal
 // short, silently), and in refinement about a million receiver-leaf pairs each, 8 to 64 of them.
 TEST(TilesGl, AFullTraversalGoesInRootRanges) {
-    EXPECT_EQ(fullTraversalRanges(256, 4), 2) << "256 roots x (341 nodes + 1) over the budget";
-    EXPECT_EQ(fullTraversalRanges(256, 0), 1);
-    EXPECT_EQ(fullTraversalRanges(1, 7), 1);
-    EXPECT_EQ(fullTraversalRanges(4096, 7), 1492) << "4,096 x (21,845 + 1) iterations";
-    EXPECT_EQ(fullTraversalRanges(4096, 8), 4096) << "at most one root a range";
-    EXPECT_EQ(fullTraversalRanges(16, 40), 16) << "a depth past any tree: no overflow";
-    // A full traversal starts at most kFullTraversalMaxDepth levels above its leaves (the same
-    // leaves); a traversal by the test keeps hier_coarsest.
-    const std::vector<LightLevel> levels = lightTreeLayout(256);
-    EXPECT_EQ(lightCutSettings(levels, 1, 256, 0.0).startLevel, kFullTraversalMaxDepth);
+    const std::vector<LightLevel> levels = lightTreeLayout(256); // sides 256, 128, ..., 1
+    const auto split = [&](int coarsest, double tau, double budget = kTraversalLoopBudget) {
+        const TraversalSplit t = traversalSplit(levels, lightCutSettings(levels, coarsest, 256, tau), budget);
+        return std::array{t.rootLevel, t.roots, t.ranges};
+    };
+    EXPECT_EQ(split(16, 0.0), (std::array{4, 256, 2})) << "256 roots x (341 nodes + 1) over the budget";
+    EXPECT_EQ(split(16, 0.01), (std::array{4, 256, 2})) << "the test's worst case: every node refined";
+    EXPECT_EQ(split(16, 1.0), (std::array{4, 256, 1})) << "never refined: one node a root";
+    EXPECT_EQ(split(256, 1.0), (std::array{0, 65536, 3})) << "65,536 roots x 2 iterations";
+    // Roots at most kFullTraversalMaxDepth levels above the leaves, below the start level when it
+    // is coarser (the ancestors walked once a root): 4 x (1 + 21,845 + 1) iterations.
+    EXPECT_EQ(split(1, 0.0), (std::array{kFullTraversalMaxDepth, 4, 2}));
+    EXPECT_EQ(split(1, 0.5), (std::array{kFullTraversalMaxDepth, 4, 2}));
+    EXPECT_EQ(split(16, 0.0, 100.0), (std::array{3, 1024, 891})) << "1,024 x (1 + 85 + 1) over 100";
+    EXPECT_EQ(split(16, 0.0, 1.0), (std::array{0, 65536, 65536})) << "at most one root a range";
+    EXPECT_EQ(split(16, 0.0, 1e300), (std::array{4, 256, 1}));
+    // The test's start level stays hier_coarsest's whatever tau.
+    EXPECT_EQ(lightCutSettings(levels, 1, 256, 0.0).startLevel, 8);
     EXPECT_EQ(lightCutSettings(levels, 1, 256, 0.5).startLevel, 8);
 
     EXPECT_EQ(traversalRanges(1576, 65536.0, 256), kMaxTraversalRanges) << "a 48 x 48 tile, 65,536 leaves";
@@ -387,6 +396,82 @@ TEST(TilesGl, AFullTraversalGoesInRootRanges) {
     EXPECT_TRUE(counting.render(s).interrupted);
     counting.setInterruptCheck({});
     EXPECT_EQ(counting.render(s).rgba8, expected.rgba8);
+}
+
+// Any traversal (hier_isr, whatever tau) is split within the loop budget: roots below the start level
+// reached through their ancestors, which the test decides once. A split traversal gives the whole
+// traversal's cut node for node (its visit and cut counts, summed over receivers, are integers) and
+// its image up to float rounding. A traversal by the test that llvmpipe's limit cut short before
+// (tau 0.00003) is gathered again, split.
+TEST(TilesGl, ASplitTraversalGivesTheWholeTraversalsCut) {
+    sharedContext();
+    const auto scene = std::make_shared<const Scene>(loadScene("builtin:cornell"));
+    const auto hierIsr = [](FrameRenderer& r) {
+        auto* technique = dynamic_cast<HierIsr*>(r.technique());
+        GIS_ASSERT(technique);
+        return technique;
+    };
+    // rsm_size 64: sides 64 ... 1; hier_coarsest 2 starts 5 levels above the leaves, whole in one
+    // dispatch with an unbounded budget. A budget of 100 takes the roots 2 levels lower (64 of them,
+    // 1 + 85 + 2 iterations each at worst), in ranges of 2.
+    for (const double tau : {0.0, 0.002, 0.05, 0.5}) {
+        SCOPED_TRACE(tau);
+        FrameState s = stateFor(*scene, "hier_isr", 96, 80);
+        s.frameParams.set("rsm_size", 64);
+        s.techniqueParams.set("tau", tau);
+        s.techniqueParams.set("max_depth", 64);
+        s.techniqueParams.set("hier_coarsest", 2);
+        FrameRenderer whole;
+        whole.setScene(scene);
+        whole.render(s);
+        hierIsr(whole)->setLoopBudget(1e300);
+        const FrameOutput expected = whole.render(s);
+        EXPECT_FALSE(expected.stats["counts"].contains("traversal_ranges"));
+        FrameRenderer split;
+        split.setScene(scene);
+        split.render(s);
+        hierIsr(split)->setLoopBudget(100.0);
+        const FrameOutput ranged = split.render(s);
+        EXPECT_EQ(counter(ranged, "traversal_split_levels"), 2.0);
+        EXPECT_EQ(counter(ranged, "traversal_ranges"), 32.0) << "57 ranges asked: 2 of the 64 roots each";
+        EXPECT_EQ(counter(ranged, "nodes_visited_mean"), counter(expected, "nodes_visited_mean"));
+        EXPECT_EQ(counter(ranged, "cut_size_mean"), counter(expected, "cut_size_mean"));
+        EXPECT_EQ(counter(ranged, "traversal_cut_short"), 0.0);
+        EXPECT_EQ(counter(expected, "traversal_cut_short"), 0.0);
+        const Difference d = compare(expected.rgba8, ranged.rgba8);
+        EXPECT_LE(d.mean, 0.02);
+        EXPECT_EQ(d.over8, 0.0);
+    }
+
+    // A traversal by the test goes whole first. At the default rsm_size (256) and hier_coarsest (16)
+    // with tau 0.00003, llvmpipe's loop limit stops receivers short in one dispatch (gather.comp
+    // counts them): the gather starts again in two ranges of 128 roots, and the next frame with the
+    // same settings starts split.
+    FrameState fine = stateFor(*scene, "hier_isr", 64, 48);
+    fine.techniqueParams.set("tau", 0.00003);
+    FrameRenderer renderer;
+    renderer.setScene(scene);
+    const bool llvmpipe = sharedContext().info().renderer.find("llvmpipe") != std::string::npos;
+    const FrameOutput first = renderer.render(fine);
+    EXPECT_EQ(counter(first, "traversal_cut_short"), 0.0);
+    if (llvmpipe) {
+        EXPECT_GT(counter(first, "traversal_cut_short_whole"), 0.0);
+        EXPECT_EQ(counter(first, "traversal_ranges"), 2.0);
+        const FrameOutput next = renderer.render(fine);
+        EXPECT_EQ(counter(next, "traversal_cut_short_whole"), 0.0) << "split from the start";
+        EXPECT_EQ(counter(next, "traversal_ranges"), 2.0);
+        EXPECT_EQ(next.rgba8, first.rgba8);
+        // Whole, as before: receivers stopped short, fewer nodes visited.
+        hierIsr(renderer)->setLoopBudget(1e300);
+        const FrameOutput cutShort = renderer.render(fine);
+        EXPECT_GT(counter(cutShort, "traversal_cut_short"), 0.0);
+        EXPECT_LT(counter(cutShort, "nodes_visited_mean"), counter(first, "nodes_visited_mean"));
+    }
+    // A traversal by the test that fits goes whole, in one dispatch.
+    FrameState usual = stateFor(*scene, "hier_isr", 64, 48);
+    const FrameOutput plain = renderer.render(usual);
+    EXPECT_FALSE(plain.stats["counts"].contains("traversal_ranges"));
+    EXPECT_EQ(counter(plain, "traversal_cut_short"), 0.0);
 }
 
 // Refinement's interruption (FrameRenderer::setInterruptCheck): a frame stops at the first check that

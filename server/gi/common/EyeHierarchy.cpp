@@ -217,6 +217,13 @@ unsigned EyeHierarchy::readReceiverCount() const {
     return std::min(header.counts.x, capacity);
 }
 
+void EyeHierarchy::clearIllumination() const {
+    // The receiver passes' image stores before the clear.
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+    const float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(mTargets.illumFbo.id(), GL_COLOR, 0, zero);
+}
+
 bool EyeHierarchy::dispatchReceivers(gl::Pass& pass, const EyeReceiverPassHandles& handles,
                                      const std::function<bool()>& stop, int chunks) const {
     // The previous dispatch's image stores (and the stencil pass's list) before this one's loads.

@@ -123,6 +123,9 @@ public:
     /// The receivers the stencil pass listed (at most the list's capacity), read back: this waits
     /// for the stencil pass.
     unsigned readReceiverCount() const;
+    /// Clears what receiver passes added to the illumination atlas since build() (a gather that
+    /// starts again).
+    void clearIllumination() const;
     /// Runs the receiver program in use once per receiver (indirect, from the count the stencil pass
     /// appended); each dispatch sees the illumination the ones before it added. With `stop` and more
     /// than one `chunks` (refinement: gatherCut) it reads the count back and runs the list in that

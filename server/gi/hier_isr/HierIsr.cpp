@@ -1,12 +1,18 @@
 #include "gi/hier_isr/HierIsr.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
+#include "core/Error.h"
 #include "gi/Catalog.h"
 #include "gi/common/VplGrid.h"
 
 namespace gis {
+namespace {
+// gather.comp's CutStats: visited (lo, hi, max), cut (lo, hi, max), receivers cut short.
+constexpr int kCutStats = 7;
+} // namespace
 
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
                                   int maxDepthResolution, double tau) {
@@ -19,24 +25,33 @@ LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coa
         s.mode = LightRefine::Always;
     else if (s.tau >= 1.0f)
         s.mode = LightRefine::Never;
-    // A full traversal reaches the same leaves from any start level: start no coarser than a root
-    // whose subtree fits one invocation's loop budget (kFullTraversalMaxDepth).
-    if (s.mode == LightRefine::Always)
-        s.startLevel = std::min(s.startLevel, s.leafLevel + kFullTraversalMaxDepth);
     return s;
 }
 
-int fullTraversalRanges(int roots, int depth) {
-    if (roots <= 1) return 1;
-    // Nodes of a root's subtree down `depth` levels (each node 4 children at most), plus the root
-    // loop's own iteration.
-    double perRoot = 1.0;
-    double level = 1.0; // nodes of one level of the subtree: 4^d (a double: no overflow at any depth)
-    for (int d = 0; d < std::max(depth, 0); ++d) perRoot += (level *= 4.0);
-    const double iterations = static_cast<double>(roots) * (perRoot + 1.0);
-    // Clamped as a double: a deep subtree's count is past any int.
-    return static_cast<int>(
-        std::clamp(std::ceil(iterations / kTraversalLoopBudget), 1.0, static_cast<double>(roots)));
+TraversalSplit traversalSplit(const std::vector<LightLevel>& levels, const LightCutSettings& s,
+                              double loopBudget) {
+    GIS_ASSERT(s.startLevel >= s.leafLevel && s.startLevel < static_cast<int>(levels.size()));
+    const double budget = std::max(loopBudget, 1.0);
+    // One root's worst case: the ancestors' loop, its subtree's nodes (every one refined, but for
+    // Never: the root alone), the roots' loop itself. Doubles: a deep subtree is past any int.
+    const auto iterationsPerRoot = [&](int rootLevel) {
+        double subtree = 1.0;
+        if (s.mode != LightRefine::Never) {
+            double level = 1.0;
+            for (int d = 0; d < rootLevel - s.leafLevel; ++d) subtree += (level *= 4.0);
+        }
+        return static_cast<double>(s.startLevel - rootLevel) + subtree + 1.0;
+    };
+    TraversalSplit split;
+    split.rootLevel = std::min(s.startLevel, s.leafLevel + kFullTraversalMaxDepth);
+    while (split.rootLevel > s.leafLevel && iterationsPerRoot(split.rootLevel) > budget) --split.rootLevel;
+    const double side = levels[static_cast<size_t>(split.rootLevel)].side;
+    split.roots = static_cast<int>(side * side);
+    // Clamped as a double before converting: a tiny budget's count is past any int.
+    split.ranges =
+        static_cast<int>(std::clamp(std::ceil(side * side * iterationsPerRoot(split.rootLevel) / budget), 1.0,
+                                    std::max(side * side, 1.0)));
+    return split;
 }
 
 int traversalRanges(double receivers, double leavesPerReceiver, int roots) {
@@ -106,12 +121,14 @@ HierIsr::HierIsr() {
     g.leafLevel = g.program.location("uLeafLevel");
     g.refineMode = g.program.location("uRefineMode");
     g.tau = g.program.location("uTau");
+    g.rootLevel = g.program.location("uRootLevel");
     g.rootFirst = g.program.location("uRootFirst");
     g.rootEnd = g.program.location("uRootEnd");
     g.stats = g.program.storageBlock("CutStats");
     g.transport = VplTransportHandles(g.program);
     g.eye = EyeReceiverPassHandles(g.program);
-    mStats = gl::Buffer::create(6 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    mStats =
+        gl::Buffer::create(kCutStats * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
 }
 
 void HierIsr::resize(int width, int height) {
@@ -133,8 +150,9 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
             [&](const ParamSet& p) { return squared(std::min<long>(in.rsmSize, p.getInt("max_depth"))); },
             counters);
 
-    const GLuint zero[6] = {};
+    const GLuint zero[kCutStats] = {};
     mStats.upload(0, sizeof zero, zero);
+    GLuint stats[kCutStats] = {};
     {
         gl::Pass pass(timer, "vpl_gather");
         if (mTree.valid()) {
@@ -151,34 +169,56 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
             mTree.bind();
             pass.buffer(g.stats, mStats);
             mEye.beginReceiverPass(pass, g.eye, in);
-            const int rootSide = mTree.levels()[static_cast<size_t>(s.startLevel)].side;
-            const int roots = rootSide * rootSide;
-            // A full traversal: the roots in ranges within llvmpipe's loop budget and, in refinement,
-            // small enough for input to stop between (traversalRanges); every receiver in each.
-            int ranges = 1;
-            if (s.mode == LightRefine::Always) {
-                ranges = fullTraversalRanges(roots, s.startLevel - s.leafLevel);
+            // One traversal in ranges of roots; false when input stopped it.
+            const auto gather = [&](const TraversalSplit& split) {
+                pass.set(g.rootLevel, split.rootLevel);
+                if (split.rootLevel < s.startLevel)
+                    counters["traversal_split_levels"] = s.startLevel - split.rootLevel;
+                int ranges = split.ranges;
+                // In refinement a full traversal's ranges are also small enough for input to stop
+                // between (traversalRanges); a traversal by the test goes in receiver chunks
+                // instead (its work is not known beforehand), in each range.
+                int chunks = 1;
                 if (in.interruptCheck) {
-                    const int leafSide = mTree.levels()[static_cast<size_t>(s.leafLevel)].side;
-                    ranges =
-                        std::max(ranges, traversalRanges(static_cast<double>(mEye.readReceiverCount()),
-                                                         static_cast<double>(leafSide) * leafSide, roots));
+                    if (s.mode == LightRefine::Always) {
+                        const int leafSide = mTree.levels()[static_cast<size_t>(s.leafLevel)].side;
+                        ranges = std::max(
+                            ranges, traversalRanges(static_cast<double>(mEye.readReceiverCount()),
+                                                    static_cast<double>(leafSide) * leafSide, split.roots));
+                    } else {
+                        chunks = gatherCut(1).cutsPerBatch;
+                    }
                 }
-            }
-            if (ranges > 1) {
-                const int perRange = (roots + ranges - 1) / ranges;
-                counters["traversal_ranges"] = (roots + perRange - 1) / perRange;
-                for (int first = 0; first < roots; first += perRange) {
-                    pass.set(g.rootFirst, first).set(g.rootEnd, std::min(first + perRange, roots));
-                    mEye.dispatchReceivers(pass, g.eye);
-                    if (first + perRange < roots && in.interrupted()) return;
+                const int perRange = (split.roots + ranges - 1) / ranges;
+                if (ranges > 1) counters["traversal_ranges"] = (split.roots + perRange - 1) / perRange;
+                for (int first = 0; first < split.roots; first += perRange) {
+                    pass.set(g.rootFirst, first).set(g.rootEnd, std::min(first + perRange, split.roots));
+                    if (!mEye.dispatchReceivers(pass, g.eye, in.interruptCheck, chunks)) return false;
+                    if (first + perRange < split.roots && in.interrupted()) return false;
                 }
-            } else {
-                // In refinement the receivers go in chunks that input can stop between (one
-                // dispatch: gatherCut of one batch).
-                pass.set(g.rootFirst, 0).set(g.rootEnd, roots);
-                if (!mEye.dispatchReceivers(pass, g.eye, in.interruptCheck, gatherCut(1).cutsPerBatch))
-                    return;
+                glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+                glGetNamedBufferSubData(mStats.id(), 0, sizeof stats, stats);
+                return true;
+            };
+            // The split that no loop limit can stop (its worst case: every node refined) is the
+            // traversal's own work for a full traversal or none; a traversal by the test is mostly
+            // far cheaper, and its worst-case split cost 10-30 % more gather time in measurement
+            // (docs/multires.md): it goes whole, and split only once a loop limit stopped receivers
+            // short (gather.comp counts them exactly), from then on while its settings stay.
+            const TraversalSplit safe = traversalSplit(mTree.levels(), s, mLoopBudget);
+            const int startSide = mTree.levels()[static_cast<size_t>(s.startLevel)].side;
+            const TraversalSplit whole{s.startLevel, startSide * startSide, 1};
+            const std::array<double, 4> key{s.tau, static_cast<double>(s.startLevel),
+                                            static_cast<double>(s.leafLevel),
+                                            static_cast<double>(mTree.levels().size())};
+            const bool splitFirst = s.mode != LightRefine::Test || mLoopBudgetSet || mSplitSettings == key;
+            if (!gather(splitFirst ? safe : whole)) return;
+            if (!splitFirst && stats[6] > 0 && (safe.ranges > 1 || safe.rootLevel < s.startLevel)) {
+                counters["traversal_cut_short_whole"] = stats[6];
+                mSplitSettings = key;
+                mEye.clearIllumination();
+                mStats.upload(0, sizeof zero, zero);
+                if (!gather(safe)) return;
             }
         }
     }
@@ -186,9 +226,6 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     mEye.reconstruct(in, params, true, mIndirect.framebuffer, timer);
     mEye.countReceivers(counters);
 
-    GLuint stats[6] = {};
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(mStats.id(), 0, sizeof stats, stats);
     const double receivers = counters["receivers_total"];
     const double visited = static_cast<double>(stats[0]) + 4294967296.0 * static_cast<double>(stats[1]);
     const double cut = static_cast<double>(stats[3]) + 4294967296.0 * static_cast<double>(stats[4]);
@@ -196,6 +233,7 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     counters["nodes_visited_max"] = stats[2];
     counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
     counters["cut_size_max"] = stats[5];
+    counters["traversal_cut_short"] = stats[6];
     mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 

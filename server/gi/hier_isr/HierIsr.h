@@ -9,11 +9,13 @@
 //   1. (renderer) RSM and G-buffer
 //   2. light_tree: the RSM's implicit mip pyramid with sums, means and min-max (LightTree.h)
 //   3. eye_mipmap, refine_flags, stencil_setup: the eye hierarchy and its receiver list (EyeHierarchy.h)
-//   4. vpl_gather: one compute dispatch over the receiver list; each receiver starts from all
+//   4. vpl_gather: compute dispatches over the receiver list; each receiver starts from all
 //      nodes of the hier_coarsest level and descends with an explicit stack while Eq. 8 asks for
 //      refinement, down to the max_depth level; every node it stops at contributes with the disk
 //      kernel (001 Eq. 1) with the node's summed flux and area. The cut covers each valid texel once,
-//      so every receiver sees the RSM's whole flux.
+//      so every receiver sees the RSM's whole flux. The traversal is split into ranges of roots
+//      (below hier_coarsest's when need be) so that no invocation passes a driver's loop limit
+//      (traversalSplit below); every split gives the same cut.
 //   5. upsample: coarse-to-fine reconstruction, albedo / pi per pixel
 //
 // Refinement test (001 Eq. 8), with the conventions 001 leaves open (digest S.5 item 3): solid angles
@@ -48,7 +50,10 @@
 //   (EyeHierarchy.h).
 //
 // Counters: nodes_visited_mean / _max and cut_size_mean / _max (per receiver; the maxima per range
-// when refinement cuts a full traversal in traversal_ranges ranges of roots), vpl_tree_levels,
+// when the traversal goes in traversal_ranges ranges of roots), traversal_split_levels (its roots
+// that many levels below hier_coarsest's, when split so), traversal_cut_short (receivers a driver's
+// loop limit stopped: 0 unless the split fell short) and traversal_cut_short_whole (those of a whole
+// traversal by the test, gathered again split), vpl_tree_levels,
 // vpl_tree_nodes (and vpl_tree_reused when the last frame's tree served: its light views were
 // reused), and the eye hierarchy's receiver counts.
 //
@@ -86,18 +91,31 @@ struct LightCutSettings {
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
                                   int maxDepthResolution, double tau);
 /// llvmpipe stops a shader invocation's loops after 65,535 iterations in all (gallivm's loop
-/// limiter, counted over every loop of the invocation), silently: a full traversal (tau 0) of 256
-/// roots four levels deep visits 67,848 nodes of cornell's tree, and a single dispatch left out
-/// the last 4 % (its last roots' light). A full traversal therefore goes in ranges of roots of at
-/// most kTraversalLoopBudget iterations an invocation, each range a dispatch over every receiver,
-/// starting at most kFullTraversalMaxDepth levels above the leaves (21,845 nodes a root). A
-/// traversal that refines by the test (0 < tau < 1) visits far fewer nodes and is not split; its
-/// receivers past the budget are cut short (nodes_visited_max near 65,535 shows it).
+/// limiter: one count per SIMD group over every loop of the invocation), silently: a full
+/// traversal (tau 0) of 256 roots four levels deep visits 67,848 nodes of cornell's tree, and a
+/// single dispatch left out the last 4 % (its last roots' light); tau 0.00003 cut receivers short
+/// the same way. traversalSplit splits a traversal so that it stays within kTraversalLoopBudget
+/// iterations an invocation whatever the test decides: its roots are taken at most
+/// kFullTraversalMaxDepth levels above the leaves (21,845 nodes a root), below the start level when
+/// need be (the test still decides the ancestors, once: the same cut, node for node), and go in
+/// ranges, each range a dispatch over every receiver. A full traversal (and one that never refines)
+/// goes so from the start. A traversal by the test goes whole first (its worst case is far above
+/// its usual work); when a loop limit stopped receivers short (gather.comp counts them exactly:
+/// traversal_cut_short_whole), it is gathered again split, and split from the start while its
+/// settings stay. traversal_cut_short counts the receivers stopped short in the frame's gather (0).
 constexpr double kTraversalLoopBudget = 60000.0;
 constexpr int kFullTraversalMaxDepth = 7;
-/// Ranges of roots a full traversal of `roots` roots, each `depth` levels above the leaves, needs
-/// to stay within kTraversalLoopBudget iterations an invocation (at most one root a range). Pure.
-int fullTraversalRanges(int roots, int depth);
+struct TraversalSplit {
+    int rootLevel = 0; ///< level index of the dispatches' roots (<= LightCutSettings::startLevel)
+    int roots = 1;     ///< nodes on that level
+    int ranges = 1;    ///< dispatches, each over every receiver and a range of the roots
+};
+/// The split of a traversal with settings `s` over the tree `levels` that keeps every invocation
+/// within `loopBudget` loop iterations at worst (every node refined, except with LightRefine::Never):
+/// the deepest subtrees that fit (at most kFullTraversalMaxDepth levels), in as few ranges as fit,
+/// at most one root a range. Pure.
+TraversalSplit traversalSplit(const std::vector<LightLevel>& levels, const LightCutSettings& s,
+                              double loopBudget = kTraversalLoopBudget);
 /// Refinement's cut of a full traversal (tau 0: every receiver visits every node down to the leaf
 /// level). Receiver chunks cannot shorten it: one group of 64 receivers over 65,536 leaves is about
 /// 44 ms of one of llvmpipe's threads. So the roots go in ranges instead, each range a dispatch over
@@ -123,6 +141,12 @@ public:
 
     /// Test hook: the light tree of the last frame.
     const LightTree& tree() const { return mTree; }
+    /// Test hook: split traversals for this loop budget instead of kTraversalLoopBudget (a small
+    /// one splits a cheap traversal as a costly one would be, to compare it with the whole).
+    void setLoopBudget(double iterations) {
+        mLoopBudget = iterations;
+        mLoopBudgetSet = true;
+    }
 
 private:
     LightTree mTree;
@@ -130,13 +154,18 @@ private:
     BiasCompensation mSsbc;
     struct GatherProgram {
         gl::Program program;
-        gl::UniformLocation startLevel, leafLevel, refineMode, tau, rootFirst, rootEnd;
+        gl::UniformLocation startLevel, leafLevel, refineMode, tau, rootLevel, rootFirst, rootEnd;
         gl::BlockBinding stats;
         VplTransportHandles transport;
         EyeReceiverPassHandles eye;
     } mGather;
     gl::Buffer mStats;
     IndirectTarget mIndirect;
+    double mLoopBudget = kTraversalLoopBudget;
+    bool mLoopBudgetSet = false; ///< a test's budget: every traversal split for it from the start
+    /// The settings (tau, start and leaf levels, tree levels) of the last traversal by the test that a
+    /// loop limit stopped short when whole: split from the start while they stay.
+    std::array<double, 4> mSplitSettings{-1.0, -1.0, -1.0, -1.0};
 };
 
 } // namespace gis
