@@ -10,8 +10,8 @@
 
 namespace gis {
 namespace {
-// gather.comp's CutStats: visited (lo, hi, max), cut (lo, hi, max), receivers cut short.
-constexpr int kCutStats = 7;
+/// gather.comp's CutStats, in order.
+enum CutStat { kVisitedLo, kVisitedHi, kVisitedMax, kCutLo, kCutHi, kCutMax, kCutShort, kCutStats };
 } // namespace
 
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
@@ -202,7 +202,7 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
             };
             // The split that no loop limit can stop (its worst case: every node refined) is the
             // traversal's own work for a full traversal or none; a traversal by the test is mostly
-            // far cheaper, and its worst-case split cost 10-30 % more gather time in measurement
+            // far cheaper, and its worst-case split cost 3-31 % more gather time in measurement
             // (docs/multires.md): it goes whole, and split only once a loop limit stopped receivers
             // short (gather.comp counts them exactly), from then on while its settings stay.
             const TraversalSplit safe = traversalSplit(mTree.levels(), s, mLoopBudget);
@@ -213,8 +213,8 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
                                             static_cast<double>(mTree.levels().size())};
             const bool splitFirst = s.mode != LightRefine::Test || mLoopBudgetSet || mSplitSettings == key;
             if (!gather(splitFirst ? safe : whole)) return;
-            if (!splitFirst && stats[6] > 0 && (safe.ranges > 1 || safe.rootLevel < s.startLevel)) {
-                counters["traversal_cut_short_whole"] = stats[6];
+            if (!splitFirst && stats[kCutShort] > 0 && (safe.ranges > 1 || safe.rootLevel < s.startLevel)) {
+                counters["traversal_cut_short_whole"] = stats[kCutShort];
                 mSplitSettings = key;
                 mEye.clearIllumination();
                 mStats.upload(0, sizeof zero, zero);
@@ -227,13 +227,14 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     mEye.countReceivers(counters);
 
     const double receivers = counters["receivers_total"];
-    const double visited = static_cast<double>(stats[0]) + 4294967296.0 * static_cast<double>(stats[1]);
-    const double cut = static_cast<double>(stats[3]) + 4294967296.0 * static_cast<double>(stats[4]);
+    const double visited =
+        static_cast<double>(stats[kVisitedLo]) + 4294967296.0 * static_cast<double>(stats[kVisitedHi]);
+    const double cut = static_cast<double>(stats[kCutLo]) + 4294967296.0 * static_cast<double>(stats[kCutHi]);
     counters["nodes_visited_mean"] = receivers > 0 ? visited / receivers : 0.0;
-    counters["nodes_visited_max"] = stats[2];
+    counters["nodes_visited_max"] = stats[kVisitedMax];
     counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
-    counters["cut_size_max"] = stats[5];
-    counters["traversal_cut_short"] = stats[6];
+    counters["cut_size_max"] = stats[kCutMax];
+    counters["traversal_cut_short"] = stats[kCutShort];
     mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
