@@ -88,32 +88,65 @@ std::vector<std::uint8_t> cropRgba8(const std::vector<std::uint8_t>& canvas, int
     return out;
 }
 
-std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
-                                      int width, int height) {
-    std::vector<std::uint8_t> out(static_cast<std::size_t>(width) * height * 4, 0);
-    if (srcWidth <= 0 || srcHeight <= 0 || src.size() < static_cast<std::size_t>(srcWidth) * srcHeight * 4)
-        return out;
-    const double sx = static_cast<double>(srcWidth) / width, sy = static_cast<double>(srcHeight) / height;
-    for (int y = 0; y < height; ++y) {
-        // Pixel centres map to pixel centres; samples outside the source clamp to its edge.
-        const double fy = std::clamp((y + 0.5) * sy - 0.5, 0.0, srcHeight - 1.0);
-        const int y0 = static_cast<int>(fy), y1 = std::min(y0 + 1, srcHeight - 1);
-        const double wy = fy - y0;
-        for (int x = 0; x < width; ++x) {
-            const double fx = std::clamp((x + 0.5) * sx - 0.5, 0.0, srcWidth - 1.0);
-            const int x0 = static_cast<int>(fx), x1 = std::min(x0 + 1, srcWidth - 1);
-            const double wx = fx - x0;
-            for (int c = 0; c < 4; ++c) {
-                auto at = [&](int px, int py) {
-                    return static_cast<double>(src[(static_cast<std::size_t>(py) * srcWidth + px) * 4 + c]);
-                };
-                const double v = (at(x0, y0) * (1 - wx) + at(x1, y0) * wx) * (1 - wy) +
-                                 (at(x0, y1) * (1 - wx) + at(x1, y1) * wx) * wy;
-                out[(static_cast<std::size_t>(y) * width + x) * 4 + c] =
-                    static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
+namespace {
+/// One output coordinate's two source taps (byte offsets) and the second tap's weight in 1/256.
+struct ResizeTap {
+    std::size_t first = 0, second = 0;
+    std::uint32_t weight = 0;
+};
+
+/// The taps of `outSize` pixel centres over `srcSize` source pixels, `stride` bytes apart. Pixel
+/// centres map to pixel centres; samples outside the source clamp to its edge.
+std::vector<ResizeTap> resizeTaps(int outSize, int srcSize, std::size_t stride) {
+    std::vector<ResizeTap> taps(static_cast<std::size_t>(outSize));
+    const double scale = static_cast<double>(srcSize) / outSize;
+    for (int i = 0; i < outSize; ++i) {
+        const double f = std::clamp((i + 0.5) * scale - 0.5, 0.0, srcSize - 1.0);
+        const int i0 = static_cast<int>(f), i1 = std::min(i0 + 1, srcSize - 1);
+        const auto weight = static_cast<std::uint32_t>(std::lround((f - i0) * 256.0));
+        taps[static_cast<std::size_t>(i)] = {static_cast<std::size_t>(i0) * stride,
+                                             static_cast<std::size_t>(i1) * stride, std::min(weight, 256u)};
+    }
+    return taps;
+}
+} // namespace
+
+void resizeRgba8Rows(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
+                     std::vector<std::uint8_t>& out, int width, int height, int rowBegin, int rowEnd) {
+    GIS_ASSERT(width > 0 && height > 0 && out.size() == static_cast<std::size_t>(width) * height * 4);
+    rowBegin = std::clamp(rowBegin, 0, height);
+    rowEnd = std::clamp(rowEnd, rowBegin, height);
+    if (srcWidth <= 0 || srcHeight <= 0 || src.size() < static_cast<std::size_t>(srcWidth) * srcHeight * 4) {
+        std::fill(out.begin() + static_cast<std::ptrdiff_t>(rowBegin) * width * 4,
+                  out.begin() + static_cast<std::ptrdiff_t>(rowEnd) * width * 4, std::uint8_t{0});
+        return;
+    }
+    // Fixed point, weights in 1/256 (within one 8-bit level of the exact bilinear value): the canvas
+    // a refinement step starts from is resized before its first tile, and the same in doubles took
+    // 18-41 ms at 960 x 800 on this project's 2-core machines.
+    const std::vector<ResizeTap> xs = resizeTaps(width, srcWidth, 4);
+    const std::vector<ResizeTap> ys = resizeTaps(height, srcHeight, static_cast<std::size_t>(srcWidth) * 4);
+    std::uint8_t* dst = out.data() + static_cast<std::size_t>(rowBegin) * width * 4;
+    for (int row = rowBegin; row < rowEnd; ++row) {
+        const ResizeTap& y = ys[static_cast<std::size_t>(row)];
+        const std::uint8_t* top = src.data() + y.first;
+        const std::uint8_t* bottom = src.data() + y.second;
+        const std::uint32_t wy = y.weight;
+        for (const ResizeTap& x : xs) {
+            const std::uint32_t wx = x.weight;
+            for (std::size_t c = 0; c < 4; ++c) {
+                const std::uint32_t upper = top[x.first + c] * (256u - wx) + top[x.second + c] * wx;
+                const std::uint32_t lower = bottom[x.first + c] * (256u - wx) + bottom[x.second + c] * wx;
+                *dst++ = static_cast<std::uint8_t>((upper * (256u - wy) + lower * wy + 32768u) >> 16);
             }
         }
     }
+}
+
+std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
+                                      int width, int height) {
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(std::max(width, 0)) * std::max(height, 0) * 4, 0);
+    if (width > 0 && height > 0) resizeRgba8Rows(src, srcWidth, srcHeight, out, width, height, 0, height);
     return out;
 }
 

@@ -35,9 +35,14 @@ void pasteTile(std::vector<std::uint8_t>& canvas, int fullWidth, int fullHeight,
                int guard);
 
 /// Bilinear resize of an RGBA8 image (the interactive frame stretched to full size as the canvas a
-/// refinement step starts from).
+/// refinement step starts from), within one 8-bit level of the exact value; an invalid source
+/// gives black.
 std::vector<std::uint8_t> resizeRgba8(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
                                       int width, int height);
+/// Rows [rowBegin, rowEnd) of the same into `out` (width x height RGBA8, sized by the caller): a
+/// resize in bands that a caller can stop between.
+void resizeRgba8Rows(const std::vector<std::uint8_t>& src, int srcWidth, int srcHeight,
+                     std::vector<std::uint8_t>& out, int width, int height, int rowBegin, int rowEnd);
 
 /// The part of `rect` inside a width x height image (empty when none is).
 TileRect clipToImage(const TileRect& rect, int width, int height);
