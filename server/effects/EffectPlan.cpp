@@ -350,6 +350,11 @@ EffectPlan planEffects(const Scene& scene, const reference::RayScene& rays, cons
     double pairsWeighted = 0.0, pairsOccludedWeighted = 0.0;
     int lit = 0, reached = 0;
     for (size_t r = 0; r < receivers.size(); ++r) {
+        if (options.stop && r > 0 && r % kPlanStopEvery == 0 && options.stop()) {
+            plan.stopped = true;
+            plan.decisions.clear();
+            return plan;
+        }
         const Point& x = receivers[r];
         glm::dvec3 direct(emission[r]);
         bool litHere = false;

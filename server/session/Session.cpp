@@ -1372,7 +1372,20 @@ void Session::workerMain() {
             if (rays) {
                 const std::string key = effectPlanKey(*scene, state);
                 if (key != planKey) {
-                    plan = planEffects(*scene, *rays, state);
+                    // A refinement step's plan (tens of ms of rays) stops for input like its tiles;
+                    // a frame that answers input, or a snapshot, plans to the end.
+                    EffectPlanOptions options;
+                    const bool refining = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
+                                                           step == static_cast<int>(Step::Final));
+                    if (refining) options.stop = [this] { return inputPending(); };
+                    EffectPlan fresh = planEffects(*scene, *rays, state, options);
+                    if (fresh.stopped) {
+                        // Whatever stopped it is served first; the step comes again after it.
+                        std::lock_guard lock(mMutex);
+                        if (!mDirty) mNextStep = static_cast<Step>(step);
+                        continue;
+                    }
+                    plan = std::move(fresh);
                     planKey = key;
                 }
                 applyEffectPlan(state, plan);

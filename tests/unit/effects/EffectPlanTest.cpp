@@ -109,6 +109,30 @@ TEST(EffectPlan, ForcedStateWinsAndIsShown) {
     EXPECT_NE(gis::describe(p.plan).find("forced on"), std::string::npos);
 }
 
+TEST(EffectPlan, AStopEndsThePlanWithoutDecisions) {
+    gis::Scene scene = gis::makeBuiltinScene("cornell");
+    FrameState state = gis::makeFrameState(scene, "ssbc");
+    state.width = state.height = 128;
+    const EffectPlan whole = gis::planEffects(scene, state);
+    int asked = 0;
+    gis::EffectPlanOptions never;
+    never.stop = [&] {
+        ++asked;
+        return false;
+    };
+    const EffectPlan unstopped = gis::planEffects(scene, state, never);
+    EXPECT_FALSE(unstopped.stopped);
+    EXPECT_EQ(gis::toJson(unstopped)["decisions"], gis::toJson(whole)["decisions"]);
+    EXPECT_GE(asked, whole.receivers / gis::kPlanStopEvery - 1) << "asked through the bounce estimate";
+    int left = 3;
+    gis::EffectPlanOptions third;
+    third.stop = [&] { return --left <= 0; };
+    const EffectPlan stopped = gis::planEffects(scene, state, third);
+    EXPECT_TRUE(stopped.stopped);
+    EXPECT_TRUE(stopped.decisions.empty());
+    EXPECT_EQ(left, 0) << "it ended at the first true";
+}
+
 TEST(EffectPlan, Deterministic) {
     const Planned a = plan("cornell"), b = plan("cornell");
     EXPECT_EQ(gis::toJson(a.plan)["decisions"], gis::toJson(b.plan)["decisions"]);
