@@ -30,10 +30,6 @@ export class PendingInputs {
         return this.items.length ? this.items[0].at : null;
     }
 
-    get size() {
-        return this.items.length;
-    }
-
     /**
      * A frame was drawn: removes the inputs it shows and returns the time of the oldest of them
      * (null: it shows none). `inputSeq` is the frame's `stats.input_seq`, `renderStart` the

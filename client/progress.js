@@ -144,21 +144,16 @@ export class RefineTracker {
 export class InputWatch {
     constructor() {
         this.inputs = new PendingInputs();
-        this.lastInputAt = null;
         this.lastDrawnAt = null;
     }
 
     reset() {
         this.inputs.clear();
-        this.lastInputAt = null;
         this.lastDrawnAt = null;
     }
 
     /** A steering input sent at `now`, numbered `seq` (its message's `seq`). */
-    input(now, seq = null) {
-        this.inputs.add(now, seq);
-        this.lastInputAt = now;
-    }
+    input(now, seq = null) { this.inputs.add(now, seq); }
 
     /**
      * A frame was drawn at `now`: the inputs it shows no longer wait. `inputSeq` is its
