@@ -143,6 +143,12 @@ async function pressLatency(key) {
         // from the input's arrival to the encoded frame.
         sockets: keyEvent.steerAt !== null && d.arrivedAt && d.input?.rendered_ms !== undefined
             ? d.arrivedAt - keyEvent.steerAt - d.input.rendered_ms - d.encode : null,
+        // The same split by the server's wall clock at the input's arrival (one machine, one clock):
+        // the camera message's way in, and the encoded frame's way out to the page's handler.
+        socketIn: keyEvent.steerAt !== null && d.input?.arrived_unix_ms !== undefined
+            ? d.input.arrived_unix_ms - keyEvent.steerAt : null,
+        socketOut: d.arrivedAt && d.input?.arrived_unix_ms !== undefined
+            ? d.arrivedAt - d.input.arrived_unix_ms - d.input.rendered_ms - d.encode : null,
     } : null;
     return { latency: d.t - t0, frameMs: d.ms, inputWait: d.input?.wait_ms ?? null, windowWait: d.input?.window_wait_ms ?? null, toSend: sent ? sent - t0 : null,
         toStats: arrived && sent ? arrived - sent : null, toDraw: arrived ? d.t - arrived : null, inPage };
@@ -155,7 +161,7 @@ function inPageSummary(results) {
     if (!pressed.length) return null;
     const pcts = (v) => ({ p50: percentile(v, 0.5), p95: percentile(v, 0.95) });
     const parts = {};
-    for (const k of ['dispatch', 'client', 'server', 'sockets', 'decodeDraw', 'decode', 'toAnimationFrame']) {
+    for (const k of ['dispatch', 'client', 'server', 'sockets', 'socketIn', 'socketOut', 'decodeDraw', 'decode', 'toAnimationFrame']) {
         const v = pressed.map((r) => r.inPage[k]).filter((x) => x !== null && x !== undefined);
         if (v.length) parts[k] = pcts(v);
     }

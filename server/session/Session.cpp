@@ -1452,14 +1452,20 @@ void Session::workerMain() {
             stats["budget"] = budgetJson;
             noteReceiverCap(stats["budget"], frame.stats, frame.width, frame.height);
         }
-        if (answersInputOf)
+        if (answersInputOf) {
             // How long the input waited for the worker (a tile or an unacknowledged frame ahead of
-            // it), and from its arrival to the frame about to be encoded.
-            stats["input"] = {
-                {"wait_ms", inputWaitMs},
-                {"window_wait_ms", windowWaitMs},
-                {"rendered_ms",
-                 std::chrono::duration<double, std::milli>(Clock::now() - *answersInputOf).count()}};
+            // it), and from its arrival to the frame about to be encoded. The arrival on the wall
+            // clock lets a client on the same machine split the rest between the two directions.
+            const double renderedMs =
+                std::chrono::duration<double, std::milli>(Clock::now() - *answersInputOf).count();
+            const double nowUnixMs = std::chrono::duration<double, std::milli>(
+                                         std::chrono::system_clock::now().time_since_epoch())
+                                         .count();
+            stats["input"] = {{"wait_ms", inputWaitMs},
+                              {"window_wait_ms", windowWaitMs},
+                              {"rendered_ms", renderedMs},
+                              {"arrived_unix_ms", std::floor((nowUnixMs - renderedMs) * 10.0) / 10.0}};
+        }
         if (!deliver(w, frame.rgba8, frame.width, frame.height, std::move(stats), stepName(step), stream,
                      snapshotFor, snapshotCodec))
             break;

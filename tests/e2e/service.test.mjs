@@ -545,6 +545,12 @@ check('input during a slow refinement is answered at the next tile or VPL part',
     }, 10000);
     const waited = Date.now() - sent;
     assert.equal(answer.stats.input_seq, 3, 'the answer shows the camera message');
+    // It says when the input arrived on the server's wall clock, this machine's: after the message
+    // left and before the frame came (a millisecond's slack for the rounding).
+    const arrived = answer.stats.input?.arrived_unix_ms;
+    const statsAt = performance.timeOrigin + client.inbox.arrivedAt.get(answer.stats);
+    assert.ok(arrived >= sent - 1 && arrived <= statsAt + 1, `input.arrived_unix_ms ${arrived} within [${sent}, ${statsAt}]`);
+    assert.ok(answer.stats.input.rendered_ms >= answer.stats.input.wait_ms, JSON.stringify(answer.stats.input));
     assert.ok(seqs.slice(0, -1).every((q) => q.endsWith(':2')), `the abandoned step's frames do not: ${seqs}`);
     const abandoned = await client.inbox.next((m) => m.type === 'progress' && m.state === 'abandoned', 'progress abandoned', 5000);
     assert.ok(abandoned.share < 1);
