@@ -38,9 +38,11 @@ struct EnvProbe::Impl {
     /// What the prefiltered cubes were asked for (probes, sizes, budget, shading switches, the
     /// scene); with the light views reused and the same key, a frame keeps them and their plan.
     std::string cubesKey;
-    /// The probes' measured cost (env_budget_ms), for the scene it was measured on.
+    /// The probes' measured cost (env_budget_ms), for the scene and the prefilter's samples it was
+    /// measured with.
     EnvProbeCostModel cost;
     std::pair<const void*, std::size_t> costScene{nullptr, 0};
+    int costSamples = 0;
     EnvProbePlan plan;
     /// Set by a frame that rendered its cubes: what noteTimings() attributes the pass times to.
     int renderedSize = 0, renderedProbes = 0;
@@ -199,9 +201,12 @@ void EnvProbe::execute(const ReflectionInputs& in, const ParamSet& fp, const gl:
         // The upload identifies the scene (a new scene gets a new upload; its triangle count guards
         // against an address reused after the old one was freed).
         const std::pair<const void*, std::size_t> sceneId{in.sceneGpu, in.sceneGpu->triangleCount()};
-        if (m.costScene != sceneId) {
+        // The prefilter's cost grows with its samples (up to 8x between the default 32 and 256), which
+        // the model's face sizes do not show: measured afresh when they change.
+        if (m.costScene != sceneId || m.costSamples != samples) {
             m.cost.clear();
             m.costScene = sceneId;
+            m.costSamples = samples;
         }
         m.plan = planEnvProbes(requestedSize, wantedProbes, budgetMs, m.cost);
     }

@@ -71,7 +71,14 @@ EnvProbePlan planEnvProbes(int requestedSize, int wantedProbes, double budgetMs,
         return plan;
     }
     if (model.empty()) {
-        plan.reason = probesText(requested, wanted) + " as asked: their cost is not measured yet";
+        // Nothing measured on this scene at these samples: one probe at env_size 512 with 256 samples
+        // takes seconds on a CPU, as one stage, so the first render is the cheapest plan the budget
+        // would keep, and the next plans from what it measured.
+        plan.size = std::min(requested, kEnvPreferredMinSize);
+        plan.probes = 1;
+        plan.reason = probesText(plan.size, 1) +
+                      ": their cost is not measured yet, so the smallest first (asked: " +
+                      probesText(requested, wanted) + ")";
         return plan;
     }
     auto predict = [&](int size, int probes) { return probes * model.probeMs(size); };

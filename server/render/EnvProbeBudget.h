@@ -6,7 +6,8 @@
 // face size's cost is the median of its last kEnvCostSamples measurements (one slow frame on a shared
 // machine does not move it). With two or more face sizes measured, a and b come from the two nearest to the
 // size asked about (b >= 0, a >= 0); with one, half of its cost is taken as fixed (the scene's draws) and
-// half as growing with the texels; with none there is no prediction and probes render as asked. Plan, first
+// half as growing with the texels; with none there is no prediction and, under a budget, the room probe
+// alone renders at kPreferredMinSize (or env_size when smaller) so that it is measured. Plan, first
 // that fits: every probe at the largest size from env_size down to kPreferredMinSize; then fewer local probes
 // (the smallest objects go first) at the largest size that fits; then the room probe alone down to kMinSize.
 // When nothing fits, the room probe alone at the smallest size.

@@ -1458,9 +1458,9 @@ void Session::workerMain() {
             // clock lets a client on the same machine split the rest between the two directions.
             const double renderedMs =
                 std::chrono::duration<double, std::milli>(Clock::now() - *answersInputOf).count();
-            const double nowUnixMs = std::chrono::duration<double, std::milli>(
-                                         std::chrono::system_clock::now().time_since_epoch())
-                                         .count();
+            const double nowUnixMs =
+                std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch())
+                    .count();
             stats["input"] = {{"wait_ms", inputWaitMs},
                               {"window_wait_ms", windowWaitMs},
                               {"rendered_ms", renderedMs},

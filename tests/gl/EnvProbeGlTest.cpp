@@ -358,11 +358,14 @@ TEST(EnvProbeGl, ProbeBudgetPlansFromMeasuredCost) {
     auto scene = std::make_shared<Scene>(loadScene(kScene));
     FrameRenderer renderer;
     renderer.setScene(scene);
-    auto frame = [&](double budgetMs) {
+    auto frame = [&](double budgetMs, int samples = 32) {
         FrameState s = makeFrameState(*scene, "none");
         s.width = 64;
         s.height = 48;
-        applyParams(s, {{"effect_env", "on"}, {"env_size", 128}, {"env_budget_ms", budgetMs}}, "test");
+        applyParams(
+            s,
+            {{"effect_env", "on"}, {"env_size", 128}, {"env_budget_ms", budgetMs}, {"env_samples", samples}},
+            "test");
         return renderer.render(s, true);
     };
     auto probeMs = [](const FrameOutput& f) {
@@ -373,14 +376,16 @@ TEST(EnvProbeGl, ProbeBudgetPlansFromMeasuredCost) {
     };
     auto reason = [](const FrameOutput& f) { return f.stats["nondiffuse"]["env"].get<std::string>(); };
 
-    // The first render compiles shaders and is not a measurement: two renders as asked.
+    // The first render compiles shaders and is not a measurement: two renders before one, each the
+    // room probe alone at 32 texels, whatever the budget.
     frame(20.0);
     const FrameOutput first = frame(20.0);
     const double wanted = counter(first, "env_probes_wanted");
     ASSERT_GE(wanted, 2.0) << "the room probe and the gold sphere's";
-    EXPECT_EQ(counter(first, "env_probes"), wanted) << "not measured yet: as asked";
-    EXPECT_EQ(counter(first, "env_size"), 128.0);
+    EXPECT_EQ(counter(first, "env_probes"), 1.0) << "not measured yet: the smallest first";
+    EXPECT_EQ(counter(first, "env_size"), 32.0);
     EXPECT_NE(reason(first).find("not measured yet"), std::string::npos) << reason(first);
+    EXPECT_EQ(badValues(first), 0u);
 
     const FrameOutput tiny = frame(0.001);
     EXPECT_EQ(counter(tiny, "env_probes"), 1.0);
@@ -395,14 +400,25 @@ TEST(EnvProbeGl, ProbeBudgetPlansFromMeasuredCost) {
     EXPECT_GT(counter(generous, "env_predicted_ms"), 0.0);
     EXPECT_NE(reason(generous).find("within"), std::string::npos) << reason(generous);
 
-    // The model's full-size cost is the median (here the mean) of the two measured full-size
-    // renders, so every probe at full size is predicted over a budget of 1.2 probes at the cheaper.
-    const double budget = 1.2 * std::min(probeMs(first), probeMs(generous));
+    // The model's full-size cost is the one full-size render's, so every probe at full size is
+    // predicted over a budget of 1.2 probes at that size.
+    const double budget = 1.2 * probeMs(generous);
     const FrameOutput planned = frame(budget);
     EXPECT_TRUE(counter(planned, "env_probes") < wanted || counter(planned, "env_size") < 128.0)
         << reason(planned);
     EXPECT_LE(counter(planned, "env_predicted_ms"), budget + 1e-9) << reason(planned);
     EXPECT_EQ(badValues(planned), 0u);
-    std::printf("[env] budget %.1f ms: %s (a probe at 128 measured %.1f / %.1f ms)\n", budget,
+    std::printf("[env] budget %.1f ms: %s (a probe at 32 measured %.1f ms, at 128 %.1f ms)\n", budget,
                 reason(planned).c_str(), probeMs(first), probeMs(generous));
+
+    // The prefilter's samples are not in the model's sizes (its cost grows with them): other samples
+    // are measured afresh, the smallest first, however generous the budget.
+    const FrameOutput moreSamples = frame(10000.0, 256);
+    EXPECT_EQ(counter(moreSamples, "env_samples"), 256.0);
+    EXPECT_EQ(counter(moreSamples, "env_probes"), 1.0) << reason(moreSamples);
+    EXPECT_EQ(counter(moreSamples, "env_size"), 32.0) << reason(moreSamples);
+    EXPECT_NE(reason(moreSamples).find("not measured yet"), std::string::npos) << reason(moreSamples);
+    const FrameOutput measured = frame(9000.0, 256); // another budget: the cubes are rendered again
+    EXPECT_EQ(counter(measured, "env_probes"), wanted) << reason(measured);
+    EXPECT_NE(reason(measured).find("within"), std::string::npos) << reason(measured);
 }

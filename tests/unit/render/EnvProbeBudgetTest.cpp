@@ -9,13 +9,24 @@
 namespace gis {
 namespace {
 
-TEST(EnvProbeBudget, WithoutBudgetOrMeasurementProbesRenderAsAsked) {
+TEST(EnvProbeBudget, BeforeAMeasurementTheRoomProbeGoesFirstAtTheSmallSize) {
     EnvProbeCostModel model;
     EXPECT_LT(model.probeMs(128), 0.0);
+    // Under a budget, unmeasured probes could take seconds (env_size 512 with 256 samples on a CPU):
+    // the room probe alone, at 32 texels, is measured first.
     EnvProbePlan plan = planEnvProbes(128, 4, 20.0, model);
+    EXPECT_EQ(plan.size, kEnvPreferredMinSize);
+    EXPECT_EQ(plan.probes, 1);
+    EXPECT_LT(plan.predictedMs, 0.0);
+    EXPECT_NE(plan.reason.find("not measured"), std::string::npos) << plan.reason;
+    EXPECT_NE(plan.reason.find("asked: env_size 128, 4 probes"), std::string::npos) << plan.reason;
+    plan = planEnvProbes(16, 4, 20.0, model);
+    EXPECT_EQ(plan.size, 16) << "a smaller env_size is kept";
+    EXPECT_EQ(plan.probes, 1);
+    // Without a budget (gi-render, the HTTP API) every probe renders as asked, measured or not.
+    plan = planEnvProbes(128, 4, 0.0, model);
     EXPECT_EQ(plan.size, 128);
     EXPECT_EQ(plan.probes, 4);
-    EXPECT_NE(plan.reason.find("not measured"), std::string::npos) << plan.reason;
     model.record(128, 4, 400.0);
     plan = planEnvProbes(128, 4, 0.0, model);
     EXPECT_EQ(plan.size, 128);
