@@ -10,7 +10,8 @@
 // Each press is timed twice: from this script's key dispatch to the page's next animation frame after
 // the draw (`still_input_to_frame_ms`, `input_to_frame_ms`), and in the page, from the key event to the
 // frame drawn on the canvas (`still_in_page`, `in_page`, with where the time went: `decodeDraw` from the
-// frame's arrival to its draw, `decode` the decode alone).
+// frame's arrival to its draw, `decode` the decode alone, `sockets` both ways through the sockets, and
+// `socketIn` / `socketOut` the same split by the server's wall clock at the input's arrival).
 // Figures are measured side by side in one run on whatever machine runs it; docs/interactive.md has
 // the ones recorded. usage:
 //   node bench/interactive/orbit.mjs [--server build/ci/bin/gi-server] [--scenes a,b] [--presses 10]
