@@ -32,3 +32,15 @@ export function patchPlacement(stats, header) {
         && p.x + header.width <= width && p.y + header.height <= height;
     return ok ? { width, height, x: p.x, y: p.y } : null;
 }
+
+/**
+ * Whether a drawn frame's figures (the overlay's frame lines, the Stats details, the panels that
+ * follow frames) are shown now, `lastShownAt` being when they last were (ms, as `now`). A refining
+ * image's patches come many a second, and each shown would lay out and paint the page again, time the
+ * page then does not spend on input: a patch's figures wait for `periodMs` after the last shown, except
+ * the patch that completes the image. Whole frames always show theirs.
+ */
+export function figuresDue(stats, now, lastShownAt, periodMs) {
+    if (!stats?.patch || stats.refine?.complete) return true;
+    return !(now - lastShownAt < periodMs);
+}

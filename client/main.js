@@ -28,6 +28,7 @@ import { MessageStack, describeError, noticeFor } from './messages.js';
 import { bindUploads } from './uploads.js';
 import { Store } from './store.js';
 import { createFrameView } from './frame-view.js';
+import { figuresDue } from './frames.js';
 import { createOutbox } from './outbox.js';
 import { createOverlay } from './overlay.js';
 import { createAccuracySection } from './sections/accuracy.js';
@@ -160,6 +161,7 @@ const store = new Store({
     lighting: null, // state.lighting {source, note}, until a frame's stats.lighting says more
     statsByFrame: new Map(), // frame -> {stats, arrivedAt}
     lastDrawn: null, // {frame, width, height, stats, arrivedAt, drawnAt, decodeMs} (times: performance.now())
+    figuresShownAt: -Infinity, // when a drawn frame's figures were last shown (performance.now())
     lastSteerAt: null, // performance.now() when the last steering message (camera, light, params) left
     framesDrawn: 0,
     decoding: false,
@@ -546,6 +548,12 @@ function recordDraw(frame, decodeMs, frameBytes) {
         state.scene = stats.scene;
         store.emit('scenes');
     }
+    overlay.frameDrawn(now);
+    // A refining image's patches show their figures at most as often as the overlay's tick
+    // (frames.js, figuresDue): each set shown lays out and paints the page again, main-thread time
+    // that input then waits for (docs/interactive.md, "The page's figures while the view refines").
+    if (!figuresDue(stats, now, state.figuresShownAt, OVERLAY_TICK_MS)) return;
+    state.figuresShownAt = now;
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
     noteDefaultLighting(stats?.lighting);
@@ -553,7 +561,6 @@ function recordDraw(frame, decodeMs, frameBytes) {
     store.emit('frame', stats);
     gizmo.render();
     showProgress();
-    overlay.frameDrawn(now);
 }
 
 // ---------------------------------------------------------------------------------------------

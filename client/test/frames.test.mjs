@@ -1,7 +1,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 
-import { enqueueFrame, isPatch, patchPlacement } from '../frames.js';
+import { enqueueFrame, figuresDue, isPatch, patchPlacement } from '../frames.js';
 
 const whole = (id) => ({ id, entry: { stats: { size: [64, 32] } } });
 const patch = (id, x = 0, y = 0) => ({ id, entry: { stats: { size: [64, 32], patch: { x, y, width: 16, height: 16 } } } });
@@ -29,4 +29,14 @@ test('a patch is placed inside the whole image, or not at all', () => {
     assert.equal(patchPlacement(patch(1, 56, 0).entry.stats, { width: 16, height: 16 }), null, 'past the right edge');
     assert.equal(patchPlacement({ patch: { x: -1, y: 0 }, size: [64, 32] }, { width: 1, height: 1 }), null);
     assert.equal(patchPlacement({ patch: { x: 0, y: 0 } }, { width: 1, height: 1 }), null, 'no size');
+});
+
+test('a patch shows its figures at most once a period; whole frames and the last patch always', () => {
+    const patch = { patch: { x: 0, y: 0, width: 8, height: 8 }, refine: { complete: false } };
+    assert.equal(figuresDue(patch, 1000, -Infinity, 250), true, 'the first patch');
+    assert.equal(figuresDue(patch, 1100, 1000, 250), false, 'one 100 ms after');
+    assert.equal(figuresDue(patch, 1250, 1000, 250), true, 'one a period after');
+    assert.equal(figuresDue({ ...patch, refine: { complete: true } }, 1010, 1000, 250), true, 'the one that completes the image');
+    assert.equal(figuresDue({ quality: 'interactive' }, 1010, 1000, 250), true, 'a whole frame');
+    assert.equal(figuresDue(null, 1010, 1000, 250), true, 'a frame without stats');
 });

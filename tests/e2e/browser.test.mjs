@@ -354,6 +354,52 @@ test('refinement fills the image in tile by tile and the overlay shows step, sha
     });
 });
 
+test('while the view refines in patches, their figures are shown at most at the overlay\'s tick', async (t) => {
+    await withAdaptive(async () => {
+        const vplGrid = await page.evaluate(() => window.giClient.params.vpl_grid ?? null);
+        await page.evaluate(() => {
+            // Patches drawn (frames drawn while the last stats are a patch's), and the overlay's frame
+            // line changed for one.
+            // When patches were drawn (two drawn between animation frames count as one), and when the
+            // overlay's frame line changed for one that did not complete its image (ms).
+            window.seenPatches = { drawn: [], shown: [] };
+            let drawn = window.giClient.framesDrawn;
+            const countDraws = () => {
+                if (!window.seenPatches) return;
+                const n = window.giClient.framesDrawn;
+                if (n !== drawn && window.giClient.lastStats?.patch) window.seenPatches.drawn.push(performance.now());
+                drawn = n;
+                requestAnimationFrame(countDraws);
+            };
+            requestAnimationFrame(countDraws);
+            new MutationObserver(() => {
+                if (window.seenPatches && window.giClient.lastStats?.patch && !window.giClient.lastStats.refine?.complete)
+                    window.seenPatches.shown.push(performance.now());
+            }).observe(document.getElementById('ov-times'), { subtree: true, childList: true, characterData: true });
+            // 16,384 VPLs: tiles in VPL parts, each sent as a patch.
+            window.giClient.send({ type: 'params', values: { vpl_grid: 128 } });
+        });
+        try {
+            const gaps = (times) => times.slice(1).map((x, i) => x - times[i]);
+            // Patches that come within the overlay's tick of each other: what the test is about.
+            const seen = await until('patches drawn less than 200 ms apart', () => window.seenPatches.drawn.length >= 12
+                && window.seenPatches.drawn.slice(1).filter((x, i) => x - window.seenPatches.drawn[i] < 200).length >= 4
+                && window.seenPatches, null, 90000);
+            t.diagnostic(`${seen.drawn.length} patches drawn, the overlay's frame line shown for ${seen.shown.length}; `
+                + `gaps between those shown ${gaps(seen.shown).map(Math.round).join(', ')} ms`);
+            assert.ok(seen.shown.length > 0, 'a patch\'s figures are shown');
+            // 250 ms apart, less the observer's timing.
+            assert.ok(gaps(seen.shown).every((g) => g >= 230),
+                `shown at most every 250 ms: ${gaps(seen.shown).map(Math.round).join(', ')} ms`);
+        } finally {
+            await page.evaluate((v) => {
+                window.seenPatches = null;
+                window.giClient.send({ type: 'params', values: { vpl_grid: v ?? 16 } });
+            }, vplGrid);
+        }
+    });
+});
+
 test('the stats overlay shows fps, latency, times, bytes and per-pass timings', async (t) => {
     // The Stats section's details of the frame on screen are kept, not built again, from frame to frame:
     // a mark on a value's element survives the frames below.
