@@ -552,7 +552,27 @@ function recordDraw(frame, decodeMs, frameBytes) {
     // A refining image's patches show their figures at most as often as the overlay's tick
     // (frames.js, figuresDue): each set shown lays out and paints the page again, main-thread time
     // that input then waits for (docs/interactive.md, "The page's figures while the view refines").
-    if (!figuresDue(stats, now, state.figuresShownAt, OVERLAY_TICK_MS)) return;
+    // The last patch held back is shown when the period ends, so the figures end on the image's.
+    if (!figuresDue(stats, now, state.figuresShownAt, OVERLAY_TICK_MS)) {
+        heldFigures = [frame, decodeMs, frameBytes];
+        heldFiguresTimer ||= setTimeout(() => {
+            heldFiguresTimer = 0;
+            const held = heldFigures;
+            heldFigures = null;
+            if (held) showFigures(...held, performance.now());
+        }, Math.max(0, OVERLAY_TICK_MS - (now - state.figuresShownAt)));
+        return;
+    }
+    heldFigures = null;
+    showFigures(frame, decodeMs, frameBytes, now);
+}
+
+let heldFigures = null; // [frame, decodeMs, frameBytes] of the last patch whose figures wait
+let heldFiguresTimer = 0;
+
+/** The overlay's frame lines, the Stats details and what else follows a drawn frame's figures. */
+function showFigures(frame, decodeMs, frameBytes, now) {
+    const stats = frame.entry?.stats ?? null;
     state.figuresShownAt = now;
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
