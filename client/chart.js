@@ -92,20 +92,31 @@ export class PassChart {
     showLegend(names, values) {
         if (!this.legend) return;
         const times = values.map((v) => v.at(-1));
-        const text = names.map((name, k) => `${name} ${Number.isFinite(times[k]) ? times[k].toFixed(1) : '–'}`).join('\n');
+        const msText = (t) => (Number.isFinite(t) ? t.toFixed(1) : '–');
+        const text = names.map((name, k) => `${name} ${msText(times[k])}`).join('\n');
         // New elements each tick restyle and lay out the overlay for nothing when no time changed.
         if (text === this.legendText) return;
         this.legendText = text;
-        this.legend.replaceChildren(...names.map((name, k) => {
-            const li = document.createElement('li');
-            li.dataset.pass = name;
-            const swatch = Object.assign(document.createElement('span'), { className: 'swatch' });
-            swatch.style.background = this.colorOf(name);
-            const ms = values[k].at(-1);
-            const span = (className, textContent) => Object.assign(document.createElement('span'), { className, textContent });
-            li.append(swatch, span('pass-name', name), span('pass-ms', Number.isFinite(ms) ? ms.toFixed(1) : '–'));
+        // Rows are kept per pass and only their times written (new rows would be styled and laid out
+        // again, about a hundred objects, at every tick while times change); a pass new to the list
+        // gets a row, and the rows are put in order only when the order changed.
+        const byName = new Map([...this.legend.children].map((li) => [li.dataset.pass, li]));
+        const rows = names.map((name, k) => {
+            let li = byName.get(name);
+            if (!li) {
+                li = document.createElement('li');
+                li.dataset.pass = name;
+                const swatch = Object.assign(document.createElement('span'), { className: 'swatch' });
+                swatch.style.background = this.colorOf(name);
+                const span = (className) => Object.assign(document.createElement('span'), { className });
+                li.append(swatch, Object.assign(span('pass-name'), { textContent: name }), span('pass-ms'));
+            }
+            const ms = li.querySelector('.pass-ms');
+            if (ms.textContent !== msText(times[k])) ms.textContent = msText(times[k]);
             return li;
-        }));
+        });
+        const shown = this.legend.children;
+        if (rows.length !== shown.length || rows.some((li, k) => shown[k] !== li)) this.legend.replaceChildren(...rows);
     }
 
     resize() {

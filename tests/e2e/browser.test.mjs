@@ -440,6 +440,17 @@ test('the stats overlay shows fps, latency, times, bytes and per-pass timings', 
     for (const name of ['shadow_map', 'gbuffer', 'vpl_gather']) {
         assert.ok(passNames.includes(name), `legend has ${name}: ${passNames}`);
     }
+    // New times for the same passes are written into the rows already there.
+    const legendBefore = await page.evaluate(() => {
+        document.querySelector('#ov-legend li[data-pass="vpl_gather"]').dataset.mark = 'kept';
+        return document.querySelector('#ov-legend').textContent;
+    });
+    await drag(page, -20);
+    await until('the legend\'s times changed', (before) => document.querySelector('#ov-legend').textContent !== before,
+        legendBefore);
+    assert.equal(await page.evaluate(() => document.querySelector('#ov-legend li[data-pass="vpl_gather"]')?.dataset.mark),
+        'kept', `the row was kept, its time rewritten: ${JSON.stringify(legendBefore)} -> ${
+            JSON.stringify(await page.evaluate(() => document.querySelector('#ov-legend').textContent))}`);
     assert.ok(await page.locator('#ov-chart canvas').count() > 0, 'uPlot drew the chart');
     const rateLine = await page.locator('#ov-rate').textContent();
     assert.match(rateLine, /\d+ fps · input→frame \d+ ms · decode \d+\.\d ms/);
