@@ -42,5 +42,5 @@ export function patchPlacement(stats, header) {
  */
 export function figuresDue(stats, now, lastShownAt, periodMs) {
     if (!stats?.patch || stats.refine?.complete) return true;
-    return !(now - lastShownAt < periodMs);
+    return now - lastShownAt >= periodMs;
 }

@@ -1363,6 +1363,9 @@ void Session::workerMain() {
         const std::string& refineNote = quality.why;
         const nlohmann::json& budgetJson = quality.budget;
         const std::string& budgetKey = quality.budgetKey;
+        // A refinement step renders in tiles that input stops between (and its effect plan stops too).
+        const bool refinement = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
+                                                 step == static_cast<int>(Step::Final));
 #if GIS_HAVE_EFFECTS
         // The effect plan: measured again only when the scene, the parameters, or the camera or light
         // change materially, never every frame.
@@ -1375,9 +1378,7 @@ void Session::workerMain() {
                     // A refinement step's plan (tens of ms of rays) stops for input like its tiles;
                     // a frame that answers input, or a snapshot, plans to the end.
                     EffectPlanOptions options;
-                    const bool refining = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
-                                                           step == static_cast<int>(Step::Final));
-                    if (refining) options.stop = [this] { return inputPending(); };
+                    if (refinement) options.stop = [this] { return inputPending(); };
                     EffectPlan fresh = planEffects(*scene, *rays, state, options);
                     if (fresh.stopped) {
                         // Whatever stopped it is served first; the step comes again after it.
@@ -1391,8 +1392,7 @@ void Session::workerMain() {
                 applyEffectPlan(state, plan);
                 std::lock_guard lock(mMutex);
                 mPlanPendingShown = false;
-            } else if (!raysFailed && !snapshotFor &&
-                       (step == static_cast<int>(Step::Balanced) || step == static_cast<int>(Step::Final))) {
+            } else if (!raysFailed && refinement) {
                 // A refinement step waits for the structure (input does not: it still renders at
                 // once), and is taken up again when the build ends.
                 bool wait = false;
@@ -1423,8 +1423,6 @@ void Session::workerMain() {
             }
         }
 #endif
-        const bool refinement = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
-                                                 step == static_cast<int>(Step::Final));
         if (refinement) {
             const RefineResult result = refineInTiles(w, state, step, stream, refineNote);
             if (result == RefineResult::Failed) break;
