@@ -83,7 +83,8 @@ const ms0 = (v) => (Number.isFinite(v) ? `${Math.round(v)} ms` : '–');
 
 /**
  * A frame's `stats.budget` as one overlay line and its reason, or null without one:
- * "budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31 · detail within 1 px, light views 1 texel".
+ * "budget 80 ms: predicted 70 ms · VPLs 256 of 1024 · scale 0.31 · detail within 1 px, light views 1 texel
+ * · maps 2048/512 of 4096/1024".
  */
 export function budgetLine(budget) {
     if (!budget || typeof budget !== 'object') return null;
@@ -106,6 +107,13 @@ export function budgetLine(budget) {
     if (eye && lights) parts.push(`detail within ${eye}, light views ${lights}`);
     else if (eye) parts.push(`detail within ${eye}`);
     else if (lights) parts.push(`light views within ${lights}`);
+    // Light views drawn again at smaller sides than the parameters ask (shadow maps / RSMs, texels).
+    const maps = budget.light_view_cap;
+    if (maps && typeof maps === 'object' && Number.isFinite(maps.shadow_side)) {
+        const rsm = Number.isFinite(maps.rsm_side);
+        parts.push(`maps ${maps.shadow_side}${rsm ? `/${maps.rsm_side}` : ''} of ` +
+            `${maps.shadow_side_asked}${rsm ? `/${maps.rsm_side_asked}` : ''}`);
+    }
     return {
         text: `budget ${ms0(budget.target_ms)}: ${parts.join(' · ')}`,
         reason: typeof budget.reason === 'string' ? budget.reason : '',

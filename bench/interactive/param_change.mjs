@@ -3,7 +3,8 @@
 // frame that answers them (render time, the environment probes' plan), then the answers to --moves
 // camera moves 2 s apart, then drags the scene's first light for --drag-s seconds (each interactive
 // frame answered with the light moved a little, so every frame draws the light views again): the
-// drag's frame times p50 / p95 and the size the frame budget rendered at.
+// drag's frame times p50 / p95 and the size the frame budget rendered at, each with the light views'
+// sides (shadow/rsm texels, and the parameters' when the budget drew them smaller).
 // docs/interactive.md, "The costliest frame parameters".
 // usage: node bench/interactive/param_change.mjs [--server PATH] [--scene builtin:gallery]
 //        [--technique multires_gather] [--params '{"env_size": 512, "env_samples": 256}'] [--moves 3] [--drag-s 6]
@@ -25,7 +26,14 @@ const interactiveAfter = async (what, frame, timeoutMs = 120000) => {
     await link.until(what, () => link.frames.some((f) => f.stats.frame > frame && f.stats.quality === 'interactive'), timeoutMs);
     return link.frames.find((f) => f.stats.frame > frame && f.stats.quality === 'interactive').stats;
 };
+// The light views' sides the frame drew or kept, "shadow/rsm", with the parameters' when larger.
+const maps = (s) => {
+    const l = s.lighting ?? {};
+    const drawn = `${l.shadow_side}/${l.rsm_side}`;
+    return l.shadow_side_asked ? `${drawn} of ${l.shadow_side_asked}/${l.rsm_side_asked}` : drawn;
+};
 const summary = (s) => ({ frame_ms: +s.frame_ms.toFixed(1), size: s.size, input_wait_ms: s.input?.wait_ms ?? null,
+    maps: maps(s), maps_kept: Boolean(s.counts?.light_views_reused),
     env: s.counts?.env_probes ? `${s.counts.env_probes} of ${s.counts.env_probes_wanted} probes at ${s.counts.env_size}` : null });
 try {
     await link.until('the first frame', () => link.stats);
@@ -63,7 +71,7 @@ try {
         await sleep(opts['drag-s'] * 1000);
         link.onFrame = null;
         report.drag = { frames: times.length, frame_ms_p50: +percentile(times, 0.5).toFixed(1),
-            frame_ms_p95: +percentile(times, 0.95).toFixed(1), last_size: link.stats.size };
+            frame_ms_p95: +percentile(times, 0.95).toFixed(1), last_size: link.stats.size, last_maps: maps(link.stats) };
     }
     console.log(JSON.stringify(report));
 } finally {

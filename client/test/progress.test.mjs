@@ -208,6 +208,14 @@ test('a frame\'s budget reads as one line with its reason', () => {
         'budget 80 ms: predicted 12 ms · VPLs 64 · detail within 1 px, light views 1 texel', 'and in the light views');
     assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, light_lod_texels: 0.5 }).text,
         'budget 80 ms: predicted 12 ms · VPLs 64 · light views within 0.5 texels');
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, light_view_cap: { shadow_side: 2048,
+        rsm_side: 512, shadow_side_asked: 4096, rsm_side_asked: 1024, predicted_ms: 19 } }).text,
+    'budget 80 ms: predicted 12 ms · VPLs 64 · maps 2048/512 of 4096/1024', 'light views drawn smaller');
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, light_view_cap: { shadow_side: 1024,
+        rsm_side: null, shadow_side_asked: 4096, rsm_side_asked: 256 } }).text,
+    'budget 80 ms: predicted 12 ms · VPLs 64 · maps 1024 of 4096', 'shadow maps alone (no RSM read)');
+    assert.equal(budgetLine({ target_ms: 80, vpls: 64, predicted_ms: 12, light_view_cap: null }).text,
+        'budget 80 ms: predicted 12 ms · VPLs 64');
     const receivers = budgetLine({ target_ms: 80, vpls: 4096, vpl_cap: null, receiver_share_cap: 0.04,
         receiver_capped_vpls: 361, predicted_ms: 70, reason: 'fits; this view\'s receivers exceed the cap' });
     assert.equal(receivers.text, 'budget 80 ms: predicted 70 ms · VPLs 361 of 4096 (receiver cap)',

@@ -60,6 +60,16 @@ struct FrameState {
         int count = 1;
         bool active() const { return count > 1; }
     } vplPart;
+    /// The live view's interactive frames (session/FrameBudget.h): when this frame must draw its light
+    /// views again (the lights or their parameters changed), it draws them at most this many texels
+    /// per side, shadow maps and RSMs apart; maps kept from an earlier frame of the same lights serve
+    /// as they are when their side lies between the cap and what the parameters ask. 0: no cap, the
+    /// parameters' sides (every other frame).
+    struct LightViewCap {
+        int shadowSide = 0;
+        int rsmSide = 0;
+        bool active() const { return shadowSide > 0 || rsmSide > 0; }
+    } lightViewCap;
     std::string technique = "rsm_gather";
     ParamSet frameParams;     ///< frameParamTable(): exposure, tone map, shadow and RSM sizes
     ParamSet techniqueParams; ///< the technique's own table

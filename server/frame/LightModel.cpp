@@ -179,6 +179,17 @@ int lightViewSide(int fullSide, int defaultSide, int views, int minSide) {
     return side;
 }
 
+LightViewSides lightViewSides(int askedShadow, int askedRsm, int capShadow, int capRsm, bool readsRsm,
+                              const KeptLightViews& kept) {
+    const int lowShadow = capShadow > 0 ? std::min(capShadow, askedShadow) : askedShadow;
+    const int lowRsm = capRsm > 0 ? std::min(capRsm, askedRsm) : askedRsm;
+    const auto serves = [](int side, int low, int high) { return side >= low && side <= high; };
+    if (kept.sameLights && serves(kept.shadowSide, lowShadow, askedShadow) &&
+        (!readsRsm || serves(kept.rsmSide, lowRsm, askedRsm)))
+        return {kept.shadowSide, kept.rsmSide, true};
+    return {lowShadow, lowRsm, false};
+}
+
 namespace {
 
 // An orthographic view along `axis` holding every corner of the bounds: the light-space box of the

@@ -126,4 +126,26 @@ LightSetModel makeLightSet(const FrameState& state, const Bounds& sceneBounds);
 /// `minSide`).
 int lightViewSide(int fullSide, int defaultSide, int views, int minSide);
 
+/// The light views an earlier frame left drawn: whether they show this frame's lights (the same light
+/// block, solid-angle rule, RSMs when this frame reads them, level of detail) and their sides.
+struct KeptLightViews {
+    bool sameLights = false;
+    int shadowSide = 0;
+    int rsmSide = 0;
+};
+/// The sides a frame's light views have, and whether the kept maps serve it.
+struct LightViewSides {
+    int shadow = 0;
+    int rsm = 0;
+    bool keep = false;
+};
+/// A frame asking for maps of `askedShadow` and `askedRsm` texels (after lightViewSide) under a cap
+/// of `capShadow` and `capRsm` (FrameState::LightViewCap; 0: none): kept maps of the same lights
+/// serve when each side lies between the capped and the asked side (at the asked side only, without
+/// a cap), so a camera move after a capped light drag, or after a refinement step drew them whole,
+/// draws nothing; else they are drawn at the capped sides. `readsRsm` false: the RSMs' side does not
+/// decide (the frame does not read them).
+LightViewSides lightViewSides(int askedShadow, int askedRsm, int capShadow, int capRsm, bool readsRsm,
+                              const KeptLightViews& kept);
+
 } // namespace gis

@@ -45,6 +45,10 @@ struct TechniqueInfo {
     /// step predicted from a frame with far fewer VPLs scales only these (AdaptiveQuality). Empty: the
     /// whole frame is taken to scale. tests/gl/TechniquesGlTest.cpp checks that a frame has each.
     std::vector<std::string> vplPasses;
+    /// The passes that run only when the light views are drawn again and whose time grows with the
+    /// RSMs' texels (the light tree built over them): the frame budget counts them with the light
+    /// views rather than with the pixels (session/FrameBudget.h). Empty: none.
+    std::vector<std::string> lightViewPasses;
     /// Effect knobs the effect plan may set (docs/effects.md): the multiresolution eye hierarchy
     /// (coarsest_size and the discontinuity thresholds of gi/common/ParamSpecs.h), VPL visibility
     /// (vpl_shadows) and bias compensation (clamp_b, ssbc_iterations).

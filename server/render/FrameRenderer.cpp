@@ -509,18 +509,43 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     GIS_ASSERT(state.width > 0 && state.height > 0);
     Stopwatch frameClock;
     const ParamSet& fp = state.frameParams;
-    const LightSetModel lightSet = makeLightSet(state, mScene->bounds);
+    LightSetModel lightSet = makeLightSet(state, mScene->bounds);
     const int views = static_cast<int>(lightSet.views.size());
+    shader::LightUniforms& lights = *mLightBlock;
+    lights = shader::LightUniforms{};
+    writeLightUniforms(lightSet, lights);
+    if (mLevelsOnDemand && wantsLevels(state) && !mSceneGpu->hasLevels())
+        mSceneGpu->setLevels(SceneGpu::prepareLevels(*mScene));
+
+    // The light views depend on the lights, the scene and the RSM's solid-angle rule only, never on
+    // the camera: with reuse on, an unchanged light block keeps last frame's maps (an orbit or the
+    // tiles of one refinement step render them once). Maps drawn at a finer level of detail than this
+    // frame tolerates serve it as well; coarser ones never serve a frame that asks for more detail
+    // (an API render after a live view's light drag). An interactive frame's cap (FrameState::
+    // LightViewCap) draws them smaller and lets kept maps of any side between it and the asked serve.
+    const bool readsRsm = findTechniqueInfo(state.technique).readsRsm;
+    const float solidAngleEqual = fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f;
+    const float lightLodWanted =
+        std::clamp(static_cast<float>(fp.getFloat("light_lod_texels")), 0.0f, kLightLodMaxTexels);
+    const float lightLodTexels = mSceneGpu->hasLevels() ? lightLodWanted : 0.0f;
+    const glm::vec2 lightKey(solidAngleEqual, readsRsm ? 1.0f : 0.0f);
+    const KeptLightViews kept{mReuseLightPasses && mLightPassesValid && lightKey == mLightPassKey &&
+                                  mLightPassLodTexels <= lightLodTexels &&
+                                  std::memcmp(mLightPassBlock.get(), &lights, sizeof lights) == 0,
+                              mLightPassShadowSide, mLightPassRsmSide};
+    const int askedShadowSide = lightSet.shadowSide, askedRsmSide = lightSet.rsmSide;
+    const LightViewSides sides = lightViewSides(askedShadowSide, askedRsmSide, state.lightViewCap.shadowSide,
+                                                state.lightViewCap.rsmSide, readsRsm, kept);
+    const bool reuseLights = sides.keep;
+    lightSet.shadowSide = sides.shadow;
+    lightSet.rsmSide = sides.rsm;
     ensureTargets(state.width, state.height, lightSet.rsmSide, lightSet.shadowSide, views);
     ensureTechnique(state.technique, state.width, state.height);
     const Reflections::Decision nonDiffuse =
         mReflections.decide(*mScene, *mSceneGpu, fp, mTechnique->glossyTransport(state.techniqueParams));
 
-    // Frame and light uniforms.
+    // Frame uniforms.
     shader::FrameUniforms u{};
-    shader::LightUniforms& lights = *mLightBlock;
-    lights = shader::LightUniforms{};
-    writeLightUniforms(lightSet, lights);
     float widestTan = 0.0f;
     for (const LightViewModel& v : lightSet.views)
         if (!v.orthographic) widestTan = std::max(widestTan, v.tanHalfFov);
@@ -530,10 +555,6 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     // which the shadow lookup's normal offset covers; offsetting it by the level's error as well was
     // measured worse: docs/interactive.md, "Level of detail").
     const auto lodPixels = static_cast<float>(fp.getFloat("lod_pixels"));
-    const auto lightLodWanted =
-        std::clamp(static_cast<float>(fp.getFloat("light_lod_texels")), 0.0f, kLightLodMaxTexels);
-    if (mLevelsOnDemand && wantsLevels(state) && !mSceneGpu->hasLevels())
-        mSceneGpu->setLevels(SceneGpu::prepareLevels(*mScene));
     const LodView lod{state.camera.position,
                       lodErrorPerMetre(lodPixels, state.camera.yfovRadians,
                                        state.window.active() ? state.window.fullHeight : state.height)};
@@ -542,9 +563,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     u.viewport = glm::vec4(state.width, state.height, 1.0f / state.width, 1.0f / state.height);
     u.rsmInfo = glm::vec4(lightSet.rsmSide, widestTan > 0.0f ? widestTan : 1.0f, lightSet.shadowSide,
                           fp.getInt("pcf_radius"));
-    u.toneInfo = glm::vec4(static_cast<float>(std::exp2(frameExposureEv(state))),
-                           fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f, lightOn ? 1.0f : 0.0f,
-                           fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f);
+    u.toneInfo =
+        glm::vec4(static_cast<float>(std::exp2(frameExposureEv(state))),
+                  fp.getEnum("tonemap") == "filmic" ? 1.0f : 0.0f, lightOn ? 1.0f : 0.0f, solidAngleEqual);
     const bool phong = fp.getEnum("specular_lobe") == "phong";
     u.shadingInfo =
         glm::vec4(phong ? 1.0f : 0.0f, fp.getFloat("glossy_split"), nonDiffuse.specular ? 1.0f : 0.0f, 0.0f);
@@ -583,18 +604,6 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glDisable(GL_CULL_FACE);
     std::vector<double> viewFlux;
     DrawCount lightDraws;
-    const bool readsRsm = findTechniqueInfo(state.technique).readsRsm;
-    // The light views depend on the lights, the scene and the RSM's solid-angle rule only, never on
-    // the camera: with reuse on, an unchanged light block keeps last frame's maps (an orbit or the
-    // tiles of one refinement step render them once).
-    const glm::vec4 lightKey(static_cast<float>(lightSet.rsmSide), static_cast<float>(lightSet.shadowSide),
-                             u.toneInfo.w, readsRsm ? 1.0f : 0.0f);
-    // Maps drawn at a finer level of detail than this frame tolerates serve it as well; coarser ones
-    // never serve a frame that asks for more detail (an API render after a live view's light drag).
-    const float lightLodTexels = mSceneGpu->hasLevels() ? lightLodWanted : 0.0f;
-    const bool reuseLights = mReuseLightPasses && mLightPassesValid && lightKey == mLightPassKey &&
-                             mLightPassLodTexels <= lightLodTexels &&
-                             std::memcmp(mLightPassBlock.get(), &lights, sizeof lights) == 0;
     if (reuseLights) {
         viewFlux = mLightPassFlux;
         mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
@@ -747,6 +756,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         if (!mLightPassBlock) mLightPassBlock = std::make_unique<shader::LightUniforms>();
         *mLightPassBlock = lights;
         mLightPassKey = lightKey;
+        mLightPassShadowSide = lightSet.shadowSide;
+        mLightPassRsmSide = lightSet.rsmSide;
         mLightPassLodTexels = lightLodTexels;
         mLightPassFlux = viewFlux;
         mLightPassesValid = true;
@@ -785,6 +796,12 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
         out.stats["nondiffuse"]["env"] =
             nonDiffuse.reasons["env"].get<std::string>() + "; " + mReflections.envPlanReason();
     out.stats["lighting"] = lightingStats(state, lightSet, viewFlux);
+    // Smaller maps than the parameters ask for (an interactive frame's cap, or maps it kept): what
+    // they ask (counts.light_views_reused says whether they were kept).
+    if (lightSet.shadowSide != askedShadowSide || (readsRsm && lightSet.rsmSide != askedRsmSide)) {
+        out.stats["lighting"]["shadow_side_asked"] = askedShadowSide;
+        out.stats["lighting"]["rsm_side_asked"] = askedRsmSide;
+    }
     if (!mNotShown.empty()) out.stats["not_shown"] = mNotShown;
     return out;
 }

@@ -242,7 +242,9 @@ private:
     bool mReuseLightPasses = false;
     bool mLightPassesValid = false; ///< the maps hold mLightPassBlock's views
     std::unique_ptr<shader::LightUniforms> mLightPassBlock;
-    glm::vec4 mLightPassKey{0.0f};
+    glm::vec2 mLightPassKey{0.0f}; ///< the solid-angle rule and whether the RSMs were drawn
+    int mLightPassShadowSide = 0;  ///< the kept maps' sides
+    int mLightPassRsmSide = 0;
     float mLightPassLodTexels = 0.0f; ///< the texels of level-of-detail error the maps were drawn with
     std::vector<double> mLightPassFlux;
 

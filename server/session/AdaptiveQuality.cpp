@@ -305,10 +305,14 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& e
     if (frameTargetMs > 0) {
         mBudget.setTargetMs(frameTargetMs);
         const TechniqueInfo& info = findTechniqueInfo(p.state.technique);
+        const ParamSet& fp = p.state.frameParams;
+        const LightViewAsk lightViews{fp.has("shadow_map_size") ? fp.getInt("shadow_map_size") : 0,
+                                      fp.has("rsm_size") ? fp.getInt("rsm_size") : 0, info.readsRsm};
         const BudgetChoice choice =
             mBudget.choose(p.budgetKey, requestedVpls, static_cast<bool>(info.limitVpls),
-                           static_cast<double>(p.state.width) * p.state.height);
+                           static_cast<double>(p.state.width) * p.state.height, lightViews);
         p.scale = choice.scale;
+        p.state.lightViewCap = {choice.shadowSideCap, choice.rsmSideCap};
         if (choice.vplCap > 0 && info.limitVpls) info.limitVpls(p.state.techniqueParams, choice.vplCap);
         // A cap the client set itself stays.
         const bool capReceivers = choice.receiverShareCap > 0.0 && info.capReceiverShare &&

@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <vector>
 
+#include "frame/FrameParams.h"
+#include "frame/LightModel.h"
+
 namespace gis {
 namespace {
 
@@ -28,7 +31,7 @@ double receiverShareCapAfter(double lastShare, bool lastCut) {
 }
 
 FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
-                             double vplCostExponent) {
+                             double vplCostExponent, const std::vector<std::string>& lightViewPasses) {
     FrameCost cost;
     cost.pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
     cost.vpls = askedVpls;
@@ -47,6 +50,40 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
             cost.receiverShare = std::min(cost.receiverShare, cap);
             cost.receiverCut = true;
         }
+    }
+    // The light views, when this frame drew them: their passes' times (gpu_ms, as technique_ms sums).
+    const nlohmann::json lighting = stats.value("lighting", nlohmann::json::object());
+    const nlohmann::json passes = stats.value("passes", nlohmann::json::array());
+    double shadowMs = 0, rsmMs = 0, techniqueLightMs = 0;
+    bool shadowPass = false;
+    for (const nlohmann::json& pass : passes) {
+        if (!pass.is_object()) continue;
+        const std::string name = pass.value("name", std::string());
+        double ms = pass.value("gpu_ms", 0.0);
+        if (!std::isfinite(ms) || ms < 0.0) ms = 0.0;
+        if (name == "shadow_map") {
+            shadowPass = true;
+            shadowMs += ms;
+        } else if (name == "rsm" || name == "rsm_flux") {
+            rsmMs += ms;
+        } else if (std::find(lightViewPasses.begin(), lightViewPasses.end(), name) != lightViewPasses.end()) {
+            rsmMs += ms;
+            techniqueLightMs += ms;
+        }
+    }
+    const int views = lighting.value("views", 0);
+    cost.lightViews = std::max(views, 0);
+    if (shadowPass && views > 0 && !counts.contains("light_views_reused")) {
+        const auto texels = [&](const char* side) {
+            const double s = lighting.value(side, 0.0);
+            return std::isfinite(s) && s > 0.0 ? double(views) * s * s : 0.0;
+        };
+        cost.drewLightViews = true;
+        cost.shadowTexels = texels("shadow_side");
+        cost.shadowMs = shadowMs;
+        cost.rsmTexels = rsmMs > 0.0 ? texels("rsm_side") : 0.0;
+        cost.rsmMs = rsmMs;
+        cost.lightViewTechniqueMs = std::min(techniqueLightMs, std::max(cost.techniqueMs, 0.0));
     }
     return cost;
 }
@@ -77,6 +114,14 @@ nlohmann::json BudgetChoice::toJson(double targetMs, long requestedVpls) const {
             {"receiver_share_cap",
              receiverShareCap > 0 ? nlohmann::json(receiverShareCap) : nlohmann::json(nullptr)},
             {"predicted_ms", predictedMs},
+            {"light_view_cap", shadowSideCap > 0 || rsmSideCap > 0
+                                   ? nlohmann::json{{"shadow_side", shadowSideCap},
+                                                    {"rsm_side", rsmSideCap > 0 ? nlohmann::json(rsmSideCap)
+                                                                                : nlohmann::json(nullptr)},
+                                                    {"shadow_side_asked", shadowSideAsked},
+                                                    {"rsm_side_asked", rsmSideAsked},
+                                                    {"predicted_ms", lightViewMs}}
+                                   : nlohmann::json(nullptr)},
             {"reason", reason}};
 }
 
@@ -102,8 +147,13 @@ double FrameBudget::vplPassesMs(const std::string& key, double pixels, long vpls
 void FrameBudget::record(const std::string& key, const FrameCost& cost) {
     if (!(cost.pixels > 0) || !std::isfinite(cost.frameMs) || cost.frameMs < 0) return;
     Rates& r = mRates[key];
-    const double technique = std::clamp(cost.techniqueMs, 0.0, cost.frameMs);
-    const double base = (cost.frameMs - technique) / cost.pixels;
+    // The light views' passes are the light views' (their own rates below), not the pixels'.
+    const double lightMs =
+        cost.drewLightViews ? std::max(cost.shadowMs, 0.0) + std::max(cost.rsmMs, 0.0) : 0.0;
+    const double technique = std::clamp(
+        cost.techniqueMs - (cost.drewLightViews ? cost.lightViewTechniqueMs : 0.0), 0.0, cost.frameMs);
+    const double base =
+        std::max(cost.frameMs - technique - std::min(lightMs, cost.frameMs - technique), 0.0) / cost.pixels;
     const double encode = std::max(cost.encodeMs, 0.0) / cost.pixels;
     const double exponent = usableVplCostExponent(cost.vplCostExponent);
     if (exponent != r.exponent) r.frames = 0; // another model: start its means again
@@ -124,13 +174,84 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
         std::isfinite(cost.receiverShare) && cost.receiverShare >= 0.0 ? cost.receiverShare : -1;
     r.receiverCut = r.receiverShare >= 0.0 && cost.receiverCut;
     ++r.frames;
+    if (cost.lightViews > 0) r.lightViews = cost.lightViews;
+    r.lastDrewLightViews = cost.drewLightViews;
+    if (cost.drewLightViews) {
+        // As the frame's rates: the newest drawing weighs half, the first one whole.
+        const double al = r.lightFrames == 0 ? 1.0 : 0.5;
+        if (cost.shadowTexels > 0.0)
+            r.shadowTexel += al * (cost.shadowMs / cost.shadowTexels - r.shadowTexel);
+        if (cost.rsmTexels > 0.0) r.rsmTexel += al * (cost.rsmMs / cost.rsmTexels - r.rsmTexel);
+        ++r.lightFrames;
+    }
 }
 
-BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, bool cappable,
-                                 double fullPixels) {
+void FrameBudget::chooseLightViews(const Rates* rates, const LightViewAsk& ask, BudgetChoice& out) const {
+    if (ask.shadowMapSize <= 0 || ask.rsmSize <= 0) return;
+    const ParamTable& table = frameParamTable();
+    const int shadowDefault = static_cast<int>(table.find("shadow_map_size")->defaultValue);
+    const int rsmDefault = static_cast<int>(table.find("rsm_size")->defaultValue);
+    const int views = rates ? std::max(rates->lightViews, 1) : 1;
+    // As the renderer sizes them (LightModel.h), and never below the defaults' sides (or the asked,
+    // when smaller): larger maps are a still view's.
+    const int shadowAsked = lightViewSide(ask.shadowMapSize, shadowDefault, views, 64);
+    const int rsmAsked = lightViewSide(ask.rsmSize, rsmDefault, views, 16);
+    const int shadowFloor = std::min(shadowAsked, lightViewSide(shadowDefault, shadowDefault, views, 64));
+    const int rsmFloor =
+        ask.readsRsm ? std::min(rsmAsked, lightViewSide(rsmDefault, rsmDefault, views, 16)) : rsmAsked;
+    out.shadowSideAsked = shadowAsked;
+    out.rsmSideAsked = rsmAsked;
+    const auto ms = [&](int shadow, int rsm) {
+        if (!rates) return 0.0;
+        const double v = views;
+        return v * double(shadow) * shadow * rates->shadowTexel +
+               (ask.readsRsm ? v * double(rsm) * rsm * rates->rsmTexel : 0.0);
+    };
+    int shadow = shadowAsked, rsm = rsmAsked;
+    const bool measured = rates && rates->lightFrames > 0;
+    const double allowed = kLightViewShareOfFrame * mConfig.targetMs;
+    if (shadow > shadowFloor || rsm > rsmFloor) {
+        if (!measured) {
+            shadow = shadowFloor;
+            rsm = rsmFloor;
+        } else {
+            // Halve the dearer of the two maps (above its floor) until they fit their share.
+            while (ms(shadow, rsm) > allowed) {
+                const double shadowPart = ms(shadow, 0), rsmPart = ms(0, rsm);
+                const bool shadowCan = shadow > shadowFloor, rsmCan = rsm > rsmFloor;
+                if (!shadowCan && !rsmCan) break;
+                if (shadowCan && (!rsmCan || shadowPart >= rsmPart))
+                    shadow = std::max(shadowFloor, shadow / 2);
+                else
+                    rsm = std::max(rsmFloor, rsm / 2);
+            }
+        }
+    }
+    out.lightViewMs = ms(shadow, rsm);
+    if (shadow == shadowAsked && rsm == rsmAsked) return;
+    out.shadowSideCap = shadow;
+    out.rsmSideCap = ask.readsRsm ? rsm : 0;
+    std::string sides =
+        "shadow maps " + std::to_string(shadow) + " of " + std::to_string(shadowAsked) + " texels";
+    if (ask.readsRsm) sides += ", RSMs " + std::to_string(rsm) + " of " + std::to_string(rsmAsked);
+    out.lightViewReason = measured ? "light views drawn again at " + sides +
+                                         fmt(" (%.0f ms predicted; they may take %.0f ms of the target)",
+                                             out.lightViewMs, allowed)
+                                   : "light views drawn again at " + sides +
+                                         ": their cost on this scene and technique is not measured yet, so "
+                                         "the defaults' sides first";
+}
+
+BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, bool cappable, double fullPixels,
+                                 const LightViewAsk& lightViews) {
     const Config& c = mConfig;
     BudgetChoice out;
     auto it = mRates.find(key);
+    chooseLightViews(it == mRates.end() ? nullptr : &it->second, lightViews, out);
+    const auto withLightViews = [&out] {
+        if (!out.lightViewReason.empty()) out.reason += "; " + out.lightViewReason;
+        return out;
+    };
     // The first two frames of a scene and technique are small ones. The first has nothing measured;
     // the first's time included compiling the technique's shaders and uploading what the scene's first
     // draw needs (471 ms for cornell's first multires_gather frame, against about 60 ms for the next
@@ -146,7 +267,7 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
                                         "included compiling its shaders") +
             ", so a small one (" + fmt("%.2f", out.scale) + " of the size" +
             (out.vplCap > 0 ? ", " + std::to_string(out.vplCap) + " VPLs" : std::string()) + ")";
-        return out;
+        return withLightViews();
     }
     Rates& rates = it->second;
     if (rates.receiverShare >= 0.0)
@@ -154,6 +275,9 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     // After a frame the cap cut, the next one may gather a quarter more per pixel and VPL (its cap
     // grows so): the technique's passes, which the gather then dominates, are predicted so.
     const double workGrowth = rates.receiverCut ? kCutReceiverShareGrowth : 1.0;
+    // A frame after one that drew its light views probably draws them too (a light drag): their
+    // predicted time comes first, whatever the size.
+    const double lightViewMs = rates.lastDrewLightViews ? out.lightViewMs : 0.0;
     // The ladder from the best frame to the cheapest: size down to the preferred minimum, then VPLs
     // down, then size down to the minimum.
     std::vector<Candidate> ladder;
@@ -175,7 +299,8 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     for (int i = 0; i < static_cast<int>(ladder.size()); ++i) {
         const Candidate& cand = ladder[static_cast<size_t>(i)];
         const long vpls = cand.vpls > 0 ? cand.vpls : requestedVpls;
-        const double ms = predict(rates, fullPixels * cand.scale * cand.scale, vpls, workGrowth);
+        const double ms =
+            predict(rates, fullPixels * cand.scale * cand.scale, vpls, workGrowth) + lightViewMs;
         // Climbing above the last choice needs 15 % headroom, so measurement noise does not make the
         // size flicker between two frames.
         const double allowed = previous >= 0 && i < previous ? target * 0.85 : target;
@@ -204,7 +329,7 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
                  ? " and " + std::to_string(out.vplCap) + " of " + std::to_string(requestedVpls) + " VPLs"
                  : std::string()) +
             fmt(" meet the %.0f ms target (%.0f ms predicted from this session's frames)", target, predicted);
-    return out;
+    return withLightViews();
 }
 
 } // namespace gis

@@ -15,10 +15,19 @@
 // frame's receiver share instead, or a quarter above the last cap after a frame it cut, which the
 // prediction then adds to the technique's passes (receiverShareCapAfter,
 // TechniqueInfo::capReceiverShare).
+//
+// The light views (shadow maps, RSMs and what is built over them, TechniqueInfo::lightViewPasses)
+// cost per texel, not per pixel, and only in frames that draw them again (a light drag, a changed
+// light parameter; an orbit keeps them). Their rates are kept apart, per texel of each kind of map:
+// a frame that draws them is predicted with them when the frame before drew them too, and when their
+// sides exceed the defaults' the frame draws them at most large enough to take kLightViewShareOfFrame
+// of the target (never below the defaults' sides): a drag at rsm_size 1024 otherwise shrank the
+// image to a tenth of its size (docs/interactive.md, "Light views in interactive frames").
 #pragma once
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -40,14 +49,32 @@ struct FrameCost {
     /// technique has no receiver list.
     double receiverShare = -1;
     bool receiverCut = false; ///< the cap cut the frame's VPLs (receiverShare is then the cap)
+    /// The light views, when the frame drew them (counts.light_views_reused absent and a shadow_map
+    /// pass timed): their views, texels (views x side^2) and ms (shadow_map; rsm, rsm_flux and the
+    /// technique's lightViewPasses). lightViewTechniqueMs is the part of techniqueMs among them.
+    bool drewLightViews = false;
+    int lightViews = 0;
+    double shadowTexels = 0, shadowMs = 0;
+    double rsmTexels = 0, rsmMs = 0;
+    double lightViewTechniqueMs = 0;
 
     /// A rendered frame's cost from its stats (frame_ms, technique_ms, counts, params) at width x
     /// height, whose parameters asked for `askedVpls` (vplEstimate), which it counts whether or not the
     /// receiver cap cut them (counts.receiver_share_capped_vpls): its time is the time of a frame that
     /// asks for them, under a cap. encodeMs stays 0.
     static FrameCost ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
-                             double vplCostExponent);
+                             double vplCostExponent, const std::vector<std::string>& lightViewPasses = {});
 };
+
+/// The light views a frame's parameters ask for: shadow_map_size and rsm_size, and whether the
+/// technique reads the RSMs (TechniqueInfo::readsRsm).
+struct LightViewAsk {
+    int shadowMapSize = 0; ///< 0: not known (no cap)
+    int rsmSize = 0;
+    bool readsRsm = true;
+};
+/// The share of the frame target that the light views may take in a frame that draws them again.
+inline constexpr double kLightViewShareOfFrame = 0.35;
 
 /// What the next interactive frame renders with, and why.
 struct BudgetChoice {
@@ -57,6 +84,12 @@ struct BudgetChoice {
     /// The gather's work cap for the next frame (TechniqueInfo::capReceiverShare), receivers per pixel;
     /// 0: none (nothing measured, or the technique has no receivers).
     double receiverShareCap = 0;
+    /// FrameState::LightViewCap for the next frame (0: none), the sides asked (after lightViewSide),
+    /// the light views' predicted ms at the capped sides, and why.
+    int shadowSideCap = 0, rsmSideCap = 0;
+    int shadowSideAsked = 0, rsmSideAsked = 0;
+    double lightViewMs = 0;
+    std::string lightViewReason;
     std::string reason;
     nlohmann::json toJson(double targetMs, long requestedVpls) const;
 };
@@ -98,7 +131,8 @@ public:
 
     /// The choice for a frame of `key` (scene/technique) whose parameters ask for `requestedVpls`
     /// (0: none) and can be capped (`cappable`) at fullPixels full-size pixels.
-    BudgetChoice choose(const std::string& key, long requestedVpls, bool cappable, double fullPixels);
+    BudgetChoice choose(const std::string& key, long requestedVpls, bool cappable, double fullPixels,
+                        const LightViewAsk& lightViews = {});
     void record(const std::string& key, const FrameCost& cost);
     /// Predicted ms of a frame of `key` at `pixels` with `vpls`; 0 when nothing is measured.
     double predictMs(const std::string& key, double pixels, long vpls) const;
@@ -115,7 +149,15 @@ private:
         bool receiverCut = false;             ///< FrameCost::receiverCut of the last frame
         int frames = 0;
         int level = -1; ///< index of the last choice in the candidate ladder
+        /// ms per texel of the shadow maps and of the RSMs (with their flux sums and the technique's
+        /// lightViewPasses), from the frames that drew them (lightFrames).
+        double shadowTexel = 0, rsmTexel = 0;
+        int lightFrames = 0;
+        bool lastDrewLightViews = false;
+        int lightViews = 1; ///< the last frame's
     };
+    /// The light views' sides and predicted ms for `ask` (BudgetChoice's light-view fields).
+    void chooseLightViews(const Rates* rates, const LightViewAsk& ask, BudgetChoice& out) const;
     /// ms at `pixels` and `vpls` from `rates`, the technique's passes times `techniqueFactor`.
     static double predict(const Rates& rates, double pixels, long vpls, double techniqueFactor);
 

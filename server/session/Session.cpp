@@ -1468,8 +1468,9 @@ void Session::workerMain() {
                      snapshotFor, snapshotCodec))
             break;
         if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
+            const TechniqueInfo& info = findTechniqueInfo(state.technique);
             FrameCost cost = FrameCost::ofFrame(frame.stats, frame.width, frame.height, vplEstimate(state),
-                                                findTechniqueInfo(state.technique).vplCostExponent);
+                                                info.vplCostExponent, info.lightViewPasses);
             {
                 std::lock_guard lock(mMutex);
                 cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);

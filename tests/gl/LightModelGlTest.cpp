@@ -223,5 +223,32 @@ TEST(LightModel, SetSkipsWithReasonsAndCapsViewTexels) {
     EXPECT_EQ(lightViewSide(256, 256, 100000, 16), 16) << "not below the floor";
 }
 
+TEST(LightModel, CappedSidesAndWhichKeptMapsServe) {
+    const KeptLightViews none{};
+    // No cap: the asked sides, and kept maps only of exactly those.
+    LightViewSides s = lightViewSides(2048, 512, 0, 0, true, none);
+    EXPECT_EQ(s.shadow, 2048);
+    EXPECT_EQ(s.rsm, 512);
+    EXPECT_FALSE(s.keep);
+    EXPECT_TRUE(lightViewSides(2048, 512, 0, 0, true, {true, 2048, 512}).keep);
+    EXPECT_FALSE(lightViewSides(2048, 512, 0, 0, true, {true, 1024, 512}).keep);
+    EXPECT_FALSE(lightViewSides(2048, 512, 0, 0, true, {false, 2048, 512}).keep) << "other lights";
+    // A cap: drawn at it, and kept maps between it and the asked serve (at their own sides).
+    s = lightViewSides(2048, 512, 1024, 128, true, none);
+    EXPECT_EQ(s.shadow, 1024);
+    EXPECT_EQ(s.rsm, 128);
+    s = lightViewSides(2048, 512, 1024, 128, true, {true, 2048, 256});
+    EXPECT_TRUE(s.keep);
+    EXPECT_EQ(s.shadow, 2048);
+    EXPECT_EQ(s.rsm, 256);
+    EXPECT_FALSE(lightViewSides(2048, 512, 1024, 128, true, {true, 512, 128}).keep) << "below the cap";
+    EXPECT_FALSE(lightViewSides(2048, 512, 1024, 128, true, {true, 4096, 128}).keep) << "above the asked";
+    // Without RSMs read, their side does not decide; a cap above the asked side is the asked side.
+    EXPECT_TRUE(lightViewSides(2048, 512, 1024, 128, false, {true, 1024, 16}).keep);
+    s = lightViewSides(1024, 256, 4096, 1024, true, none);
+    EXPECT_EQ(s.shadow, 1024);
+    EXPECT_EQ(s.rsm, 256);
+}
+
 } // namespace
 } // namespace gis::test

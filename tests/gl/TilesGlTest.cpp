@@ -147,6 +147,61 @@ TEST(TilesGl, ReusedLightViewsKeepTheLightTree) {
     }
 }
 
+// An interactive frame's cap on the light views (FrameState::LightViewCap): a frame that draws them
+// again draws them smaller, exactly as a frame asking for those sides would; kept maps of any side
+// between the cap and the asked serve; a frame without a cap draws the asked sides again.
+TEST(TilesGl, CappedLightViewsAreDrawnSmallerAndServeUntilTheAskedSidesAreWanted) {
+    ReusePair pair("builtin:cornell", "hier_isr"); // RSMs, and the light tree built over them
+    FrameRenderer &fresh = pair.fresh, &reusing = pair.reusing;
+    FrameState asked = pair.state;
+    asked.frameParams.set("shadow_map_size", 2048);
+    asked.frameParams.set("rsm_size", 512);
+    (void)reusing.render(asked);
+    const auto sides = [](const FrameOutput& f) {
+        const nlohmann::json& l = f.stats["lighting"];
+        return std::to_string(l.value("shadow_side", 0)) + "/" + std::to_string(l.value("rsm_side", 0)) +
+               (l.contains("shadow_side_asked") ? " of " + std::to_string(l.value("shadow_side_asked", 0)) +
+                                                      "/" + std::to_string(l.value("rsm_side_asked", 0))
+                                                : std::string());
+    };
+    // A light drag's frame under a cap: drawn at the cap.
+    FrameState drag = asked;
+    drag.lights[0].light.intensity *= 0.8f;
+    drag.lightViewCap = {1024, 128};
+    const FrameOutput dragged = reusing.render(drag);
+    EXPECT_EQ(sides(dragged), "1024/128 of 2048/512");
+    EXPECT_EQ(counter(dragged, "light_views_reused"), 0.0);
+    EXPECT_TRUE(hasPass(dragged, "light_tree"));
+    FrameState small = drag;
+    small.lightViewCap = {};
+    small.frameParams.set("shadow_map_size", 1024);
+    small.frameParams.set("rsm_size", 128);
+    const FrameOutput smallFrame = fresh.render(small);
+    EXPECT_EQ(sides(smallFrame), "1024/128");
+    EXPECT_EQ(dragged.rgba8, smallFrame.rgba8) << "the capped maps are the maps of those sides";
+    // An orbit after the drag, still capped: the small maps serve.
+    FrameState orbit = drag;
+    orbit.camera.position += glm::vec3(0.2f, 0.0f, 0.0f);
+    const FrameOutput orbited = reusing.render(orbit);
+    EXPECT_GT(counter(orbited, "light_views_reused"), 0.0);
+    EXPECT_EQ(sides(orbited), "1024/128 of 2048/512");
+    // A refinement step's frame (no cap) draws the asked sides; capped frames after it keep them.
+    FrameState refine = orbit;
+    refine.lightViewCap = {};
+    const FrameOutput refined = reusing.render(refine);
+    EXPECT_EQ(counter(refined, "light_views_reused"), 0.0);
+    EXPECT_EQ(sides(refined), "2048/512");
+    orbit.camera.position += glm::vec3(0.1f, 0.0f, 0.0f);
+    const FrameOutput after = reusing.render(orbit);
+    EXPECT_GT(counter(after, "light_views_reused"), 0.0);
+    EXPECT_EQ(sides(after), "2048/512");
+    // A cap above the asked sides changes nothing.
+    FrameState loose = asked;
+    loose.lights[0].light.intensity *= 0.5f;
+    loose.lightViewCap = {4096, 1024};
+    EXPECT_EQ(sides(reusing.render(loose)), "2048/512");
+}
+
 TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {
     ReusePair pair("builtin:gallery"); // a room probe and a local one
     FrameRenderer &fresh = pair.fresh, &reusing = pair.reusing;

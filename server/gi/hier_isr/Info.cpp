@@ -64,6 +64,7 @@ TechniqueInfo hierIsrInfo() {
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     info.vplPasses = {"light_tree", "vpl_gather"};
+    info.lightViewPasses = {"light_tree"};
     return info;
 }
 

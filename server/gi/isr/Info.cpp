@@ -60,6 +60,7 @@ TechniqueInfo isrInfo() {
     info.eyeHierarchy = true;
     info.biasCompensation = true;
     info.vplPasses = {"light_tree", "vpl_gather"};
+    info.lightViewPasses = {"light_tree"};
     return info;
 }
 

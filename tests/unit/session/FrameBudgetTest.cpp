@@ -334,5 +334,127 @@ TEST(FrameBudget, AJumpInReceiversIsAbsorbedWithoutAStallOrACollapse) {
     EXPECT_GT(ms, kTarget * 0.5) << "nor the budget far below its target";
 }
 
+// A light drag at large maps: a renderer whose frames cost pixels x base plus, when they draw the
+// light views, their texels at a fixed rate per map kind (shadow maps; RSMs with what is built on them).
+struct LightDragRenderer {
+    double shadowPerTexel = 2e-6, rsmPerTexel = 4e-5; // ms
+    double base = 1e-4;                               // ms per pixel
+    FrameCost frame(double pixels, int shadowSide, int rsmSide, bool drawn) const {
+        FrameCost c;
+        c.pixels = pixels;
+        c.frameMs = pixels * base;
+        c.lightViews = 1;
+        if (drawn) {
+            c.drewLightViews = true;
+            c.shadowTexels = double(shadowSide) * shadowSide;
+            c.rsmTexels = double(rsmSide) * rsmSide;
+            c.shadowMs = c.shadowTexels * shadowPerTexel;
+            c.rsmMs = c.rsmTexels * rsmPerTexel;
+            c.frameMs += c.shadowMs + c.rsmMs;
+        }
+        return c;
+    }
+};
+
+TEST(FrameBudget, LightViewsAtTheDefaultsAreNeverCapped) {
+    FrameBudget budget(FrameBudget::Config{});
+    const LightDragRenderer r;
+    const LightViewAsk defaults{1024, 256, true};
+    for (int i = 0; i < 6; ++i) {
+        const BudgetChoice c = budget.choose("k", 0, false, 960 * 800, defaults);
+        EXPECT_EQ(c.shadowSideCap, 0);
+        EXPECT_EQ(c.rsmSideCap, 0);
+        EXPECT_TRUE(c.toJson(80, 0)["light_view_cap"].is_null());
+        budget.record("k", r.frame(960 * 800 * c.scale * c.scale, 1024, 256, true));
+    }
+}
+
+TEST(FrameBudget, UnmeasuredLargeLightViewsStartAtTheDefaultsSides) {
+    FrameBudget budget(FrameBudget::Config{});
+    const BudgetChoice c = budget.choose("k", 0, false, 960 * 800, LightViewAsk{4096, 1024, true});
+    EXPECT_EQ(c.shadowSideCap, 1024);
+    EXPECT_EQ(c.rsmSideCap, 256);
+    EXPECT_NE(c.reason.find("not measured yet"), std::string::npos) << c.reason;
+    // A technique that reads no RSM: only the shadow maps are capped.
+    const BudgetChoice noRsm = budget.choose("k", 0, false, 960 * 800, LightViewAsk{4096, 1024, false});
+    EXPECT_EQ(noRsm.shadowSideCap, 1024);
+    EXPECT_EQ(noRsm.rsmSideCap, 0);
+    EXPECT_TRUE(noRsm.toJson(80, 0)["light_view_cap"]["rsm_side"].is_null());
+}
+
+TEST(FrameBudget, ALightDragAtLargeMapsKeepsTheSizeAndCapsTheDearerMap) {
+    const LightDragRenderer r;
+    const LightViewAsk large{4096, 1024, true};
+    const double full = 960 * 800;
+    // At the defaults, a drag: 1024^2 x 2e-6 = 2.1 ms of shadow maps, 256^2 x 4e-5 = 2.6 ms of RSMs.
+    FrameBudget budget(FrameBudget::Config{});
+    BudgetChoice c;
+    for (int i = 0; i < 8; ++i) {
+        c = budget.choose("k", 0, false, full, LightViewAsk{1024, 256, true});
+        budget.record("k", r.frame(full * c.scale * c.scale, 1024, 256, true));
+    }
+    const double defaultScale = c.scale;
+    // rsm_size 1024 and shadow_map_size 4096 asked: 33.6 + 41.9 ms at their full sides, over the
+    // 28 ms share of an 80 ms target. The RSMs cost more per map: halved first, to 512 (10.5 ms); then
+    // the shadow maps to 2048 (8.4 ms): 18.9 ms.
+    double lastMs = 0;
+    for (int i = 0; i < 8; ++i) {
+        c = budget.choose("k", 0, false, full, large);
+        ASSERT_GT(c.shadowSideCap, 0) << c.reason;
+        const FrameCost cost = r.frame(full * c.scale * c.scale, c.shadowSideCap, c.rsmSideCap, true);
+        lastMs = cost.frameMs;
+        budget.record("k", cost);
+    }
+    EXPECT_EQ(c.rsmSideCap, 512);
+    EXPECT_EQ(c.shadowSideCap, 2048);
+    EXPECT_EQ(c.shadowSideAsked, 4096);
+    EXPECT_EQ(c.rsmSideAsked, 1024);
+    EXPECT_NEAR(c.lightViewMs, 18.9, 0.1);
+    EXPECT_LE(lastMs, 80.0);
+    EXPECT_NE(c.reason.find("RSMs 512 of 1024"), std::string::npos) << c.reason;
+    // The pixels pay for what the light views leave of the target, not for all of it: the size
+    // stays within a few ladder steps of the drag at the defaults' (without the light views'
+    // own rates it fell to the smallest).
+    EXPECT_GE(c.scale, 0.8 * defaultScale);
+    const nlohmann::json j = c.toJson(80, 0)["light_view_cap"];
+    EXPECT_EQ(j["shadow_side"], 2048);
+    EXPECT_EQ(j["rsm_side_asked"], 1024);
+    // Frames that keep their maps (an orbit after the drag) are predicted without them, and climb.
+    budget.record("k", r.frame(full * c.scale * c.scale, 2048, 512, false));
+    const BudgetChoice orbit = budget.choose("k", 0, false, full, large);
+    EXPECT_GT(orbit.scale, c.scale);
+    EXPECT_LE(orbit.predictedMs, 80.0);
+}
+
+TEST(FrameBudget, TheLightViewsCostComesFromTheirPasses) {
+    const nlohmann::json stats = {{"frame_ms", 100.0},
+                                  {"technique_ms", 50.0},
+                                  {"counts", nlohmann::json::object()},
+                                  {"lighting", {{"views", 2}, {"shadow_side", 1024}, {"rsm_side", 512}}},
+                                  {"passes",
+                                   {{{"name", "shadow_map"}, {"gpu_ms", 8.0}},
+                                    {{"name", "rsm"}, {"gpu_ms", 6.0}},
+                                    {{"name", "rsm_flux"}, {"gpu_ms", 2.0}},
+                                    {{"name", "light_tree"}, {"gpu_ms", 10.0}},
+                                    {{"name", "vpl_gather"}, {"gpu_ms", 40.0}}}}};
+    const FrameCost c = FrameCost::ofFrame(stats, 100, 100, 0, 1.0, {"light_tree"});
+    EXPECT_TRUE(c.drewLightViews);
+    EXPECT_EQ(c.lightViews, 2);
+    EXPECT_DOUBLE_EQ(c.shadowTexels, 2.0 * 1024 * 1024);
+    EXPECT_DOUBLE_EQ(c.shadowMs, 8.0);
+    EXPECT_DOUBLE_EQ(c.rsmTexels, 2.0 * 512 * 512);
+    EXPECT_DOUBLE_EQ(c.rsmMs, 18.0);
+    EXPECT_DOUBLE_EQ(c.lightViewTechniqueMs, 10.0);
+    // Kept maps: nothing drawn, whatever passes ran.
+    nlohmann::json kept = stats;
+    kept["counts"]["light_views_reused"] = 2;
+    EXPECT_FALSE(FrameCost::ofFrame(kept, 100, 100, 0, 1.0, {"light_tree"}).drewLightViews);
+    // The pixels' rate leaves the light views out: 100 ms - 40 ms of technique - 26 ms of light views.
+    FrameBudget budget(FrameBudget::Config{});
+    budget.record("k", c);
+    budget.record("k", c);
+    EXPECT_NEAR(budget.predictMs("k", 100 * 100, 0), 74.0, 1e-9);
+}
+
 } // namespace
 } // namespace gis
