@@ -10,14 +10,25 @@
 // Reported per server setting: the drag's frames per second, their render time p50 / p95, size and
 // light-view triangles, and the press's wait and answer time p50 / max; then the ratios.
 //
+// --technique and --params (JSON, frame or technique parameters) are set once the scene shows, for
+// example the largest light views: --params '{"shadow_map_size": 4096, "rsm_size": 1024}'.
+//
 //   node bench/interactive/light_drag.mjs [--server build/ci/bin/gi-server] [--scene builtin:atrium]
 //       [--rounds 3] [--drag-s 4] [--press-ms 60] [--settings "--interactive-lod-px 1|--interactive-lod-px 0"]
+//       [--technique T] [--params JSON]
 import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:atrium', rounds: 3, 'drag-s': 4, 'press-ms': 60,
-    settings: '--interactive-lod-px 1|--interactive-lod-px 0', size: '960x800' },
-'usage: node bench/interactive/light_drag.mjs [--server PATH] [--scene NAME] [--rounds N] [--drag-s S] [--press-ms MS] [--size WxH] [--settings "FLAGS|FLAGS"]');
+    settings: '--interactive-lod-px 1|--interactive-lod-px 0', size: '960x800', technique: '', params: '' },
+'usage: node bench/interactive/light_drag.mjs [--server PATH] [--scene NAME] [--rounds N] [--drag-s S] [--press-ms MS] [--size WxH] [--settings "FLAGS|FLAGS"] [--technique T] [--params JSON]');
 const [width, height] = opts.size.split('x').map(Number);
+let params = null;
+try {
+    params = opts.params ? JSON.parse(opts.params) : null;
+} catch (e) {
+    console.error(`light_drag: --params is not JSON: ${e.message}`);
+    process.exit(2);
+}
 
 // The light `angle` into the drag: a directional light's direction turned about the vertical, another
 // light moved sideways by up to a twentieth of the scene's extent (a light on the vertical axis
@@ -39,6 +50,15 @@ async function measure(flags) {
         await link.until('the welcome', () => link.state);
         link.send({ type: 'scene', name: opts.scene });
         await link.until(`frames of ${opts.scene}`, () => link.stats?.scene === opts.scene, 120000);
+        if (opts.technique) {
+            link.send({ type: 'technique', name: opts.technique });
+            await link.until(`frames of ${opts.technique}`, () => link.stats?.technique === opts.technique, 60000);
+        }
+        if (params) {
+            const asked = link.frames.length;
+            link.send({ type: 'params', values: params });
+            await link.until('the parameters', () => link.frames.slice(asked).some((f) => f.stats.quality === 'interactive'), 60000);
+        }
         await link.until('a refined frame', () => link.stats?.refine?.complete || link.stats?.quality === 'final', 60000)
             .catch(() => {});
         const light = link.state.lights[0];
@@ -77,13 +97,20 @@ async function measure(flags) {
             await link.until('the answer to the press', () => link.frames.slice(before).some((f) => f.stats.quality === 'interactive'), 30000);
             const answer = link.frames.slice(before).find((f) => f.stats.quality === 'interactive');
             presses.push({ waitMs: answer.stats.input?.wait_ms ?? null, answerMs: answer.at - pressed, frameMs: answer.stats.frame_ms });
+            if (process.env.LIGHT_DRAG_VERBOSE) {
+                // The refinement frames before the answer: what the input may have waited for.
+                const tiles = link.frames.slice(0, before).filter((f) => f.at > released && f.stats.quality !== 'interactive');
+                console.error(JSON.stringify(presses.at(-1)), 'after', tiles.length, 'refinement frames; the last:',
+                    tiles.slice(-1).map((f) => `${f.stats.frame_ms.toFixed(1)} ms: ` + (f.stats.passes ?? [])
+                        .filter((p) => p.gpu_ms > 3).map((p) => `${p.name} ${p.gpu_ms.toFixed(1)}`).join(', ')).join(''));
+            }
             await sleep(500);
         }
         link.ws.close();
         const all = (k) => drag.flatMap((d) => d[k]);
         const r = (v) => (v === null || v === undefined ? null : +v.toFixed(1));
         return {
-            settings: flags, scene: opts.scene, rounds: opts.rounds,
+            settings: flags, scene: opts.scene, technique: link.stats?.technique, params, rounds: opts.rounds,
             drag_fps: r(percentile(drag.map((d) => d.fps), 0.5)),
             drag_frame_ms: { p50: r(percentile(all('ms'), 0.5)), p95: r(percentile(all('ms'), 0.95)) },
             drag_width_p50: percentile(all('sizes'), 0.5),

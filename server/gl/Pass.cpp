@@ -43,6 +43,7 @@ Pass::~Pass() {
     if (mBlend) glDisable(GL_BLEND);
     if (mCull) glDisable(GL_CULL_FACE);
     if (mColorMasked) glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    if (mScissor) glDisable(GL_SCISSOR_TEST);
     if (mStencil) {
         glDisable(GL_STENCIL_TEST);
         glStencilMask(0xFF);
@@ -112,6 +113,13 @@ Pass& Pass::viewport(int x, int y, int width, int height) {
     mViewport[1] = y;
     mViewport[2] = width;
     mViewport[3] = height;
+    return *this;
+}
+
+Pass& Pass::scissor(int x, int y, int width, int height) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(x, y, std::max(width, 0), std::max(height, 0));
+    mScissor = true;
     return *this;
 }
 

@@ -48,6 +48,9 @@ public:
     Pass& polygonOffset(float factor, float units);
     /// A sub-rectangle of the target (an atlas level).
     Pass& viewport(int x, int y, int width, int height);
+    /// Draws and clears touch only this rectangle of the target until the pass ends (a band of a
+    /// light view drawn in pieces).
+    Pass& scissor(int x, int y, int width, int height);
     /// Additive blending (ONE, ONE) for the pass's draws: accumulating lights or splats.
     Pass& blendAdd();
     /// Blending with separate colour and alpha factors.
@@ -125,6 +128,7 @@ private:
     bool mCull = false;
     bool mStencil = false;
     bool mColorMasked = false;
+    bool mScissor = false;
     bool mFrontFace = false;
     unsigned mClipDistances = 0; ///< bit i: GL_CLIP_DISTANCE0 + i enabled here
     std::vector<BlockBinding> mBoundBlocks;

@@ -12,6 +12,7 @@
 #include "core/Log.h"
 #include "core/Timer.h"
 #include "frame/Exposure.h"
+#include "frame/FrameParams.h"
 #include "frame/LightModel.h"
 #include "gl/Pass.h"
 #include "gl/ShaderShared.h"
@@ -79,6 +80,27 @@ std::vector<LodView> lightViewLods(const LightSetModel& set, float texels, int s
         lods.push_back(lod);
     }
     return lods;
+}
+
+// The frame parameter's default (shadow_map_size, rsm_size): texels per side.
+int defaultSide(const char* name) {
+    static const int shadow = static_cast<int>(frameParamTable().find("shadow_map_size")->defaultValue);
+    static const int rsm = static_cast<int>(frameParamTable().find("rsm_size")->defaultValue);
+    return std::string_view(name) == "rsm_size" ? rsm : shadow;
+}
+
+// Bands of rows in which refinement draws a light view larger than the default's, asking between
+// them whether input arrived: as many as the side is a multiple of the default side (at most 16), so
+// each costs about a default map (a 4096 shadow map took 25-35 ms and a 1024 RSM 25-40 ms as one
+// stage on llvmpipe, the input waiting for it). The geometry is drawn once per band: the default
+// sides, drawn whole, cost nothing more.
+int lightViewBands(int side, int defaultSide) {
+    return std::clamp(side / std::max(defaultSide, 1), 1, 16);
+}
+
+void scissorBand(gl::Pass& pass, int side, int band, int bands) {
+    const int y0 = side * band / bands, y1 = side * (band + 1) / bands;
+    pass.scissor(0, y0, side, y1 - y0);
 }
 
 } // namespace
@@ -257,29 +279,31 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene, std::unique_ptr
 void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadowSide, int views) {
     // At least one layer, so that the shadow and RSM resources exist (and read as empty) with no light.
     const int layers = std::max(views, 1);
+    // The maps of the side drawn before stay kept (mOtherShadow, mOtherRsm): interactive frames'
+    // capped light views and refinement's asked ones alternate.
+    const auto shape = [](int side, int count) { return std::pair{side, count}; };
     if (shadowSide != mShadowSize || layers != mShadowLayers) {
-        mShadowDepth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, shadowSide, shadowSide, layers);
-        mShadowDepth.setFilter(GL_LINEAR, GL_LINEAR); // hardware 2x2 PCF with the compare mode
-        glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-        glTextureParameteri(mShadowDepth.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-        mShadowFbos.clear();
-        for (int v = 0; v < layers; ++v)
-            mShadowFbos.push_back(gl::Framebuffer::ofLayer("shadow map", {}, &mShadowDepth, v));
+        const double bytes = 4.0 * mShadowSize * mShadowSize * mShadowLayers;
+        mShadow = mOtherShadow.exchange(shape(shadowSide, layers),
+                                        mShadowSize > 0 ? std::optional(shape(mShadowSize, mShadowLayers))
+                                                        : std::nullopt,
+                                        std::move(mShadow), bytes, [&] {
+                                            ++mLightMapsCreated;
+                                            return ShadowMaps::create(shadowSide, layers);
+                                        });
         mShadowSize = shadowSide;
         mShadowLayers = layers;
         mLightPassesValid = false;
     }
     if (rsmSide != mRsmSize || layers != mRsmLayers) {
-        mRsmPosition = gl::Texture::create2DArray(GL_RGBA32F, rsmSide, rsmSide, layers);
-        mRsmNormal = gl::Texture::create2DArray(GL_RGBA16F, rsmSide, rsmSide, layers);
-        mRsmFlux = gl::Texture::create2DArray(GL_RGBA32F, rsmSide, rsmSide, layers);
-        mRsmSpecular = gl::Texture::create2DArray(GL_RGBA8, rsmSide, rsmSide, layers);
-        mRsmDepth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, rsmSide, rsmSide, layers);
-        mRsmFbos.clear();
-        for (int v = 0; v < layers; ++v)
-            mRsmFbos.push_back(gl::Framebuffer::ofLayer(
-                "reflective shadow map", {&mRsmPosition, &mRsmNormal, &mRsmFlux, &mRsmSpecular}, &mRsmDepth,
-                v));
+        // Position and flux RGBA32F, normal RGBA16F, specular RGBA8, depth 32F: 48 bytes a texel.
+        const double bytes = 48.0 * mRsmSize * mRsmSize * mRsmLayers;
+        mRsm = mOtherRsm.exchange(shape(rsmSide, layers),
+                                  mRsmSize > 0 ? std::optional(shape(mRsmSize, mRsmLayers)) : std::nullopt,
+                                  std::move(mRsm), bytes, [&] {
+                                      ++mLightMapsCreated;
+                                      return Rsms::create(rsmSide, layers);
+                                  });
         mRsmSize = rsmSide;
         mRsmLayers = layers;
         mLightPassesValid = false;
@@ -295,6 +319,30 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
         mWidth = width;
         mHeight = height;
     }
+}
+
+FrameRenderer::ShadowMaps FrameRenderer::ShadowMaps::create(int side, int layers) {
+    ShadowMaps m;
+    m.depth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, side, side, layers);
+    m.depth.setFilter(GL_LINEAR, GL_LINEAR); // hardware 2x2 PCF with the compare mode
+    glTextureParameteri(m.depth.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTextureParameteri(m.depth.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    for (int v = 0; v < layers; ++v)
+        m.fbos.push_back(gl::Framebuffer::ofLayer("shadow map", {}, &m.depth, v));
+    return m;
+}
+
+FrameRenderer::Rsms FrameRenderer::Rsms::create(int side, int layers) {
+    Rsms m;
+    m.position = gl::Texture::create2DArray(GL_RGBA32F, side, side, layers);
+    m.normal = gl::Texture::create2DArray(GL_RGBA16F, side, side, layers);
+    m.flux = gl::Texture::create2DArray(GL_RGBA32F, side, side, layers);
+    m.specular = gl::Texture::create2DArray(GL_RGBA8, side, side, layers);
+    m.depth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, side, side, layers);
+    for (int v = 0; v < layers; ++v)
+        m.fbos.push_back(gl::Framebuffer::ofLayer(
+            "reflective shadow map", {&m.position, &m.normal, &m.flux, &m.specular}, &m.depth, v));
+    return m;
 }
 
 FrameRenderer::ScreenTargets FrameRenderer::ScreenTargets::create(int width, int height) {
@@ -328,48 +376,59 @@ void FrameRenderer::ensureTechnique(const std::string& name, int width, int heig
     }
 }
 
-DrawCount FrameRenderer::renderShadowMaps(int views, std::span<const LodView> lods) {
+DrawCount FrameRenderer::renderShadowMaps(int views, std::span<const LodView> lods,
+                                          const std::function<bool()>& stop) {
     // Depth only, with a slope-scaled offset against acne; layers without a view are cleared (lit).
     gl::Pass pass(mTimer, "shadow_map");
     DrawCount count;
+    const int bands = stop ? lightViewBands(mShadowSize, defaultSide("shadow_map_size")) : 1;
     for (int v = 0; v < mShadowLayers; ++v) {
-        gl::Pass layer("shadow_map view");
-        layer.target(mShadowFbos[static_cast<size_t>(v)], mShadowSize, mShadowSize)
-            .depthTest(GL_LESS)
-            .clearDepth();
-        if (v >= views) continue;
-        layer.polygonOffset(2.0f, 4.0f);
-        const MeshPass& shadow = shadowPass();
-        layer.use(shadow.program).set(shadow.view, v);
-        count +=
-            mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr, 1, -1,
-                            &mLightBlock->views[v].viewProj, false,
-                            static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)] : nullptr);
+        const int pieces = v < views ? bands : 1;
+        for (int b = 0; b < pieces; ++b) {
+            if (pieces > 1 && (v > 0 || b > 0) && stop()) return count;
+            gl::Pass layer("shadow_map view");
+            layer.target(mShadow.fbos[static_cast<size_t>(v)], mShadowSize, mShadowSize).depthTest(GL_LESS);
+            if (pieces > 1) scissorBand(layer, mShadowSize, b, pieces);
+            layer.clearDepth();
+            if (v >= views) continue;
+            layer.polygonOffset(2.0f, 4.0f);
+            const MeshPass& shadow = shadowPass();
+            layer.use(shadow.program).set(shadow.view, v);
+            count += mSceneGpu->draw(shadow.program, mSceneCutsOut ? &shadow.materials : nullptr, 1, -1,
+                                     &mLightBlock->views[v].viewProj, false,
+                                     static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)]
+                                                                          : nullptr);
+        }
     }
-    mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
+    mResources.publish("lights.shadow", "shadow_map", mShadow.depth);
     return count;
 }
 
-DrawCount FrameRenderer::renderRsms(int views, std::span<const LodView> lods) {
+DrawCount FrameRenderer::renderRsms(int views, std::span<const LodView> lods,
+                                    const std::function<bool()>& stop) {
     gl::Pass pass(mTimer, "rsm");
     DrawCount count;
+    const int bands = stop ? lightViewBands(mRsmSize, defaultSide("rsm_size")) : 1;
     for (int v = 0; v < mRsmLayers; ++v) {
-        gl::Pass layer("rsm view");
-        layer.target(mRsmFbos[static_cast<size_t>(v)], mRsmSize, mRsmSize)
-            .depthTest(GL_LESS)
-            .clearColor(4)
-            .clearDepth();
-        if (v >= views) continue;
-        const MeshPass& rsm = rsmPass();
-        layer.use(rsm.program).set(rsm.view, v);
-        count +=
-            mSceneGpu->draw(rsm.program, &rsm.materials, 1, -1, &mLightBlock->views[v].viewProj, false,
-                            static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)] : nullptr);
+        const int pieces = v < views ? bands : 1;
+        for (int b = 0; b < pieces; ++b) {
+            if (pieces > 1 && (v > 0 || b > 0) && stop()) return count;
+            gl::Pass layer("rsm view");
+            layer.target(mRsm.fbos[static_cast<size_t>(v)], mRsmSize, mRsmSize).depthTest(GL_LESS);
+            if (pieces > 1) scissorBand(layer, mRsmSize, b, pieces);
+            layer.clearColor(4).clearDepth();
+            if (v >= views) continue;
+            const MeshPass& rsm = rsmPass();
+            layer.use(rsm.program).set(rsm.view, v);
+            count += mSceneGpu->draw(
+                rsm.program, &rsm.materials, 1, -1, &mLightBlock->views[v].viewProj, false,
+                static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)] : nullptr);
+        }
     }
-    mResources.publish("lights.rsm.position", "rsm", mRsmPosition);
-    mResources.publish("lights.rsm.normal", "rsm", mRsmNormal);
-    mResources.publish("lights.rsm.flux", "rsm", mRsmFlux);
-    mResources.publish("lights.rsm.specular", "rsm", mRsmSpecular);
+    mResources.publish("lights.rsm.position", "rsm", mRsm.position);
+    mResources.publish("lights.rsm.normal", "rsm", mRsm.normal);
+    mResources.publish("lights.rsm.flux", "rsm", mRsm.flux);
+    mResources.publish("lights.rsm.specular", "rsm", mRsm.specular);
     return count;
 }
 
@@ -377,7 +436,7 @@ void FrameRenderer::measureViewFlux(int views) {
     if (views <= 0) return;
     gl::Pass pass(mTimer, "rsm_flux");
     pass.use(mFluxPass.program).set(mFluxPass.rsmSize, mRsmSize);
-    pass.texture(mFluxPass.position, mRsmPosition).texture(mFluxPass.flux, mRsmFlux);
+    pass.texture(mFluxPass.position, mRsm.position).texture(mFluxPass.flux, mRsm.flux);
     pass.buffer(mFluxPass.sums, mFluxSums);
     pass.dispatch(views).barrier(GL_BUFFER_UPDATE_BARRIER_BIT);
 }
@@ -539,6 +598,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     const bool reuseLights = sides.keep;
     lightSet.shadowSide = sides.shadow;
     lightSet.rsmSide = sides.rsm;
+    mLightMapsCreated = 0;
     ensureTargets(state.width, state.height, lightSet.rsmSide, lightSet.shadowSide, views);
     ensureTechnique(state.technique, state.width, state.height);
     const Reflections::Decision nonDiffuse =
@@ -604,24 +664,29 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     glDisable(GL_CULL_FACE);
     std::vector<double> viewFlux;
     DrawCount lightDraws;
+    // Maps larger than the defaults' are drawn in bands that input can stop (refinement only).
+    std::function<bool()> lightBandStop;
+    if (mInterruptCheck) lightBandStop = interrupted;
     if (reuseLights) {
         viewFlux = mLightPassFlux;
-        mResources.publish("lights.shadow", "shadow_map", mShadowDepth);
+        mResources.publish("lights.shadow", "shadow_map", mShadow.depth);
         if (readsRsm)
-            for (auto [name, texture] : {std::pair{"lights.rsm.position", &mRsmPosition},
-                                         {"lights.rsm.normal", &mRsmNormal},
-                                         {"lights.rsm.flux", &mRsmFlux},
-                                         {"lights.rsm.specular", &mRsmSpecular}})
+            for (auto [name, texture] : {std::pair{"lights.rsm.position", &mRsm.position},
+                                         {"lights.rsm.normal", &mRsm.normal},
+                                         {"lights.rsm.flux", &mRsm.flux},
+                                         {"lights.rsm.specular", &mRsm.specular}})
                 mResources.publish(name, "rsm", *texture);
     } else {
         // Until this frame's maps are whole, no later frame may take them for kept ones.
         mLightPassesValid = false;
-        lightDraws += renderShadowMaps(views, lightViewLods(lightSet, lightLodTexels, lightSet.shadowSide));
+        lightDraws += renderShadowMaps(views, lightViewLods(lightSet, lightLodTexels, lightSet.shadowSide),
+                                       lightBandStop);
         if (interrupted()) return interruptedOutput();
     }
     // Without a technique that reads them, the RSMs (one pass per light view) are not rendered.
     if (readsRsm && !reuseLights) {
-        lightDraws += renderRsms(views, lightViewLods(lightSet, lightLodTexels, lightSet.rsmSide));
+        lightDraws +=
+            renderRsms(views, lightViewLods(lightSet, lightLodTexels, lightSet.rsmSide), lightBandStop);
         if (interrupted()) return interruptedOutput();
         measureViewFlux(views);
         // Several views: the VPL split needs the sums before the technique's extraction is dispatched,
@@ -782,6 +847,8 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     if (mSceneGpu->lodTriangleCount() > 0) countJson["triangles_lod_stored"] = mSceneGpu->lodTriangleCount();
     countJson["pixels"] = state.width * state.height;
     if (reuseLights) countJson["light_views_reused"] = views;
+    // Shadow-map and RSM arrays allocated for this frame (none when their sides were kept).
+    if (mLightMapsCreated > 0) countJson["light_view_arrays_created"] = mLightMapsCreated;
     for (const auto& [k, v] : counters) countJson[k] = v;
     nlohmann::json params = paramsJson(state);
     out.stats = {

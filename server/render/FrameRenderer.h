@@ -109,8 +109,10 @@ private:
     void ensureTechnique(const std::string& name, int width, int height);
     // The frame's stages, in order; each publishes what it writes in mResources.
     /// `lods`: each view's tolerance for levels of detail (empty: every triangle).
-    DrawCount renderShadowMaps(int views, std::span<const LodView> lods);
-    DrawCount renderRsms(int views, std::span<const LodView> lods);
+    /// `stop` (may be empty) is asked between the pieces of maps larger than the defaults' (lightViewBands):
+    /// true leaves them incomplete (not kept, LightPasses) and returns.
+    DrawCount renderShadowMaps(int views, std::span<const LodView> lods, const std::function<bool()>& stop);
+    DrawCount renderRsms(int views, std::span<const LodView> lods, const std::function<bool()>& stop);
     /// Sums the reflected flux luminance of every view's RSM on the GPU (pass "rsm_flux").
     void measureViewFlux(int views);
     /// Those sums, read back (waits for the pass); empty without views.
@@ -198,10 +200,25 @@ private:
 
     int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0, mShadowLayers = 0, mRsmLayers = 0;
     // One layer per light view; one framebuffer per layer.
-    gl::Texture mShadowDepth;
-    std::vector<gl::Framebuffer> mShadowFbos;
-    gl::Texture mRsmPosition, mRsmNormal, mRsmFlux, mRsmSpecular, mRsmDepth;
-    std::vector<gl::Framebuffer> mRsmFbos;
+    struct ShadowMaps {
+        gl::Texture depth;
+        std::vector<gl::Framebuffer> fbos;
+        static ShadowMaps create(int side, int layers);
+    };
+    struct Rsms {
+        gl::Texture position, normal, flux, specular, depth;
+        std::vector<gl::Framebuffer> fbos;
+        static Rsms create(int side, int layers);
+    };
+    ShadowMaps mShadow;
+    Rsms mRsm;
+    /// The maps of the other side last drawn (gl/RecentTargets.h), keyed by side and layers: an
+    /// interactive frame's capped light views (FrameState::LightViewCap) and a refinement step's
+    /// asked ones alternate, and a new 4096^2 shadow array cost the step's first tile about 40 ms
+    /// before its first band (allocated and cleared). At most one, of at most 128 MiB.
+    gl::RecentTargets<std::pair<int, int>, ShadowMaps> mOtherShadow{1, 128.0 * 1024.0 * 1024.0};
+    gl::RecentTargets<std::pair<int, int>, Rsms> mOtherRsm{1, 128.0 * 1024.0 * 1024.0};
+    int mLightMapsCreated = 0; ///< arrays ensureTargets created for this frame (counts)
     /// What is sized to the frame: G-buffer, direct light, composite.
     struct ScreenTargets {
         gl::Texture gPosition, gNormal, gAlbedo, gEmissive, gSpecular, gDepth;

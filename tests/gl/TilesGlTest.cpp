@@ -195,11 +195,66 @@ TEST(TilesGl, CappedLightViewsAreDrawnSmallerAndServeUntilTheAskedSidesAreWanted
     const FrameOutput after = reusing.render(orbit);
     EXPECT_GT(counter(after, "light_views_reused"), 0.0);
     EXPECT_EQ(sides(after), "2048/512");
+    // The next drag takes back the capped arrays kept meanwhile, and the refinement after it the
+    // asked ones: nothing is allocated again, and the frames equal a fresh renderer's.
+    drag.lights[0].light.intensity *= 0.8f;
+    const FrameOutput dragAgain = reusing.render(drag);
+    EXPECT_EQ(sides(dragAgain), "1024/128 of 2048/512");
+    EXPECT_EQ(counter(dragAgain, "light_view_arrays_created"), 0.0);
+    small.lights = drag.lights;
+    EXPECT_EQ(dragAgain.rgba8, fresh.render(small).rgba8);
+    refine.lights = drag.lights;
+    const FrameOutput refinedAgain = reusing.render(refine);
+    EXPECT_EQ(sides(refinedAgain), "2048/512");
+    EXPECT_EQ(counter(refinedAgain, "light_view_arrays_created"), 0.0);
+    FrameState whole = refine;
+    EXPECT_EQ(refinedAgain.rgba8, fresh.render(whole).rgba8);
     // A cap above the asked sides changes nothing.
     FrameState loose = asked;
     loose.lights[0].light.intensity *= 0.5f;
     loose.lightViewCap = {4096, 1024};
     EXPECT_EQ(sides(reusing.render(loose)), "2048/512");
+}
+
+// Refinement (an interrupt check set) draws light views larger than the defaults' in bands of rows,
+// asking between them: the same maps as drawn in one piece, one more check per band, and a stop
+// among the bands keeps nothing for the next frame.
+TEST(TilesGl, LargeLightViewsAreDrawnInBandsThatInputCanStop) {
+    ReusePair pair("builtin:cornell");
+    FrameRenderer &whole = pair.fresh, &banded = pair.reusing;
+    int checks = 0;
+    banded.setInterruptCheck([&] {
+        ++checks;
+        return false;
+    });
+    const auto checksFor = [&](FrameState s) {
+        s.lights[0].light.intensity *= 0.9f; // the light views are drawn again
+        checks = 0;
+        const FrameOutput out = banded.render(s);
+        EXPECT_EQ(counter(out, "light_views_reused"), 0.0);
+        return std::pair{checks, out};
+    };
+    const auto [defaultChecks, atDefaults] = checksFor(pair.state);
+    FrameState large = pair.state;
+    large.frameParams.set("shadow_map_size", 2048); // two bands
+    large.frameParams.set("rsm_size", 1024);        // four bands
+    const auto [largeChecks, inBands] = checksFor(large);
+    EXPECT_EQ(largeChecks - defaultChecks, 1 + 3) << "one check between each two bands";
+    FrameState same = large;
+    same.lights[0].light.intensity *= 0.9f;
+    EXPECT_EQ(inBands.rgba8, whole.render(same).rgba8) << "the bands draw the maps drawn in one piece";
+
+    // A stop at the first check between bands: the frame ends, and its maps are not kept.
+    int calls = 0;
+    banded.setInterruptCheck([&] { return ++calls == 1; });
+    FrameState moved = large;
+    moved.lights[0].light.position += glm::vec3(0.0f, -0.1f, 0.0f);
+    const FrameOutput stopped = banded.render(moved);
+    EXPECT_TRUE(stopped.interrupted);
+    banded.setInterruptCheck({});
+    const FrameOutput next = banded.render(moved);
+    EXPECT_EQ(counter(next, "light_views_reused"), 0.0) << "half-drawn maps must not serve";
+    EXPECT_EQ(next.rgba8, whole.render(moved).rgba8);
 }
 
 TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {
