@@ -3,8 +3,9 @@
 // frame that answers them (render time, the environment probes' plan), then the answers to --moves
 // camera moves 2 s apart, then drags the scene's first light for --drag-s seconds (each interactive
 // frame answered with the light moved a little, so every frame draws the light views again): the
-// drag's frame times p50 / p95 and the size the frame budget rendered at, each with the light views'
-// sides (shadow/rsm texels, and the parameters' when the budget drew them smaller).
+// drag's frame times p50 / p95 (after its first second) and the size the frame budget rendered at,
+// and its first frame apart, each with the light views' sides (shadow/rsm texels, and the
+// parameters' when the budget drew them smaller).
 // docs/interactive.md, "The costliest frame parameters".
 // usage: node bench/interactive/param_change.mjs [--server PATH] [--scene builtin:gallery]
 //        [--technique multires_gather] [--params '{"env_size": 512, "env_samples": 256}'] [--moves 3] [--drag-s 6]
@@ -59,10 +60,12 @@ try {
         const id = light.id ?? 'light0';
         const base = light.position;
         const times = [];
+        let first = null; // the drag's first frame: the light views drawn again after kept ones
         let step = 0;
         const dragStart = performance.now();
         link.onFrame = (s) => {
             if (s.quality !== 'interactive') return;
+            first ??= s;
             if (performance.now() - dragStart > 1000) times.push(s.frame_ms); // the first second settles the budget
             step += 1;
             link.send({ type: 'light', id, light: { position: [base[0] + 0.05 * Math.sin(step / 5), base[1], base[2] + 0.05 * Math.cos(step / 5)] } });
@@ -71,7 +74,8 @@ try {
         await sleep(opts['drag-s'] * 1000);
         link.onFrame = null;
         report.drag = { frames: times.length, frame_ms_p50: +percentile(times, 0.5).toFixed(1),
-            frame_ms_p95: +percentile(times, 0.95).toFixed(1), last_size: link.stats.size, last_maps: maps(link.stats) };
+            frame_ms_p95: +percentile(times, 0.95).toFixed(1), last_size: link.stats.size, last_maps: maps(link.stats),
+            first: first && summary(first) };
     }
     console.log(JSON.stringify(report));
 } finally {

@@ -558,6 +558,36 @@ bool FrameRenderer::sceneHasLevels() const {
     return mSceneGpu && mSceneGpu->hasLevels();
 }
 
+float FrameRenderer::lightLodTexelsOf(const FrameState& state) const {
+    const float wanted = std::clamp(static_cast<float>(state.frameParams.getFloat("light_lod_texels")), 0.0f,
+                                    kLightLodMaxTexels);
+    return mSceneGpu && mSceneGpu->hasLevels() ? wanted : 0.0f;
+}
+
+glm::vec2 FrameRenderer::lightPassKey(const FrameState& state) {
+    return {state.frameParams.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f,
+            findTechniqueInfo(state.technique).readsRsm ? 1.0f : 0.0f};
+}
+
+KeptLightViews FrameRenderer::keptLightViews(const FrameState& state,
+                                             const shader::LightUniforms& lights) const {
+    return {mReuseLightPasses && mLightPassesValid && mLightPassBlock &&
+                lightPassKey(state) == mLightPassKey && mLightPassLodTexels <= lightLodTexelsOf(state) &&
+                std::memcmp(mLightPassBlock.get(), &lights, sizeof lights) == 0,
+            mLightPassShadowSide, mLightPassRsmSide};
+}
+
+bool FrameRenderer::keepsLightViews(const FrameState& state) {
+    if (!mScene || !mSceneGpu || !mLightPassesValid) return false;
+    const LightSetModel set = makeLightSet(state, mScene->bounds);
+    if (!mQueryLightBlock) mQueryLightBlock = std::make_unique<shader::LightUniforms>();
+    *mQueryLightBlock = shader::LightUniforms{};
+    writeLightUniforms(set, *mQueryLightBlock);
+    const KeptLightViews kept = keptLightViews(state, *mQueryLightBlock);
+    return kept.sameLights && kept.shadowSide <= set.shadowSide &&
+           (!findTechniqueInfo(state.technique).readsRsm || kept.rsmSide <= set.rsmSide);
+}
+
 bool FrameRenderer::wantsLevels(const FrameState& state) {
     return state.frameParams.getFloat("lod_pixels") > 0.0 ||
            state.frameParams.getFloat("light_lod_texels") > 0.0;
@@ -584,14 +614,9 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     // LightViewCap) draws them smaller and lets kept maps of any side between it and the asked serve.
     const bool readsRsm = findTechniqueInfo(state.technique).readsRsm;
     const float solidAngleEqual = fp.getEnum("rsm_solid_angle") == "equal" ? 1.0f : 0.0f;
-    const float lightLodWanted =
-        std::clamp(static_cast<float>(fp.getFloat("light_lod_texels")), 0.0f, kLightLodMaxTexels);
-    const float lightLodTexels = mSceneGpu->hasLevels() ? lightLodWanted : 0.0f;
-    const glm::vec2 lightKey(solidAngleEqual, readsRsm ? 1.0f : 0.0f);
-    const KeptLightViews kept{mReuseLightPasses && mLightPassesValid && lightKey == mLightPassKey &&
-                                  mLightPassLodTexels <= lightLodTexels &&
-                                  std::memcmp(mLightPassBlock.get(), &lights, sizeof lights) == 0,
-                              mLightPassShadowSide, mLightPassRsmSide};
+    const float lightLodTexels = lightLodTexelsOf(state);
+    const glm::vec2 lightKey = lightPassKey(state);
+    const KeptLightViews kept = keptLightViews(state, lights);
     const int askedShadowSide = lightSet.shadowSide, askedRsmSide = lightSet.rsmSide;
     const LightViewSides sides = lightViewSides(askedShadowSide, askedRsmSide, state.lightViewCap.shadowSide,
                                                 state.lightViewCap.rsmSide, readsRsm, kept);

@@ -77,6 +77,10 @@ public:
     /// the same (the stats' counts then have `light_views_reused`). Off by default, so that benchmarks
     /// and tests time every pass of every frame; the service turns it on.
     void setReuseLightPasses(bool reuse) { mReuseLightPasses = reuse; }
+    /// Whether a frame of `state` would keep the light views an earlier frame drew (the same lights and
+    /// light-view parameters, and maps no larger than it asks for; FrameState::LightViewCap decides
+    /// the rest): the frame budget predicts a frame that draws them again with their cost.
+    bool keepsLightViews(const FrameState& state);
     /// Refinement's interruption: while `check` is set, render() asks it between its stages (after the
     /// shadow maps, the RSMs, the eye passes, the technique and the reflections, and inside a technique
     /// or the environment probes where they ask, FrameInputs::interrupted, ReflectionInputs::interrupted),
@@ -111,6 +115,13 @@ private:
     /// `lods`: each view's tolerance for levels of detail (empty: every triangle).
     /// `stop` (may be empty) is asked between the pieces of maps larger than the defaults' (lightViewBands):
     /// true leaves them incomplete (not kept, LightPasses) and returns.
+    /// light_lod_texels as this frame's light views are drawn with it (0 without levels of detail).
+    float lightLodTexelsOf(const FrameState& state) const;
+    /// What kept light views must have been drawn with besides the lights (mLightPassKey): the RSM's
+    /// solid-angle rule and whether the RSMs were drawn.
+    static glm::vec2 lightPassKey(const FrameState& state);
+    /// The kept light views as a frame of `state` with the light block `lights` sees them.
+    KeptLightViews keptLightViews(const FrameState& state, const shader::LightUniforms& lights) const;
     DrawCount renderShadowMaps(int views, std::span<const LodView> lods, const std::function<bool()>& stop);
     DrawCount renderRsms(int views, std::span<const LodView> lods, const std::function<bool()>& stop);
     /// Sums the reflected flux luminance of every view's RSM on the GPU (pass "rsm_flux").
@@ -262,6 +273,7 @@ private:
     glm::vec2 mLightPassKey{0.0f}; ///< the solid-angle rule and whether the RSMs were drawn
     int mLightPassShadowSide = 0;  ///< the kept maps' sides
     int mLightPassRsmSide = 0;
+    std::unique_ptr<shader::LightUniforms> mQueryLightBlock; ///< keepsLightViews' scratch block
     float mLightPassLodTexels = 0.0f; ///< the texels of level-of-detail error the maps were drawn with
     std::vector<double> mLightPassFlux;
 

@@ -181,7 +181,8 @@ bool AdaptiveQuality::recordMinTileCost(const std::string& sceneName, const Fram
 
 AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const FrameState& requested,
                                             const nlohmann::json& explicitParams, QualityStep step,
-                                            bool snapshot, int frameTargetMs) {
+                                            bool snapshot, int frameTargetMs,
+                                            const std::function<bool(const FrameState&)>& keepsLightViews) {
     Plan p;
     p.step = step;
     p.budgetKey = sceneName + "/" + requested.technique;
@@ -229,7 +230,7 @@ AdaptiveQuality::Plan AdaptiveQuality::plan(const std::string& sceneName, const 
     if (p.step != QualityStep::Interactive && !snapshot && mLimits.refineBudgetMs > 0)
         planRefinement(sceneName, requested, explicitParams, p);
     if (p.step == QualityStep::Interactive && !snapshot) {
-        planInteractive(frameTargetMs, explicitParams, p);
+        planInteractive(frameTargetMs, explicitParams, keepsLightViews, p);
         if (budgetProbes) p.budget["env_budget_ms"] = envBudgetMs;
         // Interactive frames only: the steps that refine the view draw every triangle.
         if (mLimits.interactiveLodPixels > 0.0 && p.state.frameParams.has("lod_pixels") &&
@@ -300,14 +301,19 @@ void AdaptiveQuality::planRefinement(const std::string& sceneName, const FrameSt
     }
 }
 
-void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& explicitParams, Plan& p) {
+void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& explicitParams,
+                                      const std::function<bool(const FrameState&)>& keepsLightViews,
+                                      Plan& p) {
     const long requestedVpls = vplEstimate(p.state);
     if (frameTargetMs > 0) {
         mBudget.setTargetMs(frameTargetMs);
         const TechniqueInfo& info = findTechniqueInfo(p.state.technique);
         const ParamSet& fp = p.state.frameParams;
-        const LightViewAsk lightViews{fp.has("shadow_map_size") ? fp.getInt("shadow_map_size") : 0,
-                                      fp.has("rsm_size") ? fp.getInt("rsm_size") : 0, info.readsRsm};
+        LightViewAsk lightViews{fp.has("shadow_map_size") ? fp.getInt("shadow_map_size") : 0,
+                                fp.has("rsm_size") ? fp.getInt("rsm_size") : 0, info.readsRsm};
+        if (keepsLightViews)
+            lightViews.redraw =
+                keepsLightViews(p.state) ? LightViewAsk::Redraw::No : LightViewAsk::Redraw::Yes;
         const BudgetChoice choice =
             mBudget.choose(p.budgetKey, requestedVpls, static_cast<bool>(info.limitVpls),
                            static_cast<double>(p.state.width) * p.state.height, lightViews);

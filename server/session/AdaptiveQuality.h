@@ -12,6 +12,7 @@
 // and asks it before every frame; tests drive it directly (tests/unit/session/AdaptiveQualityTest.cpp).
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 
@@ -79,8 +80,11 @@ public:
     /// parameters) in scene `sceneName`. `explicitParams` are those the client set (they win over
     /// presets); `snapshot` asks for the best step that fits kSnapshotBudgetMs; `frameTargetMs` is the
     /// session's interactive target (0: none).
+    /// `keepsLightViews` (may be empty): whether a frame of a state keeps the light views drawn before
+    /// (FrameRenderer::keepsLightViews), asked for interactive frames.
     Plan plan(const std::string& sceneName, const FrameState& requested, const nlohmann::json& explicitParams,
-              QualityStep step, bool snapshot, int frameTargetMs);
+              QualityStep step, bool snapshot, int frameTargetMs,
+              const std::function<bool(const FrameState&)>& keepsLightViews = {});
 
     /// `requested` under the preset of `step` and then the explicit parameters; `requested` itself
     /// when there are no presets, none for this technique, or the preset asks for more VPLs than allowed.
@@ -127,7 +131,8 @@ private:
                                     QualityStep step) const;
     void planRefinement(const std::string& sceneName, const FrameState& requested,
                         const nlohmann::json& explicitParams, Plan& plan) const;
-    void planInteractive(int frameTargetMs, const nlohmann::json& explicitParams, Plan& plan);
+    void planInteractive(int frameTargetMs, const nlohmann::json& explicitParams,
+                         const std::function<bool(const FrameState&)>& keepsLightViews, Plan& plan);
 
     SessionLimits mLimits;
     nlohmann::json mPresets;

@@ -275,9 +275,13 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     // After a frame the cap cut, the next one may gather a quarter more per pixel and VPL (its cap
     // grows so): the technique's passes, which the gather then dominates, are predicted so.
     const double workGrowth = rates.receiverCut ? kCutReceiverShareGrowth : 1.0;
-    // A frame after one that drew its light views probably draws them too (a light drag): their
-    // predicted time comes first, whatever the size.
-    const double lightViewMs = rates.lastDrewLightViews ? out.lightViewMs : 0.0;
+    // A frame that draws its light views again (a light drag, a changed light parameter; when the
+    // session does not say, one after a frame that drew them): their predicted time comes first,
+    // whatever the size.
+    const bool redraw = lightViews.redraw == LightViewAsk::Redraw::Unknown
+                            ? rates.lastDrewLightViews
+                            : lightViews.redraw == LightViewAsk::Redraw::Yes;
+    const double lightViewMs = redraw ? out.lightViewMs : 0.0;
     // The ladder from the best frame to the cheapest: size down to the preferred minimum, then VPLs
     // down, then size down to the minimum.
     std::vector<Candidate> ladder;

@@ -72,6 +72,9 @@ struct LightViewAsk {
     int shadowMapSize = 0; ///< 0: not known (no cap)
     int rsmSize = 0;
     bool readsRsm = true;
+    /// Whether the frame draws its light views again (FrameRenderer::keepsLightViews); not known:
+    /// when the frame before drew them.
+    enum class Redraw { Unknown, Yes, No } redraw = Redraw::Unknown;
 };
 /// The share of the frame target that the light views may take in a frame that draws them again.
 inline constexpr double kLightViewShareOfFrame = 0.35;

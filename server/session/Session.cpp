@@ -1351,7 +1351,9 @@ void Session::workerMain() {
         // quality"; session/AdaptiveQuality.h).
         AdaptiveQuality::Plan quality =
             w.quality->plan(scene->name, state, explicitParams, static_cast<QualityStep>(step),
-                            snapshotFor != nullptr, frameTargetMs(stream));
+                            snapshotFor != nullptr, frameTargetMs(stream), [&w](const FrameState& s) {
+                                return w.renderer && w.renderer->keepsLightViews(s);
+                            });
         if (quality.skip) {
             broadcastProgress("skipped", qualityStepName(quality.step), 0.0, quality.predictedMs,
                               quality.why);

@@ -209,6 +209,15 @@ TEST(TilesGl, CappedLightViewsAreDrawnSmallerAndServeUntilTheAskedSidesAreWanted
     EXPECT_EQ(counter(refinedAgain, "light_view_arrays_created"), 0.0);
     FrameState whole = refine;
     EXPECT_EQ(refinedAgain.rgba8, fresh.render(whole).rgba8);
+    // What the frame budget asks before a frame: whether it would keep the maps drawn before.
+    EXPECT_TRUE(reusing.keepsLightViews(refine)) << "the same lights, the asked sides kept";
+    EXPECT_TRUE(reusing.keepsLightViews(drag)) << "a capped frame keeps larger maps up to the asked sides";
+    FrameState movedLight = refine;
+    movedLight.lights[0].light.intensity *= 0.5f;
+    EXPECT_FALSE(reusing.keepsLightViews(movedLight)) << "another light";
+    FrameState smallerAsked = refine;
+    smallerAsked.frameParams.set("rsm_size", 256);
+    EXPECT_FALSE(reusing.keepsLightViews(smallerAsked)) << "maps larger than asked do not serve";
     // A cap above the asked sides changes nothing.
     FrameState loose = asked;
     loose.lights[0].light.intensity *= 0.5f;

@@ -426,6 +426,34 @@ TEST(FrameBudget, ALightDragAtLargeMapsKeepsTheSizeAndCapsTheDearerMap) {
     EXPECT_LE(orbit.predictedMs, 80.0);
 }
 
+TEST(FrameBudget, AFrameSaidToDrawItsLightViewsIsPredictedWithThem) {
+    const LightDragRenderer r;
+    const double full = 960 * 800;
+    FrameBudget budget(FrameBudget::Config{});
+    LightViewAsk large{4096, 1024, true};
+    BudgetChoice c;
+    for (int i = 0; i < 8; ++i) { // a drag: the rates of both maps measured
+        c = budget.choose("k", 0, false, full, large);
+        budget.record("k", r.frame(full * c.scale * c.scale, c.shadowSideCap, c.rsmSideCap, true));
+    }
+    for (int i = 0; i < 4; ++i) { // an orbit after it: the maps kept
+        c = budget.choose("k", 0, false, full, large);
+        budget.record("k", r.frame(full * c.scale * c.scale, c.shadowSideCap, c.rsmSideCap, false));
+    }
+    const BudgetChoice orbit = budget.choose("k", 0, false, full, large);
+    // The first frame of the next drag, or the answer to a changed light parameter: after an orbit's
+    // frames, only the session's word says that this one draws the maps again.
+    large.redraw = LightViewAsk::Redraw::Yes;
+    const BudgetChoice drag = budget.choose("k", 0, false, full, large);
+    EXPECT_LT(drag.scale, orbit.scale);
+    EXPECT_LE(drag.predictedMs, 80.0);
+    EXPECT_GE(drag.predictedMs, drag.lightViewMs);
+    // And after a drag's frame, a frame said to keep them is predicted without them.
+    budget.record("k", r.frame(full * drag.scale * drag.scale, drag.shadowSideCap, drag.rsmSideCap, true));
+    large.redraw = LightViewAsk::Redraw::No;
+    EXPECT_GT(budget.choose("k", 0, false, full, large).scale, drag.scale);
+}
+
 TEST(FrameBudget, TheLightViewsCostComesFromTheirPasses) {
     const nlohmann::json stats = {{"frame_ms", 100.0},
                                   {"technique_ms", 50.0},
