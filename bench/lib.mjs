@@ -28,6 +28,20 @@ export function parseOptions(defaults, usage, argv = process.argv.slice(2)) {
     return opts;
 }
 
+/**
+ * The JSON option `--name` of `script` (parameters to send, say), `fallback` when it is empty; exits with
+ * status 2 and a message naming the option when it is not JSON.
+ */
+export function jsonOption(opts, name, script, fallback = {}) {
+    if (!opts[name]) return fallback;
+    try {
+        return JSON.parse(opts[name]);
+    } catch (e) {
+        console.error(`${script}: --${name} is not JSON: ${e.message}`);
+        process.exit(2);
+    }
+}
+
 export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
 export const freePort = () => new Promise((resolve) => {

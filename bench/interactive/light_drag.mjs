@@ -16,19 +16,13 @@
 //   node bench/interactive/light_drag.mjs [--server build/ci/bin/gi-server] [--scene builtin:atrium]
 //       [--rounds 3] [--drag-s 4] [--press-ms 60] [--settings "--interactive-lod-px 1|--interactive-lod-px 0"]
 //       [--technique T] [--params JSON]
-import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
+import { connectClient, DEFAULT_SERVER, jsonOption, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:atrium', rounds: 3, 'drag-s': 4, 'press-ms': 60,
     settings: '--interactive-lod-px 1|--interactive-lod-px 0', size: '960x800', technique: '', params: '' },
 'usage: node bench/interactive/light_drag.mjs [--server PATH] [--scene NAME] [--rounds N] [--drag-s S] [--press-ms MS] [--size WxH] [--settings "FLAGS|FLAGS"] [--technique T] [--params JSON]');
 const [width, height] = opts.size.split('x').map(Number);
-let params = null;
-try {
-    params = opts.params ? JSON.parse(opts.params) : null;
-} catch (e) {
-    console.error(`light_drag: --params is not JSON: ${e.message}`);
-    process.exit(2);
-}
+const params = jsonOption(opts, 'params', 'light_drag', null);
 
 // The light `angle` into the drag: a directional light's direction turned about the vertical, another
 // light moved sideways by up to a twentieth of the scene's extent (a light on the vertical axis

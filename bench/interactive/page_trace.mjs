@@ -8,18 +8,12 @@
 //        [--params '{"vpl_grid": 256}'] [--wait-s 4] [--seconds 5] [--server-args "FLAGS"] [--out trace.json]
 import { writeFileSync } from 'node:fs';
 
-import { DEFAULT_SERVER, parseOptions, sleep, startServer } from '../lib.mjs';
+import { DEFAULT_SERVER, jsonOption, parseOptions, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, technique: 'rsm_gather', params: '{"vpl_grid": 256}', 'wait-s': 4,
     seconds: 5, 'server-args': '', out: '', chromium: process.env.GI_CHROMIUM ?? '/usr/bin/chromium' },
 'usage: node bench/interactive/page_trace.mjs [--server PATH] [--technique T] [--params JSON] [--wait-s S] [--seconds S] [--server-args "FLAGS"] [--out FILE]');
-let params;
-try {
-    params = JSON.parse(opts.params || '{}');
-} catch (e) {
-    console.error(`page_trace: --params is not JSON: ${e.message}`);
-    process.exit(2);
-}
+const params = jsonOption(opts, 'params', 'page_trace');
 const { server, port } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 const { chromium } = await import('playwright-core');
 const browser = await chromium.launch({ executablePath: opts.chromium,

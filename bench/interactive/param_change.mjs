@@ -9,18 +9,12 @@
 // docs/interactive.md, "The costliest frame parameters".
 // usage: node bench/interactive/param_change.mjs [--server PATH] [--scene builtin:gallery]
 //        [--technique multires_gather] [--params '{"env_size": 512, "env_samples": 256}'] [--moves 3] [--drag-s 6]
-import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
+import { connectClient, DEFAULT_SERVER, jsonOption, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:gallery', technique: 'multires_gather',
     params: '{"env_size": 512, "env_samples": 256}', moves: 3, 'drag-s': 6, 'server-args': '' },
 'usage: node bench/interactive/param_change.mjs [--server PATH] [--scene S] [--technique T] [--params JSON] [--moves N] [--drag-s S] [--server-args "FLAGS"]');
-let params;
-try {
-    params = JSON.parse(opts.params || '{}');
-} catch (e) {
-    console.error(`param_change: --params is not JSON: ${e.message}`);
-    process.exit(2);
-}
+const params = jsonOption(opts, 'params', 'param_change');
 const { server, port } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 const link = await connectClient(port, { size: [960, 800], adaptive: true });
 const interactiveAfter = async (what, frame, timeoutMs = 120000) => {

@@ -7,18 +7,12 @@
 // the same cores the figures are the server's own (orbit.mjs measures the whole path in the page).
 // usage: node bench/interactive/refine_waits.mjs [--server build/ci/bin/gi-server] [--technique hier_isr]
 //        [--params '{"tau": 0}'] [--presses 40] [--scene builtin:cornell] [--server-args "FLAGS"] [--verbose 1]
-import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
+import { connectClient, DEFAULT_SERVER, jsonOption, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, technique: 'hier_isr', params: '{"tau": 0}', presses: 40,
     scene: '', 'server-args': '', verbose: 0 },
 'usage: node bench/interactive/refine_waits.mjs [--server PATH] [--technique T] [--params JSON] [--presses N] [--scene S] [--server-args "FLAGS"] [--verbose 1]');
-let params;
-try {
-    params = JSON.parse(opts.params || '{}');
-} catch (e) {
-    console.error(`refine_waits: --params is not JSON: ${e.message}`);
-    process.exit(2);
-}
+const params = jsonOption(opts, 'params', 'refine_waits');
 const { server, port, log } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 const link = await connectClient(port, { size: [960, 800] });
 try {
