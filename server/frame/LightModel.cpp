@@ -179,6 +179,13 @@ int lightViewSide(int fullSide, int defaultSide, int views, int minSide) {
     return side;
 }
 
+const LightViewDefaults& lightViewDefaults() {
+    static const LightViewDefaults defaults{
+        static_cast<int>(frameParamTable().find("shadow_map_size")->defaultValue),
+        static_cast<int>(frameParamTable().find("rsm_size")->defaultValue)};
+    return defaults;
+}
+
 LightViewSides lightViewSides(int askedShadow, int askedRsm, int capShadow, int capRsm, bool readsRsm,
                               const KeptLightViews& kept) {
     const int lowShadow = capShadow > 0 ? std::min(capShadow, askedShadow) : askedShadow;
@@ -294,9 +301,7 @@ LightSetModel makeLightSet(const FrameState& state, const Bounds& bounds) {
         set.lights.push_back(m);
     }
     const int views = std::max(static_cast<int>(set.views.size()), 1);
-    const ParamTable& table = frameParamTable();
-    const int shadowDefault = static_cast<int>(table.find("shadow_map_size")->defaultValue);
-    const int rsmDefault = static_cast<int>(table.find("rsm_size")->defaultValue);
+    const int shadowDefault = lightViewDefaults().shadowSide, rsmDefault = lightViewDefaults().rsmSide;
     set.shadowSide =
         lightViewSide(hasParams ? fp.getInt("shadow_map_size") : shadowDefault, shadowDefault, views, 64);
     set.rsmSide = lightViewSide(hasParams ? fp.getInt("rsm_size") : rsmDefault, rsmDefault, views, 16);

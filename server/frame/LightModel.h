@@ -126,6 +126,13 @@ LightSetModel makeLightSet(const FrameState& state, const Bounds& sceneBounds);
 /// `minSide`).
 int lightViewSide(int fullSide, int defaultSide, int views, int minSide);
 
+/// The frame parameters' defaults, texels per side: shadow_map_size and rsm_size.
+struct LightViewDefaults {
+    int shadowSide;
+    int rsmSide;
+};
+const LightViewDefaults& lightViewDefaults();
+
 /// The light views an earlier frame left drawn: whether they show this frame's lights (the same light
 /// block, solid-angle rule, RSMs when this frame reads them, level of detail) and their sides.
 struct KeptLightViews {

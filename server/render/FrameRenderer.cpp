@@ -12,7 +12,6 @@
 #include "core/Log.h"
 #include "core/Timer.h"
 #include "frame/Exposure.h"
-#include "frame/FrameParams.h"
 #include "frame/LightModel.h"
 #include "gl/Pass.h"
 #include "gl/ShaderShared.h"
@@ -82,13 +81,6 @@ std::vector<LodView> lightViewLods(const LightSetModel& set, float texels, int s
     return lods;
 }
 
-// The frame parameter's default (shadow_map_size, rsm_size): texels per side.
-int defaultSide(const char* name) {
-    static const int shadow = static_cast<int>(frameParamTable().find("shadow_map_size")->defaultValue);
-    static const int rsm = static_cast<int>(frameParamTable().find("rsm_size")->defaultValue);
-    return std::string_view(name) == "rsm_size" ? rsm : shadow;
-}
-
 // Bands of rows in which refinement draws a light view larger than the default's, asking between
 // them whether input arrived: as many as the side is a multiple of the default side (at most 16), so
 // each costs about a default map (a 4096 shadow map took 25-35 ms and a 1024 RSM 25-40 ms as one
@@ -98,9 +90,27 @@ int lightViewBands(int side, int defaultSide) {
     return std::clamp(side / std::max(defaultSide, 1), 1, 16);
 }
 
-void scissorBand(gl::Pass& pass, int side, int band, int bands) {
-    const int y0 = side * band / bands, y1 = side * (band + 1) / bands;
-    pass.scissor(0, y0, side, y1 - y0);
+// Every layer of a light-view array (one framebuffer each, `side` texels): bound with a depth test,
+// cleared by `clear`, and, the first `views` of them, drawn by `draw(pass, view)`. With `bands` above
+// one (lightViewBands), each view's layer goes in that many bands of rows, scissored, and `stop` is
+// asked between them. False when it said stop: the layers are then incomplete.
+bool drawLayersInBands(const char* name, const std::vector<gl::Framebuffer>& fbos, int side, int views,
+                       int bands, const std::function<bool()>& stop,
+                       const std::function<void(gl::Pass&)>& clear,
+                       const std::function<void(gl::Pass&, int)>& draw) {
+    for (int v = 0; v < static_cast<int>(fbos.size()); ++v) {
+        const int pieces = v < views ? bands : 1;
+        for (int b = 0; b < pieces; ++b) {
+            if (pieces > 1 && (v > 0 || b > 0) && stop()) return false;
+            gl::Pass layer(name);
+            layer.target(fbos[static_cast<size_t>(v)], side, side).depthTest(GL_LESS);
+            if (pieces > 1)
+                layer.scissor(0, side * b / pieces, side, side * (b + 1) / pieces - side * b / pieces);
+            clear(layer);
+            if (v < views) draw(layer, v);
+        }
+    }
+    return true;
 }
 
 } // namespace
@@ -381,16 +391,11 @@ DrawCount FrameRenderer::renderShadowMaps(int views, std::span<const LodView> lo
     // Depth only, with a slope-scaled offset against acne; layers without a view are cleared (lit).
     gl::Pass pass(mTimer, "shadow_map");
     DrawCount count;
-    const int bands = stop ? lightViewBands(mShadowSize, defaultSide("shadow_map_size")) : 1;
-    for (int v = 0; v < mShadowLayers; ++v) {
-        const int pieces = v < views ? bands : 1;
-        for (int b = 0; b < pieces; ++b) {
-            if (pieces > 1 && (v > 0 || b > 0) && stop()) return count;
-            gl::Pass layer("shadow_map view");
-            layer.target(mShadow.fbos[static_cast<size_t>(v)], mShadowSize, mShadowSize).depthTest(GL_LESS);
-            if (pieces > 1) scissorBand(layer, mShadowSize, b, pieces);
-            layer.clearDepth();
-            if (v >= views) continue;
+    const int bands = stop ? lightViewBands(mShadowSize, lightViewDefaults().shadowSide) : 1;
+    const bool whole = drawLayersInBands(
+        "shadow_map view", mShadow.fbos, mShadowSize, views, bands, stop,
+        [](gl::Pass& layer) { layer.clearDepth(); },
+        [&](gl::Pass& layer, int v) {
             layer.polygonOffset(2.0f, 4.0f);
             const MeshPass& shadow = shadowPass();
             layer.use(shadow.program).set(shadow.view, v);
@@ -398,9 +403,8 @@ DrawCount FrameRenderer::renderShadowMaps(int views, std::span<const LodView> lo
                                      &mLightBlock->views[v].viewProj, false,
                                      static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)]
                                                                           : nullptr);
-        }
-    }
-    mResources.publish("lights.shadow", "shadow_map", mShadow.depth);
+        });
+    if (whole) mResources.publish("lights.shadow", "shadow_map", mShadow.depth);
     return count;
 }
 
@@ -408,23 +412,18 @@ DrawCount FrameRenderer::renderRsms(int views, std::span<const LodView> lods,
                                     const std::function<bool()>& stop) {
     gl::Pass pass(mTimer, "rsm");
     DrawCount count;
-    const int bands = stop ? lightViewBands(mRsmSize, defaultSide("rsm_size")) : 1;
-    for (int v = 0; v < mRsmLayers; ++v) {
-        const int pieces = v < views ? bands : 1;
-        for (int b = 0; b < pieces; ++b) {
-            if (pieces > 1 && (v > 0 || b > 0) && stop()) return count;
-            gl::Pass layer("rsm view");
-            layer.target(mRsm.fbos[static_cast<size_t>(v)], mRsmSize, mRsmSize).depthTest(GL_LESS);
-            if (pieces > 1) scissorBand(layer, mRsmSize, b, pieces);
-            layer.clearColor(4).clearDepth();
-            if (v >= views) continue;
+    const int bands = stop ? lightViewBands(mRsmSize, lightViewDefaults().rsmSide) : 1;
+    const bool whole = drawLayersInBands(
+        "rsm view", mRsm.fbos, mRsmSize, views, bands, stop,
+        [](gl::Pass& layer) { layer.clearColor(4).clearDepth(); },
+        [&](gl::Pass& layer, int v) {
             const MeshPass& rsm = rsmPass();
             layer.use(rsm.program).set(rsm.view, v);
             count += mSceneGpu->draw(
                 rsm.program, &rsm.materials, 1, -1, &mLightBlock->views[v].viewProj, false,
                 static_cast<size_t>(v) < lods.size() ? &lods[static_cast<size_t>(v)] : nullptr);
-        }
-    }
+        });
+    if (!whole) return count;
     mResources.publish("lights.rsm.position", "rsm", mRsm.position);
     mResources.publish("lights.rsm.normal", "rsm", mRsm.normal);
     mResources.publish("lights.rsm.flux", "rsm", mRsm.flux);
@@ -583,9 +582,10 @@ bool FrameRenderer::keepsLightViews(const FrameState& state) {
     if (!mQueryLightBlock) mQueryLightBlock = std::make_unique<shader::LightUniforms>();
     *mQueryLightBlock = shader::LightUniforms{};
     writeLightUniforms(set, *mQueryLightBlock);
-    const KeptLightViews kept = keptLightViews(state, *mQueryLightBlock);
-    return kept.sameLights && kept.shadowSide <= set.shadowSide &&
-           (!findTechniqueInfo(state.technique).readsRsm || kept.rsmSide <= set.rsmSide);
+    // Under whatever cap the budget then sets: kept maps of any side up to the asked serve.
+    return lightViewSides(set.shadowSide, set.rsmSide, 1, 1, findTechniqueInfo(state.technique).readsRsm,
+                          keptLightViews(state, *mQueryLightBlock))
+        .keep;
 }
 
 bool FrameRenderer::wantsLevels(const FrameState& state) {

@@ -225,8 +225,8 @@ private:
     Rsms mRsm;
     /// The maps of the other side last drawn (gl/RecentTargets.h), keyed by side and layers: an
     /// interactive frame's capped light views (FrameState::LightViewCap) and a refinement step's
-    /// asked ones alternate, and a new 4096^2 shadow array cost the step's first tile about 40 ms
-    /// before its first band (allocated and cleared). At most one, of at most 128 MiB.
+    /// asked ones alternate, and allocating them again held the step's first tile (about 40 ms for a
+    /// 4096^2 shadow array on llvmpipe, docs/interactive.md). At most one, of at most 128 MiB.
     gl::RecentTargets<std::pair<int, int>, ShadowMaps> mOtherShadow{1, 128.0 * 1024.0 * 1024.0};
     gl::RecentTargets<std::pair<int, int>, Rsms> mOtherRsm{1, 128.0 * 1024.0 * 1024.0};
     int mLightMapsCreated = 0; ///< arrays ensureTargets created for this frame (counts)

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <vector>
 
-#include "frame/FrameParams.h"
 #include "frame/LightModel.h"
 
 namespace gis {
@@ -188,9 +187,7 @@ void FrameBudget::record(const std::string& key, const FrameCost& cost) {
 
 void FrameBudget::chooseLightViews(const Rates* rates, const LightViewAsk& ask, BudgetChoice& out) const {
     if (ask.shadowMapSize <= 0 || ask.rsmSize <= 0) return;
-    const ParamTable& table = frameParamTable();
-    const int shadowDefault = static_cast<int>(table.find("shadow_map_size")->defaultValue);
-    const int rsmDefault = static_cast<int>(table.find("rsm_size")->defaultValue);
+    const int shadowDefault = lightViewDefaults().shadowSide, rsmDefault = lightViewDefaults().rsmSide;
     const int views = rates ? std::max(rates->lightViews, 1) : 1;
     // As the renderer sizes them (LightModel.h), and never below the defaults' sides (or the asked,
     // when smaller): larger maps are a still view's.

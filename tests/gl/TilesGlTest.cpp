@@ -266,6 +266,41 @@ TEST(TilesGl, LargeLightViewsAreDrawnInBandsThatInputCanStop) {
     EXPECT_EQ(next.rgba8, whole.render(moved).rgba8);
 }
 
+// The same on a Blender export whose two point lamps and sun make 13 views (the asked 4096 and 1024
+// become 2048 and 512 shared sides, lightViewSide): two bands per view and map, checks between
+// every two; the bands draw the maps drawn in one piece, and a capped frame the maps of those sides.
+TEST(TilesGl, LightViewsInBandsAndUnderACapOnBlenderLamps) {
+    ReusePair pair(std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/point_lamps.glb");
+    FrameRenderer &whole = pair.fresh, &banded = pair.reusing;
+    FrameState large = pair.state;
+    large.frameParams.set("shadow_map_size", 4096);
+    large.frameParams.set("rsm_size", 1024);
+    int checks = 0;
+    banded.setInterruptCheck([&] {
+        ++checks;
+        return false;
+    });
+    const FrameOutput inBands = banded.render(large);
+    ASSERT_EQ(inBands.stats["lighting"]["views"], 13);
+    EXPECT_EQ(inBands.stats["lighting"]["shadow_side"], 2048);
+    EXPECT_EQ(inBands.stats["lighting"]["rsm_side"], 512);
+    EXPECT_GE(checks, 2 * (13 * 2 - 1)) << "a check between every two bands of both arrays";
+    EXPECT_EQ(inBands.rgba8, whole.render(large).rgba8);
+    banded.setInterruptCheck({});
+    // An interactive frame's cap at the defaults' sides (lightViewSide: 1024 and 256 for 13 views).
+    FrameState capped = large;
+    capped.lights[0].light.intensity *= 0.5f;
+    capped.lightViewCap = {1024, 256};
+    const FrameOutput small = banded.render(capped);
+    EXPECT_EQ(small.stats["lighting"]["shadow_side"], 1024);
+    EXPECT_EQ(small.stats["lighting"]["rsm_side_asked"], 512);
+    FrameState asked = capped;
+    asked.lightViewCap = {};
+    asked.frameParams.set("shadow_map_size", 1024);
+    asked.frameParams.set("rsm_size", 256);
+    EXPECT_EQ(small.rgba8, whole.render(asked).rgba8);
+}
+
 TEST(TilesGl, ReusedEnvironmentProbesRenderTheSameFrame) {
     ReusePair pair("builtin:gallery"); // a room probe and a local one
     FrameRenderer &fresh = pair.fresh, &reusing = pair.reusing;
