@@ -60,6 +60,7 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
         const std::string name = pass.value("name", std::string());
         double ms = pass.value("gpu_ms", 0.0);
         if (!std::isfinite(ms) || ms < 0.0) ms = 0.0;
+        cost.passesMs += ms;
         if (name == "shadow_map") {
             shadowPass = true;
             shadowMs += ms;
@@ -143,9 +144,15 @@ double FrameBudget::vplPassesMs(const std::string& key, double pixels, long vpls
     return r.vpl * pixels * std::pow(static_cast<double>(std::max(1L, vpls)), r.exponent);
 }
 
-void FrameBudget::record(const std::string& key, const FrameCost& cost) {
-    if (!(cost.pixels > 0) || !std::isfinite(cost.frameMs) || cost.frameMs < 0) return;
+void FrameBudget::record(const std::string& key, const FrameCost& measured) {
+    if (!(measured.pixels > 0) || !std::isfinite(measured.frameMs) || measured.frameMs < 0) return;
     Rates& r = mRates[key];
+    FrameCost cost = measured;
+    // A first frame's time outside its passes is compiling and first uploads (cornell's first
+    // hier_isr frame: 343 ms, its passes 238 ms; the next at that size 205 ms): its passes stand for
+    // it. The passes keep some of it (direct 15 against 9 ms), which only errs towards a small frame.
+    r.firstByPasses = r.frames == 0 && cost.passesMs > 0.0 && std::isfinite(cost.passesMs);
+    if (r.firstByPasses) cost.frameMs = std::min(cost.frameMs, cost.passesMs);
     // The light views' passes are the light views' (their own rates below), not the pixels'.
     const double lightMs =
         cost.drewLightViews ? std::max(cost.shadowMs, 0.0) + std::max(cost.rsmMs, 0.0) : 0.0;
@@ -249,13 +256,16 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
         if (!out.lightViewReason.empty()) out.reason += "; " + out.lightViewReason;
         return out;
     };
-    // The first two frames of a scene and technique are small ones. The first has nothing measured;
-    // the first's time included compiling the technique's shaders and uploading what the scene's first
-    // draw needs (471 ms for cornell's first multires_gather frame, against about 60 ms for the next
-    // at that size), and its rates would take the next frames down to 16 VPLs and a fifth of the size,
-    // from which the budget climbs for a second. The second's time replaces the first's (record).
+    // The first frame of a scene and technique is a small one: nothing is measured. Its time included
+    // compiling the technique's shaders and uploading what the scene's first draw needs (471 ms for
+    // cornell's first multires_gather frame, against about 60 ms for the next at that size), and its
+    // whole time would take the next frames down to 16 VPLs and a fifth of the size, from which the
+    // budget climbs for a second; its passes alone (record) predict the second frame, and without
+    // them the second is a small one too (a guess: hier_isr at tau 0 took 205 ms so). The second's
+    // time replaces the first's (record).
     const int measured = it == mRates.end() ? 0 : it->second.frames;
-    if (measured < 2) {
+    const bool onlyFirst = measured == 1;
+    if (measured == 0 || (onlyFirst && !it->second.firstByPasses)) {
         out.scale = std::clamp(c.firstScale, c.minScale, c.maxScale);
         if (cappable && requestedVpls > c.firstVplCap) out.vplCap = c.firstVplCap;
         out.reason =
@@ -330,6 +340,9 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
                  ? " and " + std::to_string(out.vplCap) + " of " + std::to_string(requestedVpls) + " VPLs"
                  : std::string()) +
             fmt(" meet the %.0f ms target (%.0f ms predicted from this session's frames)", target, predicted);
+    if (onlyFirst)
+        out.reason += "; second frame of this scene and technique: predicted from the first one's passes, "
+                      "without its compile time";
     return withLightViews();
 }
 

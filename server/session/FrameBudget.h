@@ -37,9 +37,12 @@ namespace gis {
 
 /// One measured interactive frame.
 struct FrameCost {
-    double pixels = 0;      ///< rendered
-    long vpls = 0;          ///< rendered (0: the technique has none)
-    double frameMs = 0;     ///< the renderer's frame_ms
+    double pixels = 0;  ///< rendered
+    long vpls = 0;      ///< rendered (0: the technique has none)
+    double frameMs = 0; ///< the renderer's frame_ms
+    /// The frame's timed passes together (gpu_ms, as technique_ms sums); 0: not known. A scene and
+    /// technique's first frame spends most of its compile and first-upload time outside them.
+    double passesMs = 0;
     double techniqueMs = 0; ///< the technique's passes within it
     double encodeMs = 0;
     /// The technique's passes cost about pixels x vpls^vplCostExponent (TechniqueInfo::vplCostExponent).
@@ -122,9 +125,10 @@ public:
         double preferredMinScale = 0.3; ///< below this, VPLs go first
         double minScale = 0.1;
         long minVpls = 16;
-        /// The first two frames of a scene and technique (nothing measured, then only a frame that
-        /// compiled the technique's shaders): this size factor, at most firstVplCap VPLs (a guess
-        /// kept small, so that those frames stay short).
+        /// The first frame of a scene and technique (nothing measured), and the second when the
+        /// first's passes were not timed (only a frame that compiled the technique's shaders): this
+        /// size factor, at most firstVplCap VPLs (a guess kept small, so that those frames stay
+        /// short).
         double firstScale = 0.35;
         long firstVplCap = 1024;
     };
@@ -151,6 +155,8 @@ private:
         double receiverShare = -1;            ///< the last frame's (FrameCost::receiverShare)
         bool receiverCut = false;             ///< FrameCost::receiverCut of the last frame
         int frames = 0;
+        /// The only frame measured was a first one, counted by its passes (FrameCost::passesMs).
+        bool firstByPasses = false;
         int level = -1; ///< index of the last choice in the candidate ladder
         /// ms per texel of the shadow maps and of the RSMs (with their flux sums and the technique's
         /// lightViewPasses), from the frames that drew them (lightFrames).

@@ -63,6 +63,42 @@ TEST(FrameBudget, TheFirstFramesTimeIsNotTrusted) {
     EXPECT_GT(third.scale, first.scale) << third.reason;
 }
 
+TEST(FrameBudget, TheFirstFramesPassesPredictTheSecond) {
+    FrameBudget budget(FrameBudget::Config{});
+    const double full = 960 * 800;
+    const BudgetChoice first = budget.choose("k", 65536, true, full);
+    const double pixels = full * first.scale * first.scale;
+    // hier_isr at tau 0 on cornell: the first frame's passes took 238 ms, its whole time 343 ms
+    // (compiling); at the same size and VPLs the next took 205 ms. A dear first frame must not be
+    // followed by another as dear.
+    FrameCost compiled = synthetic(pixels, first.vplCap, 1e-4, 2e-6);
+    const FrameCost warm = compiled;
+    compiled.passesMs = warm.frameMs;
+    compiled.frameMs = warm.frameMs + 105.0;
+    ASSERT_GT(warm.frameMs, 150.0);
+    budget.record("k", compiled);
+    EXPECT_NEAR(budget.predictMs("k", pixels, first.vplCap), warm.frameMs, 1e-9)
+        << "the first frame counts by its passes";
+    const BudgetChoice second = budget.choose("k", 65536, true, full);
+    EXPECT_NE(second.reason.find("first one's passes"), std::string::npos) << second.reason;
+    EXPECT_GT(second.predictedMs, 0.0);
+    EXPECT_LE(second.predictedMs, 80.0) << second.reason;
+    ASSERT_GT(second.vplCap, 0);
+    EXPECT_LT(second.vplCap, first.vplCap) << second.reason;
+    const double secondPixels = full * second.scale * second.scale;
+    EXPECT_LE(synthetic(secondPixels, second.vplCap, 1e-4, 2e-6).frameMs, 80.0);
+
+    // Untimed passes (0) leave the rule before: the second frame is the first's guess again.
+    FrameBudget untimed(FrameBudget::Config{});
+    untimed.choose("k", 65536, true, full);
+    FrameCost noPasses = compiled;
+    noPasses.passesMs = 0;
+    untimed.record("k", noPasses);
+    const BudgetChoice guess = untimed.choose("k", 65536, true, full);
+    EXPECT_DOUBLE_EQ(guess.scale, first.scale);
+    EXPECT_EQ(guess.vplCap, first.vplCap);
+}
+
 TEST(FrameBudget, CheapFramesGetFullQuality) {
     FrameBudget budget(FrameBudget::Config{});
     double ms = 0;
