@@ -6,13 +6,18 @@
 // of other qualities (refinement steps) came between, the frames' p95 and slowest render time, how many
 // the receiver cap gave fewer VPLs, and frames rendered but never received; with WS_ORBIT_DUMP=1 the
 // last frame's passes and timings as well, with --slow-ms each frame slower than that, with --first N
-// the session's first N interactive frames (how the budget starts). usage:
+// the session's first N interactive frames (how the budget starts); with --technique (and --params)
+// the client switches to that technique once the scene is up, as a user does, and --first lists the
+// frames from the switch on. usage:
 //   node bench/interactive/ws_orbit.mjs [--server build/ci/bin/gi-server] [--scene builtin:cornell]
 //        [--seconds 10] [--server-args "--technique hier_isr"] [--slow-ms 150] [--first 12]
-import { DEFAULT_SERVER, connectClient, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
+//        [--technique hier_isr] [--params '{"tau": 0}']
+import { DEFAULT_SERVER, connectClient, jsonOption, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
-const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:cornell', seconds: 10, 'server-args': '', 'slow-ms': 0, first: 0 },
-    'usage: node bench/interactive/ws_orbit.mjs [--server PATH] [--scene NAME] [--seconds S] [--server-args "FLAGS"] [--slow-ms MS] [--first N]');
+const opts = parseOptions({ server: DEFAULT_SERVER, scene: 'builtin:cornell', seconds: 10, 'server-args': '', 'slow-ms': 0,
+    first: 0, technique: '', params: '' },
+'usage: node bench/interactive/ws_orbit.mjs [--server PATH] [--scene NAME] [--seconds S] [--server-args "FLAGS"] [--slow-ms MS] [--first N] [--technique T] [--params JSON]');
+const params = jsonOption(opts, 'params', 'ws_orbit');
 const { server, port, log } = await startServer(opts.server,
     opts['server-args'] ? opts['server-args'].split(' ').filter(Boolean) : []);
 const link = await connectClient(port, { client: 'ws_orbit', size: [960, 800] });
@@ -20,6 +25,19 @@ try {
     await link.until('the welcome', () => link.state);
     link.send({ type: 'scene', name: opts.scene });
     await link.until(`frames of ${opts.scene}`, () => link.stats?.scene === opts.scene, 120000);
+} catch (e) {
+    console.error(`${e.message}; the server's log:\n${log()}`);
+    process.exit(1);
+}
+const switchedFrom = link.frames.length;
+try {
+    if (opts.technique) {
+        link.send({ type: 'technique', name: opts.technique });
+        if (Object.keys(params).length) link.send({ type: 'params', values: params });
+        await link.until(`frames of ${opts.technique}`, () => link.stats?.technique === opts.technique, 60000);
+    } else if (Object.keys(params).length) {
+        link.send({ type: 'params', values: params });
+    }
 } catch (e) {
     console.error(`${e.message}; the server's log:\n${log()}`);
     process.exit(1);
@@ -88,11 +106,15 @@ if (process.env.WS_ORBIT_DUMP)
     console.log(JSON.stringify({ passes: last.passes, timing: last.timing, input: last.input,
         readback: last.readback_ms, technique_ms: last.technique_ms }));
 link.ws.close();
-// The session's first interactive frames, from the connection on: what the budget chose before it had
-// measured much.
-for (const f of link.frames.filter((x) => x.stats.quality === 'interactive').slice(0, opts.first)) {
+// The session's first interactive frames, from the connection on (from the switch to --technique on):
+// what the budget chose before it had measured much.
+const firstFrames = opts.technique
+    ? link.frames.slice(switchedFrom).filter((x) => x.stats.technique === opts.technique)
+    : link.frames;
+for (const f of firstFrames.filter((x) => x.stats.quality === 'interactive').slice(0, opts.first)) {
     console.log(JSON.stringify({ first_frame: f.stats.frame, technique: f.stats.technique, size: f.stats.size,
-        vpls: f.stats.counts?.vpl_count ?? null, frame_ms: +f.stats.frame_ms.toFixed(1), budget: f.stats.budget?.reason ?? null }));
+        vpls: f.stats.counts?.vpl_count ?? null, frame_ms: +f.stats.frame_ms.toFixed(1),
+        technique_ms: +(f.stats.technique_ms ?? 0).toFixed(1), budget: f.stats.budget?.reason ?? null }));
 }
 server.kill();
 process.exit(0);

@@ -268,6 +268,7 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     if (measured == 0 || (onlyFirst && !it->second.firstByPasses)) {
         out.scale = std::clamp(c.firstScale, c.minScale, c.maxScale);
         if (cappable && requestedVpls > c.firstVplCap) out.vplCap = c.firstVplCap;
+        out.receiverShareCap = std::clamp(c.firstReceiverShareCap, kMinReceiverShareCap, 1.0);
         out.reason =
             std::string(measured == 0 ? "first frame of this scene and technique: nothing measured yet"
                                       : "second frame of this scene and technique: the first one's time "

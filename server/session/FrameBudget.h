@@ -131,6 +131,10 @@ public:
         /// short).
         double firstScale = 0.35;
         long firstVplCap = 1024;
+        /// ...and the gather's work capped at this many receivers per pixel (receiver_share_cap):
+        /// VPLs alone do not bound a gather over receivers (hier_isr at tau 0 with depth_threshold 0,
+        /// every pixel a receiver: 1,219 ms for the first frame's 1024 VPLs). Twice cornell's share.
+        double firstReceiverShareCap = 0.25;
     };
     explicit FrameBudget(Config config) : mConfig(config) {}
     const Config& config() const { return mConfig; }

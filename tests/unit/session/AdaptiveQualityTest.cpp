@@ -386,16 +386,18 @@ TEST(AdaptiveQuality, EveryLiveStepDrawsTheLightViewsWithinATexelUnlessTheClient
 namespace gis {
 namespace {
 
-// The frame budget's receiver cap reaches the technique that has one (multires_gather), after the
-// first measured frame, unless the client set the parameter itself; other techniques are untouched.
+// The frame budget's receiver cap reaches the technique that has one (multires_gather): a guess for
+// the first frame, then from the measured frames, unless the client set the parameter itself; other
+// techniques are untouched.
 TEST(AdaptiveQuality, InteractiveFramesCapTheGatherAtTwiceTheLastReceiverShare) {
     AdaptiveQuality q(limits(), nullptr);
     const nlohmann::json none = nlohmann::json::object();
     FrameState asked = makeFrameState(cornell(), "multires_gather");
     asked.width = asked.height = 256;
     const AdaptiveQuality::Plan first = q.plan("cornell", asked, none, QualityStep::Interactive, false, 80);
-    EXPECT_DOUBLE_EQ(first.state.techniqueParams.getFloat("receiver_share_cap"), 1.0) << "nothing measured";
-    EXPECT_TRUE(first.budget["receiver_share_cap"].is_null());
+    const double guess = FrameBudget::Config{}.firstReceiverShareCap;
+    EXPECT_DOUBLE_EQ(first.state.techniqueParams.getFloat("receiver_share_cap"), guess) << "nothing measured";
+    EXPECT_DOUBLE_EQ(first.budget["receiver_share_cap"].get<double>(), guess);
 
     FrameCost cost;
     cost.pixels = 100 * 100;
