@@ -30,6 +30,14 @@ double usableVplCostExponent(double exponent) {
     return std::isfinite(exponent) ? std::clamp(exponent, 0.05, 1.0) : 1.0;
 }
 
+double frameVplCostExponent(const TechniqueInfo& info, const nlohmann::json& counts) {
+    if (info.localVplCostExponent && counts.is_object()) {
+        const double local = info.localVplCostExponent(counts);
+        if (std::isfinite(local) && local > 0.0) return usableVplCostExponent(local);
+    }
+    return usableVplCostExponent(info.vplCostExponent);
+}
+
 long capVplsForReceivers(const TechniqueInfo& info, ParamSet& technique, long estimate, double pixels,
                          double receivers) {
     if (!info.limitVpls || !technique.has("receiver_share_cap") || estimate <= 0) return 0;

@@ -39,6 +39,12 @@ struct TechniqueInfo {
     /// size). 1 for the techniques that sum over every VPL; below 1 for a traversal whose cut grows
     /// much more slowly than its leaves (hier_isr). The frame budget models and caps with it.
     double vplCostExponent = 1.0;
+    /// The exponent near a rendered frame's own VPL count, from its counters (stats.counts), for the
+    /// frame budget's model of the next interactive frames (frameVplCostExponent). Empty: the
+    /// technique's cost has one exponent. hier_isr's traversal grows about linearly with its leaves
+    /// at tau 0, and at a few hundred leaves at any tau, but far more slowly over thousands at tau
+    /// 0.01, so that no one exponent fits both the live view's frames and a final step.
+    std::function<double(const nlohmann::json& counts)> localVplCostExponent;
     /// The passes (gl::Pass names) whose time grows with vplEstimate, as vpls^vplCostExponent: the
     /// gathers and splats over the VPLs and what is built over them. The rest of a frame (shadow maps,
     /// G-buffer, eye hierarchy, upsampling) costs about the same at any VPL count, so a refinement
@@ -94,6 +100,11 @@ void limitGridVpls(ParamSet& technique, long vpls);
 /// budget, refinement's planner, the receiver cap): within [0.05, 1] (above 1 would model VPLs
 /// that cost more than linearly, 0 none at all); 1 when not finite.
 double usableVplCostExponent(double exponent);
+
+/// The cost exponent near a rendered frame with these counters: the technique's
+/// localVplCostExponent where it has one and it gives a number, vplCostExponent otherwise; as
+/// usableVplCostExponent makes it.
+double frameVplCostExponent(const TechniqueInfo& info, const nlohmann::json& counts);
 
 /// The receiver work cap (capReceiverShare) of a frame whose eye hierarchy listed `receivers` over
 /// `pixels`, for a technique whose parameters ask for `estimate` VPLs (vplEstimate): where receivers

@@ -30,7 +30,8 @@ double receiverShareCapAfter(double lastShare, bool lastCut) {
 }
 
 FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
-                             double vplCostExponent, const std::vector<std::string>& lightViewPasses) {
+                             double vplCostExponent, const std::vector<std::string>& lightViewPasses,
+                             const std::vector<std::string>& vplPasses) {
     FrameCost cost;
     cost.pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
     cost.vpls = askedVpls;
@@ -61,6 +62,8 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
         double ms = pass.value("gpu_ms", 0.0);
         if (!std::isfinite(ms) || ms < 0.0) ms = 0.0;
         cost.passesMs += ms;
+        if (std::find(vplPasses.begin(), vplPasses.end(), name) != vplPasses.end())
+            cost.vplPassesMs = std::max(cost.vplPassesMs, 0.0) + ms;
         if (name == "shadow_map") {
             shadowPass = true;
             shadowMs += ms;
@@ -156,17 +159,27 @@ void FrameBudget::record(const std::string& key, const FrameCost& measured) {
     // The light views' passes are the light views' (their own rates below), not the pixels'.
     const double lightMs =
         cost.drewLightViews ? std::max(cost.shadowMs, 0.0) + std::max(cost.rsmMs, 0.0) : 0.0;
-    const double technique = std::clamp(
-        cost.techniqueMs - (cost.drewLightViews ? cost.lightViewTechniqueMs : 0.0), 0.0, cost.frameMs);
+    const double lightTechniqueMs = cost.drewLightViews ? cost.lightViewTechniqueMs : 0.0;
+    const double technique = std::clamp(cost.techniqueMs - lightTechniqueMs, 0.0, cost.frameMs);
+    // What grows with the VPLs: the technique's VPL passes where it names them (the rest of its
+    // passes cost per pixel, with the renderer's: counted with the VPLs they had a frame with few
+    // VPLs predict its next level at several times its cost), all its passes otherwise.
+    const double scaling = cost.vpls > 0 && std::isfinite(cost.vplPassesMs) && cost.vplPassesMs >= 0.0
+                               ? std::clamp(cost.vplPassesMs - lightTechniqueMs, 0.0, technique)
+                               : technique;
     const double base =
-        std::max(cost.frameMs - technique - std::min(lightMs, cost.frameMs - technique), 0.0) / cost.pixels;
+        std::max(cost.frameMs - scaling - std::min(lightMs, cost.frameMs - scaling), 0.0) / cost.pixels;
     const double encode = std::max(cost.encodeMs, 0.0) / cost.pixels;
     const double exponent = usableVplCostExponent(cost.vplCostExponent);
-    if (exponent != r.exponent) r.frames = 0; // another model: start its means again
+    // Another exponent (measured near each frame for some techniques): the VPL rate is carried over so
+    // that it predicts the last frame's VPLs as before.
+    if (exponent != r.exponent && r.lastVpls > 0)
+        r.vpl *= std::pow(static_cast<double>(r.lastVpls), r.exponent - exponent);
     r.exponent = exponent;
+    if (cost.vpls > 0) r.lastVpls = cost.vpls;
     const double vpl =
-        cost.vpls > 0 ? technique / (cost.pixels * std::pow(static_cast<double>(cost.vpls), exponent)) : 0.0;
-    const double tech = technique / cost.pixels;
+        cost.vpls > 0 ? scaling / (cost.pixels * std::pow(static_cast<double>(cost.vpls), exponent)) : 0.0;
+    const double tech = scaling / cost.pixels;
     // Half the weight on the newest frame: one noisy frame moves the choice, two confirm it. The
     // second frame replaces the first, whose time included compiling the technique's shaders
     // (FrameBudget::choose).

@@ -6,10 +6,11 @@
 //
 // Model, per scene and technique, from the last interactive frames (exponential means):
 //   ms(pixels, vpls) = pixels * (baseRate + encodeRate) + pixels * vpls^e * vplRate
-// with e the technique's vplCostExponent (1 for a sum over every VPL, 0.4 for hier_isr's traversal).
-// where baseRate comes from the renderer's own stages (shadow maps, G-buffer, direct, composite,
-// reflections, overheads) and vplRate from the technique's passes. Counting all of the technique's
-// passes as VPL-bound over-predicts what more VPLs cost, so the budget climbs cautiously.
+// with e the technique's exponent near the last frame (frameVplCostExponent: 1 for a sum over every
+// VPL; for hier_isr's traversal, measured from its visits, about 1 at tau 0 or a few hundred leaves
+// and far lower over thousands), where baseRate comes from the renderer's own stages (shadow maps,
+// G-buffer, direct, composite, reflections, overheads) and the technique's passes that do not grow
+// with the VPLs (eye hierarchy, upsampling), and vplRate from its VPL passes (TechniqueInfo::vplPasses).
 // A technique that gathers over receivers (multires_gather) costs receivers x VPLs, and a view's
 // receivers are not a model's to predict: the next frame's gather is capped at twice the last
 // frame's receiver share instead, or a quarter above the last cap after a frame it cut, which the
@@ -44,6 +45,10 @@ struct FrameCost {
     /// technique's first frame spends most of its compile and first-upload time outside them.
     double passesMs = 0;
     double techniqueMs = 0; ///< the technique's passes within it
+    /// The technique's VPL passes within those (TechniqueInfo::vplPasses): what grows with the VPLs;
+    /// its other passes (the eye hierarchy, upsampling) cost per pixel. Below 0: the technique names
+    /// none, and all of techniqueMs grows with the VPLs.
+    double vplPassesMs = -1;
     double encodeMs = 0;
     /// The technique's passes cost about pixels x vpls^vplCostExponent (TechniqueInfo::vplCostExponent).
     double vplCostExponent = 1.0;
@@ -66,7 +71,8 @@ struct FrameCost {
     /// receiver cap cut them (counts.receiver_share_capped_vpls): its time is the time of a frame that
     /// asks for them, under a cap. encodeMs stays 0.
     static FrameCost ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
-                             double vplCostExponent, const std::vector<std::string>& lightViewPasses = {});
+                             double vplCostExponent, const std::vector<std::string>& lightViewPasses = {},
+                             const std::vector<std::string>& vplPasses = {});
 };
 
 /// The light views a frame's parameters ask for: shadow_map_size and rsm_size, and whether the
@@ -155,6 +161,7 @@ private:
     struct Rates {
         double base = 0, encode = 0, vpl = 0; ///< ms per pixel, ms per pixel, ms per pixel per VPL^exponent
         double exponent = 1.0;                ///< FrameCost::vplCostExponent of the last frame
+        long lastVpls = 0;                    ///< FrameCost::vpls of the last frame
         double tech = 0;                      ///< ms per pixel of the technique when it has no VPLs
         double receiverShare = -1;            ///< the last frame's (FrameCost::receiverShare)
         bool receiverCut = false;             ///< FrameCost::receiverCut of the last frame

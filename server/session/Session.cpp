@@ -1471,8 +1471,10 @@ void Session::workerMain() {
             break;
         if (step == static_cast<int>(Step::Interactive) && !snapshotFor) {
             const TechniqueInfo& info = findTechniqueInfo(state.technique);
-            FrameCost cost = FrameCost::ofFrame(frame.stats, frame.width, frame.height, vplEstimate(state),
-                                                info.vplCostExponent, info.lightViewPasses);
+            FrameCost cost = FrameCost::ofFrame(
+                frame.stats, frame.width, frame.height, vplEstimate(state),
+                frameVplCostExponent(info, frame.stats.value("counts", nlohmann::json::object())),
+                info.lightViewPasses, info.vplPasses);
             {
                 std::lock_guard lock(mMutex);
                 cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);

@@ -393,3 +393,36 @@ TEST(LightTree, RenderingTwiceGivesIdenticalBytes) {
         EXPECT_TRUE(a.out.linear == b.out.linear) << technique;
     }
 }
+
+namespace gis {
+namespace {
+
+// The traversal's cost exponent near a frame's own leaves (hier_isr's localVplCostExponent, which
+// the frame budget models the live view with): its visits against those one level coarser would
+// make. A full traversal visits about four times the nodes per level down, the leaves' growth;
+// the error bound at its default stops most receivers far above the finest level, where more
+// leaves cost little more; with no refinement there is no level to compare and the technique's
+// fixed exponent serves.
+TEST(LightTree, TheTraversalsCostExponentNearTheFrameFollowsItsVisits) {
+    const TechniqueInfo& info = findTechniqueInfo("hier_isr");
+    const auto exponentOf = [&](double tau, int maxDepth) {
+        const Frame f = render("builtin:cornell", "hier_isr", 96, 80,
+                               {{"tau", tau}, {"max_depth", maxDepth}, {"hier_coarsest", 1}});
+        const nlohmann::json counts = f.out.stats["counts"];
+        EXPECT_LE(counts.value("nodes_visited_leaf_mean", -1.0), counts.value("nodes_visited_mean", 0.0));
+        return std::pair{frameVplCostExponent(info, counts), counts.value("nodes_visited_leaf_mean", -1.0)};
+    };
+    const auto [full, fullLeafVisits] = exponentOf(0.0, 64);
+    EXPECT_GT(fullLeafVisits, 1000.0);
+    EXPECT_NEAR(full, 1.0, 0.1) << "a full traversal grows with its leaves";
+    const auto [bounded, boundedLeafVisits] = exponentOf(0.01, 256);
+    EXPECT_GT(boundedLeafVisits, 0.0);
+    EXPECT_LT(bounded, 0.4) << "the default bound: far more slowly over thousands of leaves";
+    EXPECT_GT(bounded, 0.0);
+    const auto [roots, rootsLeafVisits] = exponentOf(1.0, 64);
+    EXPECT_EQ(rootsLeafVisits, 0.0);
+    EXPECT_DOUBLE_EQ(roots, usableVplCostExponent(info.vplCostExponent)) << "no level to compare";
+}
+
+} // namespace
+} // namespace gis

@@ -11,7 +11,18 @@
 namespace gis {
 namespace {
 /// gather.comp's CutStats, in order.
-enum CutStat { kVisitedLo, kVisitedHi, kVisitedMax, kCutLo, kCutHi, kCutMax, kCutShort, kCutStats };
+enum CutStat {
+    kVisitedLo,
+    kVisitedHi,
+    kVisitedMax,
+    kCutLo,
+    kCutHi,
+    kCutMax,
+    kCutShort,
+    kLeafVisitedLo,
+    kLeafVisitedHi,
+    kCutStats
+};
 } // namespace
 
 LightCutSettings lightCutSettings(const std::vector<LightLevel>& levels, int coarsestResolution,
@@ -235,6 +246,9 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
     counters["cut_size_max"] = stats[kCutMax];
     counters["traversal_cut_short"] = stats[kCutShort];
+    const double leafVisited = static_cast<double>(stats[kLeafVisitedLo]) +
+                               4294967296.0 * static_cast<double>(stats[kLeafVisitedHi]);
+    counters["nodes_visited_leaf_mean"] = receivers > 0 ? leafVisited / receivers : 0.0;
     mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 

@@ -19,9 +19,10 @@
 
 // Traversal statistics: 64-bit sums as (lo, hi) pairs (a full traversal at R = 256 visits 87k
 // nodes per receiver, which overflows 32 bits over a frame), and the receivers whose traversal a
-// driver's loop limit cut short (the traversal's split, HierIsr.h, keeps llvmpipe's from it).
+// driver's loop limit cut short (the traversal's split, HierIsr.h, keeps llvmpipe's from it), and
+// the visits on the leaf level: without them the sum is the work one level coarser would do.
 layout(std430, binding = 3) buffer CutStats {
-    uint gVisitedLo, gVisitedHi, gVisitedMax, gCutLo, gCutHi, gCutMax, gCutShort;
+    uint gVisitedLo, gVisitedHi, gVisitedMax, gCutLo, gCutHi, gCutMax, gCutShort, gLeafVisitedLo, gLeafVisitedHi;
 };
 
 uniform int uStartLevel;  // level index of the traversal's start (hier_coarsest)
@@ -69,7 +70,7 @@ void main() {
 
     uint stack[kStack];
     vec3 e = vec3(0.0);
-    uint visited = 0u, cut = 0u;
+    uint visited = 0u, cut = 0u, leafVisited = 0u;
     int splitLevels = max(uStartLevel - uRootLevel, 0);
     int rootSide = lightLevelSide(uRootLevel);
     int rootBegin = max(uRootFirst, 0);
@@ -109,6 +110,7 @@ void main() {
             ivec2 c = ivec2(int((s >> 4) & 0x3FFFu), int(s >> 18));
             LightNode node = lightNodeTexel(lightNodeIndex(level, c));
             ++visited;
+            if (level == uLeafLevel) ++leafVisited;
             if (node.position.w < 0.5) continue; // empty: no flux below it
             if (level > uLeafLevel && sp + 4 <= kStack && refines(node, level, pos, scale)) {
                 int child = level - 1;
@@ -130,5 +132,6 @@ void main() {
     GIS_ADD64(gCutLo, gCutHi, cut);
     atomicMax(gCutMax, cut);
     if (rootsDone < rootEnd - rootBegin) atomicAdd(gCutShort, 1u);
+    GIS_ADD64(gLeafVisitedLo, gLeafVisitedHi, leafVisited);
     eyeAddIllumination(a, max(sanitize(e), vec3(0.0)));
 }

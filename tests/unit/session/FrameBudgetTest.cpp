@@ -195,6 +195,55 @@ TEST(FrameBudget, ASublinearCostLiftsTheCapToTheTarget) {
         << "linear model: " << linear.reason << " (" << linearMs << " ms); sublinear: " << sublinear.reason;
 }
 
+// hier_isr's exponent is measured near each frame (frameVplCostExponent), so it changes from frame
+// to frame: the VPL rate carries over (the last frame's VPLs predicted as before), the means are not
+// started again (which sent every frame back to the first frame's guess).
+TEST(FrameBudget, AnExponentMeasuredPerFrameCarriesTheRateOver) {
+    FrameBudget budget(FrameBudget::Config{});
+    FrameCost cost = synthetic(288 * 240, 256, 2e-4, 2e-6);
+    cost.passesMs = cost.frameMs;
+    cost.vplCostExponent = 1.0;
+    budget.record("k", cost);
+    budget.record("k", cost);
+    const double before = budget.predictMs("k", 288 * 240, 256);
+    ASSERT_GT(before, 0.0);
+    cost.vplCostExponent = 0.2;
+    budget.record("k", cost);
+    EXPECT_NEAR(budget.predictMs("k", 288 * 240, 256), before, 1e-9 * before);
+    EXPECT_NEAR(budget.vplPassesMs("k", 288 * 240, 1024), cost.techniqueMs * std::pow(4.0, 0.2),
+                1e-9 * cost.techniqueMs)
+        << "more VPLs at the new exponent";
+    const BudgetChoice next = budget.choose("k", 65536, true, 960 * 800);
+    EXPECT_EQ(next.reason.find("first frame"), std::string::npos) << next.reason;
+    EXPECT_EQ(next.reason.find("second frame"), std::string::npos) << next.reason;
+}
+
+// A technique that names its VPL passes (TechniqueInfo::vplPasses): only they grow with the VPLs,
+// its other passes cost per pixel. With all of them counted as VPL-bound, a frame whose eye
+// hierarchy and upsampling dwarf its gather (hier_isr's at 16 leaves: 12 ms against 4) predicts the
+// next level of leaves at four times all of it.
+TEST(FrameBudget, OnlyTheVplPassesGrowWithTheVpls) {
+    const double pixels = 288 * 240;
+    FrameCost cost;
+    cost.pixels = pixels;
+    cost.vpls = 16;
+    cost.techniqueMs = 16.0; // eye hierarchy and upsampling 12 ms, gather 4 ms
+    cost.vplPassesMs = 4.0;
+    cost.frameMs = 30.0;
+    cost.passesMs = 30.0;
+    FrameBudget named(FrameBudget::Config{});
+    named.record("k", cost);
+    named.record("k", cost);
+    EXPECT_NEAR(named.predictMs("k", pixels, 16), 30.0, 1e-9);
+    EXPECT_NEAR(named.predictMs("k", pixels, 64), 30.0 + 3 * 4.0, 1e-9);
+    EXPECT_NEAR(named.vplPassesMs("k", pixels, 64), 16.0, 1e-9);
+    cost.vplPassesMs = -1; // not named: the whole technique grows
+    FrameBudget unnamed(FrameBudget::Config{});
+    unnamed.record("k", cost);
+    unnamed.record("k", cost);
+    EXPECT_NEAR(unnamed.predictMs("k", pixels, 64), 30.0 + 3 * 16.0, 1e-9);
+}
+
 TEST(FrameBudget, GarbageMeasurementsAreIgnored) {
     FrameBudget budget(FrameBudget::Config{});
     FrameCost bad;
@@ -513,6 +562,11 @@ TEST(FrameBudget, TheLightViewsCostComesFromTheirPasses) {
     EXPECT_DOUBLE_EQ(c.rsmTexels, 2.0 * 512 * 512);
     EXPECT_DOUBLE_EQ(c.rsmMs, 18.0);
     EXPECT_DOUBLE_EQ(c.lightViewTechniqueMs, 10.0);
+    EXPECT_DOUBLE_EQ(c.passesMs, 66.0);
+    EXPECT_LT(c.vplPassesMs, 0.0) << "no VPL passes named";
+    EXPECT_DOUBLE_EQ(
+        FrameCost::ofFrame(stats, 100, 100, 0, 1.0, {"light_tree"}, {"light_tree", "vpl_gather"}).vplPassesMs,
+        50.0);
     // Kept maps: nothing drawn, whatever passes ran.
     nlohmann::json kept = stats;
     kept["counts"]["light_views_reused"] = 2;
