@@ -314,9 +314,16 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& e
         if (keepsLightViews)
             lightViews.redraw =
                 keepsLightViews(p.state) ? LightViewAsk::Redraw::No : LightViewAsk::Redraw::Yes;
-        const BudgetChoice choice =
-            mBudget.choose(p.budgetKey, requestedVpls, static_cast<bool>(info.limitVpls),
-                           static_cast<double>(p.state.width) * p.state.height, lightViews);
+        // What a cap leaves of the VPLs: the technique's own knob, on a copy of the frame.
+        const auto renderedVpls = [&info, &p](long cap) {
+            FrameState capped = p.state;
+            info.limitVpls(capped.techniqueParams, cap);
+            return vplEstimate(capped);
+        };
+        const BudgetChoice choice = mBudget.choose(
+            p.budgetKey, requestedVpls, static_cast<bool>(info.limitVpls),
+            static_cast<double>(p.state.width) * p.state.height, lightViews,
+            info.limitVpls ? std::function<long(long)>(renderedVpls) : std::function<long(long)>());
         p.scale = choice.scale;
         p.state.lightViewCap = {choice.shadowSideCap, choice.rsmSideCap};
         if (choice.vplCap > 0 && info.limitVpls) info.limitVpls(p.state.techniqueParams, choice.vplCap);

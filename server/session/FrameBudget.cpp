@@ -260,7 +260,8 @@ void FrameBudget::chooseLightViews(const Rates* rates, const LightViewAsk& ask, 
 }
 
 BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, bool cappable, double fullPixels,
-                                 const LightViewAsk& lightViews) {
+                                 const LightViewAsk& lightViews,
+                                 const std::function<long(long)>& renderedVpls) {
     const Config& c = mConfig;
     BudgetChoice out;
     auto it = mRates.find(key);
@@ -305,14 +306,22 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
     const double lightViewMs = redraw ? out.lightViewMs : 0.0;
     // The ladder from the best frame to the cheapest: size down to the preferred minimum, then VPLs
     // down, then size down to the minimum.
+    // A cap of v renders what the technique's knob leaves of it: hier_isr's 444 are 256 leaves, and
+    // predicted as 444 at its exponent near 1 the step above the 256 looked 1.7x dearer than it is.
+    const auto rendered = [&](long v) {
+        const long r = renderedVpls ? renderedVpls(v) : v;
+        return r > 0 ? std::min(r, v) : v;
+    };
     std::vector<Candidate> ladder;
     for (double s = c.maxScale; s > c.preferredMinScale * 1.0001; s *= 0.9) ladder.push_back({s, 0});
     ladder.push_back({c.preferredMinScale, 0});
     long lastVpls = 0;
     if (cappable && requestedVpls > c.minVpls) {
-        for (double v = requestedVpls * 0.7; v > c.minVpls; v *= 0.7)
-            ladder.push_back({c.preferredMinScale, lastVpls = static_cast<long>(v)});
-        ladder.push_back({c.preferredMinScale, lastVpls = c.minVpls});
+        for (double v = requestedVpls * 0.7; v > c.minVpls; v *= 0.7) {
+            const long r = rendered(static_cast<long>(v));
+            if (r != lastVpls) ladder.push_back({c.preferredMinScale, lastVpls = r});
+        }
+        if (lastVpls != c.minVpls) ladder.push_back({c.preferredMinScale, lastVpls = rendered(c.minVpls)});
     }
     for (double s = c.preferredMinScale * 0.9; s > c.minScale; s *= 0.9) ladder.push_back({s, lastVpls});
     ladder.push_back({c.minScale, lastVpls});

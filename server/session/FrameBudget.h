@@ -26,6 +26,7 @@
 // image to a tenth of its size (docs/interactive.md, "Light views in interactive frames").
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -147,9 +148,12 @@ public:
     void setTargetMs(double ms) { mConfig.targetMs = ms; }
 
     /// The choice for a frame of `key` (scene/technique) whose parameters ask for `requestedVpls`
-    /// (0: none) and can be capped (`cappable`) at fullPixels full-size pixels.
+    /// (0: none) and can be capped (`cappable`) at fullPixels full-size pixels. `renderedVpls`, when
+    /// given, says how many VPLs a cap of v leaves the technique (its knob's steps: hier_isr's leaves
+    /// go in fours), which the candidates are predicted and reported with.
     BudgetChoice choose(const std::string& key, long requestedVpls, bool cappable, double fullPixels,
-                        const LightViewAsk& lightViews = {});
+                        const LightViewAsk& lightViews = {},
+                        const std::function<long(long)>& renderedVpls = {});
     void record(const std::string& key, const FrameCost& cost);
     /// Predicted ms of a frame of `key` at `pixels` with `vpls`; 0 when nothing is measured.
     double predictMs(const std::string& key, double pixels, long vpls) const;

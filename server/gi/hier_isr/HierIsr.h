@@ -49,7 +49,9 @@
 //   Eye hierarchy: coarsest_size, depth/normal metrics and thresholds, diagonal_refine, detail_alpha
 //   (EyeHierarchy.h).
 //
-// Counters: nodes_visited_mean / _max and cut_size_mean / _max (per receiver; the maxima per range
+// Counters: nodes_visited_mean / _max, nodes_visited_leaf_mean (the visits on the max_depth level:
+// without them, the work a level coarser would do; Info.cpp's localVplCostExponent) and
+// cut_size_mean / _max (per receiver; the maxima per range
 // when the traversal goes in traversal_ranges ranges of roots), traversal_split_levels (its roots
 // that many levels below hier_coarsest's, when split so), traversal_cut_short (receivers a driver's
 // loop limit stopped: 0 unless the split fell short) and traversal_cut_short_whole (those of a whole

@@ -244,6 +244,36 @@ TEST(FrameBudget, OnlyTheVplPassesGrowWithTheVpls) {
     EXPECT_NEAR(unnamed.predictMs("k", pixels, 64), 30.0 + 3 * 16.0, 1e-9);
 }
 
+// A cap renders what the technique's knob leaves of it (hier_isr's leaves go in fours): the
+// candidates are predicted at that. Predicted at the cap itself, 311 "VPLs" over a frame measured at
+// 256 leaves looked 1.2x dearer than the 256 leaves they render, and the frame fell to 64.
+TEST(FrameBudget, CandidatesArePredictedAtTheVplsTheTechniqueRenders) {
+    const double full = 960 * 800, pixels = full * 0.3 * 0.3;
+    FrameCost cost;
+    cost.pixels = pixels;
+    cost.vpls = 256;
+    cost.frameMs = 74.0;
+    cost.passesMs = 74.0;
+    cost.techniqueMs = 54.0;
+    cost.vplPassesMs = 54.0;
+    const auto leavesUnder = [](long cap) {
+        long side = 1;
+        while ((side * 2) * (side * 2) <= cap) side *= 2;
+        return side * side;
+    };
+    FrameBudget quantised(FrameBudget::Config{}), plain(FrameBudget::Config{});
+    for (FrameBudget* b : {&quantised, &plain}) {
+        b->record("k", cost);
+        b->record("k", cost);
+    }
+    const BudgetChoice q = quantised.choose("k", 65536, true, full, {}, leavesUnder);
+    EXPECT_DOUBLE_EQ(q.scale, 0.3);
+    EXPECT_EQ(q.vplCap, 256) << q.reason;
+    EXPECT_NEAR(q.predictedMs, 74.0, 1e-9);
+    const BudgetChoice p = plain.choose("k", 65536, true, full);
+    EXPECT_LT(leavesUnder(p.vplCap), 256) << p.reason;
+}
+
 TEST(FrameBudget, GarbageMeasurementsAreIgnored) {
     FrameBudget budget(FrameBudget::Config{});
     FrameCost bad;
