@@ -70,6 +70,12 @@ struct FrameState {
         int rsmSide = 0;
         bool active() const { return shadowSide > 0 || rsmSide > 0; }
     } lightViewCap;
+    /// The live view's interactive frames: the technique's cost exponent at the VPLs this frame asks
+    /// for, as the session's frames measured it there (FrameBudget::exponentAt; hier_isr's traversal
+    /// grows as leaves^0.13 near 65,536 leaves at the default tau, against its fixed 0.4), which the
+    /// receiver cap cuts the VPLs by (capVplsForReceivers). 0: the technique's fixed
+    /// vplCostExponent (every other frame: a render request gives the same bytes whatever came before).
+    double receiverCapExponent = 0.0;
     std::string technique = "rsm_gather";
     ParamSet frameParams;     ///< frameParamTable(): exposure, tone map, shadow and RSM sizes
     ParamSet techniqueParams; ///< the technique's own table

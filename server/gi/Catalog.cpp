@@ -39,16 +39,16 @@ double frameVplCostExponent(const TechniqueInfo& info, const nlohmann::json& cou
 }
 
 long capVplsForReceivers(const TechniqueInfo& info, ParamSet& technique, long estimate, double pixels,
-                         double receivers) {
+                         double receivers, double exponent) {
     if (!info.limitVpls || !technique.has("receiver_share_cap") || estimate <= 0) return 0;
     const double shareCap = technique.getFloat("receiver_share_cap");
     if (!(shareCap < 1.0) || !(pixels > 0.0) || !(receivers > shareCap * pixels)) return 0;
     constexpr long kFloorVpls = 16;
-    const double exponent = usableVplCostExponent(info.vplCostExponent);
+    const double e = usableVplCostExponent(exponent > 0.0 ? exponent : info.vplCostExponent);
     const double workShare = shareCap * pixels / receivers; // (0, 1)
-    const long allowed = std::max(
-        std::min(estimate, kFloorVpls),
-        static_cast<long>(std::floor(static_cast<double>(estimate) * std::pow(workShare, 1.0 / exponent))));
+    const long allowed =
+        std::max(std::min(estimate, kFloorVpls),
+                 static_cast<long>(std::floor(static_cast<double>(estimate) * std::pow(workShare, 1.0 / e))));
     if (allowed >= estimate) return 0;
     info.limitVpls(technique, allowed);
     return allowed;

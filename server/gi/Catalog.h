@@ -111,9 +111,11 @@ double frameVplCostExponent(const TechniqueInfo& info, const nlohmann::json& cou
 /// exceed receiver_share_cap x pixels, lowers the VPL knob through info.limitVpls to at most
 /// estimate x (cap x pixels / receivers)^(1 / vplCostExponent), so that receivers x VPLs^exponent
 /// stay at the cap's, and never below 16 VPLs (the frame budget's floor; a smaller estimate stays).
+/// `exponent` > 0 replaces vplCostExponent: the technique's own measurement at `estimate` (hier_isr's
+/// near its asked leaves, whose cost grows there far more slowly than the fixed exponent says).
 /// Returns the VPLs it allowed, or 0 when the frame is within the cap (the parameters unchanged).
 long capVplsForReceivers(const TechniqueInfo& info, ParamSet& technique, long estimate, double pixels,
-                         double receivers);
+                         double receivers, double exponent = 0.0);
 
 // The entries, one per technique folder (gi/<name>/Info.cpp).
 TechniqueInfo noIndirectInfo();

@@ -77,6 +77,9 @@ struct FrameInputs {
     /// vplParts is vplPart, their light scaled by vplParts. 1 part: every VPL.
     int vplPart = 0;
     int vplParts = 1;
+    /// FrameState::receiverCapExponent: what the receiver cap cuts the VPLs by (0: the technique's
+    /// fixed exponent).
+    double receiverCapExponent = 0.0;
     /// A later VPL part of the image the previous frame rendered (same size, window, camera and
     /// parameters): what a technique derived from the G-buffer alone (the eye hierarchy) still holds.
     bool sameImageAsLastPart = false;

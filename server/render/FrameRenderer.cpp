@@ -786,6 +786,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     in.sceneCutsOut = mSceneCutsOut;
     in.sceneExtent = std::max(glm::length(mScene->bounds.max - mScene->bounds.min), 1e-3f);
     in.sceneSize = std::max(mScene->bounds.longestSide(), kMinSceneSize);
+    in.receiverCapExponent = state.receiverCapExponent;
     if (vplParts) {
         in.vplParts = state.vplPart.count;
         in.vplPart = std::clamp(state.vplPart.index, 0, state.vplPart.count - 1);

@@ -330,7 +330,12 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& e
         // A cap the client set itself stays.
         const bool capReceivers = choice.receiverShareCap > 0.0 && info.capReceiverShare &&
                                   !explicitParams.contains("receiver_share_cap");
-        if (capReceivers) info.capReceiverShare(p.state.techniqueParams, choice.receiverShareCap);
+        if (capReceivers) {
+            info.capReceiverShare(p.state.techniqueParams, choice.receiverShareCap);
+            // The cap cuts by the exponent this session's frames measured at the VPLs asked for
+            // (hier_isr's near 65,536 leaves is about a third of its fixed one).
+            p.state.receiverCapExponent = mBudget.exponentAt(p.budgetKey, vplEstimate(p.state));
+        }
         p.budget = choice.toJson(frameTargetMs, requestedVpls);
         if (!capReceivers) p.budget["receiver_share_cap"] = nullptr;
     } else {

@@ -36,6 +36,12 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
     cost.pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
     cost.vpls = askedVpls;
     cost.vplCostExponent = vplCostExponent;
+    {
+        const double gathered =
+            stats.value("counts", nlohmann::json::object()).value("receiver_share_capped_vpls", 0.0);
+        cost.gatheredVpls =
+            std::isfinite(gathered) && gathered >= 1.0 ? static_cast<long>(gathered) : askedVpls;
+    }
     cost.frameMs = stats.value("frame_ms", 0.0);
     cost.techniqueMs = stats.value("technique_ms", 0.0);
     const nlohmann::json counts = stats.value("counts", nlohmann::json::object());
@@ -147,6 +153,13 @@ double FrameBudget::vplPassesMs(const std::string& key, double pixels, long vpls
     return r.vpl * pixels * std::pow(static_cast<double>(std::max(1L, vpls)), r.exponent);
 }
 
+double FrameBudget::exponentAt(const std::string& key, long vpls) const {
+    const auto it = mRates.find(key);
+    if (it == mRates.end()) return 0.0;
+    const auto at = it->second.exponentAt.find(vpls);
+    return at == it->second.exponentAt.end() ? 0.0 : at->second;
+}
+
 void FrameBudget::record(const std::string& key, const FrameCost& measured) {
     if (!(measured.pixels > 0) || !std::isfinite(measured.frameMs) || measured.frameMs < 0) return;
     Rates& r = mRates[key];
@@ -177,6 +190,11 @@ void FrameBudget::record(const std::string& key, const FrameCost& measured) {
         r.vpl *= std::pow(static_cast<double>(r.lastVpls), r.exponent - exponent);
     r.exponent = exponent;
     if (cost.vpls > 0) r.lastVpls = cost.vpls;
+    const long gathered = cost.gatheredVpls > 0 ? cost.gatheredVpls : cost.vpls;
+    if (gathered > 0) {
+        if (r.exponentAt.size() >= kMaxExponentCounts && !r.exponentAt.count(gathered)) r.exponentAt.clear();
+        r.exponentAt[gathered] = exponent;
+    }
     const double vpl =
         cost.vpls > 0 ? scaling / (cost.pixels * std::pow(static_cast<double>(cost.vpls), exponent)) : 0.0;
     const double tech = scaling / cost.pixels;

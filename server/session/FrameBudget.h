@@ -58,6 +58,9 @@ struct FrameCost {
     /// technique has no receiver list.
     double receiverShare = -1;
     bool receiverCut = false; ///< the cap cut the frame's VPLs (receiverShare is then the cap)
+    /// The VPLs the frame gathered from: those the receiver cap left it (counts
+    /// receiver_share_capped_vpls), or vpls; where vplCostExponent was measured.
+    long gatheredVpls = 0;
     /// The light views, when the frame drew them (counts.light_views_reused absent and a shadow_map
     /// pass timed): their views, texels (views x side^2) and ms (shadow_map; rsm, rsm_flux and the
     /// technique's lightViewPasses). lightViewTechniqueMs is the part of techniqueMs among them.
@@ -160,6 +163,10 @@ public:
     /// Predicted ms of the technique's VPL passes alone over `pixels` with `vpls` (pixels x vpls^e at
     /// the measured rate); 0 when nothing is measured or the technique's frames had no VPLs.
     double vplPassesMs(const std::string& key, double pixels, long vpls) const;
+    /// The cost exponent the last frame of `key` that gathered from exactly `vpls` VPLs measured
+    /// (FrameCost::vplCostExponent at FrameCost::gatheredVpls): what the receiver cap of a frame
+    /// asking for them cuts by (FrameState::receiverCapExponent). 0 when none did.
+    double exponentAt(const std::string& key, long vpls) const;
 
 private:
     struct Rates {
@@ -179,7 +186,11 @@ private:
         int lightFrames = 0;
         bool lastDrewLightViews = false;
         int lightViews = 1; ///< the last frame's
+        /// FrameCost::vplCostExponent by FrameCost::gatheredVpls, the newest frame's at each count
+        /// (hier_isr's leaves are powers of four: a handful; at most kMaxExponentCounts).
+        std::map<long, double> exponentAt;
     };
+    static constexpr size_t kMaxExponentCounts = 64;
     /// The light views' sides and predicted ms for `ask` (BudgetChoice's light-view fields).
     void chooseLightViews(const Rates* rates, const LightViewAsk& ask, BudgetChoice& out) const;
     /// ms at `pixels` and `vpls` from `rates`, the technique's passes times `techniqueFactor`.

@@ -426,3 +426,52 @@ TEST(LightTree, TheTraversalsCostExponentNearTheFrameFollowsItsVisits) {
 
 } // namespace
 } // namespace gis
+
+namespace gis {
+namespace {
+
+// hier_isr's receiver cap cuts its leaves by the exponent the live view measured at the asked leaves
+// (FrameState::receiverCapExponent): near 65,536 leaves at the default tau its traversal's cost grows
+// as leaves^0.1, and the fixed 0.4 cut so few that the frame did far more than the cap's work. Every
+// pixel a receiver (thresholds 0); a cap of half the pixels must hold the gather's visits to half of
+// the uncapped frame's.
+TEST(LightTree, TheReceiverCapCutsByTheExponentMeasuredAtTheAskedLeaves) {
+    const nlohmann::json asked = {
+        {"tau", 0.01}, {"max_depth", 256}, {"depth_threshold", 0.0}, {"normal_threshold", 0.0}};
+    const auto countsOf = [&](double cap, double exponent) {
+        nlohmann::json params = asked;
+        params["receiver_share_cap"] = cap;
+        test::sharedContext();
+        const auto scene = std::make_shared<Scene>(loadScene("builtin:cornell"));
+        FrameRenderer renderer;
+        renderer.setScene(scene);
+        FrameState state = makeFrameState(*scene, "hier_isr");
+        state.width = 96;
+        state.height = 80;
+        applyParams(state, params, "test");
+        state.receiverCapExponent = exponent;
+        return renderer.render(state, true).stats["counts"];
+    };
+    const auto work = [](const nlohmann::json& c) {
+        return c.value("nodes_visited_mean", 0.0) * c.value("receivers_total", 0.0);
+    };
+    const double pixels = 96.0 * 80.0;
+    const nlohmann::json whole = countsOf(1.0, 0.0);
+    ASSERT_GT(whole.value("receivers_total", 0.0), 0.6 * pixels) << "thresholds 0: most pixels receive";
+    const double measured = frameVplCostExponent(findTechniqueInfo("hier_isr"), whole);
+    EXPECT_LT(measured, 0.4);
+    const double allowed = 0.5 * pixels / whole.value("receivers_total", 1.0) * work(whole);
+
+    const nlohmann::json capped = countsOf(0.5, measured);
+    ASSERT_TRUE(capped.contains("receiver_share_capped_vpls"));
+    EXPECT_LE(work(capped), allowed) << "leaves " << capped["receiver_share_capped_vpls"];
+    // Without a measurement (a render request), the fixed exponent, as before: it cut too few.
+    const nlohmann::json fixed = countsOf(0.5, 0.0);
+    ASSERT_TRUE(fixed.contains("receiver_share_capped_vpls"));
+    EXPECT_GT(fixed["receiver_share_capped_vpls"].get<double>(),
+              capped["receiver_share_capped_vpls"].get<double>());
+    EXPECT_GT(work(fixed), allowed) << "the fixed exponent's cut, which this test is about";
+}
+
+} // namespace
+} // namespace gis

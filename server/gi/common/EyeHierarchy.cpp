@@ -420,7 +420,7 @@ bool EyeHierarchy::capVplsToReceivers(const FrameInputs& in, const TechniqueInfo
                                       Counters& counters) const {
     if (!params.has("receiver_share_cap") || !(params.getFloat("receiver_share_cap") < 1.0)) return false;
     if (capVplsForReceivers(info, params, vpls(params), static_cast<double>(in.width) * in.height,
-                            static_cast<double>(listedReceivers())) == 0)
+                            static_cast<double>(listedReceivers()), in.receiverCapExponent) == 0)
         return false;
     counters["receiver_share_capped_vpls"] = static_cast<double>(vpls(params));
     return true;

@@ -94,7 +94,8 @@ public:
     /// the last build() was for (receiverList only): with a cap below 1, reads the receivers back and,
     /// over the cap's share of the frame's pixels, lowers `params`' VPL knob through info.limitVpls and
     /// writes the counter receiver_share_capped_vpls = vpls(params). `vpls`: the technique's VPL count
-    /// under a parameter set. Returns whether it cut; a frame without a cap waits for nothing.
+    /// under a parameter set; the exponent is the frame's (FrameInputs::receiverCapExponent). Returns
+    /// whether it cut; a frame without a cap waits for nothing.
     bool capVplsToReceivers(const FrameInputs& in, const TechniqueInfo& info, ParamSet& params,
                             const std::function<long(const ParamSet&)>& vpls, Counters& counters) const;
     /// Reconstructs level 0 ("upsample") and writes the full-resolution indirect radiance.

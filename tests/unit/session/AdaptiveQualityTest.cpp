@@ -445,3 +445,40 @@ TEST(AdaptiveQuality, InteractiveFramesCapTheGatherAtTwiceTheLastReceiverShare) 
 
 } // namespace
 } // namespace gis
+
+namespace gis {
+namespace {
+
+// An interactive frame's receiver cap cuts by the exponent the session's frames measured at the VPLs
+// it asks for (FrameState::receiverCapExponent); with none measured there, 0 (the technique's fixed
+// one), and refinement steps never carry one.
+TEST(AdaptiveQuality, TheReceiverCapCutsByTheExponentMeasuredAtTheAskedVpls) {
+    AdaptiveQuality q(limits(), nullptr);
+    const nlohmann::json none = nlohmann::json::object();
+    FrameState asked = makeFrameState(cornell(), "hier_isr");
+    asked.width = asked.height = 64;
+    const AdaptiveQuality::Plan first = q.plan("cornell", asked, none, QualityStep::Interactive, false, 80);
+    EXPECT_DOUBLE_EQ(first.state.receiverCapExponent, 0.0) << "nothing measured";
+
+    // Cheap frames at the asked leaves, whose traversal grew as leaves^0.13 there.
+    const long leaves = vplEstimate(asked);
+    FrameCost cost;
+    cost.pixels = 64 * 64;
+    cost.vpls = leaves;
+    cost.gatheredVpls = leaves;
+    cost.frameMs = 5;
+    cost.passesMs = 5;
+    cost.techniqueMs = 2;
+    cost.receiverShare = 0.1;
+    cost.vplCostExponent = 0.13;
+    q.budget().record(first.budgetKey, cost);
+    q.budget().record(first.budgetKey, cost);
+    const AdaptiveQuality::Plan next = q.plan("cornell", asked, none, QualityStep::Interactive, false, 80);
+    ASSERT_EQ(vplEstimate(next.state), leaves) << next.budget.dump();
+    EXPECT_DOUBLE_EQ(next.state.receiverCapExponent, 0.13);
+    EXPECT_DOUBLE_EQ(q.plan("cornell", asked, none, QualityStep::Final, false, 80).state.receiverCapExponent,
+                     0.0);
+}
+
+} // namespace
+} // namespace gis

@@ -274,6 +274,33 @@ TEST(FrameBudget, CandidatesArePredictedAtTheVplsTheTechniqueRenders) {
     EXPECT_LT(leavesUnder(p.vplCap), 256) << p.reason;
 }
 
+// The exponent each frame measured is kept by the VPLs it gathered from (the receiver cap's cut,
+// when it cut): what the next cap at those VPLs cuts by.
+TEST(FrameBudget, ExponentsAreKeptByTheVplsGathered) {
+    FrameBudget budget(FrameBudget::Config{});
+    EXPECT_EQ(budget.exponentAt("k", 65536), 0.0);
+    FrameCost cost = synthetic(288 * 240, 65536, 2e-4, 1e-9);
+    cost.gatheredVpls = 65536;
+    cost.vplCostExponent = 0.13;
+    budget.record("k", cost);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 65536), 0.13);
+    cost.gatheredVpls = 256; // the cap cut it to 256 leaves, where the traversal grows faster
+    cost.vplCostExponent = 0.85;
+    budget.record("k", cost);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 256), 0.85);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 65536), 0.13);
+    EXPECT_EQ(budget.exponentAt("k", 1024), 0.0);
+    EXPECT_EQ(budget.exponentAt("other", 65536), 0.0);
+
+    const nlohmann::json stats = {
+        {"frame_ms", 10.0},
+        {"technique_ms", 5.0},
+        {"params", {{"receiver_share_cap", 0.2}}},
+        {"counts", {{"receivers_total", 500.0}, {"receiver_share_capped_vpls", 256.0}}}};
+    EXPECT_EQ(FrameCost::ofFrame(stats, 50, 20, 65536, 0.85).gatheredVpls, 256);
+    EXPECT_EQ(FrameCost::ofFrame({{"frame_ms", 10.0}}, 50, 20, 65536, 0.13).gatheredVpls, 65536);
+}
+
 TEST(FrameBudget, GarbageMeasurementsAreIgnored) {
     FrameBudget budget(FrameBudget::Config{});
     FrameCost bad;
