@@ -36,15 +36,11 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
     cost.pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
     cost.vpls = askedVpls;
     cost.vplCostExponent = vplCostExponent;
-    {
-        const double gathered =
-            stats.value("counts", nlohmann::json::object()).value("receiver_share_capped_vpls", 0.0);
-        cost.gatheredVpls =
-            std::isfinite(gathered) && gathered >= 1.0 ? static_cast<long>(gathered) : askedVpls;
-    }
     cost.frameMs = stats.value("frame_ms", 0.0);
     cost.techniqueMs = stats.value("technique_ms", 0.0);
     const nlohmann::json counts = stats.value("counts", nlohmann::json::object());
+    const double gathered = counts.value("receiver_share_capped_vpls", 0.0);
+    cost.gatheredVpls = std::isfinite(gathered) && gathered >= 1.0 ? static_cast<long>(gathered) : askedVpls;
     if (counts.contains("receivers_total") && cost.pixels > 0.0) {
         cost.receiverShare = counts.value("receivers_total", 0.0) / cost.pixels;
         // A frame the cap cut did the cap's work per pixel and asked VPL, whatever grid the rounding
