@@ -18,6 +18,13 @@ FrameCost synthetic(double pixels, long vpls, double basePerPixel, double perPix
     return c;
 }
 
+// hier_isr's leaves under a cap of `cap` (its limitVpls): a power of four.
+long leavesUnder(long cap) {
+    long side = 1;
+    while ((side * 2) * (side * 2) <= cap) side *= 2;
+    return side * side;
+}
+
 // Runs the loop choose -> render -> record a few times and returns the settled choice.
 BudgetChoice settle(FrameBudget& budget, long vpls, double fullPixels, double base, double perVpl,
                     double* lastMs = nullptr) {
@@ -160,11 +167,6 @@ TEST(FrameBudget, ASublinearCostLiftsTheCapToTheTarget) {
     const double fullPixels = 960.0 * 800.0;
     const double base = 22.0 / (288.0 * 240.0);                             // ms per pixel
     const double perUnit = 87.6 / (288.0 * 240.0 * std::pow(65536.0, 0.4)); // ms per pixel per leaf^0.4
-    auto leavesUnder = [](long cap) {
-        long side = 1;
-        while ((side * 2) * (side * 2) <= cap) side *= 2;
-        return side * side;
-    };
     auto run = [&](double modelExponent, double* lastMs) {
         FrameBudget budget(FrameBudget::Config{});
         BudgetChoice c;
@@ -256,11 +258,6 @@ TEST(FrameBudget, CandidatesArePredictedAtTheVplsTheTechniqueRenders) {
     cost.passesMs = 74.0;
     cost.techniqueMs = 54.0;
     cost.vplPassesMs = 54.0;
-    const auto leavesUnder = [](long cap) {
-        long side = 1;
-        while ((side * 2) * (side * 2) <= cap) side *= 2;
-        return side * side;
-    };
     FrameBudget quantised(FrameBudget::Config{}), plain(FrameBudget::Config{});
     for (FrameBudget* b : {&quantised, &plain}) {
         b->record("k", cost);
