@@ -4,6 +4,7 @@
 // parameters and odd sizes.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 
@@ -471,6 +472,116 @@ TEST(LightTree, TheReceiverCapCutsByTheExponentMeasuredAtTheAskedLeaves) {
     EXPECT_GT(fixed["receiver_share_capped_vpls"].get<double>(),
               capped["receiver_share_capped_vpls"].get<double>());
     EXPECT_GT(work(fixed), allowed) << "the fixed exponent's cut, which this test is about";
+}
+
+} // namespace
+} // namespace gis
+
+namespace gis {
+namespace {
+
+// Where input may stop the frame (refinement), a level of the light tree over more than
+// kBuildChunkNodes nodes goes in chunks with input asked between them: over a 1024 RSM, level 1's
+// 262,144 nodes in four. The chunks build the tree the one dispatch builds, node for node, and a
+// stop at any check leaves nothing half-built for the next frame.
+TEST(LightTree, BigTreesAreBuiltInChunksThatInputCanStop) {
+    test::sharedContext();
+    const auto scene = std::make_shared<Scene>(loadScene("builtin:cornell"));
+    const auto stateWith = [&](int rsmSize, float intensity) {
+        FrameState state = makeFrameState(*scene, "hier_isr");
+        state.width = 48;
+        state.height = 40;
+        applyParams(state, {{"rsm_size", rsmSize}}, "test");
+        state.lights[0].light.intensity *= intensity;
+        return state;
+    };
+    const auto nodesOf = [](FrameRenderer& r) {
+        const auto* hier = dynamic_cast<const HierIsr*>(r.technique());
+        EXPECT_NE(hier, nullptr);
+        return hier ? hier->tree().readNodes() : std::vector<shader::LightNode>{};
+    };
+    const auto sameNodes = [](const std::vector<shader::LightNode>& a,
+                              const std::vector<shader::LightNode>& b) {
+        return a.size() == b.size() &&
+               std::memcmp(a.data(), b.data(), a.size() * sizeof(shader::LightNode)) == 0;
+    };
+    FrameRenderer whole;
+    whole.setScene(scene);
+    (void)whole.render(stateWith(1024, 1.0f));
+    const auto wholeNodes = nodesOf(whole);
+    ASSERT_GT(wholeNodes.size(), 262144u * 4);
+
+    int checks = 0;
+    FrameRenderer chunked;
+    chunked.setScene(scene);
+    chunked.setInterruptCheck([&] {
+        ++checks;
+        return false;
+    });
+    (void)chunked.render(stateWith(256, 1.0f));
+    const int atDefaults = checks;
+    checks = 0;
+    EXPECT_FALSE(chunked.render(stateWith(1024, 1.0f)).interrupted);
+    EXPECT_EQ(checks - atDefaults, 3 + 3) << "the RSMs' four bands and level 1's four chunks";
+    EXPECT_TRUE(sameNodes(nodesOf(chunked), wholeNodes)) << "the chunks build the same nodes";
+
+    // A stop at each check of a frame that redraws the light views and rebuilds the tree: the next
+    // frame, uninterrupted, is the frame a fresh renderer draws. One renderer, as a session's: the
+    // light's intensity alternates, so that every stopped frame draws its light views again.
+    const int total = checks;
+    FrameRenderer fresh;
+    fresh.setScene(scene);
+    const std::vector<uint8_t> expected[2] = {fresh.render(stateWith(1024, 0.5f)).rgba8,
+                                              fresh.render(stateWith(1024, 0.25f)).rgba8};
+    FrameRenderer renderer;
+    renderer.setReuseLightPasses(true); // as sessions render: kept light views could go stale
+    renderer.setScene(scene);
+    (void)renderer.render(stateWith(1024, 1.0f));
+    for (int stopAt = 1; stopAt <= total; ++stopAt) {
+        const float intensity = stopAt % 2 ? 0.5f : 0.25f;
+        int asked = 0;
+        renderer.setInterruptCheck([&] { return ++asked >= stopAt; });
+        EXPECT_TRUE(renderer.render(stateWith(1024, intensity)).interrupted) << "check " << stopAt;
+        renderer.setInterruptCheck({});
+        EXPECT_EQ(renderer.render(stateWith(1024, intensity)).rgba8, expected[stopAt % 2 ? 0 : 1])
+            << "after a stop at check " << stopAt;
+    }
+}
+
+} // namespace
+} // namespace gis
+
+namespace gis {
+namespace {
+
+// A tree's node buffer serves smaller trees (up to kKeptTreeBytes): a live view that drags at 256 RSMs
+// and refines at the asked 1024 created the 1024's 112 MB buffer at every refinement, about 60 ms
+// of input waiting. The smaller tree in the larger buffer is the tree a fresh renderer builds.
+TEST(LightTree, ALargerNodeBufferServesASmallerTree) {
+    const auto treeOf = [](const Frame& f) -> const LightTree& {
+        return dynamic_cast<const HierIsr&>(*f.technique).tree();
+    };
+    const Frame large = render("builtin:cornell", "hier_isr", 32, 32, {{"rsm_size", 1024}});
+    const GLuint buffer = treeOf(large).nodes().id();
+    const Frame small = render("builtin:cornell", "hier_isr", 32, 32, {{"rsm_size", 256}});
+    EXPECT_EQ(treeOf(small).nodes().id(), buffer) << "kept";
+    const auto smallNodes = treeOf(small).readNodes();
+    EXPECT_EQ(smallNodes.size(), static_cast<size_t>(treeOf(small).levels().back().offset + 1));
+
+    test::sharedContext();
+    const auto scene = std::make_shared<Scene>(loadScene("builtin:cornell"));
+    FrameRenderer fresh;
+    fresh.setScene(scene);
+    FrameState state = makeFrameState(*scene, "hier_isr");
+    state.width = state.height = 32;
+    applyParams(state, {{"rsm_size", 256}}, "test");
+    (void)fresh.render(state, true);
+    const auto freshNodes = dynamic_cast<const HierIsr&>(*fresh.technique()).tree().readNodes();
+    ASSERT_EQ(freshNodes.size(), smallNodes.size());
+    EXPECT_EQ(
+        std::memcmp(freshNodes.data(), smallNodes.data(), smallNodes.size() * sizeof(shader::LightNode)), 0);
+    EXPECT_EQ(treeOf(render("builtin:cornell", "hier_isr", 32, 32, {{"rsm_size", 1024}})).nodes().id(),
+              buffer);
 }
 
 } // namespace

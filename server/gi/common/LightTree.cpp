@@ -33,6 +33,7 @@ LightTree::LightTree() {
               p.location("uLevel"),
               p.location("uTiles"),
               p.location("uViewSide"),
+              p.location("uFirstNode"),
               p.textureUnit("uRsmPosition"),
               p.textureUnit("uRsmNormal"),
               p.textureUnit("uRsmFlux")};
@@ -47,9 +48,16 @@ void LightTree::ensureLayout(int rsmSize) {
     mLevels = lightTreeLayout(rsmSize);
     const LightLevel& last = mLevels.back();
     const int nodeCount = last.offset + last.side * last.side;
-    mNodes = gl::Buffer::create(static_cast<GLsizeiptr>(nodeCount) *
-                                static_cast<GLsizeiptr>(sizeof(shader::LightNode)));
-    mNodeTexels.view(mNodes, GL_RGBA32F, 0, mNodes.size());
+    mNodeBytes = static_cast<GLsizeiptr>(nodeCount) * static_cast<GLsizeiptr>(sizeof(shader::LightNode));
+    // A larger buffer serves a smaller tree: a live view whose drag draws 256 RSMs and whose
+    // refinement draws the asked 1024 alternates between the two, and creating the 1024's 112 MB
+    // buffer took about 60 ms each time (llvmpipe clears it), input waiting. Kept up to
+    // kKeptTreeBytes; a larger one goes when a smaller tree is asked for.
+    const bool fits = mNodes && mNodes.size() >= mNodeBytes;
+    if (!fits || (mNodes.size() > mNodeBytes && mNodes.size() > kKeptTreeBytes)) {
+        mNodes = gl::Buffer::create(mNodeBytes);
+        mNodeTexels.view(mNodes, GL_RGBA32F, 0, mNodes.size());
+    }
     shader::LightTreeUniforms u{};
     for (size_t l = 0; l < mLevels.size(); ++l)
         u.level[l] = glm::ivec4(mLevels[l].offset, mLevels[l].side, 1 << l, 0);
@@ -111,10 +119,19 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
             .texture(mBuild.normal, in.get("lights.rsm.normal"))
             .texture(mBuild.flux, in.get("lights.rsm.flux"));
         // Level 1's dispatch writes level 0 too (light_tree_build.comp); then one dispatch per level.
+        // Where input may stop the frame (refinement), a level of more than kBuildChunkNodes nodes
+        // goes in chunks with input asked between them: over a 1024 RSM the tree took 38 ms, most of
+        // it level 1's one dispatch, which a camera move waited for. A stopped build is not valid:
+        // the next frame builds it again.
         for (size_t l = 1; l < mLevels.size(); ++l) {
             if (l > 1) pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT); // level l - 1 is complete
             const int count = mLevels[l].side * mLevels[l].side;
-            pass.set(mBuild.level, static_cast<int>(l)).dispatch((count + 63) / 64);
+            const int chunk = in.interruptCheck ? kBuildChunkNodes : count;
+            pass.set(mBuild.level, static_cast<int>(l));
+            for (int first = 0; first < count; first += chunk) {
+                if (first > 0 && in.interrupted()) return;
+                pass.set(mBuild.firstNode, first).dispatch((std::min(chunk, count - first) + 63) / 64);
+            }
         }
         pass.barrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                      GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -125,9 +142,9 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
 std::vector<shader::LightNode> LightTree::readNodes() const {
     std::vector<shader::LightNode> nodes;
     if (!mNodes) return nodes;
-    nodes.resize(static_cast<size_t>(mNodes.size()) / sizeof(shader::LightNode));
+    nodes.resize(static_cast<size_t>(mNodeBytes) / sizeof(shader::LightNode));
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(mNodes.id(), 0, mNodes.size(), nodes.data());
+    glGetNamedBufferSubData(mNodes.id(), 0, mNodeBytes, nodes.data());
     return nodes;
 }
 

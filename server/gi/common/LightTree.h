@@ -45,13 +45,22 @@ int lightTreeTiles(int views);
 /// "16^2 light patches" style parameter names. Clamps to the tree (R when resolution >= R).
 int lightLevelForResolution(const std::vector<LightLevel>& levels, int resolution);
 
+/// A level of the tree built where input may stop the frame goes in dispatches of at most this many
+/// nodes, input asked between them (LightTree::build): a quarter of level 1 over a 1024 RSM, about
+/// 7 ms on llvmpipe; the default 256 RSM's whole level 1 (16,384 nodes) stays one.
+inline constexpr int kBuildChunkNodes = 65536;
+/// The largest node buffer a light tree keeps for a smaller tree (LightTree::ensureLayout): a 1024
+/// RSM's tree of one view, 112 MB.
+inline constexpr long long kKeptTreeBytes = 128ll << 20;
+
 class LightTree {
 public:
     LightTree();
     /// Builds every level from the RSM (pass "light_tree"); nothing when the light is off (valid()
     /// then reports false). Writes the counters vpl_tree_levels and vpl_tree_nodes. Light views the
     /// frame reuses (FrameInputs::lightViewsReused) keep the last build: no pass, and the counter
-    /// vpl_tree_reused.
+    /// vpl_tree_reused. With an interrupt check (FrameInputs::interruptCheck) a big level goes in
+    /// chunks of kBuildChunkNodes with input asked between them; a stop leaves the tree not valid.
     void build(const FrameInputs& in, gl::PassTimer& timer, Counters& counters);
     bool valid() const { return mValid; }
     const std::vector<LightLevel>& levels() const { return mLevels; }
@@ -74,10 +83,11 @@ private:
 
     struct BuildProgram {
         gl::Program program;
-        gl::UniformLocation level, tiles, viewSide;
+        gl::UniformLocation level, tiles, viewSide, firstNode;
         gl::TextureUnit position, normal, flux;
     } mBuild;
     gl::Buffer mNodes, mUbo;
+    GLsizeiptr mNodeBytes = 0;     ///< of mNodes, the tree's (the buffer may be larger: ensureLayout)
     gl::BufferTexture mNodeTexels; ///< mNodes as RGBA32F texels (light_tree.glsl, lightNodeTexel)
     int mMaxTexels = 0;            ///< GL_MAX_TEXTURE_BUFFER_SIZE
     bool mWarnedTexels = false;

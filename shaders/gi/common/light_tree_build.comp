@@ -26,6 +26,7 @@ layout(binding = 2) uniform sampler2DArray uRsmFlux;
 uniform int uLevel;    // >= 1; level 1 also writes level 0, straight from the RSM
 uniform int uTiles;    // views per mosaic row
 uniform int uViewSide; // RSM texels per view side
+uniform int uFirstNode; // this dispatch's first node of the level (a level may go in chunks)
 
 LightNode emptyNode() {
     LightNode n;
@@ -108,7 +109,7 @@ LightNode combine(LightNode c[4]) {
 
 void main() {
     int side = lightLevelSide(uLevel);
-    int index = int(gl_GlobalInvocationID.x);
+    int index = uFirstNode + int(gl_GlobalInvocationID.x);
     if (index >= side * side) return;
     ivec2 t = ivec2(index % side, index / side);
     int childSide = lightLevelSide(uLevel - 1);
