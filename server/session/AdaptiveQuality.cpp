@@ -314,9 +314,10 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& e
         if (keepsLightViews)
             lightViews.redraw =
                 keepsLightViews(p.state) ? LightViewAsk::Redraw::No : LightViewAsk::Redraw::Yes;
-        // What a cap leaves of the VPLs: the technique's own knob, on a copy of the frame.
-        const auto renderedVpls = [&info, &p](long cap) {
-            FrameState capped = p.state;
+        // What a cap leaves of the VPLs: the technique's own knob, on one copy of the frame.
+        FrameState capped = p.state;
+        const auto renderedVpls = [&info, &p, &capped](long cap) {
+            capped.techniqueParams = p.state.techniqueParams;
             info.limitVpls(capped.techniqueParams, cap);
             return vplEstimate(capped);
         };

@@ -30,8 +30,7 @@ double receiverShareCapAfter(double lastShare, bool lastCut) {
 }
 
 FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
-                             double vplCostExponent, const std::vector<std::string>& lightViewPasses,
-                             const std::vector<std::string>& vplPasses) {
+                             double vplCostExponent, const std::vector<std::string>& lightViewPasses) {
     FrameCost cost;
     cost.pixels = static_cast<double>(std::max(width, 0)) * std::max(height, 0);
     cost.vpls = askedVpls;
@@ -64,8 +63,6 @@ FrameCost FrameCost::ofFrame(const nlohmann::json& stats, int width, int height,
         double ms = pass.value("gpu_ms", 0.0);
         if (!std::isfinite(ms) || ms < 0.0) ms = 0.0;
         cost.passesMs += ms;
-        if (std::find(vplPasses.begin(), vplPasses.end(), name) != vplPasses.end())
-            cost.vplPassesMs = std::max(cost.vplPassesMs, 0.0) + ms;
         if (name == "shadow_map") {
             shadowPass = true;
             shadowMs += ms;

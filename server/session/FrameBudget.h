@@ -46,9 +46,10 @@ struct FrameCost {
     /// technique's first frame spends most of its compile and first-upload time outside them.
     double passesMs = 0;
     double techniqueMs = 0; ///< the technique's passes within it
-    /// The technique's VPL passes within those (TechniqueInfo::vplPasses): what grows with the VPLs;
-    /// its other passes (the eye hierarchy, upsampling) cost per pixel. Below 0: the technique names
-    /// none, and all of techniqueMs grows with the VPLs.
+    /// The technique's VPL passes within those (TechniqueInfo::vplPasses; the session fills it in with
+    /// vplPassesMs, AdaptiveQuality.h): what grows with the VPLs; its other passes (the eye hierarchy,
+    /// upsampling) cost per pixel. Below 0: the technique names none, and all of techniqueMs grows
+    /// with the VPLs.
     double vplPassesMs = -1;
     double encodeMs = 0;
     /// The technique's passes cost about pixels x vpls^vplCostExponent (TechniqueInfo::vplCostExponent).
@@ -75,8 +76,7 @@ struct FrameCost {
     /// receiver cap cut them (counts.receiver_share_capped_vpls): its time is the time of a frame that
     /// asks for them, under a cap. encodeMs stays 0.
     static FrameCost ofFrame(const nlohmann::json& stats, int width, int height, long askedVpls,
-                             double vplCostExponent, const std::vector<std::string>& lightViewPasses = {},
-                             const std::vector<std::string>& vplPasses = {});
+                             double vplCostExponent, const std::vector<std::string>& lightViewPasses = {});
 };
 
 /// The light views a frame's parameters ask for: shadow_map_size and rsm_size, and whether the

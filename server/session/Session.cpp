@@ -1474,7 +1474,8 @@ void Session::workerMain() {
             FrameCost cost = FrameCost::ofFrame(
                 frame.stats, frame.width, frame.height, vplEstimate(state),
                 frameVplCostExponent(info, frame.stats.value("counts", nlohmann::json::object())),
-                info.lightViewPasses, info.vplPasses);
+                info.lightViewPasses);
+            cost.vplPassesMs = vplPassesMs(state.technique, frame.stats);
             {
                 std::lock_guard lock(mMutex);
                 cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);

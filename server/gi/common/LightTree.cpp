@@ -51,8 +51,8 @@ void LightTree::ensureLayout(int rsmSize) {
     mNodeBytes = static_cast<GLsizeiptr>(nodeCount) * static_cast<GLsizeiptr>(sizeof(shader::LightNode));
     // A larger buffer serves a smaller tree: a live view whose drag draws 256 RSMs and whose
     // refinement draws the asked 1024 alternates between the two, and creating the 1024's 112 MB
-    // buffer took about 60 ms each time (llvmpipe clears it), input waiting. Kept up to
-    // kKeptTreeBytes; a larger one goes when a smaller tree is asked for.
+    // buffer took about 60 ms each time, input waiting. Kept up to kKeptTreeBytes; a larger one goes
+    // when a smaller tree is asked for (docs/interactive.md, "The light tree in refinement").
     const bool fits = mNodes && mNodes.size() >= mNodeBytes;
     if (!fits || (mNodes.size() > mNodeBytes && mNodes.size() > kKeptTreeBytes)) {
         mNodes = gl::Buffer::create(mNodeBytes);

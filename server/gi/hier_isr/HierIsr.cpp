@@ -238,17 +238,18 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
     mEye.countReceivers(counters);
 
     const double receivers = counters["receivers_total"];
-    const double visited =
-        static_cast<double>(stats[kVisitedLo]) + 4294967296.0 * static_cast<double>(stats[kVisitedHi]);
-    const double cut = static_cast<double>(stats[kCutLo]) + 4294967296.0 * static_cast<double>(stats[kCutHi]);
+    const auto sum64 = [&stats](CutStat lo, CutStat hi) {
+        return static_cast<double>(stats[lo]) + 4294967296.0 * static_cast<double>(stats[hi]);
+    };
+    const double visited = sum64(kVisitedLo, kVisitedHi);
+    const double cut = sum64(kCutLo, kCutHi);
     counters["nodes_visited_mean"] = receivers > 0 ? visited / receivers : 0.0;
     counters["nodes_visited_max"] = stats[kVisitedMax];
     counters["cut_size_mean"] = receivers > 0 ? cut / receivers : 0.0;
     counters["cut_size_max"] = stats[kCutMax];
     counters["traversal_cut_short"] = stats[kCutShort];
-    const double leafVisited = static_cast<double>(stats[kLeafVisitedLo]) +
-                               4294967296.0 * static_cast<double>(stats[kLeafVisitedHi]);
-    counters["nodes_visited_leaf_mean"] = receivers > 0 ? leafVisited / receivers : 0.0;
+    counters["nodes_visited_leaf_mean"] =
+        receivers > 0 ? sum64(kLeafVisitedLo, kLeafVisitedHi) / receivers : 0.0;
     mSsbc.apply(in, params, mIndirect.texture, timer, counters);
 }
 
