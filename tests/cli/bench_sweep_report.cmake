@@ -56,7 +56,9 @@ if(NOT ERR MATCHES "is above a fifth of the smallest error [0-9.]+: rendering it
 endif()
 run_ok(${BENCH} report --in ${WORK}/sweep --out ${WORK}/docs/accuracy.md --presets ${WORK}/presets.json)
 file(READ ${WORK}/docs/accuracy.md md)
-foreach(expect "\\| technique \\| points \\| front point \\|" "\\| rsm_gather \\| 2 \\| defaults \\|"
+# Both rsm_gather points are within the reference's noise of each other at 32x32, so the front keeps
+# whichever was faster in this run: the row names one of the two, not a fixed one.
+foreach(expect "\\| technique \\| points \\| front point \\|" "\\| rsm_gather \\| 2 \\| (defaults|[a-z_]+=[0-9.]+) \\|"
         "Pareto front" "## Presets" "gi-bench sweep --scenes builtin:cornell-empty"
         "Reference `one-bounce-unoccluded` at 8 spp; its relative noise \\(from the samples' spread\\) is 0\\.[0-9]+ of the image"
         "indirect rel. RMSE \\| image rel. RMSE \\| direct pass" "more than a fifth of the smallest error")
