@@ -9,6 +9,7 @@
 #include "frame/FrameState.h"
 #include "frame/Tiles.h"
 #include "gi/Catalog.h"
+#include "gi/common/EyeHierarchy.h"
 #include "gi/common/VplGrid.h"
 #include "gi/hier_isr/HierIsr.h"
 
@@ -545,6 +546,62 @@ TEST(TilesGl, AFullTraversalGoesInRootRanges) {
     EXPECT_EQ(counter(ranged, "cut_size_mean"), counter(expected, "cut_size_mean"));
     EXPECT_GT(counter(expected, "nodes_visited_mean"), 65535.0);
     // Stopped between two ranges, the next frame is the whole one.
+    int asked = 0;
+    counting.setInterruptCheck([&] { return ++asked >= checks - 2; });
+    EXPECT_TRUE(counting.render(s).interrupted);
+    counting.setInterruptCheck({});
+    EXPECT_EQ(counting.render(s).rgba8, expected.rgba8);
+}
+
+// A full traversal with fewer roots than its pieces (balanced's hier_coarsest 1: one root over 256
+// leaves) goes in receiver chunks for the rest: in refinement no stretch of the gather runs whole
+// (one such dispatch held input up to 37 ms), and each receiver's sum is the one dispatch's.
+TEST(TilesGl, AFullTraversalWithFewRootsGoesInReceiverChunks) {
+    const auto pieces = [](double receivers, double leaves, int roots, int minRanges) {
+        const TraversalPieces p = fullTraversalPieces(receivers, leaves, roots, minRanges);
+        return std::array{p.ranges, p.chunks};
+    };
+    EXPECT_EQ(pieces(3000, 256.0, 1, 1), (std::array{1, 8})) << "one root: the usual eight, in chunks";
+    EXPECT_EQ(pieces(3000, 256.0, 4, 1), (std::array{4, 2}));
+    EXPECT_EQ(pieces(3000, 256.0, 256, 1), (std::array{8, 1})) << "roots enough: ranges alone";
+    EXPECT_EQ(pieces(1576, 65536.0, 4, 2), (std::array{4, 16})) << "64 pieces asked over 4 roots";
+    EXPECT_EQ(pieces(1576, 65536.0, 256, 2), (std::array{64, 1}));
+    EXPECT_EQ(pieces(3000, 1024.0, 256, 32), (std::array{32, 1})) << "the loop budget's ranges stay";
+    EXPECT_EQ(pieces(3000, 1024.0, 12, 1), (std::array{6, 2})) << "whole roots a range: 2 each";
+    EXPECT_EQ(pieces(100, std::nan(""), 1, 1), (std::array{1, 8})) << "unknown work: the usual eight";
+    EXPECT_EQ(pieces(0, 256.0, 0, 1), (std::array{1, 8})) << "no root, no receiver: no division by zero";
+
+    sharedContext();
+    const auto scene = std::make_shared<const Scene>(loadScene("builtin:cornell"));
+    FrameState s = stateFor(*scene, "hier_isr", 96, 80);
+    s.techniqueParams.set("tau", 0.0);
+    s.techniqueParams.set("hier_coarsest", 1);
+    s.techniqueParams.set("max_depth", 16);
+    FrameRenderer plain;
+    plain.setScene(scene);
+    const FrameOutput expected = plain.render(s);
+    EXPECT_FALSE(expected.stats["counts"].contains("traversal_receiver_chunks"));
+    int checks = 0;
+    FrameRenderer counting;
+    counting.setScene(scene);
+    counting.setInterruptCheck([&] {
+        ++checks;
+        return false;
+    });
+    const FrameOutput chunked = counting.render(s);
+    EXPECT_FALSE(chunked.stats["counts"].contains("traversal_ranges")) << "one root: one range";
+    const double chunks = counter(chunked, "traversal_receiver_chunks");
+    EXPECT_EQ(chunks, 8.0);
+    // Shadow maps, RSMs, eye passes, the geometry levels, the stencil, between the chunks, after it;
+    // fewer when the receivers fill fewer groups than the chunks.
+    const double receivers = counter(chunked, "receivers_total");
+    const double groups = std::ceil(receivers / GIS_EYE_RECEIVER_GROUP);
+    const double perChunk = std::ceil(groups / chunks);
+    EXPECT_EQ(checks, 5 + static_cast<int>(std::ceil(groups / perChunk)) - 1 + 1);
+    EXPECT_GT(checks, 6) << "the gather did go in pieces";
+    EXPECT_EQ(chunked.rgba8, expected.rgba8) << "each receiver's sum as in one dispatch";
+    EXPECT_EQ(counter(chunked, "nodes_visited_mean"), counter(expected, "nodes_visited_mean"));
+    // Stopped between two chunks, the next frame is the whole one.
     int asked = 0;
     counting.setInterruptCheck([&] { return ++asked >= checks - 2; });
     EXPECT_TRUE(counting.render(s).interrupted);

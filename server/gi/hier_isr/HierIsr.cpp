@@ -75,6 +75,19 @@ int traversalRanges(double receivers, double leavesPerReceiver, int roots) {
     return static_cast<int>(ranges);
 }
 
+TraversalPieces fullTraversalPieces(double receivers, double leavesPerReceiver, int roots, int minRanges) {
+    TraversalPieces pieces;
+    const int wanted = traversalRanges(receivers, leavesPerReceiver, kMaxTraversalRanges);
+    const int rootCount = std::max(roots, 1);
+    const int asked =
+        std::clamp(std::max(traversalRanges(receivers, leavesPerReceiver, roots), minRanges), 1, rootCount);
+    // What the loop over the roots dispatches: whole roots a range.
+    const int perRange = (rootCount + asked - 1) / asked;
+    pieces.ranges = (rootCount + perRange - 1) / perRange;
+    pieces.chunks = std::max(1, (wanted + pieces.ranges - 1) / pieces.ranges);
+    return pieces;
+}
+
 std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
                              const std::vector<LightLevel>& levels, const LightCutSettings& s,
                              float tanHalfFov, glm::vec3 receiver) {
@@ -186,16 +199,19 @@ void HierIsr::execute(const FrameInputs& in, const ParamSet& params, gl::PassTim
                 if (split.rootLevel < s.startLevel)
                     counters["traversal_split_levels"] = s.startLevel - split.rootLevel;
                 int ranges = split.ranges;
-                // In refinement a full traversal's ranges are also small enough for input to stop
-                // between (traversalRanges); a traversal by the test goes in receiver chunks
-                // instead (its work is not known beforehand), in each range.
+                // In refinement a full traversal's pieces are also small enough for input to stop
+                // between (fullTraversalPieces); a traversal by the test goes in receiver chunks
+                // (its work is not known beforehand), in each range.
                 int chunks = 1;
                 if (in.interruptCheck) {
                     if (s.mode == LightRefine::Always) {
                         const int leafSide = mTree.levels()[static_cast<size_t>(s.leafLevel)].side;
-                        ranges = std::max(
-                            ranges, traversalRanges(static_cast<double>(mEye.readReceiverCount()),
-                                                    static_cast<double>(leafSide) * leafSide, split.roots));
+                        const TraversalPieces pieces = fullTraversalPieces(
+                            static_cast<double>(mEye.readReceiverCount()),
+                            static_cast<double>(leafSide) * leafSide, split.roots, ranges);
+                        ranges = pieces.ranges;
+                        chunks = pieces.chunks;
+                        if (chunks > 1) counters["traversal_receiver_chunks"] = chunks;
                     } else {
                         chunks = gatherCut(1).cutsPerBatch;
                     }

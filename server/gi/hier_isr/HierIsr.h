@@ -127,6 +127,16 @@ TraversalSplit traversalSplit(const std::vector<LightLevel>& levels, const Light
 constexpr double kTraversalPairsPerRange = 1048576.0;
 constexpr int kMaxTraversalRanges = 64;
 int traversalRanges(double receivers, double leavesPerReceiver, int roots);
+/// Refinement's pieces of a full traversal over `roots` roots: its ranges (traversalRanges, at least
+/// `minRanges`, the loop budget's) and, where the roots are too few for the pieces its work asks
+/// (balanced's hier_coarsest 1 over 256 leaves has one root: one dispatch, up to 37 ms between two
+/// checks of a tile), each range's receivers in chunks for the rest. Few roots mean few leaves, or
+/// ranges already as large as a root's subtree, so a chunk's group stays short there. Pure.
+struct TraversalPieces {
+    int ranges = 1; ///< dispatches over the roots
+    int chunks = 1; ///< receiver chunks in each (EyeHierarchy::dispatchReceivers)
+};
+TraversalPieces fullTraversalPieces(double receivers, double leavesPerReceiver, int roots, int minRanges);
 /// CPU mirror of gather.comp's traversal for one receiver at `receiver`: the flat indices of the
 /// nodes that contribute (its cut). `tanHalfFov` is gFrame.rsmInfo.y. For tests.
 std::vector<int> lightCutCpu(const std::vector<shader::LightNode>& nodes,
