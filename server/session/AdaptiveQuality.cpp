@@ -305,6 +305,7 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& e
                                       const std::function<bool(const FrameState&)>& keepsLightViews,
                                       Plan& p) {
     const long requestedVpls = vplEstimate(p.state);
+    p.techniqueParamsKey = p.state.techniqueParams.toJson().dump();
     if (frameTargetMs > 0) {
         mBudget.setTargetMs(frameTargetMs);
         const TechniqueInfo& info = findTechniqueInfo(p.state.technique);
@@ -335,7 +336,8 @@ void AdaptiveQuality::planInteractive(int frameTargetMs, const nlohmann::json& e
             info.capReceiverShare(p.state.techniqueParams, choice.receiverShareCap);
             // The cap cuts by the exponent this session's frames measured at the VPLs asked for
             // (hier_isr's near 65,536 leaves is about a third of its fixed one).
-            p.state.receiverCapExponent = mBudget.exponentAt(p.budgetKey, vplEstimate(p.state));
+            p.state.receiverCapExponent =
+                mBudget.exponentAt(p.budgetKey, vplEstimate(p.state), p.techniqueParamsKey);
         }
         p.budget = choice.toJson(frameTargetMs, requestedVpls);
         if (!capReceivers) p.budget["receiver_share_cap"] = nullptr;

@@ -75,6 +75,9 @@ public:
         double scale = 1.0;    ///< interactive: the size factor applied to the state
         nlohmann::json budget; ///< interactive: stats.budget (null otherwise)
         std::string budgetKey; ///< "scene/technique": where the frame's cost is recorded
+        /// Interactive: the technique's parameters before the budget's caps, as JSON
+        /// (FrameCost::techniqueParams: what the frame's measured cost exponent holds for).
+        std::string techniqueParamsKey;
     };
     /// The plan for `step` of `requested` (the session's state: its full size, the client's
     /// parameters) in scene `sceneName`. `explicitParams` are those the client set (they win over

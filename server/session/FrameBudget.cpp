@@ -146,9 +146,9 @@ double FrameBudget::vplPassesMs(const std::string& key, double pixels, long vpls
     return r.vpl * pixels * std::pow(static_cast<double>(std::max(1L, vpls)), r.exponent);
 }
 
-double FrameBudget::exponentAt(const std::string& key, long vpls) const {
+double FrameBudget::exponentAt(const std::string& key, long vpls, const std::string& techniqueParams) const {
     const auto it = mRates.find(key);
-    if (it == mRates.end()) return 0.0;
+    if (it == mRates.end() || it->second.exponentParams != techniqueParams) return 0.0;
     const auto at = it->second.exponentAt.find(vpls);
     return at == it->second.exponentAt.end() ? 0.0 : at->second;
 }
@@ -184,6 +184,11 @@ void FrameBudget::record(const std::string& key, const FrameCost& measured) {
     r.exponent = exponent;
     if (cost.vpls > 0) r.lastVpls = cost.vpls;
     const long gathered = cost.gatheredVpls > 0 ? cost.gatheredVpls : cost.vpls;
+    // Exponents measured under other parameters (another tau) do not hold for these.
+    if (cost.techniqueParams != r.exponentParams) {
+        r.exponentAt.clear();
+        r.exponentParams = cost.techniqueParams;
+    }
     if (gathered > 0) {
         if (r.exponentAt.size() >= kMaxExponentCounts && !r.exponentAt.count(gathered)) r.exponentAt.clear();
         r.exponentAt[gathered] = exponent;

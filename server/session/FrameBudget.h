@@ -62,6 +62,10 @@ struct FrameCost {
     /// The VPLs the frame gathered from: those the receiver cap left it (counts
     /// receiver_share_capped_vpls), or vpls; where vplCostExponent was measured.
     long gatheredVpls = 0;
+    /// The technique's parameters before the budget's caps, as JSON (AdaptiveQuality::Plan::
+    /// techniqueParamsKey): what vplCostExponent holds for. hier_isr's at 256 leaves is about 1 at
+    /// tau 0 and 0.85 at tau 0.01; a change of them forgets the exponents measured before.
+    std::string techniqueParams;
     /// The light views, when the frame drew them (counts.light_views_reused absent and a shadow_map
     /// pass timed): their views, texels (views x side^2) and ms (shadow_map; rsm, rsm_flux and the
     /// technique's lightViewPasses). lightViewTechniqueMs is the part of techniqueMs among them.
@@ -164,9 +168,10 @@ public:
     /// the measured rate); 0 when nothing is measured or the technique's frames had no VPLs.
     double vplPassesMs(const std::string& key, double pixels, long vpls) const;
     /// The cost exponent the last frame of `key` that gathered from exactly `vpls` VPLs measured
-    /// (FrameCost::vplCostExponent at FrameCost::gatheredVpls): what the receiver cap of a frame
-    /// asking for them cuts by (FrameState::receiverCapExponent). 0 when none did.
-    double exponentAt(const std::string& key, long vpls) const;
+    /// (FrameCost::vplCostExponent at FrameCost::gatheredVpls) under the technique parameters
+    /// `techniqueParams` (FrameCost::techniqueParams): what the receiver cap of a frame asking for them
+    /// cuts by (FrameState::receiverCapExponent). 0 when none did, or none under those parameters.
+    double exponentAt(const std::string& key, long vpls, const std::string& techniqueParams) const;
 
 private:
     struct Rates {
@@ -189,6 +194,7 @@ private:
         /// FrameCost::vplCostExponent by FrameCost::gatheredVpls, the newest frame's at each count
         /// (hier_isr's leaves are powers of four: a handful; at most kMaxExponentCounts).
         std::map<long, double> exponentAt;
+        std::string exponentParams; ///< FrameCost::techniqueParams of the frames in exponentAt
     };
     static constexpr size_t kMaxExponentCounts = 64;
     /// The light views' sides and predicted ms for `ask` (BudgetChoice's light-view fields).

@@ -1365,6 +1365,7 @@ void Session::workerMain() {
         const std::string& refineNote = quality.why;
         const nlohmann::json& budgetJson = quality.budget;
         const std::string& budgetKey = quality.budgetKey;
+        const std::string& techniqueParamsKey = quality.techniqueParamsKey;
         // A refinement step renders in tiles that input stops between (and its effect plan stops too).
         const bool refinement = !snapshotFor && (step == static_cast<int>(Step::Balanced) ||
                                                  step == static_cast<int>(Step::Final));
@@ -1476,6 +1477,7 @@ void Session::workerMain() {
                 frameVplCostExponent(info, frame.stats.value("counts", nlohmann::json::object())),
                 info.lightViewPasses);
             cost.vplPassesMs = vplPassesMs(state.technique, frame.stats);
+            cost.techniqueParams = techniqueParamsKey;
             {
                 std::lock_guard lock(mMutex);
                 cost.encodeMs = mLastFrame.stats.value("encode_ms", 0.0);

@@ -471,11 +471,20 @@ TEST(AdaptiveQuality, TheReceiverCapCutsByTheExponentMeasuredAtTheAskedVpls) {
     cost.techniqueMs = 2;
     cost.receiverShare = 0.1;
     cost.vplCostExponent = 0.13;
+    cost.techniqueParams = first.techniqueParamsKey;
     q.budget().record(first.budgetKey, cost);
     q.budget().record(first.budgetKey, cost);
     const AdaptiveQuality::Plan next = q.plan("cornell", asked, none, QualityStep::Interactive, false, 80);
     ASSERT_EQ(vplEstimate(next.state), leaves) << next.budget.dump();
     EXPECT_DOUBLE_EQ(next.state.receiverCapExponent, 0.13);
+    // Under another tau that exponent does not hold: the cap cuts by the technique's fixed one.
+    FrameState otherTau = asked;
+    otherTau.techniqueParams.set("tau", 0.0);
+    const nlohmann::json explicitTau = {{"tau", 0.0}};
+    const AdaptiveQuality::Plan changed =
+        q.plan("cornell", otherTau, explicitTau, QualityStep::Interactive, false, 80);
+    EXPECT_NE(changed.techniqueParamsKey, first.techniqueParamsKey);
+    EXPECT_DOUBLE_EQ(changed.state.receiverCapExponent, 0.0) << changed.budget.dump();
     EXPECT_DOUBLE_EQ(q.plan("cornell", asked, none, QualityStep::Final, false, 80).state.receiverCapExponent,
                      0.0);
 }

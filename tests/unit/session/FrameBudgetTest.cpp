@@ -276,19 +276,31 @@ TEST(FrameBudget, CandidatesArePredictedAtTheVplsTheTechniqueRenders) {
 // when it cut): what the next cap at those VPLs cuts by.
 TEST(FrameBudget, ExponentsAreKeptByTheVplsGathered) {
     FrameBudget budget(FrameBudget::Config{});
-    EXPECT_EQ(budget.exponentAt("k", 65536), 0.0);
+    EXPECT_EQ(budget.exponentAt("k", 65536, ""), 0.0);
     FrameCost cost = synthetic(288 * 240, 65536, 2e-4, 1e-9);
     cost.gatheredVpls = 65536;
     cost.vplCostExponent = 0.13;
     budget.record("k", cost);
-    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 65536), 0.13);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 65536, ""), 0.13);
     cost.gatheredVpls = 256; // the cap cut it to 256 leaves, where the traversal grows faster
     cost.vplCostExponent = 0.85;
     budget.record("k", cost);
-    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 256), 0.85);
-    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 65536), 0.13);
-    EXPECT_EQ(budget.exponentAt("k", 1024), 0.0);
-    EXPECT_EQ(budget.exponentAt("other", 65536), 0.0);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 256, ""), 0.85);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 65536, ""), 0.13);
+    EXPECT_EQ(budget.exponentAt("k", 1024, ""), 0.0);
+    EXPECT_EQ(budget.exponentAt("other", 65536, ""), 0.0);
+    // Under other technique parameters (another tau) the exponents measured before do not hold: none
+    // is given for them, and a frame under them forgets the old ones.
+    const std::string otherTau = R"({"tau":0.0})";
+    EXPECT_EQ(budget.exponentAt("k", 256, otherTau), 0.0);
+    cost.techniqueParams = otherTau;
+    cost.gatheredVpls = 4096;
+    cost.vplCostExponent = 0.98;
+    budget.record("k", cost);
+    EXPECT_DOUBLE_EQ(budget.exponentAt("k", 4096, otherTau), 0.98);
+    EXPECT_EQ(budget.exponentAt("k", 256, otherTau), 0.0);
+    EXPECT_EQ(budget.exponentAt("k", 256, ""), 0.0);
+    EXPECT_EQ(budget.exponentAt("k", 4096, ""), 0.0);
 
     const nlohmann::json stats = {
         {"frame_ms", 10.0},
