@@ -234,6 +234,7 @@ const hook = {
     get welcome() { return state.welcome ? structuredClone(state.welcome) : null; },
     get frameTargetMs() { return state.frameTargetMs; },
     get chartRedraws() { return chart.redraws; },
+    get figuresShownAt() { return state.figuresShownAt; }, // when a frame's figures were last shown (ms)
     get inputPending() { return watch.pending; }, // an input no drawn frame shows yet
     get steerSeq() { return lastSteerSeq(); }, // the number of the last steering message sent
     get explicit() { return [...state.explicit]; },
@@ -559,21 +560,23 @@ function recordDraw(frame, decodeMs, frameBytes) {
             heldFiguresTimer = 0;
             const held = heldFigures;
             heldFigures = null;
-            if (held) showFigures(...held, performance.now());
+            if (held) showFigures(...held);
         }, Math.max(0, OVERLAY_TICK_MS - (now - state.figuresShownAt)));
         return;
     }
     heldFigures = null;
-    showFigures(frame, decodeMs, frameBytes, now);
+    showFigures(frame, decodeMs, frameBytes);
 }
 
 let heldFigures = null; // [frame, decodeMs, frameBytes] of the last patch whose figures wait
 let heldFiguresTimer = 0;
 
 /** The overlay's frame lines, the Stats details and what else follows a drawn frame's figures. */
-function showFigures(frame, decodeMs, frameBytes, now) {
+function showFigures(frame, decodeMs, frameBytes) {
     const stats = frame.entry?.stats ?? null;
-    state.figuresShownAt = now;
+    // When they are shown, not when the frame was drawn: the work between the two (the chart, the
+    // latency figures) varies, and the period is the page's, between two shows.
+    state.figuresShownAt = performance.now();
     const net = networkMs(state.rttMs, frame.entry?.arrivedAt, frame.arrivedAt);
     showFrameStats(frame.header, stats, { decodeMs, net, bytes: stats?.bytes ?? frameBytes });
     noteDefaultLighting(stats?.lighting);

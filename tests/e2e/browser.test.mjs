@@ -372,9 +372,14 @@ test('while the view refines in patches, their figures are shown at most at the 
                 requestAnimationFrame(countDraws);
             };
             requestAnimationFrame(countDraws);
+            // The client's own stamp of the show: the observer runs at the end of the task that
+            // showed them, whose work after the show varies (a gap of 207 ms between two shows 250 ms
+            // apart under load).
             new MutationObserver(() => {
-                if (window.seenPatches && window.giClient.lastStats?.patch && !window.giClient.lastStats.refine?.complete)
-                    window.seenPatches.shown.push(performance.now());
+                if (window.seenPatches && window.giClient.lastStats?.patch && !window.giClient.lastStats.refine?.complete) {
+                    const at = window.giClient.figuresShownAt;
+                    if (at !== window.seenPatches.shown.at(-1)) window.seenPatches.shown.push(at);
+                }
             }).observe(document.getElementById('ov-times'), { subtree: true, childList: true, characterData: true });
             // 16,384 VPLs: tiles in VPL parts, each sent as a patch.
             window.giClient.send({ type: 'params', values: { vpl_grid: 128 } });
@@ -388,8 +393,8 @@ test('while the view refines in patches, their figures are shown at most at the 
             t.diagnostic(`${seen.drawn.length} patches drawn, the overlay's frame line shown for ${seen.shown.length}; `
                 + `gaps between those shown ${gaps(seen.shown).map(Math.round).join(', ')} ms`);
             assert.ok(seen.shown.length > 0, 'a patch\'s figures are shown');
-            // 250 ms apart, less the observer's timing.
-            assert.ok(gaps(seen.shown).every((g) => g >= 230),
+            // 250 ms apart by the client's clock, less a timer's rounding.
+            assert.ok(gaps(seen.shown).every((g) => g >= 245),
                 `shown at most every 250 ms: ${gaps(seen.shown).map(Math.round).join(', ')} ms`);
         } finally {
             await page.evaluate((v) => {
