@@ -47,6 +47,10 @@ struct FrameInputs {
     const FrameResources* resources = nullptr;
     int rsmSize = 0;    ///< texels per side of each light view's RSM layer
     int lightViews = 0; ///< RSM layers that hold a light view (0: no light is on)
+    /// The side the parameters ask for (after the views' own limits): above rsmSize in an interactive
+    /// frame that capped its light views (FrameState::lightViewCap), whose still view draws them at
+    /// this side again. 0: rsmSize.
+    int rsmSizeAsked = 0;
     /// Reflected flux luminance of each view's RSM (the VPL budget's split); empty without a light.
     std::vector<double> viewFlux;
     const shader::LightUniforms* lights = nullptr; ///< CPU copy of the bound gLights block

@@ -767,6 +767,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     in.height = state.height;
     in.resources = &mResources;
     in.rsmSize = lightSet.rsmSide;
+    in.rsmSizeAsked = askedRsmSide;
     in.lightViews = views;
     in.viewFlux = viewFlux;
     in.lights = &lights;

@@ -584,5 +584,51 @@ TEST(LightTree, ALargerNodeBufferServesASmallerTree) {
               buffer);
 }
 
+// A light drag's capped maps ask for a smaller tree than the still view's, which builds the asked
+// side's again: that tree's buffer is kept beyond the kept size (13 point-lamp views at 1024: 447 MB,
+// created again after each drag, held input about 200 ms), and goes once the asked side is smaller.
+TEST(LightTree, ACappedFrameKeepsTheBufferItsAskedMapsNeed) {
+    test::sharedContext();
+    const auto scene = std::make_shared<Scene>(loadScene("builtin:cornell"));
+    FrameRenderer renderer;
+    renderer.setScene(scene);
+    FrameState asked = makeFrameState(*scene, "hier_isr");
+    asked.width = asked.height = 32;
+    applyParams(asked, {{"rsm_size", 512}}, "test");
+    (void)renderer.render(asked, true);
+    auto& technique = dynamic_cast<HierIsr&>(*renderer.technique());
+    technique.setKeptTreeBytes(1 << 20); // a 512 tree (28 MB) is past it
+    ASSERT_GT(lightTreeBytes(512), 1 << 20);
+    const GLuint buffer = technique.tree().nodes().id();
+    EXPECT_EQ(static_cast<long long>(technique.tree().nodes().size()), lightTreeBytes(512));
+
+    FrameState drag = asked;
+    drag.lights[0].light.intensity *= 0.8f;
+    drag.lightViewCap = {0, 128};
+    const FrameOutput dragged = renderer.render(drag, true);
+    ASSERT_EQ(dragged.stats["lighting"].value("rsm_side", 0), 128);
+    EXPECT_EQ(technique.tree().rsmSize(), 128) << "built again, over the capped maps";
+    EXPECT_EQ(technique.tree().nodes().id(), buffer) << "kept for the asked side's tree";
+    // The capped frame is the frame of those maps.
+    FrameRenderer fresh;
+    fresh.setScene(scene);
+    FrameState small = drag;
+    small.lightViewCap = {};
+    applyParams(small, {{"rsm_size", 128}}, "test");
+    EXPECT_EQ(dragged.rgba8, fresh.render(small, true).rgba8);
+
+    FrameState still = drag;
+    still.lightViewCap = {};
+    (void)renderer.render(still, true);
+    EXPECT_EQ(technique.tree().rsmSize(), 512);
+    EXPECT_EQ(technique.tree().nodes().id(), buffer) << "nothing created for the asked maps";
+
+    // Asked for smaller maps, the larger buffer goes.
+    small.lights[0].light.intensity *= 0.8f;
+    (void)renderer.render(small, true);
+    EXPECT_NE(technique.tree().nodes().id(), buffer);
+    EXPECT_EQ(static_cast<long long>(technique.tree().nodes().size()), lightTreeBytes(128));
+}
+
 } // namespace
 } // namespace gis

@@ -43,7 +43,14 @@ LightTree::LightTree() {
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &mMaxTexels);
 }
 
-void LightTree::ensureLayout(int rsmSize) {
+long long lightTreeBytes(int rsmSize) {
+    const std::vector<LightLevel> levels = lightTreeLayout(rsmSize);
+    const LightLevel& last = levels.back();
+    return (static_cast<long long>(last.offset) + static_cast<long long>(last.side) * last.side) *
+           static_cast<long long>(sizeof(shader::LightNode));
+}
+
+void LightTree::ensureLayout(int rsmSize, int keptSize) {
     if (rsmSize == mRsmSize && mNodes) return;
     mLevels = lightTreeLayout(rsmSize);
     const LightLevel& last = mLevels.back();
@@ -51,10 +58,14 @@ void LightTree::ensureLayout(int rsmSize) {
     mNodeBytes = static_cast<GLsizeiptr>(nodeCount) * static_cast<GLsizeiptr>(sizeof(shader::LightNode));
     // A larger buffer serves a smaller tree: a live view whose drag draws 256 RSMs and whose
     // refinement draws the asked 1024 alternates between the two, and creating the 1024's 112 MB
-    // buffer took about 60 ms each time, input waiting. Kept up to kKeptTreeBytes; a larger one goes
-    // when a smaller tree is asked for (docs/interactive.md, "The light tree in refinement").
+    // buffer took about 60 ms each time, input waiting. Kept up to kKeptTreeBytes, or up to what
+    // the asked side's tree needs while a drag's capped maps ask for a smaller one (13 point-lamp
+    // views at rsm_size 1024, 512 each in the mosaic: 447 MB, created again in each refinement after
+    // a drag, about 230 ms); a larger one goes when a smaller tree is asked for (docs/interactive.md,
+    // "The light tree in refinement").
     const bool fits = mNodes && mNodes.size() >= mNodeBytes;
-    if (!fits || (mNodes.size() > mNodeBytes && mNodes.size() > kKeptTreeBytes)) {
+    const long long kept = std::max(mKeptBytes, keptSize > rsmSize ? lightTreeBytes(keptSize) : 0ll);
+    if (!fits || (mNodes.size() > mNodeBytes && mNodes.size() > kept)) {
         mNodes = gl::Buffer::create(mNodeBytes);
         mNodeTexels.view(mNodes, GL_RGBA32F, 0, mNodes.size());
     }
@@ -95,7 +106,7 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
     mLastInputs.lights = nullptr; // the renderer's per-frame copy: gone after the frame
     mValid = false;
     if (in.rsmSize <= 0 || !in.find("lights.rsm.position")) return;
-    ensureLayout(tiles * in.rsmSize);
+    ensureLayout(tiles * in.rsmSize, tiles * std::max(in.rsmSizeAsked, in.rsmSize));
     mTiles = tiles;
     counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
     counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);

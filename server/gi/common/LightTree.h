@@ -50,8 +50,11 @@ int lightLevelForResolution(const std::vector<LightLevel>& levels, int resolutio
 /// 7 ms on llvmpipe; the default 256 RSM's whole level 1 (16,384 nodes) stays one.
 inline constexpr int kBuildChunkNodes = 65536;
 /// The largest node buffer a light tree keeps for a smaller tree (LightTree::ensureLayout): a 1024
-/// RSM's tree of one view, 112 MB.
+/// RSM's tree of one view, 112 MB; or what the asked RSM side's tree needs
+/// (FrameInputs::rsmSizeAsked), whose still view builds it again.
 inline constexpr long long kKeptTreeBytes = 128ll << 20;
+/// Bytes of the nodes of a tree over a level 0 of `rsmSize` texels a side. Pure.
+long long lightTreeBytes(int rsmSize);
 
 class LightTree {
 public:
@@ -76,10 +79,13 @@ public:
     /// Test hooks: the nodes read back (synchronises), and the inputs of the last build (the
     /// renderer's RSM textures; valid until the renderer reallocates them).
     std::vector<shader::LightNode> readNodes() const;
+    /// Test hook: keep node buffers up to `bytes` for smaller trees instead of kKeptTreeBytes.
+    void setKeptBytes(long long bytes) { mKeptBytes = bytes; }
     const FrameInputs& lastInputs() const { return mLastInputs; }
 
 private:
-    void ensureLayout(int rsmSize);
+    /// `keptSize`: the level 0 side whose tree's buffer is kept beyond kKeptTreeBytes.
+    void ensureLayout(int rsmSize, int keptSize);
 
     struct BuildProgram {
         gl::Program program;
@@ -96,6 +102,7 @@ private:
     int mTiles = 1;
     bool mValid = false;
     FrameInputs mLastInputs;
+    long long mKeptBytes = kKeptTreeBytes; ///< setKeptBytes
 };
 
 } // namespace gis

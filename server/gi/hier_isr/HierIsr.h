@@ -153,6 +153,8 @@ public:
 
     /// Test hook: the light tree of the last frame.
     const LightTree& tree() const { return mTree; }
+    /// Test hook: LightTree::setKeptBytes.
+    void setKeptTreeBytes(long long bytes) { mTree.setKeptBytes(bytes); }
     /// Test hook: split traversals for this loop budget instead of kTraversalLoopBudget (a small
     /// one splits a cheap traversal as a costly one would be, to compare it with the whole).
     void setLoopBudget(double iterations) {
