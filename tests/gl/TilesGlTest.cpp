@@ -46,6 +46,35 @@ FrameState stateFor(const Scene& scene, const std::string& technique, int w, int
     return s;
 }
 
+// A frame of `state` rendered by a plain renderer (expected) and by one whose interrupt check never
+// stops (checked, its checks counted), as refinement renders it.
+struct CheckedFrame {
+    FrameOutput expected, checked;
+    int checks = 0;
+    FrameRenderer counting;
+    CheckedFrame(const std::shared_ptr<const Scene>& scene, const FrameState& state) {
+        FrameRenderer plain;
+        plain.setScene(scene);
+        expected = plain.render(state);
+        counting.setScene(scene);
+        counting.setInterruptCheck([this] {
+            ++checks;
+            return false;
+        });
+        checked = counting.render(state);
+    }
+    // Stopped at the check two before the last (inside the gather's pieces), the frame returns
+    // interrupted, and the next frame without a check is the whole one.
+    void expectAStopKeepsNothing(const FrameState& state) {
+        int asked = 0;
+        const int stopAt = checks - 2;
+        counting.setInterruptCheck([&] { return ++asked >= stopAt; });
+        EXPECT_TRUE(counting.render(state).interrupted);
+        counting.setInterruptCheck({});
+        EXPECT_EQ(counting.render(state).rgba8, expected.rgba8);
+    }
+};
+
 std::vector<std::uint8_t> renderTiled(FrameRenderer& renderer, const FrameState& full, double tilePixels) {
     std::vector<std::uint8_t> canvas(static_cast<std::size_t>(full.width) * full.height * 4, 0);
     const int guard = tileGuardPx(full);
@@ -521,17 +550,9 @@ TEST(TilesGl, AFullTraversalGoesInRootRanges) {
     const auto scene = std::make_shared<const Scene>(loadScene("builtin:cornell"));
     FrameState s = stateFor(*scene, "hier_isr", 96, 80);
     s.techniqueParams.set("tau", 0.0);
-    FrameRenderer plain;
-    plain.setScene(scene);
-    const FrameOutput expected = plain.render(s);
-    int checks = 0;
-    FrameRenderer counting;
-    counting.setScene(scene);
-    counting.setInterruptCheck([&] {
-        ++checks;
-        return false;
-    });
-    const FrameOutput ranged = counting.render(s);
+    CheckedFrame frames(scene, s);
+    const FrameOutput &expected = frames.expected, &ranged = frames.checked;
+    const int checks = frames.checks;
     const double ranges = counter(ranged, "traversal_ranges");
     EXPECT_GE(ranges, 8.0);
     EXPECT_EQ(counter(expected, "traversal_ranges"), 2.0) << "without a check: the loop budget's ranges";
@@ -546,11 +567,7 @@ TEST(TilesGl, AFullTraversalGoesInRootRanges) {
     EXPECT_EQ(counter(ranged, "cut_size_mean"), counter(expected, "cut_size_mean"));
     EXPECT_GT(counter(expected, "nodes_visited_mean"), 65535.0);
     // Stopped between two ranges, the next frame is the whole one.
-    int asked = 0;
-    counting.setInterruptCheck([&] { return ++asked >= checks - 2; });
-    EXPECT_TRUE(counting.render(s).interrupted);
-    counting.setInterruptCheck({});
-    EXPECT_EQ(counting.render(s).rgba8, expected.rgba8);
+    frames.expectAStopKeepsNothing(s);
 }
 
 // A full traversal with fewer roots than its pieces (balanced's hier_coarsest 1: one root over 256
@@ -577,18 +594,10 @@ TEST(TilesGl, AFullTraversalWithFewRootsGoesInReceiverChunks) {
     s.techniqueParams.set("tau", 0.0);
     s.techniqueParams.set("hier_coarsest", 1);
     s.techniqueParams.set("max_depth", 16);
-    FrameRenderer plain;
-    plain.setScene(scene);
-    const FrameOutput expected = plain.render(s);
+    CheckedFrame frames(scene, s);
+    const FrameOutput &expected = frames.expected, &chunked = frames.checked;
+    const int checks = frames.checks;
     EXPECT_FALSE(expected.stats["counts"].contains("traversal_receiver_chunks"));
-    int checks = 0;
-    FrameRenderer counting;
-    counting.setScene(scene);
-    counting.setInterruptCheck([&] {
-        ++checks;
-        return false;
-    });
-    const FrameOutput chunked = counting.render(s);
     EXPECT_FALSE(chunked.stats["counts"].contains("traversal_ranges")) << "one root: one range";
     const double chunks = counter(chunked, "traversal_receiver_chunks");
     EXPECT_EQ(chunks, 8.0);
@@ -602,11 +611,7 @@ TEST(TilesGl, AFullTraversalWithFewRootsGoesInReceiverChunks) {
     EXPECT_EQ(chunked.rgba8, expected.rgba8) << "each receiver's sum as in one dispatch";
     EXPECT_EQ(counter(chunked, "nodes_visited_mean"), counter(expected, "nodes_visited_mean"));
     // Stopped between two chunks, the next frame is the whole one.
-    int asked = 0;
-    counting.setInterruptCheck([&] { return ++asked >= checks - 2; });
-    EXPECT_TRUE(counting.render(s).interrupted);
-    counting.setInterruptCheck({});
-    EXPECT_EQ(counting.render(s).rgba8, expected.rgba8);
+    frames.expectAStopKeepsNothing(s);
 }
 
 // Any traversal (hier_isr, whatever tau) is split within the loop budget: roots below the start level
