@@ -337,7 +337,9 @@ BudgetChoice FrameBudget::choose(const std::string& key, long requestedVpls, boo
             const long r = rendered(static_cast<long>(v));
             if (r != lastVpls) ladder.push_back({c.preferredMinScale, lastVpls = r});
         }
-        if (lastVpls != c.minVpls) ladder.push_back({c.preferredMinScale, lastVpls = rendered(c.minVpls)});
+        // The floor as rendered: a knob in steps may already have reached it (a candidate twice).
+        const long floorVpls = rendered(c.minVpls);
+        if (floorVpls != lastVpls) ladder.push_back({c.preferredMinScale, lastVpls = floorVpls});
     }
     for (double s = c.preferredMinScale * 0.9; s > c.minScale; s *= 0.9) ladder.push_back({s, lastVpls});
     ladder.push_back({c.minScale, lastVpls});
