@@ -31,10 +31,32 @@ Backend defaultBackend() {
     return Backend::Egl;
 }
 
+namespace {
+thread_local Context* tCurrent = nullptr;
+} // namespace
+
+Context::~Context() {
+    if (tCurrent == this) tCurrent = nullptr;
+}
+
+void Context::makeCurrent() {
+    bind();
+    tCurrent = this;
+}
+
+void Context::releaseCurrent() {
+    unbind();
+    if (tCurrent == this) tCurrent = nullptr;
+}
+
+Context* Context::current() { return tCurrent; }
+
 void Context::refreshInfo() { detail::fillContextInfo(mInfo); }
 
 std::unique_ptr<Context> createContext(Backend backend) {
-    return backend == Backend::Egl ? createEglContext() : createOsMesaContext();
+    auto context = backend == Backend::Egl ? createEglContext() : createOsMesaContext();
+    tCurrent = context.get(); // both platforms return it current
+    return context;
 }
 
 namespace detail {

@@ -29,14 +29,24 @@ struct ContextInfo {
 /// One GL context, current on at most one thread at a time. Not thread-safe itself.
 class Context {
 public:
-    virtual ~Context() = default;
-    virtual void makeCurrent() = 0;
-    virtual void releaseCurrent() = 0;
+    virtual ~Context();
+    /// Makes this context current on the calling thread (Context::current() then returns it).
+    void makeCurrent();
+    void releaseCurrent();
     const ContextInfo& info() const { return mInfo; }
     /// Reads vendor/renderer/version strings; the context must be current.
     void refreshInfo();
+    /// A context of the same backend that shares this one's objects (buffers, textures, programs),
+    /// current on no thread: for work another thread does while this one goes on
+    /// (gl/Background.h). Any thread may call it. Throws gis::Error when the driver refuses.
+    virtual std::unique_ptr<Context> createShared() const = 0;
+    /// The context made current on the calling thread through this interface (createContext,
+    /// makeCurrent), or null.
+    static Context* current();
 
 protected:
+    virtual void bind() = 0;   ///< the platform's make-current
+    virtual void unbind() = 0; ///< the platform's release
     ContextInfo mInfo;
 };
 

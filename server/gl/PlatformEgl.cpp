@@ -90,23 +90,41 @@ const SharedDisplay& sharedDisplay() {
     return display;
 }
 
+const EGLint kContextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+
 class EglContext final : public Context {
 public:
-    EglContext(EGLDisplay display, EGLContext context, const std::string& kind) : mDisplay(display), mContext(context) {
+    EglContext(EGLDisplay display, EGLConfig config, EGLContext context, const std::string& kind)
+        : mDisplay(display), mConfig(config), mContext(context) {
         mInfo.backend = kind;
     }
     ~EglContext() override {
         if (eglGetCurrentContext() == mContext) eglMakeCurrent(mDisplay, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(mDisplay, mContext);
     }
-    void makeCurrent() override {
+    std::unique_ptr<Context> createShared() const override {
+        // The rendering API is per thread in EGL: the calling thread may not have bound it yet.
+        if (!eglBindAPI(EGL_OPENGL_API)) throw Error("gl: eglBindAPI(EGL_OPENGL_API) failed (" + eglErrorText() + ")");
+        EGLContext shared = eglCreateContext(mDisplay, mConfig, mContext, kContextAttribs);
+        if (shared == EGL_NO_CONTEXT)
+            throw Error("gl: eglCreateContext sharing objects failed on " + mInfo.backend + " (" +
+                        eglErrorText() + ")");
+        auto result = std::make_unique<EglContext>(mDisplay, mConfig, shared, mInfo.backend);
+        result->mInfo = mInfo;
+        return result;
+    }
+
+private:
+    void bind() override {
+        eglBindAPI(EGL_OPENGL_API);
         if (!eglMakeCurrent(mDisplay, EGL_NO_SURFACE, EGL_NO_SURFACE, mContext))
             logError("gl: eglMakeCurrent failed (" + eglErrorText() + ")");
     }
-    void releaseCurrent() override { eglMakeCurrent(mDisplay, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+    void unbind() override { eglMakeCurrent(mDisplay, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
 
-private:
     EGLDisplay mDisplay;
+    EGLConfig mConfig;
     EGLContext mContext;
 };
 
@@ -129,12 +147,10 @@ std::unique_ptr<Context> createEglContext() {
     }
     if (count < 1) throw Error("gl: no EGL config with desktop OpenGL on " + shared.kind + " (" + eglErrorText() + ")");
 
-    const EGLint ctxAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, ctxAttribs);
+    EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, kContextAttribs);
     if (context == EGL_NO_CONTEXT)
         throw Error("gl: eglCreateContext(OpenGL 4.5 core) failed on " + shared.kind + " (" + eglErrorText() + ")");
-    auto result = std::make_unique<EglContext>(display, context, shared.kind);
+    auto result = std::make_unique<EglContext>(display, config, context, shared.kind);
     if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
         throw Error("gl: eglMakeCurrent without a surface failed on " + shared.kind + " (" + eglErrorText() + ")");
     detail::ensureEntryPoints(Backend::Egl, eglGetProc);

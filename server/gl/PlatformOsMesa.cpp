@@ -66,16 +66,28 @@ const OsMesaLibrary& library() {
 
 GlProc osmesaGetProc(const char* name) { return reinterpret_cast<GlProc>(library().getProcAddress(name)); }
 
+const int kContextAttribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 8,
+                               OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
+                               OSMESA_CONTEXT_MAJOR_VERSION, 4, OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+
 class OsMesaContextImpl final : public Context {
 public:
     explicit OsMesaContextImpl(OSMesaContext ctx) : mContext(ctx), mBuffer(kSize * kSize * 4) { mInfo.backend = "osmesa"; }
     ~OsMesaContextImpl() override { library().destroyContext(mContext); }
-    // OSMesa needs a client colour buffer to make a context current, even when all rendering
-    // goes to framebuffer objects; a tiny one suffices.
-    void makeCurrent() override { library().makeCurrent(mContext, mBuffer.data(), GL_UNSIGNED_BYTE, kSize, kSize); }
-    void releaseCurrent() override { library().makeCurrent(nullptr, nullptr, GL_UNSIGNED_BYTE, 0, 0); }
+    std::unique_ptr<Context> createShared() const override {
+        OSMesaContext shared = library().createContextAttribs(kContextAttribs, mContext);
+        if (!shared) throw Error("gl: OSMesaCreateContextAttribs sharing objects failed");
+        auto result = std::make_unique<OsMesaContextImpl>(shared);
+        result->mInfo = mInfo;
+        return result;
+    }
 
 private:
+    // OSMesa needs a client colour buffer to make a context current, even when all rendering
+    // goes to framebuffer objects; a tiny one suffices.
+    void bind() override { library().makeCurrent(mContext, mBuffer.data(), GL_UNSIGNED_BYTE, kSize, kSize); }
+    void unbind() override { library().makeCurrent(nullptr, nullptr, GL_UNSIGNED_BYTE, 0, 0); }
+
     static constexpr int kSize = 4;
     OSMesaContext mContext;
     std::vector<unsigned char> mBuffer;
@@ -86,10 +98,7 @@ private:
 std::unique_ptr<Context> createOsMesaContext() {
     const OsMesaLibrary& lib = library();
     if (!lib.error.empty()) throw Error(lib.error);
-    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 8,
-                           OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                           OSMESA_CONTEXT_MAJOR_VERSION, 4, OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
-    OSMesaContext ctx = lib.createContextAttribs(attribs, nullptr);
+    OSMesaContext ctx = lib.createContextAttribs(kContextAttribs, nullptr);
     if (!ctx) throw Error("gl: OSMesaCreateContextAttribs(OpenGL 4.5 core) failed");
     auto result = std::make_unique<OsMesaContextImpl>(ctx);
     result->makeCurrent();

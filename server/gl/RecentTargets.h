@@ -37,15 +37,7 @@ public:
         take(key); // one entry per shape
         if (mMaxKept == 0 || !(cost <= mMaxKeptCost)) return;
         mEntries.push_front({key, std::move(targets), cost});
-        double total = 0.0;
-        std::size_t count = 0;
-        for (auto it = mEntries.begin(); it != mEntries.end(); ++it) {
-            total += it->cost;
-            if (++count > mMaxKept || total > mMaxKeptCost) {
-                mEntries.erase(it, mEntries.end());
-                break;
-            }
-        }
+        trim();
     }
 
     /// A change of shape: the targets of `next`, those kept for it or else `create()`, while the
@@ -59,10 +51,32 @@ public:
         return kept ? std::move(*kept) : create();
     }
 
+    /// Whether targets of `key` are kept.
+    bool holds(const Key& key) const {
+        return std::any_of(mEntries.begin(), mEntries.end(), [&](const Entry& e) { return e.key == key; });
+    }
+    /// A new limit on the kept targets' total cost; those past it go now, the oldest first.
+    void setMaxKeptCost(double maxKeptCost) {
+        mMaxKeptCost = maxKeptCost;
+        trim();
+    }
+
     std::size_t size() const { return mEntries.size(); }
     void clear() { mEntries.clear(); }
 
 private:
+    void trim() {
+        double total = 0.0;
+        std::size_t count = 0;
+        for (auto it = mEntries.begin(); it != mEntries.end(); ++it) {
+            total += it->cost;
+            if (++count > mMaxKept || total > mMaxKeptCost) {
+                mEntries.erase(it, mEntries.end());
+                break;
+            }
+        }
+    }
+
     struct Entry {
         Key key;
         Targets targets;

@@ -2,12 +2,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <thread>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "GlTestSupport.h"
 #include "core/Error.h"
+#include "gl/Background.h"
+#include "gl/Platform.h"
 #include "gl/ShaderShared.h"
 #include "scene/SceneLoader.h"
 #include <unistd.h>
@@ -42,6 +48,87 @@ TEST(Context, CreatesOpenGL45Core) {
     EXPECT_FALSE(ctx.info().renderer.empty());
     std::printf("backend %s, renderer %s, %s\n", ctx.info().backend.c_str(), ctx.info().renderer.c_str(),
                 ctx.info().version.c_str());
+}
+
+// Objects made on a helper thread in a shared context (gl/Background.h) serve the asking context:
+// the size asked, data written and read back there, and the asking thread's context stays current.
+// What is never taken is deleted by its owner; a making that fails says why.
+TEST(Context, ObjectsMadeInTheBackgroundServeTheAskingContext) {
+    auto& ctx = test::sharedContext();
+    ASSERT_EQ(gl::Context::current(), &ctx);
+    constexpr GLsizeiptr kBytes = 3 << 20;
+    auto pending = gl::Background<gl::Buffer>::start([] { return gl::Buffer::create(kBytes); });
+    EXPECT_TRUE(pending.started());
+    for (int i = 0; i < 5000 && !pending.ready(); ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    EXPECT_TRUE(pending.ready());
+    EXPECT_EQ(gl::Context::current(), &ctx);
+    std::optional<gl::Buffer> made = pending.take();
+    EXPECT_FALSE(pending.started());
+    EXPECT_TRUE(pending.error().empty()) << pending.error();
+    ASSERT_TRUE(made && *made);
+    gl::Buffer buffer = std::move(*made);
+    EXPECT_EQ(buffer.size(), kBytes);
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(buffer.id(), GL_BUFFER_SIZE, &size);
+    EXPECT_EQ(size, kBytes);
+    std::vector<std::uint32_t> written(1024);
+    for (size_t i = 0; i < written.size(); ++i) written[i] = static_cast<std::uint32_t>(i * 2654435761u);
+    const GLintptr offset = kBytes - static_cast<GLintptr>(written.size() * 4);
+    buffer.upload(offset, static_cast<GLsizeiptr>(written.size() * 4), written.data());
+    std::vector<std::uint32_t> read(written.size());
+    glGetNamedBufferSubData(buffer.id(), offset, static_cast<GLsizeiptr>(read.size() * 4), read.data());
+    EXPECT_EQ(read, written);
+
+    // A texture array, sampled here after the helper made it.
+    auto texture = gl::Background<gl::Texture>::start([] {
+                       return gl::Texture::create2DArray(GL_RGBA32F, 64, 64, 3);
+                   }).take();
+    ASSERT_TRUE(texture && *texture);
+    const float texel[4] = {0.25f, 0.5f, 0.75f, 1.0f};
+    glTextureSubImage3D(texture->id(), 0, 5, 7, 2, 1, 1, 1, GL_RGBA, GL_FLOAT, texel);
+    float back[4] = {};
+    glGetTextureSubImage(texture->id(), 0, 5, 7, 2, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof back, back);
+    EXPECT_EQ(std::vector<float>(back, back + 4), std::vector<float>(texel, texel + 4));
+
+    // Dropped before it is taken (a renderer that goes while its storage is made), and replaced.
+    {
+        auto dropped = gl::Background<gl::Buffer>::start([] { return gl::Buffer::create(kBytes); });
+    }
+    auto replaced = gl::Background<gl::Buffer>::start([] { return gl::Buffer::create(kBytes); });
+    replaced = gl::Background<gl::Buffer>::start([] { return gl::Buffer::create(kBytes / 2); });
+    EXPECT_EQ(replaced.take()->size(), kBytes / 2);
+
+    // A making that throws, or leaves a GL error, gives nothing and says why.
+    auto thrown = gl::Background<gl::Buffer>::start([]() -> gl::Buffer { throw Error("no storage today"); });
+    EXPECT_FALSE(thrown.take());
+    EXPECT_EQ(thrown.error(), "no storage today");
+    auto refused = gl::Background<gl::Texture>::start([] {
+        gl::Texture t = gl::Texture::create2DArray(GL_RGBA32F, 64, 64, 1);
+        glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_RGBA); // not a filter
+        return t;
+    });
+    EXPECT_FALSE(refused.take());
+    EXPECT_NE(refused.error().find("GL_INVALID_ENUM"), std::string::npos) << refused.error();
+
+    // The maker: made here without a stop; in the background with one, a stop leaving it going on
+    // for the next call of the same key.
+    gl::BackgroundMaker<int, gl::Buffer> maker;
+    EXPECT_EQ(maker.make(1, {}, [] { return gl::Buffer::create(1024); })->size(), 1024);
+    EXPECT_EQ(maker.starts(), 0);
+    EXPECT_FALSE(maker.make(
+        2, [] { return true; }, [] { return gl::Buffer::create(kBytes); }));
+    EXPECT_EQ(maker.starts(), 1);
+    EXPECT_EQ(maker
+                  .make(
+                      2, [] { return false; }, [] { return gl::Buffer::create(kBytes); })
+                  ->size(),
+              kBytes);
+    EXPECT_EQ(maker.starts(), 1) << "the making the stop left going on";
+    EXPECT_EQ(maker.failures(), 0);
+
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+    EXPECT_EQ(gl::Context::current(), &ctx);
 }
 
 TEST(Context, SharedStructLayoutMatchesGlsl) {

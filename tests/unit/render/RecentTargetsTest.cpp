@@ -97,5 +97,25 @@ TEST(RecentTargets, TheOldestGoBeyondTheCountOrTheCost) {
     EXPECT_EQ(alive, 0);
 }
 
+// The light maps' limit follows the asked maps (FrameRenderer::ensureTargets): raised, larger
+// targets are kept; lowered, those past it go at once.
+TEST(RecentTargets, ANewCostLimitKeepsLargerTargetsOrLetsThemGo) {
+    int alive = 0;
+    gl::RecentTargets<Size, Counted> recent(1, 100.0);
+    recent.keep({512, 13}, Counted(&alive, 1), 164.0);
+    EXPECT_FALSE(recent.holds({512, 13})) << "past the limit: not kept";
+    EXPECT_EQ(alive, 0);
+    recent.setMaxKeptCost(164.0);
+    recent.keep({512, 13}, Counted(&alive, 2), 164.0);
+    EXPECT_TRUE(recent.holds({512, 13}));
+    EXPECT_FALSE(recent.holds({256, 13}));
+    EXPECT_EQ(alive, 1);
+    recent.setMaxKeptCost(200.0);
+    EXPECT_TRUE(recent.holds({512, 13})) << "a higher limit lets it stay";
+    recent.setMaxKeptCost(100.0);
+    EXPECT_FALSE(recent.holds({512, 13})) << "a lower one lets it go at once";
+    EXPECT_EQ(alive, 0);
+}
+
 } // namespace
 } // namespace gis
