@@ -16,6 +16,7 @@
 #include "core/Param.h"
 #include "gi/Catalog.h"
 #include "gl/FrameResources.h"
+#include "gl/Background.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -92,6 +93,9 @@ struct FrameInputs {
     /// whole what it keeps for later frames; the renderer's check finishes the GL work queued before it
     /// asks, so the work between two checks is one stage. Empty: frames run to the end.
     std::function<bool()> interruptCheck;
+    /// With interruptCheck, storage of at least this many bytes is made in the background while
+    /// input is asked (gl/Background.h; FrameRenderer::setBackgroundBytes).
+    double backgroundBytes = static_cast<double>(gl::kBackgroundBytes);
 
     /// Whether the frame should stop here (interruptCheck, when set).
     bool interrupted() const { return interruptCheck && interruptCheck(); }

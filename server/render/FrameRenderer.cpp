@@ -286,34 +286,60 @@ void FrameRenderer::setScene(std::shared_ptr<const Scene> scene, std::unique_ptr
     mPartAverage.averaged = 0; // no part of another scene's image follows
 }
 
-void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadowSide, int views) {
+template <class Maps>
+std::optional<Maps> FrameRenderer::makeLightMaps(gl::BackgroundMaker<std::pair<int, int>, Maps>& maker,
+                                                 std::pair<int, int> shape,
+                                                 const std::function<bool()>& stop) {
+    // On llvmpipe 13 views' 512^2 RSMs (164 MB) took 85-97 ms to make, one call that held input.
+    const bool background = stop && Maps::bytes(shape.first, shape.second) >= mBackgroundBytes;
+    std::optional<Maps> made = maker.make(shape, background ? stop : std::function<bool()>(),
+                                          [shape] { return Maps::makeTextures(shape.first, shape.second); });
+    if (maker.failures() > mWarnedMakerFailures) {
+        logWarn("light maps: made in the frame, not in the background (" + maker.lastError() + ")");
+        mWarnedMakerFailures = maker.failures();
+    }
+    if (!made) return std::nullopt;
+    made->attach();
+    ++mLightMapsCreated;
+    return made;
+}
+
+bool FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadowSide, int views,
+                                  int askedRsmSide, int askedShadowSide, const std::function<bool()>& stop) {
     // At least one layer, so that the shadow and RSM resources exist (and read as empty) with no light.
     const int layers = std::max(views, 1);
     // The maps of the side drawn before stay kept (mOtherShadow, mOtherRsm): interactive frames'
-    // capped light views and refinement's asked ones alternate.
+    // capped light views and refinement's asked ones alternate. The asked ones are kept whatever
+    // their size, as the next refinement draws them again (13 point-lamp views' 512^2 RSMs, 164 MB,
+    // were made again in each refinement after a drag); other ones up to kKeptLightMapBytes.
     const auto shape = [](int side, int count) { return std::pair{side, count}; };
-    if (shadowSide != mShadowSize || layers != mShadowLayers) {
-        const double bytes = 4.0 * mShadowSize * mShadowSize * mShadowLayers;
+    mOtherShadow.setMaxKeptCost(std::max(kKeptLightMapBytes, ShadowMaps::bytes(askedShadowSide, layers)));
+    mOtherRsm.setMaxKeptCost(std::max(kKeptLightMapBytes, Rsms::bytes(askedRsmSide, layers)));
+    // New maps are made before any kept ones move, so that a stop leaves everything as it was.
+    std::optional<ShadowMaps> newShadow;
+    std::optional<Rsms> newRsm;
+    const bool shadowChanges = shadowSide != mShadowSize || layers != mShadowLayers;
+    const bool rsmChanges = rsmSide != mRsmSize || layers != mRsmLayers;
+    if (shadowChanges && !mOtherShadow.holds(shape(shadowSide, layers)) &&
+        !(newShadow = makeLightMaps(mShadowMaker, shape(shadowSide, layers), stop)))
+        return false;
+    if (rsmChanges && !mOtherRsm.holds(shape(rsmSide, layers)) &&
+        !(newRsm = makeLightMaps(mRsmMaker, shape(rsmSide, layers), stop)))
+        return false;
+    if (shadowChanges) {
         mShadow = mOtherShadow.exchange(shape(shadowSide, layers),
                                         mShadowSize > 0 ? std::optional(shape(mShadowSize, mShadowLayers))
                                                         : std::nullopt,
-                                        std::move(mShadow), bytes, [&] {
-                                            ++mLightMapsCreated;
-                                            return ShadowMaps::create(shadowSide, layers);
-                                        });
+                                        std::move(mShadow), ShadowMaps::bytes(mShadowSize, mShadowLayers),
+                                        [&] { return std::move(*newShadow); });
         mShadowSize = shadowSide;
         mShadowLayers = layers;
         mLightPassesValid = false;
     }
-    if (rsmSide != mRsmSize || layers != mRsmLayers) {
-        // Position and flux RGBA32F, normal RGBA16F, specular RGBA8, depth 32F: 48 bytes a texel.
-        const double bytes = 48.0 * mRsmSize * mRsmSize * mRsmLayers;
-        mRsm = mOtherRsm.exchange(shape(rsmSide, layers),
-                                  mRsmSize > 0 ? std::optional(shape(mRsmSize, mRsmLayers)) : std::nullopt,
-                                  std::move(mRsm), bytes, [&] {
-                                      ++mLightMapsCreated;
-                                      return Rsms::create(rsmSide, layers);
-                                  });
+    if (rsmChanges) {
+        mRsm = mOtherRsm.exchange(
+            shape(rsmSide, layers), mRsmSize > 0 ? std::optional(shape(mRsmSize, mRsmLayers)) : std::nullopt,
+            std::move(mRsm), Rsms::bytes(mRsmSize, mRsmLayers), [&] { return std::move(*newRsm); });
         mRsmSize = rsmSide;
         mRsmLayers = layers;
         mLightPassesValid = false;
@@ -329,30 +355,37 @@ void FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
         mWidth = width;
         mHeight = height;
     }
+    return true;
 }
 
-FrameRenderer::ShadowMaps FrameRenderer::ShadowMaps::create(int side, int layers) {
+FrameRenderer::ShadowMaps FrameRenderer::ShadowMaps::makeTextures(int side, int layers) {
     ShadowMaps m;
     m.depth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, side, side, layers);
     m.depth.setFilter(GL_LINEAR, GL_LINEAR); // hardware 2x2 PCF with the compare mode
     glTextureParameteri(m.depth.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
     glTextureParameteri(m.depth.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-    for (int v = 0; v < layers; ++v)
-        m.fbos.push_back(gl::Framebuffer::ofLayer("shadow map", {}, &m.depth, v));
     return m;
 }
 
-FrameRenderer::Rsms FrameRenderer::Rsms::create(int side, int layers) {
+void FrameRenderer::ShadowMaps::attach() {
+    for (int v = 0; v < depth.layers(); ++v)
+        fbos.push_back(gl::Framebuffer::ofLayer("shadow map", {}, &depth, v));
+}
+
+FrameRenderer::Rsms FrameRenderer::Rsms::makeTextures(int side, int layers) {
     Rsms m;
     m.position = gl::Texture::create2DArray(GL_RGBA32F, side, side, layers);
     m.normal = gl::Texture::create2DArray(GL_RGBA16F, side, side, layers);
     m.flux = gl::Texture::create2DArray(GL_RGBA32F, side, side, layers);
     m.specular = gl::Texture::create2DArray(GL_RGBA8, side, side, layers);
     m.depth = gl::Texture::create2DArray(GL_DEPTH_COMPONENT32F, side, side, layers);
-    for (int v = 0; v < layers; ++v)
-        m.fbos.push_back(gl::Framebuffer::ofLayer(
-            "reflective shadow map", {&m.position, &m.normal, &m.flux, &m.specular}, &m.depth, v));
     return m;
+}
+
+void FrameRenderer::Rsms::attach() {
+    for (int v = 0; v < depth.layers(); ++v)
+        fbos.push_back(gl::Framebuffer::ofLayer("reflective shadow map",
+                                                {&position, &normal, &flux, &specular}, &depth, v));
 }
 
 FrameRenderer::ScreenTargets FrameRenderer::ScreenTargets::create(int width, int height) {
@@ -623,8 +656,36 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     const bool reuseLights = sides.keep;
     lightSet.shadowSide = sides.shadow;
     lightSet.rsmSide = sides.rsm;
+    // Refinement's interruption (setInterruptCheck): latched, so that the technique's checks and the
+    // renderer's agree once it said stop. The work queued so far is finished before the check is
+    // asked: GL work once queued runs to its end (llvmpipe rasterises a pass when a later one reads
+    // its target), so a check asked before it would stop the frame one stage later than it seems
+    // and leave that stage to delay the frame that answers the input.
+    bool stopAsked = false;
+    auto interrupted = [&] {
+        if (!stopAsked && mInterruptCheck) {
+            glFinish();
+            stopAsked = mInterruptCheck();
+        }
+        return stopAsked;
+    };
+    // What an interrupted frame drew is not kept: redrawn light views and environment cubes are marked
+    // stale before they are drawn, and the VPL parts' mean follows only a frame that completed (a
+    // frame that does not follow it resets it before drawing over the G-buffer it keeps).
+    auto interruptedOutput = [&] {
+        FrameOutput out;
+        out.width = state.width;
+        out.height = state.height;
+        out.interrupted = true;
+        return out;
+    };
+
     mLightMapsCreated = 0;
-    ensureTargets(state.width, state.height, lightSet.rsmSide, lightSet.shadowSide, views);
+    // Maps too large to make within a slice are made in the background while input is asked.
+    if (!ensureTargets(state.width, state.height, lightSet.rsmSide, lightSet.shadowSide, views, askedRsmSide,
+                       askedShadowSide,
+                       mInterruptCheck ? std::function<bool()>(interrupted) : std::function<bool()>()))
+        return interruptedOutput();
     ensureTechnique(state.technique, state.width, state.height);
     const Reflections::Decision nonDiffuse =
         mReflections.decide(*mScene, *mSceneGpu, fp, mTechnique->glossyTransport(state.techniqueParams));
@@ -659,30 +720,6 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     mLightUbo.upload(0, sizeof lights, &lights);
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_FRAME, mFrameUbo.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, GIS_UBO_LIGHTS, mLightUbo.id());
-
-    // Refinement's interruption (setInterruptCheck): latched, so that the technique's checks and the
-    // renderer's agree once it said stop. The work queued so far is finished before the check is
-    // asked: GL work once queued runs to its end (llvmpipe rasterises a pass when a later one reads
-    // its target), so a check asked before it would stop the frame one stage later than it seems
-    // and leave that stage to delay the frame that answers the input.
-    bool stopAsked = false;
-    auto interrupted = [&] {
-        if (!stopAsked && mInterruptCheck) {
-            glFinish();
-            stopAsked = mInterruptCheck();
-        }
-        return stopAsked;
-    };
-    // What an interrupted frame drew is not kept: redrawn light views and environment cubes are marked
-    // stale before they are drawn, and the VPL parts' mean follows only a frame that completed (a
-    // frame that does not follow it resets it before drawing over the G-buffer it keeps).
-    auto interruptedOutput = [&] {
-        FrameOutput out;
-        out.width = state.width;
-        out.height = state.height;
-        out.interrupted = true;
-        return out;
-    };
 
     mTimer.beginFrame();
     glDisable(GL_BLEND);
@@ -768,6 +805,7 @@ FrameOutput FrameRenderer::render(const FrameState& state, bool wantLinear, bool
     in.resources = &mResources;
     in.rsmSize = lightSet.rsmSide;
     in.rsmSizeAsked = askedRsmSide;
+    in.backgroundBytes = mBackgroundBytes;
     in.lightViews = views;
     in.viewFlux = viewFlux;
     in.lights = &lights;

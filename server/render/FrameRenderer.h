@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "frame/FrameState.h"
 #include "frame/LightModel.h"
 #include "gi/Technique.h"
+#include "gl/Background.h"
 #include "gl/FrameResources.h"
 #include "gl/Objects.h"
 #include "gl/RecentTargets.h"
@@ -89,6 +91,12 @@ public:
     /// for the next (redrawn light views, environment cubes; the VPL parts' mean is not added to); GL
     /// work already issued still runs. Empty (the default): every frame runs to the end.
     void setInterruptCheck(std::function<bool()> check) { mInterruptCheck = std::move(check); }
+    /// While the check is set, light maps and light-tree buffers of at least `bytes` are made on a
+    /// helper thread, the check asked every millisecond until they are (gl/Background.h; default
+    /// gl::kBackgroundBytes). Tests that count the checks set it past what they make.
+    void setBackgroundBytes(double bytes) { mBackgroundBytes = bytes; }
+    /// Test hook: light maps whose making started in the background so far.
+    int lightMapsStartedInBackground() const { return mShadowMaker.starts() + mRsmMaker.starts(); }
     /// Levels of detail (lod_pixels): on demand (the default) the first frame that asks for them builds
     /// them on this thread (CLI renders, benchmarks, tests); a session turns that off, builds them on a
     /// thread of its own and hands them in with setSceneLevels (until then its frames draw every
@@ -109,7 +117,12 @@ public:
     const FrameResources& resources() const { return mResources; }
 
 private:
-    void ensureTargets(int width, int height, int rsmSide, int shadowSide, int views);
+    /// The light maps and screen targets for the frame. `asked`: the light views' sides before an
+    /// interactive frame's cap, whose maps stay kept whatever their size. With `stop` (refinement),
+    /// large maps are made in the background while it is asked (gl/Background.h); false when it said
+    /// stop first, the targets unchanged.
+    bool ensureTargets(int width, int height, int rsmSide, int shadowSide, int views, int askedRsmSide,
+                       int askedShadowSide, const std::function<bool()>& stop);
     void ensureTechnique(const std::string& name, int width, int height);
     // The frame's stages, in order; each publishes what it writes in mResources.
     /// `lods`: each view's tolerance for levels of detail (empty: every triangle).
@@ -211,25 +224,42 @@ private:
 
     int mWidth = 0, mHeight = 0, mRsmSize = 0, mShadowSize = 0, mShadowLayers = 0, mRsmLayers = 0;
     // One layer per light view; one framebuffer per layer.
+    // Light maps: textures made by makeTextures (any thread sharing the context's objects: see
+    // gl/Background.h), framebuffers attached by attach (the renderer's context).
     struct ShadowMaps {
         gl::Texture depth;
         std::vector<gl::Framebuffer> fbos;
-        static ShadowMaps create(int side, int layers);
+        static ShadowMaps makeTextures(int side, int layers);
+        void attach();
+        static double bytes(int side, int layers) { return 4.0 * side * side * layers; }
     };
     struct Rsms {
         gl::Texture position, normal, flux, specular, depth;
         std::vector<gl::Framebuffer> fbos;
-        static Rsms create(int side, int layers);
+        static Rsms makeTextures(int side, int layers);
+        void attach();
+        /// Position and flux RGBA32F, normal RGBA16F, specular RGBA8, depth 32F: 48 bytes a texel.
+        static double bytes(int side, int layers) { return 48.0 * side * side * layers; }
     };
+    /// Maps of (side, layers) `shape`, made in the background with `stop` (see ensureTargets).
+    template <class Maps>
+    std::optional<Maps> makeLightMaps(gl::BackgroundMaker<std::pair<int, int>, Maps>& maker,
+                                      std::pair<int, int> shape, const std::function<bool()>& stop);
     ShadowMaps mShadow;
     Rsms mRsm;
     /// The maps of the other side last drawn (gl/RecentTargets.h), keyed by side and layers: an
     /// interactive frame's capped light views (FrameState::LightViewCap) and a refinement step's
     /// asked ones alternate, and allocating them again held the step's first tile (about 40 ms for a
-    /// 4096^2 shadow array on llvmpipe, docs/interactive.md). At most one, of at most 128 MiB.
-    gl::RecentTargets<std::pair<int, int>, ShadowMaps> mOtherShadow{1, 128.0 * 1024.0 * 1024.0};
-    gl::RecentTargets<std::pair<int, int>, Rsms> mOtherRsm{1, 128.0 * 1024.0 * 1024.0};
-    int mLightMapsCreated = 0; ///< arrays ensureTargets created for this frame (counts)
+    /// 4096^2 shadow array on llvmpipe, docs/interactive.md). At most one, of at most
+    /// kKeptLightMapBytes, or of the asked maps' size (ensureTargets).
+    static constexpr double kKeptLightMapBytes = 128.0 * 1024.0 * 1024.0;
+    gl::RecentTargets<std::pair<int, int>, ShadowMaps> mOtherShadow{1, kKeptLightMapBytes};
+    gl::RecentTargets<std::pair<int, int>, Rsms> mOtherRsm{1, kKeptLightMapBytes};
+    gl::BackgroundMaker<std::pair<int, int>, ShadowMaps> mShadowMaker;
+    gl::BackgroundMaker<std::pair<int, int>, Rsms> mRsmMaker;
+    int mLightMapsCreated = 0;    ///< arrays ensureTargets created for this frame (counts)
+    int mWarnedMakerFailures = 0; ///< light maps' background makings that failed, logged
+    double mBackgroundBytes = static_cast<double>(gl::kBackgroundBytes); ///< setBackgroundBytes
     /// What is sized to the frame: G-buffer, direct light, composite.
     struct ScreenTargets {
         gl::Texture gPosition, gNormal, gAlbedo, gEmissive, gSpecular, gDepth;

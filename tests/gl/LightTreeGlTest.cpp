@@ -514,6 +514,7 @@ TEST(LightTree, BigTreesAreBuiltInChunksThatInputCanStop) {
     int checks = 0;
     FrameRenderer chunked;
     chunked.setScene(scene);
+    chunked.setBackgroundBytes(1e12); // the polls of a background making would add checks
     chunked.setInterruptCheck([&] {
         ++checks;
         return false;
@@ -628,6 +629,59 @@ TEST(LightTree, ACappedFrameKeepsTheBufferItsAskedMapsNeed) {
     (void)renderer.render(small, true);
     EXPECT_NE(technique.tree().nodes().id(), buffer);
     EXPECT_EQ(static_cast<long long>(technique.tree().nodes().size()), lightTreeBytes(128));
+}
+
+// Where input may stop the frame, a large node buffer is made on a helper thread while input is
+// asked (llvmpipe zeroed 447 MB in one 240 ms call that input waited for): input asked meanwhile
+// stops the frame with the tree not valid, and the next frame takes the same storage and is the
+// frame a renderer making it in the frame draws.
+TEST(LightTree, InputStopsTheFrameWhileANodeBufferIsMadeInTheBackground) {
+    test::sharedContext();
+    const auto scene = std::make_shared<Scene>(loadScene("builtin:cornell"));
+    FrameRenderer renderer;
+    renderer.setScene(scene);
+    FrameState state = makeFrameState(*scene, "hier_isr");
+    state.width = state.height = 32;
+    (void)renderer.render(state, true);
+    auto& technique = dynamic_cast<HierIsr&>(*renderer.technique());
+    renderer.setBackgroundBytes(1);
+    const GLuint before = technique.tree().nodes().id();
+
+    // Without an interrupt check (a live frame, a render request) the buffer is made in the frame.
+    FrameState larger = state;
+    applyParams(larger, {{"rsm_size", 384}}, "test");
+    (void)renderer.render(larger, true);
+    EXPECT_EQ(technique.tree().backgroundStarts(), 0);
+    EXPECT_EQ(technique.tree().rsmSize(), 384);
+    EXPECT_NE(technique.tree().nodes().id(), before);
+
+    // Refinement asks for larger maps: input stops the frame while their tree's buffer is made.
+    FrameState asked = state;
+    applyParams(asked, {{"rsm_size", 512}}, "test");
+    int checksAfterStart = 0;
+    renderer.setInterruptCheck([&] {
+        if (technique.tree().backgroundStarts() == 0) return false;
+        ++checksAfterStart;
+        return true;
+    });
+    EXPECT_TRUE(renderer.render(asked, true).interrupted);
+    EXPECT_EQ(technique.tree().backgroundStarts(), 1);
+    EXPECT_EQ(checksAfterStart, 1) << "the first check after the start stops the frame";
+    EXPECT_FALSE(technique.tree().valid());
+    EXPECT_EQ(technique.tree().rsmSize(), 384) << "the layout is not changed by a stopped frame";
+
+    // The next frame takes the buffer started for it, and draws what a fresh renderer draws.
+    renderer.setInterruptCheck([] { return false; });
+    const FrameOutput taken = renderer.render(asked, true);
+    renderer.setInterruptCheck({});
+    ASSERT_FALSE(taken.interrupted);
+    EXPECT_EQ(technique.tree().backgroundStarts(), 1) << "no second start";
+    EXPECT_TRUE(technique.tree().valid());
+    EXPECT_EQ(technique.tree().rsmSize(), 512);
+    EXPECT_EQ(static_cast<long long>(technique.tree().nodes().size()), lightTreeBytes(512));
+    FrameRenderer fresh;
+    fresh.setScene(scene);
+    EXPECT_EQ(taken.rgba8, fresh.render(asked, true).rgba8);
 }
 
 } // namespace

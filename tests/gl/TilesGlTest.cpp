@@ -46,6 +46,10 @@ FrameState stateFor(const Scene& scene, const std::string& technique, int w, int
     return s;
 }
 
+// Tests that count a frame's checks make its storage in the frame: a background making asks the check
+// once a millisecond until it is done (FrameRenderer::setBackgroundBytes).
+constexpr double kNoBackground = 1e15;
+
 // A frame of `state` rendered by a plain renderer (expected) and by one whose interrupt check never
 // stops (checked, its checks counted), as refinement renders it.
 struct CheckedFrame {
@@ -57,6 +61,7 @@ struct CheckedFrame {
         plain.setScene(scene);
         expected = plain.render(state);
         counting.setScene(scene);
+        counting.setBackgroundBytes(kNoBackground);
         counting.setInterruptCheck([this] {
             ++checks;
             return false;
@@ -116,6 +121,7 @@ struct ReusePair {
         fresh.setScene(scene);
         reusing.setScene(scene);
         reusing.setReuseLightPasses(true);
+        reusing.setBackgroundBytes(kNoBackground);
         state = stateFor(*scene, technique, 96, 80);
         (void)reusing.render(state);
     }
@@ -294,6 +300,73 @@ TEST(TilesGl, LargeLightViewsAreDrawnInBandsThatInputCanStop) {
     const FrameOutput next = banded.render(moved);
     EXPECT_EQ(counter(next, "light_views_reused"), 0.0) << "half-drawn maps must not serve";
     EXPECT_EQ(next.rgba8, whole.render(moved).rgba8);
+}
+
+// Where input may stop the frame, light maps too large to make within a slice are made on a helper
+// thread, input asked meanwhile (llvmpipe made 13 views' 512^2 RSMs in one 85-97 ms call): a stop
+// leaves them being made, the next frame takes them (no second making) and is the frame a renderer
+// making them in the frame draws. Without a check they are made in the frame.
+TEST(TilesGl, LargeLightMapsAreMadeInTheBackgroundWhileInputIsAsked) {
+    ReusePair pair("builtin:cornell");
+    FrameRenderer& renderer = pair.reusing;
+    renderer.setBackgroundBytes(1); // every new map in the background
+    FrameState large = pair.state;
+    large.frameParams.set("rsm_size", 512);
+    int asked = 0;
+    renderer.setInterruptCheck([&] { return ++asked == 1; });
+    EXPECT_TRUE(renderer.render(large).interrupted);
+    EXPECT_EQ(asked, 1) << "stopped while the RSMs were made, before any pass";
+    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 1) << "the RSMs; the shadow maps are unchanged";
+
+    renderer.setInterruptCheck([] { return false; });
+    const FrameOutput taken = renderer.render(large);
+    ASSERT_FALSE(taken.interrupted);
+    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 1) << "the making the stop left going on";
+    EXPECT_EQ(counter(taken, "light_view_arrays_created"), 1.0);
+    EXPECT_EQ(taken.stats["lighting"].value("rsm_side", 0), 512);
+    EXPECT_EQ(taken.rgba8, pair.fresh.render(large).rgba8);
+
+    // Without a check (a live frame, a render request): made in the frame.
+    renderer.setInterruptCheck({});
+    FrameState other = pair.state;
+    other.frameParams.set("rsm_size", 384);
+    const FrameOutput made = renderer.render(other);
+    EXPECT_EQ(counter(made, "light_view_arrays_created"), 1.0);
+    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 1);
+}
+
+// The asked light maps stay kept through an interactive frame's capped ones whatever their size: 13
+// point-lamp views' 512^2 RSMs (164 MB, past the other side's 128 MiB) were made again in each
+// refinement after a drag. Asked for smaller maps, they go.
+TEST(TilesGl, TheAskedLightMapsAreKeptThroughCappedFrames) {
+    ReusePair pair(std::string(GIS_SOURCE_DIR) + "/tests/data/corpus/point_lamps.glb");
+    FrameRenderer& renderer = pair.reusing;
+    FrameState asked = pair.state;
+    asked.frameParams.set("rsm_size", 1024);
+    const FrameOutput still = renderer.render(asked);
+    ASSERT_EQ(still.stats["lighting"].value("rsm_side", 0), 512) << "13 views share 512-texel sides";
+    const int views = still.stats["lighting"].value("views", 0);
+    ASSERT_GE(views, 13);
+    ASSERT_GT(48.0 * 512 * 512 * views, 128.0 * 1024 * 1024) << "past the other side's limit";
+
+    FrameState drag = asked;
+    drag.lights[0].light.intensity *= 0.8f;
+    drag.lightViewCap = {0, 256};
+    const FrameOutput capped = renderer.render(drag);
+    EXPECT_EQ(capped.stats["lighting"].value("rsm_side", 0), 256);
+    EXPECT_EQ(counter(capped, "light_view_arrays_created"), 0.0) << "the first frame's 256 RSMs, kept";
+    FrameState back = drag;
+    back.lightViewCap = {};
+    const FrameOutput refined = renderer.render(back);
+    EXPECT_EQ(refined.stats["lighting"].value("rsm_side", 0), 512);
+    EXPECT_EQ(counter(refined, "light_view_arrays_created"), 0.0) << "the asked RSMs, kept";
+    EXPECT_EQ(refined.rgba8, pair.fresh.render(back).rgba8);
+
+    // Asked for 256 maps: the 512 ones go, and coming back to 1024 makes them again.
+    FrameState small = back;
+    small.frameParams.set("rsm_size", 256);
+    (void)renderer.render(small);
+    EXPECT_EQ(counter(renderer.render(back), "light_view_arrays_created"), 1.0);
 }
 
 // The same on a Blender export whose two point lamps and sun make 13 views (the asked 4096 and 1024
@@ -703,6 +776,7 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
     auto reusingRenderer = [&](const std::shared_ptr<const Scene>& scene) {
         auto r = std::make_unique<FrameRenderer>();
         r->setReuseLightPasses(true); // as sessions render: kept light views are what could go stale
+        r->setBackgroundBytes(kNoBackground);
         r->setScene(scene);
         return r;
     };
@@ -779,6 +853,7 @@ TEST(TilesGl, InterruptedFramesKeepNothingHalfDone) {
         {
             FrameRenderer counting;
             counting.setReuseLightPasses(true);
+            counting.setBackgroundBytes(kNoBackground);
             counting.setScene(gallery);
             counting.render(cubes);
             counting.setInterruptCheck([&] {

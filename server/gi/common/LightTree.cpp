@@ -1,6 +1,8 @@
 #include "gi/common/LightTree.h"
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 #include "core/Error.h"
 #include "core/Log.h"
@@ -50,12 +52,13 @@ long long lightTreeBytes(int rsmSize) {
            static_cast<long long>(sizeof(shader::LightNode));
 }
 
-void LightTree::ensureLayout(int rsmSize, int keptSize) {
-    if (rsmSize == mRsmSize && mNodes) return;
-    mLevels = lightTreeLayout(rsmSize);
-    const LightLevel& last = mLevels.back();
+bool LightTree::ensureLayout(int rsmSize, int keptSize, const FrameInputs& in) {
+    if (rsmSize == mRsmSize && mNodes) return true;
+    std::vector<LightLevel> levels = lightTreeLayout(rsmSize);
+    const LightLevel& last = levels.back();
     const int nodeCount = last.offset + last.side * last.side;
-    mNodeBytes = static_cast<GLsizeiptr>(nodeCount) * static_cast<GLsizeiptr>(sizeof(shader::LightNode));
+    const GLsizeiptr nodeBytes =
+        static_cast<GLsizeiptr>(nodeCount) * static_cast<GLsizeiptr>(sizeof(shader::LightNode));
     // A larger buffer serves a smaller tree: a live view whose drag draws 256 RSMs and whose
     // refinement draws the asked 1024 alternates between the two, and creating the 1024's 112 MB
     // buffer took about 60 ms each time, input waiting. Kept up to kKeptTreeBytes, or up to what
@@ -63,18 +66,40 @@ void LightTree::ensureLayout(int rsmSize, int keptSize) {
     // views at rsm_size 1024, 512 each in the mosaic: 447 MB, created again in each refinement after
     // a drag, about 230 ms); a larger one goes when a smaller tree is asked for (docs/interactive.md,
     // "The light tree in refinement").
-    const bool fits = mNodes && mNodes.size() >= mNodeBytes;
+    const bool fits = mNodes && mNodes.size() >= nodeBytes;
     const long long kept = std::max(mKeptBytes, keptSize > rsmSize ? lightTreeBytes(keptSize) : 0ll);
-    if (!fits || (mNodes.size() > mNodeBytes && mNodes.size() > kept)) {
-        mNodes = gl::Buffer::create(mNodeBytes);
+    if (!fits || (mNodes.size() > nodeBytes && mNodes.size() > kept)) {
+        gl::Buffer made = makeNodeBuffer(nodeBytes, in);
+        if (!made) return false;
+        mNodes = std::move(made);
         mNodeTexels.view(mNodes, GL_RGBA32F, 0, mNodes.size());
     }
+    mLevels = std::move(levels);
+    mNodeBytes = nodeBytes;
     shader::LightTreeUniforms u{};
     for (size_t l = 0; l < mLevels.size(); ++l)
         u.level[l] = glm::ivec4(mLevels[l].offset, mLevels[l].side, 1 << l, 0);
     u.info = glm::ivec4(static_cast<int>(mLevels.size()), rsmSize, nodeCount, 0);
     mUbo.upload(0, sizeof u, &u);
     mRsmSize = rsmSize;
+    return true;
+}
+
+gl::Buffer LightTree::makeNodeBuffer(GLsizeiptr bytes, const FrameInputs& in) {
+    // Where input may stop the frame, large storage is made on a helper thread and input is asked
+    // while it is made (gl/Background.h): llvmpipe zeroes it in one call, 60 ms for a 1024 RSM's
+    // tree of one view (112 MB), 240 ms for 13 point-lamp views' (447 MB). A stop leaves it being
+    // made: the next frame that asks for the same size takes it.
+    const bool background = in.interruptCheck && static_cast<double>(bytes) >= in.backgroundBytes;
+    std::optional<gl::Buffer> made = mMaker.make(
+        bytes, background ? std::function<bool()>([&] { return in.interrupted(); }) : std::function<bool()>(),
+        [bytes] { return gl::Buffer::create(bytes); });
+    if (mMaker.failures() > mWarnedFailures) {
+        logWarn("light tree: the nodes' storage could not be made in the background (" + mMaker.lastError() +
+                "); made in the frame");
+        mWarnedFailures = mMaker.failures();
+    }
+    return made ? std::move(*made) : gl::Buffer{};
 }
 
 void LightTree::bind() const {
@@ -106,7 +131,8 @@ void LightTree::build(const FrameInputs& in, gl::PassTimer& timer, Counters& cou
     mLastInputs.lights = nullptr; // the renderer's per-frame copy: gone after the frame
     mValid = false;
     if (in.rsmSize <= 0 || !in.find("lights.rsm.position")) return;
-    ensureLayout(tiles * in.rsmSize, tiles * std::max(in.rsmSizeAsked, in.rsmSize));
+    // Input asked while the nodes' storage was made stops the frame here (the tree is not valid).
+    if (!ensureLayout(tiles * in.rsmSize, tiles * std::max(in.rsmSizeAsked, in.rsmSize), in)) return;
     mTiles = tiles;
     counters["vpl_tree_levels"] = static_cast<double>(mLevels.size());
     counters["vpl_tree_nodes"] = static_cast<double>(mLevels.back().offset + 1);

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "gi/Technique.h"
+#include "gl/Background.h"
 #include "gl/Objects.h"
 #include "gl/PassTimer.h"
 #include "gl/Shader.h"
@@ -81,11 +82,16 @@ public:
     std::vector<shader::LightNode> readNodes() const;
     /// Test hook: keep node buffers up to `bytes` for smaller trees instead of kKeptTreeBytes.
     void setKeptBytes(long long bytes) { mKeptBytes = bytes; }
+    /// Node buffers started in the background so far.
+    int backgroundStarts() const { return mMaker.starts(); }
     const FrameInputs& lastInputs() const { return mLastInputs; }
 
 private:
-    /// `keptSize`: the level 0 side whose tree's buffer is kept beyond kKeptTreeBytes.
-    void ensureLayout(int rsmSize, int keptSize);
+    /// `keptSize`: the level 0 side whose tree's buffer is kept beyond kKeptTreeBytes. False when
+    /// input stopped the frame while a new buffer was made (the layout is then unchanged).
+    bool ensureLayout(int rsmSize, int keptSize, const FrameInputs& in);
+    /// A node buffer of `bytes`; empty when input stopped the frame while it was made.
+    gl::Buffer makeNodeBuffer(GLsizeiptr bytes, const FrameInputs& in);
 
     struct BuildProgram {
         gl::Program program;
@@ -102,7 +108,9 @@ private:
     int mTiles = 1;
     bool mValid = false;
     FrameInputs mLastInputs;
-    long long mKeptBytes = kKeptTreeBytes; ///< setKeptBytes
+    long long mKeptBytes = kKeptTreeBytes;              ///< setKeptBytes
+    gl::BackgroundMaker<GLsizeiptr, gl::Buffer> mMaker; ///< node storage (makeNodeBuffer)
+    int mWarnedFailures = 0;
 };
 
 } // namespace gis
