@@ -5,14 +5,21 @@
 // about to be encoded (`rendered_ms`). Reports p50, p95 and the largest of each, and with --verbose 1
 // the slowest presses with the tiles and progress messages just before them. Without a browser on
 // the same cores the figures are the server's own (orbit.mjs measures the whole path in the page).
+//
+// With --between JSON each press meets a fresh start of --params: before it, the --between values
+// are set and their refinement awaited, then --params are set again and the press comes at a random
+// moment up to --window-ms after their answer (what refinement makes once per configuration, such
+// as the light tree's buffer for the largest maps, is then made again before every press).
 // usage: node bench/interactive/refine_waits.mjs [--server build/ci/bin/gi-server] [--technique hier_isr]
 //        [--params '{"tau": 0}'] [--presses 40] [--scene builtin:cornell] [--server-args "FLAGS"] [--verbose 1]
+//        [--between '{"rsm_size": 256}' [--window-ms 800]]
 import { connectClient, DEFAULT_SERVER, jsonOption, parseOptions, percentile, sleep, startServer } from '../lib.mjs';
 
 const opts = parseOptions({ server: DEFAULT_SERVER, technique: 'hier_isr', params: '{"tau": 0}', presses: 40,
-    scene: '', 'server-args': '', verbose: 0 },
-'usage: node bench/interactive/refine_waits.mjs [--server PATH] [--technique T] [--params JSON] [--presses N] [--scene S] [--server-args "FLAGS"] [--verbose 1]');
+    scene: '', 'server-args': '', verbose: 0, between: '', 'window-ms': 800 },
+'usage: node bench/interactive/refine_waits.mjs [--server PATH] [--technique T] [--params JSON] [--presses N] [--scene S] [--server-args "FLAGS"] [--verbose 1] [--between JSON [--window-ms MS]]');
 const params = jsonOption(opts, 'params', 'refine_waits');
+const between = jsonOption(opts, 'between', 'refine_waits', null);
 const { server, port, log } = await startServer(opts.server, opts['server-args'].split(' ').filter(Boolean));
 const link = await connectClient(port, { size: [960, 800] });
 try {
@@ -26,9 +33,26 @@ try {
     await link.until('a refinement tile', () => link.frames.some((f) => f.stats.technique === opts.technique && f.stats.tile));
     const camera = structuredClone(link.state.camera);
     const presses = [];
+    // Sets `values` and waits for the interactive frame that answers them.
+    const setParams = async (values) => {
+        const asked = performance.now();
+        link.send({ type: 'params', values });
+        await link.until('the answer to the parameters', () => link.frames.some((f) => f.at > asked && f.stats.input), 60000);
+    };
     for (let i = 0; i < opts.presses; i++) {
-        // Somewhere inside a step: long enough for refinement to start again after the last answer.
-        await sleep(400 + Math.random() * 900);
+        let delay = null;
+        if (between) {
+            await setParams(between);
+            const settled = performance.now();
+            await link.until('the refinement of --between', () => link.frames.some((f) => f.at > settled &&
+                (f.stats.refine?.complete || f.stats.quality === 'final')), 60000).catch(() => {});
+            await setParams(params);
+            delay = Math.random() * opts['window-ms'];
+            await sleep(delay);
+        } else {
+            // Somewhere inside a step: long enough for refinement to start again after the last answer.
+            await sleep(400 + Math.random() * 900);
+        }
         const t = performance.now();
         const context = {
             tiles: link.frames.filter((f) => f.at > t - 400 && f.stats.tile).map((f) => ({ ago_ms: Math.round(t - f.at),
@@ -40,11 +64,12 @@ try {
         link.send({ type: 'camera', ...camera });
         await link.until('the answer to a camera move', () => link.frames.some((f) => f.at > t && f.stats.input), 30000);
         const answer = link.frames.find((f) => f.at > t && f.stats.input);
-        presses.push({ wait: answer.stats.input.wait_ms, rendered: answer.stats.input.rendered_ms,
+        presses.push({ ...(delay !== null ? { delay_ms: Math.round(delay) } : {}), wait: answer.stats.input.wait_ms, rendered: answer.stats.input.rendered_ms,
             frame: answer.stats.frame_ms, refining: context.tiles.length > 0, context });
     }
     const pcts = (v) => ({ p50: percentile(v, 0.5), p95: percentile(v, 0.95), max: v.length ? Math.max(...v) : null });
-    const report = { technique: opts.technique, params, presses: presses.length,
+    const report = { technique: opts.technique, params, ...(between ? { between, window_ms: opts['window-ms'] } : {}),
+        presses: presses.length,
         presses_after_a_tile: presses.filter((p) => p.refining).length,
         input_wait_ms: pcts(presses.map((p) => p.wait)), arrival_to_encode_ms: pcts(presses.map((p) => p.rendered)),
         answer_frame_ms_p50: percentile(presses.map((p) => p.frame), 0.5) };
