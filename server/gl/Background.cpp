@@ -33,7 +33,7 @@ std::string glErrorText(GLenum e) {
 
 BackgroundJob::BackgroundJob(std::function<std::string()> work) : mState(std::make_unique<State>()) {
     Context* asking = Context::current();
-    GIS_ASSERT(asking != nullptr);
+    if (!asking) throw Error("gl: no context is current on this thread to share objects with");
     std::unique_ptr<Context> shared = asking->createShared();
     State* state = mState.get();
     mState->helper = std::thread([state, work = std::move(work), context = std::move(shared)]() mutable {

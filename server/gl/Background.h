@@ -27,7 +27,8 @@ namespace detail {
 /// The thread and shared context behind Background<T>: runs `work` with a context sharing
 /// Context::current()'s objects current, then glFinish (the asking context sees the objects once
 /// the making one has finished them: GL's rule for shared objects). `work` returns "" or what
-/// failed; a GL error after it fails it too. Throws gis::Error when no shared context can be made.
+/// failed; a GL error after it fails it too. Throws gis::Error when no shared context can be made
+/// (none is current on the calling thread, or the driver refuses).
 class BackgroundJob {
 public:
     explicit BackgroundJob(std::function<std::string()> work);

@@ -315,31 +315,30 @@ bool FrameRenderer::ensureTargets(int width, int height, int rsmSide, int shadow
     const auto shape = [](int side, int count) { return std::pair{side, count}; };
     mOtherShadow.setMaxKeptCost(std::max(kKeptLightMapBytes, ShadowMaps::bytes(askedShadowSide, layers)));
     mOtherRsm.setMaxKeptCost(std::max(kKeptLightMapBytes, Rsms::bytes(askedRsmSide, layers)));
-    // New maps are made before any kept ones move, so that a stop leaves everything as it was.
-    std::optional<ShadowMaps> newShadow;
-    std::optional<Rsms> newRsm;
-    const bool shadowChanges = shadowSide != mShadowSize || layers != mShadowLayers;
-    const bool rsmChanges = rsmSide != mRsmSize || layers != mRsmLayers;
-    if (shadowChanges && !mOtherShadow.holds(shape(shadowSide, layers)) &&
-        !(newShadow = makeLightMaps(mShadowMaker, shape(shadowSide, layers), stop)))
-        return false;
-    if (rsmChanges && !mOtherRsm.holds(shape(rsmSide, layers)) &&
-        !(newRsm = makeLightMaps(mRsmMaker, shape(rsmSide, layers), stop)))
-        return false;
-    if (shadowChanges) {
+    // A stop while new maps are made leaves the current ones in place (a stop while the RSMs are
+    // made keeps the shadow maps just made: the light views are drawn again after a change anyway).
+    if (shadowSide != mShadowSize || layers != mShadowLayers) {
+        std::optional<ShadowMaps> made;
+        if (!mOtherShadow.holds(shape(shadowSide, layers)) &&
+            !(made = makeLightMaps(mShadowMaker, shape(shadowSide, layers), stop)))
+            return false;
         mShadow = mOtherShadow.exchange(shape(shadowSide, layers),
                                         mShadowSize > 0 ? std::optional(shape(mShadowSize, mShadowLayers))
                                                         : std::nullopt,
                                         std::move(mShadow), ShadowMaps::bytes(mShadowSize, mShadowLayers),
-                                        [&] { return std::move(*newShadow); });
+                                        [&] { return std::move(*made); });
         mShadowSize = shadowSide;
         mShadowLayers = layers;
         mLightPassesValid = false;
     }
-    if (rsmChanges) {
+    if (rsmSide != mRsmSize || layers != mRsmLayers) {
+        std::optional<Rsms> made;
+        if (!mOtherRsm.holds(shape(rsmSide, layers)) &&
+            !(made = makeLightMaps(mRsmMaker, shape(rsmSide, layers), stop)))
+            return false;
         mRsm = mOtherRsm.exchange(
             shape(rsmSide, layers), mRsmSize > 0 ? std::optional(shape(mRsmSize, mRsmLayers)) : std::nullopt,
-            std::move(mRsm), Rsms::bytes(mRsmSize, mRsmLayers), [&] { return std::move(*newRsm); });
+            std::move(mRsm), Rsms::bytes(mRsmSize, mRsmLayers), [&] { return std::move(*made); });
         mRsmSize = rsmSide;
         mRsmLayers = layers;
         mLightPassesValid = false;

@@ -120,7 +120,8 @@ private:
     /// The light maps and screen targets for the frame. `asked`: the light views' sides before an
     /// interactive frame's cap, whose maps stay kept whatever their size. With `stop` (refinement),
     /// large maps are made in the background while it is asked (gl/Background.h); false when it said
-    /// stop first, the targets unchanged.
+    /// stop first; the next frame takes what was being made (shadow maps made before the stop are
+    /// already in place).
     bool ensureTargets(int width, int height, int rsmSide, int shadowSide, int views, int askedRsmSide,
                        int askedShadowSide, const std::function<bool()>& stop);
     void ensureTechnique(const std::string& name, int width, int height);

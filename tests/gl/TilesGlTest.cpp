@@ -2,8 +2,10 @@
 // every technique (exactly for per-pixel ones; the screen-space hierarchy and bias compensation within
 // the bounds measured here), and reusing the light views across frames must change nothing.
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 #include "GlTestSupport.h"
 #include "frame/FrameState.h"
@@ -326,13 +328,31 @@ TEST(TilesGl, LargeLightMapsAreMadeInTheBackgroundWhileInputIsAsked) {
     EXPECT_EQ(taken.stats["lighting"].value("rsm_side", 0), 512);
     EXPECT_EQ(taken.rgba8, pair.fresh.render(large).rgba8);
 
+    // Both maps new, input waiting all along: each frame stops while one is made, the shadow maps
+    // are put in place once made, and each making starts once.
+    FrameState both = pair.state;
+    both.frameParams.set("shadow_map_size", 2048);
+    both.frameParams.set("rsm_size", 1024);
+    renderer.setInterruptCheck([] { return true; });
+    // (A session answers the input between two tries; a millisecond stands for that frame here.)
+    for (int frame = 0; frame < 2000 && renderer.lightMapsStartedInBackground() < 3; ++frame) {
+        EXPECT_TRUE(renderer.render(both).interrupted);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 3) << "the shadow maps', then the RSMs'";
+    renderer.setInterruptCheck([] { return false; });
+    const FrameOutput bothTaken = renderer.render(both);
+    ASSERT_FALSE(bothTaken.interrupted);
+    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 3);
+    EXPECT_EQ(bothTaken.rgba8, pair.fresh.render(both).rgba8);
+
     // Without a check (a live frame, a render request): made in the frame.
     renderer.setInterruptCheck({});
     FrameState other = pair.state;
     other.frameParams.set("rsm_size", 384);
     const FrameOutput made = renderer.render(other);
     EXPECT_EQ(counter(made, "light_view_arrays_created"), 1.0);
-    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 1);
+    EXPECT_EQ(renderer.lightMapsStartedInBackground(), 3);
 }
 
 // The asked light maps stay kept through an interactive frame's capped ones whatever their size: 13
