@@ -17,10 +17,13 @@
 #include <thread>
 #include <utility>
 
+#include "core/Log.h"
+
 namespace gis::gl {
 
 /// Storage of at least this many bytes that a frame input may stop needs is made in the background
-/// (its owners' rule): 32 MiB took about 15 ms to make on llvmpipe, within a refinement slice.
+/// (its owners' rule): 32 MiB is about 17 ms on llvmpipe at the 447 MB buffer's rate, within a
+/// refinement slice.
 inline constexpr long long kBackgroundBytes = 32ll << 20;
 
 namespace detail {
@@ -104,22 +107,24 @@ private:
 
 /// Objects of a Key (a size, a shape) made where input may stop the frame: made in the background
 /// while `stop` is asked every millisecond. A stop leaves the making going on, and the next call for
-/// the same key takes it; a call for another key drops it.
+/// the same key takes it; a call for another key drops it. A making that fails in the background is
+/// made in the frame, with a warning naming `what`.
 template <class Key, class T> class BackgroundMaker {
 public:
-    /// `make()`'s result for `key`: made here when `stop` is empty, else in the background (made
-    /// here when that fails). Nothing when `stop` said yes first. `make` runs on another thread:
-    /// it must own what it reads.
+    explicit BackgroundMaker(std::string what) : mWhat(std::move(what)) {}
+    /// `make()`'s result for `key`, of `bytes`: made here when `stop` is empty or `bytes` is under
+    /// `backgroundBytes`, else in the background. Nothing when `stop` said yes first. `make` runs on
+    /// another thread: it must own what it reads.
     template <class Make>
-    std::optional<T> make(const Key& key, const std::function<bool()>& stop, Make&& make) {
-        if (!stop) return make();
+    std::optional<T> make(const Key& key, double bytes, double backgroundBytes,
+                          const std::function<bool()>& stop, Make&& make) {
+        if (!stop || bytes < backgroundBytes) return make();
         if (mPending.started() && !(mKey == key)) mPending = {};
         if (!mPending.started()) {
             try {
                 mPending = Background<T>::start(make);
             } catch (const std::exception& e) {
-                ++mFailures;
-                mLastError = e.what();
+                failed(e.what());
                 return make();
             }
             mKey = key;
@@ -131,22 +136,23 @@ public:
         }
         std::optional<T> made = mPending.take();
         if (made) return made;
-        ++mFailures;
-        mLastError = mPending.error();
+        failed(mPending.error());
         return make();
     }
     /// Makings started in the background so far, and those that failed there (made in the frame).
     int starts() const { return mStarts; }
     int failures() const { return mFailures; }
-    /// Why the last background making failed ("" when none did).
-    const std::string& lastError() const { return mLastError; }
 
 private:
+    void failed(const std::string& why) {
+        ++mFailures;
+        logWarn(mWhat + ": made in the frame, not in the background (" + why + ")");
+    }
+    std::string mWhat;
     Background<T> mPending;
     Key mKey{};
     int mStarts = 0;
     int mFailures = 0;
-    std::string mLastError;
 };
 
 } // namespace gis::gl

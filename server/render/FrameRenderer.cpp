@@ -291,13 +291,9 @@ std::optional<Maps> FrameRenderer::makeLightMaps(gl::BackgroundMaker<std::pair<i
                                                  std::pair<int, int> shape,
                                                  const std::function<bool()>& stop) {
     // On llvmpipe 13 views' 512^2 RSMs (164 MB) took 85-97 ms to make, one call that held input.
-    const bool background = stop && Maps::bytes(shape.first, shape.second) >= mBackgroundBytes;
-    std::optional<Maps> made = maker.make(shape, background ? stop : std::function<bool()>(),
-                                          [shape] { return Maps::makeTextures(shape.first, shape.second); });
-    if (maker.failures() > mWarnedMakerFailures) {
-        logWarn("light maps: made in the frame, not in the background (" + maker.lastError() + ")");
-        mWarnedMakerFailures = maker.failures();
-    }
+    std::optional<Maps> made =
+        maker.make(shape, Maps::bytes(shape.first, shape.second), mBackgroundBytes, stop,
+                   [shape] { return Maps::makeTextures(shape.first, shape.second); });
     if (!made) return std::nullopt;
     made->attach();
     ++mLightMapsCreated;

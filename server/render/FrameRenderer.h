@@ -256,10 +256,9 @@ private:
     static constexpr double kKeptLightMapBytes = 128.0 * 1024.0 * 1024.0;
     gl::RecentTargets<std::pair<int, int>, ShadowMaps> mOtherShadow{1, kKeptLightMapBytes};
     gl::RecentTargets<std::pair<int, int>, Rsms> mOtherRsm{1, kKeptLightMapBytes};
-    gl::BackgroundMaker<std::pair<int, int>, ShadowMaps> mShadowMaker;
-    gl::BackgroundMaker<std::pair<int, int>, Rsms> mRsmMaker;
-    int mLightMapsCreated = 0;    ///< arrays ensureTargets created for this frame (counts)
-    int mWarnedMakerFailures = 0; ///< light maps' background makings that failed, logged
+    gl::BackgroundMaker<std::pair<int, int>, ShadowMaps> mShadowMaker{"shadow maps"};
+    gl::BackgroundMaker<std::pair<int, int>, Rsms> mRsmMaker{"reflective shadow maps"};
+    int mLightMapsCreated = 0; ///< arrays ensureTargets created for this frame (counts)
     double mBackgroundBytes = static_cast<double>(gl::kBackgroundBytes); ///< setBackgroundBytes
     /// What is sized to the frame: G-buffer, direct light, composite.
     struct ScreenTargets {

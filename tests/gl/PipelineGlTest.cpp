@@ -113,17 +113,17 @@ TEST(Context, ObjectsMadeInTheBackgroundServeTheAskingContext) {
 
     // The maker: made here without a stop; in the background with one, a stop leaving it going on
     // for the next call of the same key.
-    gl::BackgroundMaker<int, gl::Buffer> maker;
-    EXPECT_EQ(maker.make(1, {}, [] { return gl::Buffer::create(1024); })->size(), 1024);
+    gl::BackgroundMaker<int, gl::Buffer> maker("test buffers");
+    const auto small = [] { return gl::Buffer::create(1024); };
+    const auto large = [] { return gl::Buffer::create(kBytes); };
+    const auto stop = [] { return true; };
+    const auto goOn = [] { return false; };
+    EXPECT_EQ(maker.make(1, 1024, 1, {}, small)->size(), 1024);
+    EXPECT_EQ(maker.make(1, 1024, 2048, stop, small)->size(), 1024) << "under the background's size";
     EXPECT_EQ(maker.starts(), 0);
-    EXPECT_FALSE(maker.make(
-        2, [] { return true; }, [] { return gl::Buffer::create(kBytes); }));
+    EXPECT_FALSE(maker.make(2, kBytes, 1, stop, large));
     EXPECT_EQ(maker.starts(), 1);
-    EXPECT_EQ(maker
-                  .make(
-                      2, [] { return false; }, [] { return gl::Buffer::create(kBytes); })
-                  ->size(),
-              kBytes);
+    EXPECT_EQ(maker.make(2, kBytes, 1, goOn, large)->size(), kBytes);
     EXPECT_EQ(maker.starts(), 1) << "the making the stop left going on";
     EXPECT_EQ(maker.failures(), 0);
 

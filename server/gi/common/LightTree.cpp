@@ -90,15 +90,10 @@ gl::Buffer LightTree::makeNodeBuffer(GLsizeiptr bytes, const FrameInputs& in) {
     // while it is made (gl/Background.h): llvmpipe zeroes it in one call, 60 ms for a 1024 RSM's
     // tree of one view (112 MB), 240 ms for 13 point-lamp views' (447 MB). A stop leaves it being
     // made: the next frame that asks for the same size takes it.
-    const bool background = in.interruptCheck && static_cast<double>(bytes) >= in.backgroundBytes;
     std::optional<gl::Buffer> made = mMaker.make(
-        bytes, background ? std::function<bool()>([&] { return in.interrupted(); }) : std::function<bool()>(),
+        bytes, static_cast<double>(bytes), in.backgroundBytes,
+        in.interruptCheck ? std::function<bool()>([&] { return in.interrupted(); }) : std::function<bool()>(),
         [bytes] { return gl::Buffer::create(bytes); });
-    if (mMaker.failures() > mWarnedFailures) {
-        logWarn("light tree: the nodes' storage could not be made in the background (" + mMaker.lastError() +
-                "); made in the frame");
-        mWarnedFailures = mMaker.failures();
-    }
     return made ? std::move(*made) : gl::Buffer{};
 }
 

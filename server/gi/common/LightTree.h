@@ -108,9 +108,8 @@ private:
     int mTiles = 1;
     bool mValid = false;
     FrameInputs mLastInputs;
-    long long mKeptBytes = kKeptTreeBytes;              ///< setKeptBytes
-    gl::BackgroundMaker<GLsizeiptr, gl::Buffer> mMaker; ///< node storage (makeNodeBuffer)
-    int mWarnedFailures = 0;
+    long long mKeptBytes = kKeptTreeBytes;                                  ///< setKeptBytes
+    gl::BackgroundMaker<GLsizeiptr, gl::Buffer> mMaker{"light tree nodes"}; ///< makeNodeBuffer
 };
 
 } // namespace gis
